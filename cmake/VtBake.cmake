@@ -1,0 +1,26 @@
+# vt_add_library(NAME DIR PUBLIC_DEPS deps... PRIVATE_DEPS deps...)
+# Every .cpp in DIR (not in subfolders) becomes part of NAME, so adding a capability is adding
+# a file. A folder with no sources yet is an INTERFACE library so dependants still link.
+function(vt_add_library name)
+  cmake_parse_arguments(ARG "" "" "PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  file(GLOB sources CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/*.cpp" "${CMAKE_CURRENT_SOURCE_DIR}/*.c")
+  if(sources)
+    add_library(${name} STATIC ${sources})
+    target_link_libraries(${name} PUBLIC vt_common ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+  else()
+    add_library(${name} INTERFACE)
+    target_link_libraries(${name} INTERFACE vt_common ${ARG_PUBLIC_DEPS})
+  endif()
+endfunction()
+
+# vt_add_test_suite(NAME DEPS...): one GoogleTest executable from every test_*.cpp in the folder.
+function(vt_add_test_suite name)
+  file(GLOB sources CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/test_*.cpp")
+  if(NOT sources)
+    return()
+  endif()
+  add_executable(${name} ${sources})
+  target_link_libraries(${name} PRIVATE ${ARGN} GTest::gtest GTest::gtest_main Threads::Threads)
+  target_compile_definitions(${name} PRIVATE VT_TEST_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600)
+endfunction()

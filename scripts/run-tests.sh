@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Sets up a Debian 12 machine, builds vtbake and runs the whole test suite: the runtime side
+# (codec, format, runtime) under ASan/UBSan, then everything in Release. Ends with ctest's summary.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+jobs=$(nproc)
+
+cmake --preset asan-runtime >/dev/null
+cmake --build --preset asan-runtime -j "$jobs"
+ctest --preset asan-runtime -j "$jobs"
+
+cmake --preset release >/dev/null
+cmake --build --preset release -j "$jobs"
+ctest --preset release -j "$jobs"
