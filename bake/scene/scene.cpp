@@ -1,0 +1,114 @@
+// Scene hierarchy flattening, geometry validation and matrix helpers.
+#include "bake/scene/scene.h"
+
+#include <cmath>
+#include <string>
+
+namespace vt::scene {
+
+Mat4 multiply(const Mat4& a, const Mat4& b) {
+  Mat4 r{};
+  for (int c = 0; c < 4; ++c)
+    for (int row = 0; row < 4; ++row) {
+      double s = 0;
+      for (int k = 0; k < 4; ++k) s += a[k * 4 + row] * b[c * 4 + k];
+      r[c * 4 + row] = s;
+    }
+  return r;
+}
+
+std::array<double, 3> transform_point(const Mat4& m, const Vec3& p) {
+  std::array<double, 3> r;
+  for (int i = 0; i < 3; ++i) r[i] = m[i] * p[0] + m[4 + i] * p[1] + m[8 + i] * p[2] + m[12 + i];
+  return r;
+}
+
+std::array<double, 3> transform_direction(const Mat4& m, const Vec3& d) {
+  // Cofactor matrix of the upper 3x3 = inverse-transpose times the determinant; the scale
+  // does not matter for a direction and this stays defined for singular matrices.
+  auto a = [&](int row, int col) { return m[col * 4 + row]; };
+  double c[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) {
+      int r1 = (r + 1) % 3, r2 = (r + 2) % 3, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+      c[r][k] = a(r1, k1) * a(r2, k2) - a(r1, k2) * a(r2, k1);
+    }
+  std::array<double, 3> out;
+  for (int r = 0; r < 3; ++r) out[r] = c[r][0] * d[0] + c[r][1] * d[1] + c[r][2] * d[2];
+  double len = std::sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2]);
+  if (len > 0)
+    for (double& v : out) v /= len;
+  return out;
+}
+
+std::vector<Instance> Scene::instances() const {
+  std::vector<Instance> result;
+  std::vector<char> visited(nodes.size(), 0);
+  struct Item {
+    int node;
+    Mat4 parent;
+  };
+  std::vector<Item> stack;
+  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, kIdentity});
+  while (!stack.empty()) {
+    Item item = stack.back();
+    stack.pop_back();
+    if (item.node < 0 || item.node >= static_cast<int>(nodes.size()) || visited[item.node])
+      continue;
+    visited[item.node] = 1;
+    const Node& node = nodes[item.node];
+    Mat4 world = multiply(item.parent, node.local);
+    if (node.mesh >= 0 && node.mesh < static_cast<int>(meshes.size()))
+      result.push_back({node.mesh, item.node, world});
+    for (auto it = node.children.rbegin(); it != node.children.rend(); ++it)
+      stack.push_back({*it, world});
+  }
+  return result;
+}
+
+size_t Scene::triangle_count() const {
+  size_t n = 0;
+  for (const Mesh& m : meshes)
+    for (const Primitive& p : m.primitives) n += p.triangle_count();
+  return n;
+}
+
+Status validate_geometry(const Scene& scene) {
+  for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
+    const Mesh& mesh = scene.meshes[mi];
+    for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
+      const Primitive& p = mesh.primitives[pi];
+      std::string where = "mesh '" + (mesh.name.empty() ? std::to_string(mi) : mesh.name) +
+                          "' primitive " + std::to_string(pi);
+      if (!scene.source_path.empty()) where = scene.source_path + ": " + where;
+      for (size_t v = 0; v < p.positions.size(); ++v)
+        for (float c : p.positions[v])
+          if (!std::isfinite(c))
+            return Error(ErrorCode::kCorrupt,
+                         where + ": vertex " + std::to_string(v) + " has a non-finite position");
+      if (p.indices.size() % 3 != 0)
+        return Error(ErrorCode::kCorrupt, where + ": index count " +
+                                              std::to_string(p.indices.size()) +
+                                              " is not a multiple of 3");
+      for (size_t i = 0; i < p.indices.size(); ++i)
+        if (p.indices[i] >= p.positions.size())
+          return Error(ErrorCode::kCorrupt, where + ": triangle " + std::to_string(i / 3) +
+                                                " uses vertex " + std::to_string(p.indices[i]) +
+                                                " of " + std::to_string(p.positions.size()));
+      auto check = [&](size_t n, const char* what) -> Status {
+        if (n != 0 && n != p.positions.size())
+          return Error(ErrorCode::kCorrupt, where + ": " + what + " has " + std::to_string(n) +
+                                                " entries for " +
+                                                std::to_string(p.positions.size()) + " vertices");
+        return Status::Ok();
+      };
+      VT_RETURN_IF_ERROR(check(p.normals.size(), "NORMAL"));
+      VT_RETURN_IF_ERROR(check(p.tangents.size(), "TANGENT"));
+      VT_RETURN_IF_ERROR(check(p.colors.size(), "COLOR_0"));
+      for (const auto& uv : p.uvs) VT_RETURN_IF_ERROR(check(uv.size(), "TEXCOORD"));
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace vt::scene

@@ -1,0 +1,133 @@
+// The scene model shared by unwrap, transfer and the validation renderer: meshes made of
+// triangle primitives, glTF metallic-roughness materials, images (by file or embedded), and a
+// node hierarchy that flattens into mesh instances with world matrices.
+// Import: glTF 2.0 (.gltf/.glb, KHR_draco_mesh_compression), Wavefront OBJ (+MTL), PLY, Draco
+// (.drc). Export: glTF 2.0 binary (.glb). Errors name the file and the problem.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/status.h"
+
+namespace vt::scene {
+
+using Vec2 = std::array<float, 2>;
+using Vec3 = std::array<float, 3>;
+using Vec4 = std::array<float, 4>;
+// Column-major 4x4 (glTF's order); double so that large world offsets keep their precision.
+using Mat4 = std::array<double, 16>;
+
+constexpr Mat4 kIdentity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+
+enum class WrapMode { kRepeat, kClampToEdge, kMirroredRepeat };
+enum class AlphaMode { kOpaque, kMask, kBlend };
+
+// One texture slot of a material. image < 0 means the slot is unused.
+struct TextureRef {
+  int image = -1;    // index into Scene::images
+  int texcoord = 0;  // which UV set of the primitive (TEXCOORD_n) it reads
+  WrapMode wrap_s = WrapMode::kRepeat;
+  WrapMode wrap_t = WrapMode::kRepeat;
+  bool valid() const { return image >= 0; }
+};
+
+// glTF 2.0 metallic-roughness material; factors multiply the textures as in the glTF spec.
+struct Material {
+  std::string name;
+  Vec4 base_color_factor = {1, 1, 1, 1};  // linear RGBA
+  TextureRef base_color_texture;          // sRGB RGBA
+  float metallic_factor = 1.0f;
+  float roughness_factor = 1.0f;
+  TextureRef metallic_roughness_texture;  // G = roughness, B = metallic (linear)
+  TextureRef normal_texture;              // tangent space, linear
+  float normal_scale = 1.0f;
+  TextureRef occlusion_texture;  // R = occlusion (may be the same image as metallic-roughness)
+  float occlusion_strength = 1.0f;
+  Vec3 emissive_factor = {0, 0, 0};
+  TextureRef emissive_texture;  // sRGB RGB
+  AlphaMode alpha_mode = AlphaMode::kOpaque;
+  float alpha_cutoff = 0.5f;
+  bool double_sided = false;
+};
+
+// An image a material uses: either a file (uri, resolved relative to the scene file's folder
+// into `path`) or bytes embedded in the scene (a .glb buffer view or a data: URI).
+struct Image {
+  std::string name;
+  std::string uri;   // as written in the source; empty when embedded
+  std::string path;  // file to open: uri resolved against the scene's folder; empty when embedded
+  std::string mime_type;       // "image/png", "image/jpeg", ... (may be empty for files)
+  std::vector<uint8_t> bytes;  // embedded data; empty for files
+  bool embedded() const { return path.empty(); }
+};
+
+// Indexed triangles with per-vertex attributes. Every attribute array is either empty or has
+// positions.size() entries; indices.size() is a multiple of 3.
+struct Primitive {
+  std::vector<Vec3> positions;
+  std::vector<Vec3> normals;           // optional
+  std::vector<Vec4> tangents;          // optional; w = handedness (+1 / -1)
+  std::vector<std::vector<Vec2>> uvs;  // UV sets: uvs[n] is TEXCOORD_n (glTF convention, v down)
+  std::vector<Vec4> colors;            // optional, linear RGBA
+  std::vector<uint32_t> indices;       // triangle list
+  int material = -1;                   // index into Scene::materials; -1 = default material
+
+  size_t vertex_count() const { return positions.size(); }
+  size_t triangle_count() const { return indices.size() / 3; }
+};
+
+struct Mesh {
+  std::string name;
+  std::vector<Primitive> primitives;
+};
+
+struct Node {
+  std::string name;
+  Mat4 local = kIdentity;  // transform relative to the parent
+  int mesh = -1;           // index into Scene::meshes, -1 = none
+  std::vector<int> children;
+};
+
+// One placement of a mesh in the world (a node with a mesh, after flattening the hierarchy).
+struct Instance {
+  int mesh = -1;
+  int node = -1;
+  Mat4 world = kIdentity;
+};
+
+struct Scene {
+  std::string source_path;  // the file it was loaded from (for error messages)
+  std::vector<Mesh> meshes;
+  std::vector<Material> materials;
+  std::vector<Image> images;
+  std::vector<Node> nodes;
+  std::vector<int> roots;  // nodes of the displayed scene
+
+  // Every mesh instance in the node hierarchy below `roots`, depth first, with world matrices.
+  // A node reached twice or a cycle is visited once (cycles are broken, never followed).
+  std::vector<Instance> instances() const;
+  size_t triangle_count() const;  // over meshes (not instances)
+};
+
+// Loads .gltf, .glb, .obj, .ply or .drc (chosen by extension, case-insensitive). OBJ, PLY and
+// DRC give one mesh under one root node. Non-finite positions are kept; callers that need
+// finite geometry check it (see validate_geometry).
+Expected<Scene> load_scene(const std::string& path);
+
+// Checks indices are in range and positions finite. The error names the mesh, primitive and
+// vertex or triangle, e.g. "mesh 'Body' primitive 0: vertex 17 has a non-finite position".
+Status validate_geometry(const Scene& scene);
+
+// Writes the scene as glTF 2.0 binary. Embedded images are stored in the .glb; file images
+// keep their uri (rewritten relative to the output's folder when possible).
+Status save_glb(const Scene& scene, const std::string& path);
+
+// Matrix helpers (column-major).
+Mat4 multiply(const Mat4& a, const Mat4& b);
+std::array<double, 3> transform_point(const Mat4& m, const Vec3& p);
+std::array<double, 3> transform_direction(const Mat4& m, const Vec3& d);  // inverse-transpose
+
+}  // namespace vt::scene
