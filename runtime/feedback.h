@@ -1,0 +1,77 @@
+// The feedback buffer and its resolver.
+//
+// Feedback buffer (written by the renderer's feedback pass, read back to the CPU): one uint32
+// per pixel, row-major, no padding between rows:
+//   bits  0-11  page x at the wanted level (0..4095)
+//   bits 12-23  page y at the wanted level (0..4095)
+//   bits 24-28  wanted level (0..31)
+//   bits 29-31  zero
+//   0xFFFFFFFF  no request (background pixel)
+// Any other value with bits 29-31 set, or naming a page outside the geometry, is counted as
+// invalid and ignored.
+//
+// The resolver turns a buffer into the deduplicated set of pages the frame needs: each request
+// is shifted by the LOD bias, moved to its nearest present ancestor (pages absent from the file
+// resolve to the parent), and completed with its chain of present ancestors up to the last
+// level. Result order is the load priority: coarser level first, then more pixels first, then
+// (y, x) so the order never depends on anything but the buffer.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "format/page_geometry.h"
+#include "runtime/page_source.h"
+
+namespace vt {
+
+inline constexpr uint32_t kFeedbackNone = 0xFFFFFFFFu;
+inline constexpr uint32_t kFeedbackMaxPages = 4096;  // per axis, 12 bits
+inline constexpr uint32_t kFeedbackMaxLevels = 32;   // 5 bits
+
+inline uint32_t feedback_pack(uint32_t level, uint32_t x, uint32_t y) {
+  return (x & 0xFFFu) | ((y & 0xFFFu) << 12) | ((level & 0x1Fu) << 24);
+}
+inline PageId feedback_unpack(uint32_t value) {
+  return PageId{(value >> 24) & 0x1Fu, value & 0xFFFu, (value >> 12) & 0xFFFu};
+}
+
+struct PageRequest {
+  PageId id;
+  uint32_t pixels = 0;  // pixels asking for this page or any of its descendants
+};
+
+struct ResolveStats {
+  uint64_t pixels = 0;          // non-background pixels read
+  uint64_t invalid_pixels = 0;  // malformed values or pages outside the geometry
+  uint32_t unique_values = 0;   // distinct feedback values before ancestor completion
+};
+
+// Reusable: keeps its hash tables between frames so a steady state allocates nothing.
+// Not thread-safe (one resolver per caller thread).
+class FeedbackResolver {
+ public:
+  // `source` gives the geometry and the presence map; it must outlive the resolver.
+  explicit FeedbackResolver(const PageSource& source);
+  ~FeedbackResolver();
+  FeedbackResolver(FeedbackResolver&&) noexcept;
+  FeedbackResolver& operator=(FeedbackResolver&&) noexcept;
+
+  // Resolves `feedback` (any number of pixels) with `lod_bias` >= 0 levels added to every
+  // request. Replaces `out` with the prioritised page set. Runs in one pass over the buffer
+  // (runs of equal values are counted at once) plus work proportional to the distinct pages.
+  ResolveStats resolve(std::span<const uint32_t> feedback, uint32_t lod_bias,
+                       std::vector<PageRequest>& out);
+
+  // Nearest present page at or above `id` (id itself when present); the last level's page when
+  // no ancestor is present.
+  PageId nearest_present(PageId id) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace vt
