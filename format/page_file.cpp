@@ -1,0 +1,106 @@
+// Names of the page-file enums, as docs/FORMAT.md and `vtbake info --json` spell them.
+#include "format/page_file.h"
+
+namespace vt {
+
+const char* to_string(LayerSemantic v) {
+  switch (v) {
+    case LayerSemantic::kAlbedo:
+      return "albedo";
+    case LayerSemantic::kNormal:
+      return "normal";
+    case LayerSemantic::kOrm:
+      return "orm";
+    case LayerSemantic::kEmissive:
+      return "emissive";
+    case LayerSemantic::kCustom:
+      return "custom";
+  }
+  return "unknown";
+}
+
+const char* to_string(TexelType v) {
+  switch (v) {
+    case TexelType::kU8:
+      return "u8";
+    case TexelType::kF16:
+      return "f16";
+    case TexelType::kF32:
+      return "f32";
+  }
+  return "unknown";
+}
+
+const char* to_string(PageCodec v) {
+  switch (v) {
+    case PageCodec::kRaw:
+      return "raw";
+    case PageCodec::kRawZstd:
+      return "raw+zstd";
+    case PageCodec::kDct:
+      return "dct";
+    case PageCodec::kBcZstd:
+      return "bc+zstd";
+  }
+  return "unknown";
+}
+
+const char* to_string(RuntimeFormat v) {
+  switch (v) {
+    case RuntimeFormat::kRgba8:
+      return "rgba8";
+    case RuntimeFormat::kBc1:
+      return "bc1";
+    case RuntimeFormat::kBc3:
+      return "bc3";
+    case RuntimeFormat::kBc4:
+      return "bc4";
+    case RuntimeFormat::kBc5:
+      return "bc5";
+    case RuntimeFormat::kBc7:
+      return "bc7";
+    case RuntimeFormat::kR8:
+      return "r8";
+    case RuntimeFormat::kRg8:
+      return "rg8";
+    case RuntimeFormat::kRgba16f:
+      return "rgba16f";
+    case RuntimeFormat::kRgba32f:
+      return "rgba32f";
+  }
+  return "unknown";
+}
+
+const char* to_string(ColorSpace v) {
+  switch (v) {
+    case ColorSpace::kLinear:
+      return "linear";
+    case ColorSpace::kSrgb:
+      return "srgb";
+  }
+  return "unknown";
+}
+
+const char* to_string(AddressMode v) {
+  switch (v) {
+    case AddressMode::kClamp:
+      return "clamp";
+    case AddressMode::kWrap:
+      return "wrap";
+  }
+  return "unknown";
+}
+
+uint32_t texel_type_bytes(TexelType type) {
+  switch (type) {
+    case TexelType::kU8:
+      return 1;
+    case TexelType::kF16:
+      return 2;
+    case TexelType::kF32:
+      return 4;
+  }
+  return 0;
+}
+
+}  // namespace vt

@@ -1,0 +1,146 @@
+// Shared by the page-file tests: procedural page files with a known content for every page.
+#pragma once
+
+#include <unistd.h>
+#include <zstd.h>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "format/page_file.h"
+
+namespace vt::testing {
+
+inline std::string temp_path(const std::string& name) {
+  static int counter = 0;
+  auto dir = std::filesystem::temp_directory_path() /
+             ("vtbake_format_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+  std::filesystem::create_directories(dir);
+  return (dir / name).string();
+}
+
+inline std::vector<uint8_t> read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::vector<uint8_t>(std::istreambuf_iterator<char>(in), {});
+}
+
+inline void write_bytes(const std::string& path, const std::vector<uint8_t>& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+}
+
+// What one page of one layer holds in a generated file.
+struct ExpectedPage {
+  PageId id;
+  uint32_t layer = 0;
+  PageState state = PageState::kAbsent;
+  std::vector<uint8_t> stored;  // the coded bytes (stored pages)
+  std::vector<uint8_t> texels;  // decoded texels (stored and constant pages)
+};
+
+struct GeneratedFile {
+  PageFileDesc desc;
+  std::vector<ExpectedPage> pages;  // every (page, layer), level 0 first
+};
+
+// Random content for every page of `desc`: a mix of absent, constant and stored pages, with
+// texels smooth enough for zstd to compress.
+inline GeneratedFile generate(PageFileDesc desc, uint32_t seed) {
+  GeneratedFile f;
+  f.desc = std::move(desc);
+  const PageGeometry& g = f.desc.geometry;
+  std::mt19937 rng(seed);
+  const size_t texels = size_t(g.page_size()) * g.page_size();
+  for (uint32_t level = 0; level < g.level_count(); ++level)
+    for (uint32_t y = 0; y < g.pages_y(level); ++y)
+      for (uint32_t x = 0; x < g.pages_x(level); ++x)
+        for (uint32_t layer = 0; layer < f.desc.layers.size(); ++layer) {
+          const LayerSpec& spec = f.desc.layers[layer];
+          const size_t tb = spec.texel_bytes();
+          ExpectedPage p;
+          p.id = {level, x, y};
+          p.layer = layer;
+          const uint32_t pick = rng() % 8;
+          if (pick == 0) {
+            p.state = PageState::kAbsent;
+          } else if (pick == 1) {
+            p.state = PageState::kConstant;
+            std::vector<uint8_t> value(tb);
+            for (auto& b : value) b = uint8_t(rng());
+            p.texels.resize(texels * tb);
+            for (size_t i = 0; i < texels; ++i) std::memcpy(&p.texels[i * tb], value.data(), tb);
+          } else {
+            p.state = PageState::kStored;
+            p.texels.resize(texels * tb);
+            uint8_t v = uint8_t(rng());
+            for (auto& b : p.texels) b = (rng() % 4 == 0) ? (v = uint8_t(rng())) : v;
+            if (spec.codec == PageCodec::kRaw) {
+              p.stored = p.texels;
+            } else {
+              p.stored.resize(ZSTD_compressBound(p.texels.size()));
+              size_t n = ZSTD_compress(p.stored.data(), p.stored.size(), p.texels.data(),
+                                       p.texels.size(), 1);
+              p.stored.resize(n);
+            }
+          }
+          f.pages.push_back(std::move(p));
+        }
+  return f;
+}
+
+// Writes the file with `threads` threads, pages in an order shuffled by `order_seed`.
+inline Status write_file(const GeneratedFile& f, const std::string& path, int threads,
+                         uint32_t order_seed) {
+  auto writer = PageFileWriter::create(path, f.desc);
+  if (!writer.ok()) return writer.status();
+  std::vector<size_t> order(f.pages.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::shuffle(order.begin(), order.end(), std::mt19937(order_seed));
+  std::vector<Status> results(threads);
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t)
+    pool.emplace_back([&, t] {
+      for (size_t i = t; i < order.size(); i += threads) {
+        const ExpectedPage& p = f.pages[order[i]];
+        Status s;
+        if (p.state == PageState::kStored)
+          s = (*writer)->add_page(p.id, p.layer, p.stored);
+        else if (p.state == PageState::kConstant)
+          s = (*writer)->add_constant_page(
+              p.id, p.layer,
+              std::span<const uint8_t>(p.texels.data(), f.desc.layers[p.layer].texel_bytes()));
+        if (!s.ok() && results[t].ok()) results[t] = s;
+      }
+    });
+  for (auto& th : pool) th.join();
+  for (auto& s : results)
+    if (!s.ok()) return s;
+  return (*writer)->finish();
+}
+
+inline LayerSpec layer(const std::string& name, uint8_t channels, TexelType type, PageCodec codec) {
+  LayerSpec l;
+  l.name = name;
+  l.channels = channels;
+  l.texel_type = type;
+  l.codec = codec;
+  return l;
+}
+
+// The small file the corruption tests mangle: 3 levels, 9 pages, 2 layers (raw, raw+zstd).
+inline GeneratedFile small_file() {
+  PageFileDesc desc;
+  desc.geometry = {20, 12, 8, 2};
+  desc.layers = {layer("albedo", 1, TexelType::kU8, PageCodec::kRaw),
+                 layer("height", 2, TexelType::kU8, PageCodec::kRawZstd)};
+  desc.metadata_json = R"({"tool":"test"})";
+  return generate(desc, 3);
+}
+
+}  // namespace vt::testing
