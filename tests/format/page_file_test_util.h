@@ -140,7 +140,13 @@ inline GeneratedFile small_file() {
   desc.layers = {layer("albedo", 1, TexelType::kU8, PageCodec::kRaw),
                  layer("height", 2, TexelType::kU8, PageCodec::kRawZstd)};
   desc.metadata_json = R"({"tool":"test"})";
-  return generate(desc, 3);
+  // The first seed whose file has absent, constant and stored pages in both layers.
+  for (uint32_t seed = 1;; ++seed) {
+    GeneratedFile f = generate(desc, seed);
+    int seen[2][3] = {};
+    for (auto& p : f.pages) seen[p.layer][int(p.state)] = 1;
+    if (seen[0][0] && seen[0][1] && seen[0][2] && seen[1][0] && seen[1][1] && seen[1][2]) return f;
+  }
 }
 
 }  // namespace vt::testing

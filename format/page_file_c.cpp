@@ -1,0 +1,179 @@
+// The C API over PageFileReader: a thin layer that turns Status into codes and messages.
+#include "format/page_file_c.h"
+
+#include <cstring>
+#include <exception>
+#include <memory>
+#include <string>
+
+#include "format/page_file.h"
+
+struct vtpf_file {
+  std::unique_ptr<vt::PageFileReader> reader;
+};
+
+namespace {
+
+std::string& last_error() {
+  thread_local std::string message;
+  return message;
+}
+
+int fail(const vt::Status& s) {
+  last_error() = s.message();
+  return int(s.code());
+}
+
+int fail_null(const char* what) {
+  last_error() = std::string(what) + " is NULL";
+  return VTPF_ERR_INVALID_ARGUMENT;
+}
+
+}  // namespace
+
+extern "C" {
+
+vtpf_file* vtpf_open(const char* path, int verify_checksums) {
+  last_error().clear();
+  if (!path) {
+    fail_null("path");
+    return nullptr;
+  }
+  try {
+    vt::ReaderOptions options;
+    options.verify_checksums = verify_checksums != 0;
+    auto reader = vt::PageFileReader::open(path, options);
+    if (!reader.ok()) {
+      fail(reader.status());
+      return nullptr;
+    }
+    return new vtpf_file{std::move(reader).value()};
+  } catch (const std::exception& e) {  // std::bad_alloc must not cross into C
+    last_error() = std::string(path) + ": " + e.what();
+    return nullptr;
+  }
+}
+
+void vtpf_close(vtpf_file* file) {
+  delete file;
+}
+
+const char* vtpf_last_error(void) {
+  return last_error().c_str();
+}
+
+int vtpf_get_geometry(const vtpf_file* file, vtpf_geometry* out) {
+  if (!file) return fail_null("file");
+  if (!out) return fail_null("out");
+  const vt::PageGeometry& g = file->reader->geometry();
+  out->width = g.width;
+  out->height = g.height;
+  out->payload = g.payload;
+  out->border = g.border;
+  out->page_size = g.page_size();
+  out->level_count = g.level_count();
+  out->layer_count = uint32_t(file->reader->layers().size());
+  out->version = file->reader->version();
+  return VTPF_OK;
+}
+
+uint32_t vtpf_pages_x(const vtpf_file* file, uint32_t level) {
+  if (!file || level >= file->reader->geometry().level_count()) return 0;
+  return file->reader->geometry().pages_x(level);
+}
+
+uint32_t vtpf_pages_y(const vtpf_file* file, uint32_t level) {
+  if (!file || level >= file->reader->geometry().level_count()) return 0;
+  return file->reader->geometry().pages_y(level);
+}
+
+int vtpf_get_layer(const vtpf_file* file, uint32_t layer, vtpf_layer_info* out) {
+  if (!file) return fail_null("file");
+  if (!out) return fail_null("out");
+  const auto& layers = file->reader->layers();
+  if (layer >= layers.size())
+    return fail(vt::Error(vt::ErrorCode::kInvalidArgument,
+                          file->reader->path() + ": no layer " + std::to_string(layer)));
+  const vt::LayerSpec& l = layers[layer];
+  out->semantic = uint8_t(l.semantic);
+  out->channels = l.channels;
+  out->texel_type = uint8_t(l.texel_type);
+  out->codec = uint8_t(l.codec);
+  out->runtime_format = uint8_t(l.runtime_format);
+  out->color_space = uint8_t(l.color_space);
+  out->address_mode = uint8_t(l.address_mode);
+  out->texel_bytes = l.texel_bytes();
+  out->name = l.name.c_str();
+  out->decoded_page_bytes = file->reader->decoded_page_bytes(layer);
+  return VTPF_OK;
+}
+
+const char* vtpf_metadata(const vtpf_file* file, size_t* size) {
+  if (!file) {
+    if (size) *size = 0;
+    return "";
+  }
+  if (size) *size = file->reader->metadata_json().size();
+  return file->reader->metadata_json().data();
+}
+
+int vtpf_get_entry(const vtpf_file* file, uint32_t level, uint32_t x, uint32_t y, uint32_t layer,
+                   vtpf_page_entry* out) {
+  if (!file) return fail_null("file");
+  if (!out) return fail_null("out");
+  auto e = file->reader->entry({level, x, y}, layer);
+  if (!e.ok()) return fail(e.status());
+  out->state = uint8_t(e->state);
+  out->codec = uint8_t(e->codec);
+  out->offset = e->offset;
+  out->size = e->size;
+  out->checksum = e->checksum;
+  std::memcpy(out->constant, e->constant, sizeof(out->constant));
+  return VTPF_OK;
+}
+
+int vtpf_read_stored(const vtpf_file* file, uint32_t level, uint32_t x, uint32_t y, uint32_t layer,
+                     void* buf, size_t capacity, size_t* size) {
+  if (!file) return fail_null("file");
+  auto e = file->reader->entry({level, x, y}, layer);
+  if (!e.ok()) return fail(e.status());
+  if (size) *size = e->size;
+  if (e->state == vt::PageState::kStored && (capacity < e->size || !buf))
+    return fail(vt::Error(vt::ErrorCode::kInvalidArgument,
+                          file->reader->path() + ": buffer of " + std::to_string(capacity) +
+                              " bytes for a page of " + std::to_string(e->size)));
+  try {
+    auto bytes = file->reader->read_stored({level, x, y}, layer);
+    if (!bytes.ok()) return fail(bytes.status());
+    std::memcpy(buf, bytes->data(), bytes->size());
+  } catch (const std::exception& ex) {
+    return fail(vt::Error(vt::ErrorCode::kResourceLimit, ex.what()));
+  }
+  return VTPF_OK;
+}
+
+int vtpf_read_texels(const vtpf_file* file, uint32_t level, uint32_t x, uint32_t y, uint32_t layer,
+                     void* out, size_t capacity) {
+  if (!file) return fail_null("file");
+  if (!out) return fail_null("out");
+  const size_t needed = file->reader->decoded_page_bytes(layer);
+  if (layer < file->reader->layers().size() && capacity < needed)
+    return fail(vt::Error(vt::ErrorCode::kInvalidArgument,
+                          file->reader->path() + ": buffer of " + std::to_string(capacity) +
+                              " bytes for a decoded page of " + std::to_string(needed)));
+  try {
+    vt::Status s = file->reader->read_texels(
+        {level, x, y}, layer, std::span<uint8_t>(static_cast<uint8_t*>(out), needed));
+    return s.ok() ? VTPF_OK : fail(s);
+  } catch (const std::exception& ex) {
+    return fail(vt::Error(vt::ErrorCode::kResourceLimit, ex.what()));
+  }
+}
+
+int vtpf_verify(const vtpf_file* file) {
+  if (!file) return fail_null("file");
+  vt::Status s = file->reader->verify();
+  return s.ok() ? VTPF_OK : fail(s);
+}
+
+}  // extern "C"
