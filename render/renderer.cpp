@@ -1,0 +1,845 @@
+#include "render/renderer.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "render/shaders.h"
+
+namespace vt::render {
+namespace {
+
+#define VT_VK(call) VT_RETURN_IF_ERROR(vk_status((call), #call))
+
+constexpr VkFormat kColorFormat = VK_FORMAT_R8G8B8A8_UNORM;
+constexpr VkFormat kUintFormat = VK_FORMAT_R32_UINT;
+constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+constexpr VkFormat kPageTableFormat = VK_FORMAT_R8G8B8A8_UINT;
+
+// Mirrors `Push` in shaders/common.glsl.
+struct Push {
+  float mvp[16];
+  float tex[4];
+  int32_t vt[4];
+  int32_t misc[4];
+};
+static_assert(sizeof(Push) == 112, "push constants must match shaders/common.glsl");
+
+uint32_t next_pow2(uint32_t v) {
+  uint32_t p = 1;
+  while (p < v) p <<= 1;
+  return p;
+}
+
+uint32_t mip_count(uint32_t w, uint32_t h) {
+  uint32_t n = 1;
+  while ((w >> n) > 0 || (h >> n) > 0) ++n;
+  return n;
+}
+
+}  // namespace
+
+std::vector<std::vector<uint8_t>> box_mip_chain(const uint8_t* rgba, uint32_t width,
+                                                uint32_t height) {
+  std::vector<std::vector<uint8_t>> levels;
+  levels.emplace_back(rgba, rgba + size_t(width) * height * 4);
+  uint32_t w = width, h = height;
+  while (w > 1 || h > 1) {
+    uint32_t nw = std::max(1u, w / 2), nh = std::max(1u, h / 2);
+    const std::vector<uint8_t>& src = levels.back();
+    std::vector<uint8_t> dst(size_t(nw) * nh * 4);
+    for (uint32_t y = 0; y < nh; ++y) {
+      uint32_t y0 = std::min(2 * y, h - 1), y1 = std::min(2 * y + 1, h - 1);
+      for (uint32_t x = 0; x < nw; ++x) {
+        uint32_t x0 = std::min(2 * x, w - 1), x1 = std::min(2 * x + 1, w - 1);
+        for (int c = 0; c < 4; ++c) {
+          uint32_t s = src[(size_t(y0) * w + x0) * 4 + c] + src[(size_t(y0) * w + x1) * 4 + c] +
+                       src[(size_t(y1) * w + x0) * 4 + c] + src[(size_t(y1) * w + x1) * 4 + c];
+          dst[(size_t(y) * nw + x) * 4 + c] = uint8_t((s + 2) / 4);
+        }
+      }
+    }
+    levels.push_back(std::move(dst));
+    w = nw;
+    h = nh;
+  }
+  return levels;
+}
+
+VkFormat cache_vk_format(RuntimeFormat f) {
+  switch (f) {
+    case RuntimeFormat::kRgba8:
+      return VK_FORMAT_R8G8B8A8_UNORM;
+    case RuntimeFormat::kR8:
+      return VK_FORMAT_R8_UNORM;
+    case RuntimeFormat::kRg8:
+      return VK_FORMAT_R8G8_UNORM;
+    case RuntimeFormat::kBc1:
+      return VK_FORMAT_BC1_RGB_UNORM_BLOCK;
+    case RuntimeFormat::kBc3:
+      return VK_FORMAT_BC3_UNORM_BLOCK;
+    case RuntimeFormat::kBc4:
+      return VK_FORMAT_BC4_UNORM_BLOCK;
+    case RuntimeFormat::kBc5:
+      return VK_FORMAT_BC5_UNORM_BLOCK;
+    case RuntimeFormat::kBc7:
+      return VK_FORMAT_BC7_UNORM_BLOCK;
+    default:
+      return VK_FORMAT_UNDEFINED;
+  }
+}
+
+size_t cache_page_bytes(RuntimeFormat f, uint32_t page_size) {
+  size_t texels = size_t(page_size) * page_size;
+  switch (f) {
+    case RuntimeFormat::kRgba8:
+      return texels * 4;
+    case RuntimeFormat::kR8:
+      return texels;
+    case RuntimeFormat::kRg8:
+      return texels * 2;
+    case RuntimeFormat::kBc1:
+    case RuntimeFormat::kBc4:
+      return texels / 2;
+    case RuntimeFormat::kBc3:
+    case RuntimeFormat::kBc5:
+    case RuntimeFormat::kBc7:
+      return texels;
+    default:
+      return 0;
+  }
+}
+
+struct Renderer::Impl {
+  explicit Impl(VulkanContext& c) : ctx(c) {}
+  ~Impl();
+
+  VulkanContext& ctx;
+  VkDevice dev = VK_NULL_HANDLE;
+  VkSampler trilinear_clamp = VK_NULL_HANDLE;
+  VkSampler trilinear_repeat = VK_NULL_HANDLE;
+  VkSampler cache_sampler = VK_NULL_HANDLE;
+  VkSampler table_sampler = VK_NULL_HANDLE;
+  VkDescriptorSetLayout ref_set_layout = VK_NULL_HANDLE;
+  VkDescriptorSetLayout vt_set_layout = VK_NULL_HANDLE;
+  VkPipelineLayout ref_layout = VK_NULL_HANDLE;
+  VkPipelineLayout fb_layout = VK_NULL_HANDLE;
+  VkPipelineLayout vt_layout = VK_NULL_HANDLE;
+  VkPipeline ref_pipe = VK_NULL_HANDLE;
+  VkPipeline fb_pipe = VK_NULL_HANDLE;
+  VkPipeline vt_pipe = VK_NULL_HANDLE;
+  VkDescriptorPool ref_pool = VK_NULL_HANDLE;
+  VkDescriptorPool vt_pool = VK_NULL_HANDLE;
+
+  Image color, status, depth, fb, fb_depth;
+  Buffer color_rb, status_rb, fb_rb;
+
+  struct GpuMesh {
+    Buffer vertices, indices;
+    uint32_t index_count = 0;
+    uint32_t texture = 0;
+    float alpha_cutoff = -1.0f;
+  };
+  std::vector<GpuMesh> meshes;
+
+  struct GpuTexture {
+    Image image;
+    VkDescriptorSet set = VK_NULL_HANDLE;
+    uint32_t width = 0, height = 0, max_level = 0;
+    AddressMode mode = AddressMode::kClamp;
+  };
+  std::vector<GpuTexture> textures;
+
+  bool has_vt = false;
+  VirtualTextureSetup vt;
+  Image cache, table;
+  VkDescriptorSet vt_set = VK_NULL_HANDLE;
+
+  Status init(const RenderOptions& o);
+  Expected<VkPipeline> make_pipeline(VkPipelineLayout layout, std::span<const uint32_t> fs,
+                                     std::span<const VkFormat> color_formats);
+  Expected<VkSampler> make_sampler(VkFilter filter, VkSamplerMipmapMode mip,
+                                   VkSamplerAddressMode address);
+  Expected<Image> make_target(uint32_t w, uint32_t h, VkFormat f, bool depth_target);
+  void begin_pass(VkCommandBuffer cmd, std::span<const Image* const> targets, const Image& depth,
+                  uint32_t w, uint32_t h, std::span<const VkClearColorValue> clears);
+  void end_pass(VkCommandBuffer cmd, std::span<const Image* const> targets,
+                std::span<const Buffer* const> readbacks, uint32_t w, uint32_t h);
+};
+
+Renderer::Impl::~Impl() {
+  if (!dev) return;
+  vkDeviceWaitIdle(dev);
+  for (VkPipeline p : {ref_pipe, fb_pipe, vt_pipe}) {
+    if (p) vkDestroyPipeline(dev, p, nullptr);
+  }
+  for (VkPipelineLayout l : {ref_layout, fb_layout, vt_layout}) {
+    if (l) vkDestroyPipelineLayout(dev, l, nullptr);
+  }
+  for (VkDescriptorSetLayout l : {ref_set_layout, vt_set_layout}) {
+    if (l) vkDestroyDescriptorSetLayout(dev, l, nullptr);
+  }
+  for (VkDescriptorPool p : {ref_pool, vt_pool}) {
+    if (p) vkDestroyDescriptorPool(dev, p, nullptr);
+  }
+  for (VkSampler s : {trilinear_clamp, trilinear_repeat, cache_sampler, table_sampler}) {
+    if (s) vkDestroySampler(dev, s, nullptr);
+  }
+}
+
+Expected<VkSampler> Renderer::Impl::make_sampler(VkFilter filter, VkSamplerMipmapMode mip,
+                                                 VkSamplerAddressMode address) {
+  VkSamplerCreateInfo ci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+  ci.magFilter = ci.minFilter = filter;
+  ci.mipmapMode = mip;
+  ci.addressModeU = ci.addressModeV = ci.addressModeW = address;
+  ci.maxLod = VK_LOD_CLAMP_NONE;
+  VkSampler s;
+  VT_VK(vkCreateSampler(dev, &ci, nullptr, &s));
+  return s;
+}
+
+Expected<Image> Renderer::Impl::make_target(uint32_t w, uint32_t h, VkFormat f, bool depth_target) {
+  ImageDesc d;
+  d.width = w;
+  d.height = h;
+  d.format = f;
+  d.usage = depth_target ? VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT
+                         : (VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+  d.aspect = depth_target ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
+  return ctx.create_image(d);
+}
+
+Expected<VkPipeline> Renderer::Impl::make_pipeline(VkPipelineLayout layout,
+                                                   std::span<const uint32_t> fs,
+                                                   std::span<const VkFormat> color_formats) {
+  auto module = [&](std::span<const uint32_t> code) -> Expected<VkShaderModule> {
+    VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    ci.codeSize = code.size_bytes();
+    ci.pCode = code.data();
+    VkShaderModule m;
+    VT_VK(vkCreateShaderModule(dev, &ci, nullptr, &m));
+    return m;
+  };
+  VT_ASSIGN_OR_RETURN(VkShaderModule vs, module(spirv_mesh_vert()));
+  auto fs_module = module(fs);
+  if (!fs_module.ok()) {
+    vkDestroyShaderModule(dev, vs, nullptr);
+    return fs_module.status();
+  }
+  VkPipelineShaderStageCreateInfo stages[2] = {
+      {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
+      {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
+  stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
+  stages[0].module = vs;
+  stages[0].pName = "main";
+  stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
+  stages[1].module = *fs_module;
+  stages[1].pName = "main";
+
+  VkVertexInputBindingDescription binding{0, sizeof(Vertex), VK_VERTEX_INPUT_RATE_VERTEX};
+  VkVertexInputAttributeDescription attrs[2] = {
+      {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, x)},
+      {1, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, u)}};
+  VkPipelineVertexInputStateCreateInfo vi{
+      VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+  vi.vertexBindingDescriptionCount = 1;
+  vi.pVertexBindingDescriptions = &binding;
+  vi.vertexAttributeDescriptionCount = 2;
+  vi.pVertexAttributeDescriptions = attrs;
+  VkPipelineInputAssemblyStateCreateInfo ia{
+      VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+  ia.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+  VkPipelineViewportStateCreateInfo vp{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+  vp.viewportCount = 1;
+  vp.scissorCount = 1;
+  VkPipelineRasterizationStateCreateInfo rs{
+      VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+  rs.polygonMode = VK_POLYGON_MODE_FILL;
+  rs.cullMode = VK_CULL_MODE_NONE;  // unwrapped scenes may have open or two-sided surfaces
+  rs.lineWidth = 1.0f;
+  VkPipelineMultisampleStateCreateInfo ms{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+  ms.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+  VkPipelineDepthStencilStateCreateInfo ds{
+      VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+  ds.depthTestEnable = VK_TRUE;
+  ds.depthWriteEnable = VK_TRUE;
+  ds.depthCompareOp = VK_COMPARE_OP_LESS;
+  std::vector<VkPipelineColorBlendAttachmentState> blends(color_formats.size());
+  for (auto& b : blends) b.colorWriteMask = 0xF;
+  VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+  cb.attachmentCount = uint32_t(blends.size());
+  cb.pAttachments = blends.data();
+  VkDynamicState dyn[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+  VkPipelineDynamicStateCreateInfo dy{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+  dy.dynamicStateCount = 2;
+  dy.pDynamicStates = dyn;
+  VkPipelineRenderingCreateInfo ri{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
+  ri.colorAttachmentCount = uint32_t(color_formats.size());
+  ri.pColorAttachmentFormats = color_formats.data();
+  ri.depthAttachmentFormat = kDepthFormat;
+
+  VkGraphicsPipelineCreateInfo ci{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+  ci.pNext = &ri;
+  ci.stageCount = 2;
+  ci.pStages = stages;
+  ci.pVertexInputState = &vi;
+  ci.pInputAssemblyState = &ia;
+  ci.pViewportState = &vp;
+  ci.pRasterizationState = &rs;
+  ci.pMultisampleState = &ms;
+  ci.pDepthStencilState = &ds;
+  ci.pColorBlendState = &cb;
+  ci.pDynamicState = &dy;
+  ci.layout = layout;
+  VkPipeline pipe = VK_NULL_HANDLE;
+  VkResult r = vkCreateGraphicsPipelines(dev, VK_NULL_HANDLE, 1, &ci, nullptr, &pipe);
+  vkDestroyShaderModule(dev, vs, nullptr);
+  vkDestroyShaderModule(dev, *fs_module, nullptr);
+  VT_VK(r);
+  return pipe;
+}
+
+Status Renderer::Impl::init(const RenderOptions& o) {
+  dev = ctx.device();
+  VT_ASSIGN_OR_RETURN(trilinear_clamp, make_sampler(VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR,
+                                                    VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE));
+  VT_ASSIGN_OR_RETURN(trilinear_repeat,
+                      make_sampler(VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR,
+                                   VK_SAMPLER_ADDRESS_MODE_REPEAT));
+  VT_ASSIGN_OR_RETURN(cache_sampler, make_sampler(VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_NEAREST,
+                                                  VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE));
+  VT_ASSIGN_OR_RETURN(table_sampler, make_sampler(VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST,
+                                                  VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE));
+
+  VkDescriptorSetLayoutBinding bindings[2] = {};
+  for (uint32_t i = 0; i < 2; ++i) {
+    bindings[i].binding = i;
+    bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    bindings[i].descriptorCount = 1;
+    bindings[i].stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT;
+  }
+  VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  sl.bindingCount = 1;
+  sl.pBindings = bindings;
+  VT_VK(vkCreateDescriptorSetLayout(dev, &sl, nullptr, &ref_set_layout));
+  sl.bindingCount = 2;
+  VT_VK(vkCreateDescriptorSetLayout(dev, &sl, nullptr, &vt_set_layout));
+
+  VkPushConstantRange push{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                           sizeof(Push)};
+  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pl.pushConstantRangeCount = 1;
+  pl.pPushConstantRanges = &push;
+  VT_VK(vkCreatePipelineLayout(dev, &pl, nullptr, &fb_layout));
+  pl.setLayoutCount = 1;
+  pl.pSetLayouts = &ref_set_layout;
+  VT_VK(vkCreatePipelineLayout(dev, &pl, nullptr, &ref_layout));
+  pl.pSetLayouts = &vt_set_layout;
+  VT_VK(vkCreatePipelineLayout(dev, &pl, nullptr, &vt_layout));
+
+  const VkFormat ref_formats[] = {kColorFormat};
+  const VkFormat fb_formats[] = {kUintFormat};
+  const VkFormat vt_formats[] = {kColorFormat, kUintFormat};
+  VT_ASSIGN_OR_RETURN(ref_pipe, make_pipeline(ref_layout, spirv_reference_frag(), ref_formats));
+  VT_ASSIGN_OR_RETURN(fb_pipe, make_pipeline(fb_layout, spirv_feedback_frag(), fb_formats));
+  VT_ASSIGN_OR_RETURN(vt_pipe, make_pipeline(vt_layout, spirv_virtual_frag(), vt_formats));
+
+  uint32_t fw = std::max(1u, o.width / o.feedback_divisor);
+  uint32_t fh = std::max(1u, o.height / o.feedback_divisor);
+  VT_ASSIGN_OR_RETURN(color, make_target(o.width, o.height, kColorFormat, false));
+  VT_ASSIGN_OR_RETURN(status, make_target(o.width, o.height, kUintFormat, false));
+  VT_ASSIGN_OR_RETURN(depth, make_target(o.width, o.height, kDepthFormat, true));
+  VT_ASSIGN_OR_RETURN(fb, make_target(fw, fh, kUintFormat, false));
+  VT_ASSIGN_OR_RETURN(fb_depth, make_target(fw, fh, kDepthFormat, true));
+  const VkDeviceSize full = VkDeviceSize(o.width) * o.height * 4;
+  VT_ASSIGN_OR_RETURN(color_rb, ctx.create_buffer(full, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true));
+  VT_ASSIGN_OR_RETURN(status_rb, ctx.create_buffer(full, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true));
+  VT_ASSIGN_OR_RETURN(
+      fb_rb, ctx.create_buffer(VkDeviceSize(fw) * fh * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true));
+  return Status::Ok();
+}
+
+void Renderer::Impl::begin_pass(VkCommandBuffer cmd, std::span<const Image* const> targets,
+                                const Image& depth_image, uint32_t w, uint32_t h,
+                                std::span<const VkClearColorValue> clears) {
+  std::vector<VkRenderingAttachmentInfo> atts;
+  for (size_t i = 0; i < targets.size(); ++i) {
+    VulkanContext::transition(cmd, *targets[i], VK_IMAGE_LAYOUT_UNDEFINED,
+                              VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
+    VkRenderingAttachmentInfo a{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    a.imageView = targets[i]->view();
+    a.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    a.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    a.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    a.clearValue.color = clears[i];
+    atts.push_back(a);
+  }
+  VulkanContext::transition(cmd, depth_image, VK_IMAGE_LAYOUT_UNDEFINED,
+                            VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
+  VkRenderingAttachmentInfo da{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+  da.imageView = depth_image.view();
+  da.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+  da.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+  da.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+  da.clearValue.depthStencil = {1.0f, 0};
+  VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
+  ri.renderArea = {{0, 0}, {w, h}};
+  ri.layerCount = 1;
+  ri.colorAttachmentCount = uint32_t(atts.size());
+  ri.pColorAttachments = atts.data();
+  ri.pDepthAttachment = &da;
+  vkCmdBeginRendering(cmd, &ri);
+  VkViewport viewport{0, 0, float(w), float(h), 0.0f, 1.0f};
+  VkRect2D scissor{{0, 0}, {w, h}};
+  vkCmdSetViewport(cmd, 0, 1, &viewport);
+  vkCmdSetScissor(cmd, 0, 1, &scissor);
+}
+
+void Renderer::Impl::end_pass(VkCommandBuffer cmd, std::span<const Image* const> targets,
+                              std::span<const Buffer* const> readbacks, uint32_t w, uint32_t h) {
+  vkCmdEndRendering(cmd);
+  for (size_t i = 0; i < targets.size(); ++i) {
+    VulkanContext::transition(cmd, *targets[i], VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                              VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+    VkBufferImageCopy c{};
+    c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    c.imageExtent = {w, h, 1};
+    vkCmdCopyImageToBuffer(cmd, targets[i]->handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                           readbacks[i]->handle(), 1, &c);
+  }
+  VkMemoryBarrier2 mb{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+  mb.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+  mb.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+  mb.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
+  mb.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
+  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dep.memoryBarrierCount = 1;
+  dep.pMemoryBarriers = &mb;
+  vkCmdPipelineBarrier2(cmd, &dep);
+}
+
+Renderer::Renderer(std::unique_ptr<Impl> impl, const RenderOptions& options)
+    : impl_(std::move(impl)), options_(options) {}
+Renderer::~Renderer() = default;
+
+Expected<std::unique_ptr<Renderer>> Renderer::create(VulkanContext& ctx,
+                                                     const RenderOptions& options) {
+  if (options.width == 0 || options.height == 0 || options.width > 16384 ||
+      options.height > 16384 || options.feedback_divisor == 0) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "render: size " + std::to_string(options.width) + "x" +
+                     std::to_string(options.height) + " / feedback divisor " +
+                     std::to_string(options.feedback_divisor) + " is out of range");
+  }
+  auto impl = std::make_unique<Impl>(ctx);
+  VT_RETURN_IF_ERROR(impl->init(options));
+  return std::unique_ptr<Renderer>(new Renderer(std::move(impl), options));
+}
+
+uint32_t Renderer::feedback_width() const {
+  return impl_->fb.desc().width;
+}
+uint32_t Renderer::feedback_height() const {
+  return impl_->fb.desc().height;
+}
+
+Status Renderer::set_meshes(std::span<const MeshData> meshes) {
+  std::vector<Impl::GpuMesh> gpu;
+  for (size_t i = 0; i < meshes.size(); ++i) {
+    const MeshData& m = meshes[i];
+    if (m.indices.size() % 3 != 0) {
+      return Error(ErrorCode::kInvalidArgument,
+                   "render: mesh " + std::to_string(i) + " index count is not a multiple of 3");
+    }
+    for (uint32_t idx : m.indices) {
+      if (idx >= m.vertices.size()) {
+        return Error(ErrorCode::kInvalidArgument,
+                     "render: mesh " + std::to_string(i) + " has an index past its vertices");
+      }
+    }
+    if (m.indices.empty()) continue;
+    Impl::GpuMesh g;
+    std::span<const uint8_t> vb(reinterpret_cast<const uint8_t*>(m.vertices.data()),
+                                m.vertices.size() * sizeof(Vertex));
+    std::span<const uint8_t> ib(reinterpret_cast<const uint8_t*>(m.indices.data()),
+                                m.indices.size() * sizeof(uint32_t));
+    VT_ASSIGN_OR_RETURN(g.vertices,
+                        impl_->ctx.create_buffer_with(vb, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT));
+    VT_ASSIGN_OR_RETURN(g.indices,
+                        impl_->ctx.create_buffer_with(ib, VK_BUFFER_USAGE_INDEX_BUFFER_BIT));
+    g.index_count = uint32_t(m.indices.size());
+    g.texture = m.reference_texture;
+    g.alpha_cutoff = m.alpha_cutoff;
+    gpu.push_back(std::move(g));
+  }
+  impl_->meshes = std::move(gpu);
+  return Status::Ok();
+}
+
+Status Renderer::set_reference_textures(std::span<const ReferenceTexture> textures) {
+  Impl& s = *impl_;
+  vkDeviceWaitIdle(s.dev);
+  s.textures.clear();
+  if (s.ref_pool) vkDestroyDescriptorPool(s.dev, s.ref_pool, nullptr);
+  s.ref_pool = VK_NULL_HANDLE;
+  if (textures.empty()) return Status::Ok();
+
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, uint32_t(textures.size())};
+  VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pci.maxSets = uint32_t(textures.size());
+  pci.poolSizeCount = 1;
+  pci.pPoolSizes = &size;
+  VT_VK(vkCreateDescriptorPool(s.dev, &pci, nullptr, &s.ref_pool));
+
+  for (size_t t = 0; t < textures.size(); ++t) {
+    const ReferenceTexture& tex = textures[t];
+    const std::string name = "render: reference texture " + std::to_string(t);
+    if (tex.width == 0 || tex.height == 0 || tex.levels.empty()) {
+      return Error(ErrorCode::kInvalidArgument, name + " is empty");
+    }
+    uint32_t levels =
+        std::min<uint32_t>(uint32_t(tex.levels.size()), mip_count(tex.width, tex.height));
+    std::vector<ImageCopy> copies;
+    std::vector<uint8_t> staging;
+    for (uint32_t l = 0; l < levels; ++l) {
+      uint32_t w = std::max(1u, tex.width >> l), h = std::max(1u, tex.height >> l);
+      if (tex.levels[l].size() != size_t(w) * h * 4) {
+        return Error(ErrorCode::kInvalidArgument,
+                     name + " level " + std::to_string(l) + " has the wrong byte count");
+      }
+      copies.push_back({staging.size(), l, 0, 0, w, h});
+      staging.insert(staging.end(), tex.levels[l].begin(), tex.levels[l].end());
+    }
+    Impl::GpuTexture g;
+    g.width = tex.width;
+    g.height = tex.height;
+    g.max_level = std::min(levels - 1, tex.max_level);
+    g.mode = tex.address_mode;
+    ImageDesc d;
+    d.width = tex.width;
+    d.height = tex.height;
+    d.mip_levels = levels;
+    VT_ASSIGN_OR_RETURN(g.image, s.ctx.create_image(d));
+    VT_ASSIGN_OR_RETURN(Buffer buf,
+                        s.ctx.create_buffer_with(staging, VK_BUFFER_USAGE_TRANSFER_SRC_BIT));
+    VT_RETURN_IF_ERROR(s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+      VulkanContext::transition(cmd, g.image, VK_IMAGE_LAYOUT_UNDEFINED,
+                                VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+      VulkanContext::copy_buffer_to_image(cmd, buf, g.image, copies);
+      VulkanContext::transition(cmd, g.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    }));
+    VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    ai.descriptorPool = s.ref_pool;
+    ai.descriptorSetCount = 1;
+    ai.pSetLayouts = &s.ref_set_layout;
+    VT_VK(vkAllocateDescriptorSets(s.dev, &ai, &g.set));
+    VkDescriptorImageInfo ii{g.mode == AddressMode::kWrap ? s.trilinear_repeat : s.trilinear_clamp,
+                             g.image.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    w.dstSet = g.set;
+    w.descriptorCount = 1;
+    w.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    w.pImageInfo = &ii;
+    vkUpdateDescriptorSets(s.dev, 1, &w, 0, nullptr);
+    s.textures.push_back(std::move(g));
+  }
+  return Status::Ok();
+}
+
+Status Renderer::set_virtual_texture(const VirtualTextureSetup& setup) {
+  Impl& s = *impl_;
+  VT_RETURN_IF_ERROR(setup.geometry.validate().with_context("render: virtual texture"));
+  const PageGeometry& g = setup.geometry;
+  const uint32_t ps = g.page_size();
+  if (setup.slots_x == 0 || setup.slots_y == 0 || setup.slots_x > 256 || setup.slots_y > 256 ||
+      uint64_t(setup.slots_x) * ps > 16384 || uint64_t(setup.slots_y) * ps > 16384) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "render: a physical cache of " + std::to_string(setup.slots_x) + "x" +
+                     std::to_string(setup.slots_y) + " slots of " + std::to_string(ps) +
+                     " texels exceeds 16384 texels or 256 slots per side");
+  }
+  // Page coordinates are 12 bits in the feedback format, levels 5 bits.
+  if (g.pages_x(0) > 4096 || g.pages_y(0) > 4096 || g.level_count() > 31) {
+    return Error(ErrorCode::kUnsupported,
+                 "render: more than 4096 pages per side do not fit the feedback format");
+  }
+  const VkFormat cache_format = cache_vk_format(setup.cache_format);
+  if (cache_format == VK_FORMAT_UNDEFINED || !s.ctx.supports_sampled_linear(cache_format)) {
+    return Error(ErrorCode::kUnsupported, std::string("render: cannot sample a ") +
+                                              to_string(setup.cache_format) +
+                                              " physical cache with linear filtering");
+  }
+  vkDeviceWaitIdle(s.dev);
+  s.has_vt = false;
+  if (s.vt_pool) vkDestroyDescriptorPool(s.dev, s.vt_pool, nullptr);
+  s.vt_pool = VK_NULL_HANDLE;
+
+  ImageDesc cd;
+  cd.width = setup.slots_x * ps;
+  cd.height = setup.slots_y * ps;
+  cd.format = cache_format;
+  VT_ASSIGN_OR_RETURN(s.cache, s.ctx.create_image(cd));
+  // Vulkan mips halve with floor but page grids halve with ceil: a power-of-two base keeps every
+  // level's grid inside its mip (ceil(n / 2^L) <= next_pow2(n) / 2^L).
+  ImageDesc td;
+  td.width = next_pow2(g.pages_x(0));
+  td.height = next_pow2(g.pages_y(0));
+  td.mip_levels = mip_count(td.width, td.height);
+  td.format = kPageTableFormat;
+  if (td.mip_levels < g.level_count()) {
+    return Error(ErrorCode::kInternal, "render: page-table mip chain shorter than the levels");
+  }
+  VT_ASSIGN_OR_RETURN(s.table, s.ctx.create_image(td));
+  // Zero the table (no page valid) so a frame before the first upload reads defined data.
+  std::vector<uint8_t> zeros(size_t(td.width) * td.height * 4, 0);
+  VT_ASSIGN_OR_RETURN(Buffer zb, s.ctx.create_buffer_with(zeros, VK_BUFFER_USAGE_TRANSFER_SRC_BIT));
+  VT_RETURN_IF_ERROR(s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    VulkanContext::transition(cmd, s.cache, VK_IMAGE_LAYOUT_UNDEFINED,
+                              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    VulkanContext::transition(cmd, s.table, VK_IMAGE_LAYOUT_UNDEFINED,
+                              VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    std::vector<ImageCopy> copies;
+    for (uint32_t l = 0; l < td.mip_levels; ++l) {
+      copies.push_back({0, l, 0, 0, std::max(1u, td.width >> l), std::max(1u, td.height >> l)});
+    }
+    VulkanContext::copy_buffer_to_image(cmd, zb, s.table, copies);
+    VulkanContext::transition(cmd, s.table, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  }));
+
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2};
+  VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pci.maxSets = 1;
+  pci.poolSizeCount = 1;
+  pci.pPoolSizes = &size;
+  VT_VK(vkCreateDescriptorPool(s.dev, &pci, nullptr, &s.vt_pool));
+  VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  ai.descriptorPool = s.vt_pool;
+  ai.descriptorSetCount = 1;
+  ai.pSetLayouts = &s.vt_set_layout;
+  VT_VK(vkAllocateDescriptorSets(s.dev, &ai, &s.vt_set));
+  VkDescriptorImageInfo infos[2] = {
+      {s.cache_sampler, s.cache.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+      {s.table_sampler, s.table.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
+  VkWriteDescriptorSet w[2] = {{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET},
+                               {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET}};
+  for (uint32_t i = 0; i < 2; ++i) {
+    w[i].dstSet = s.vt_set;
+    w[i].dstBinding = i;
+    w[i].descriptorCount = 1;
+    w[i].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    w[i].pImageInfo = &infos[i];
+  }
+  vkUpdateDescriptorSets(s.dev, 2, w, 0, nullptr);
+  s.vt = setup;
+  s.has_vt = true;
+  return Status::Ok();
+}
+
+Status Renderer::upload_slots(std::span<const SlotUpload> pages) {
+  Impl& s = *impl_;
+  if (!s.has_vt) return Error(ErrorCode::kInvalidArgument, "render: no virtual texture set");
+  if (pages.empty()) return Status::Ok();
+  const uint32_t ps = s.vt.geometry.page_size();
+  const size_t bytes = cache_page_bytes(s.vt.cache_format, ps);
+  std::vector<uint8_t> staging;
+  staging.reserve(bytes * pages.size());
+  std::vector<ImageCopy> copies;
+  for (const SlotUpload& p : pages) {
+    if (p.slot_x >= s.vt.slots_x || p.slot_y >= s.vt.slots_y || p.bytes.size() != bytes) {
+      return Error(ErrorCode::kInvalidArgument,
+                   "render: page upload to slot (" + std::to_string(p.slot_x) + ", " +
+                       std::to_string(p.slot_y) + ") has a bad slot or " +
+                       std::to_string(p.bytes.size()) + " bytes instead of " +
+                       std::to_string(bytes));
+    }
+    copies.push_back({staging.size(), 0, int32_t(p.slot_x * ps), int32_t(p.slot_y * ps), ps, ps});
+    staging.insert(staging.end(), p.bytes.begin(), p.bytes.end());
+  }
+  VT_ASSIGN_OR_RETURN(Buffer buf,
+                      s.ctx.create_buffer_with(staging, VK_BUFFER_USAGE_TRANSFER_SRC_BIT));
+  return s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    VulkanContext::transition(cmd, s.cache, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                              VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    VulkanContext::copy_buffer_to_image(cmd, buf, s.cache, copies);
+    VulkanContext::transition(cmd, s.cache, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  });
+}
+
+Status Renderer::upload_page_table(const PageTableLevels& table) {
+  Impl& s = *impl_;
+  if (!s.has_vt) return Error(ErrorCode::kInvalidArgument, "render: no virtual texture set");
+  const PageGeometry& g = s.vt.geometry;
+  if (table.levels.size() != g.level_count()) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "render: page table has " + std::to_string(table.levels.size()) +
+                     " levels, the geometry " + std::to_string(g.level_count()));
+  }
+  std::vector<uint8_t> staging;
+  std::vector<ImageCopy> copies;
+  for (uint32_t l = 0; l < g.level_count(); ++l) {
+    if (table.levels[l].size() != g.pages_in_level(l) * 4) {
+      return Error(ErrorCode::kInvalidArgument,
+                   "render: page table level " + std::to_string(l) + " has the wrong size");
+    }
+    copies.push_back({staging.size(), l, 0, 0, g.pages_x(l), g.pages_y(l)});
+    staging.insert(staging.end(), table.levels[l].begin(), table.levels[l].end());
+  }
+  VT_ASSIGN_OR_RETURN(Buffer buf,
+                      s.ctx.create_buffer_with(staging, VK_BUFFER_USAGE_TRANSFER_SRC_BIT));
+  return s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    VulkanContext::transition(cmd, s.table, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                              VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    VulkanContext::copy_buffer_to_image(cmd, buf, s.table, copies);
+    VulkanContext::transition(cmd, s.table, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  });
+}
+
+Expected<Rgba8Image> Renderer::render_reference(const Camera& camera) {
+  Impl& s = *impl_;
+  for (const auto& m : s.meshes) {
+    if (m.texture >= s.textures.size()) {
+      return Error(ErrorCode::kInvalidArgument, "render: a mesh names reference texture " +
+                                                    std::to_string(m.texture) + " but only " +
+                                                    std::to_string(s.textures.size()) + " are set");
+    }
+  }
+  const uint32_t w = options_.width, h = options_.height;
+  const Image* targets[] = {&s.color};
+  const Buffer* readbacks[] = {&s.color_rb};
+  const VkClearColorValue clears[] = {{{0.0f, 0.0f, 0.0f, 0.0f}}};
+  VT_RETURN_IF_ERROR(s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    s.begin_pass(cmd, targets, s.depth, w, h, clears);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.ref_pipe);
+    for (const auto& m : s.meshes) {
+      const auto& t = s.textures[m.texture];
+      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.ref_layout, 0, 1, &t.set, 0,
+                              nullptr);
+      Push p{};
+      std::memcpy(p.mvp, camera.view_proj.m.data(), sizeof(p.mvp));
+      p.tex[0] = float(t.width);
+      p.tex[1] = float(t.height);
+      p.tex[2] = 1.0f;
+      p.tex[3] = m.alpha_cutoff;
+      p.misc[1] = t.mode == AddressMode::kWrap ? 1 : 0;
+      p.misc[2] = int32_t(t.max_level);
+      vkCmdPushConstants(cmd, s.ref_layout,
+                         VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(p),
+                         &p);
+      VkDeviceSize offset = 0;
+      VkBuffer vb = m.vertices.handle();
+      vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
+      vkCmdBindIndexBuffer(cmd, m.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
+      vkCmdDrawIndexed(cmd, m.index_count, 1, 0, 0, 0);
+    }
+    s.end_pass(cmd, targets, readbacks, w, h);
+  }));
+  Rgba8Image out;
+  out.width = w;
+  out.height = h;
+  out.texels.assign(s.color_rb.mapped(), s.color_rb.mapped() + size_t(w) * h * 4);
+  return out;
+}
+
+namespace {
+
+// Fills the virtual-texture fields of the push constants.
+void fill_vt_push(Push& p, const VirtualTextureSetup& vt) {
+  const PageGeometry& g = vt.geometry;
+  p.tex[0] = float(g.width);
+  p.tex[1] = float(g.height);
+  p.vt[0] = int32_t(g.level_count());
+  p.vt[1] = int32_t(g.payload);
+  p.vt[2] = int32_t(g.border);
+  p.vt[3] = int32_t(g.page_size());
+  p.misc[1] = vt.address_mode == AddressMode::kWrap ? 1 : 0;
+  p.misc[2] = int32_t(g.level_count()) - 1;
+}
+
+}  // namespace
+
+Expected<FeedbackImage> Renderer::render_feedback(const Camera& camera, uint32_t frame) {
+  Impl& s = *impl_;
+  if (!s.has_vt) return Error(ErrorCode::kInvalidArgument, "render: no virtual texture set");
+  const uint32_t w = feedback_width(), h = feedback_height();
+  // Four sub-pixel positions, one per frame, so that over a cycle the low-resolution pass
+  // sees the footprints of every quarter of its pixels.
+  static const float kJitter[4][2] = {
+      {-0.25f, -0.25f}, {0.25f, 0.25f}, {0.25f, -0.25f}, {-0.25f, 0.25f}};
+  Mat4 mvp = jitter(camera.view_proj, kJitter[frame & 3][0], kJitter[frame & 3][1], int(w), int(h));
+  const Image* targets[] = {&s.fb};
+  const Buffer* readbacks[] = {&s.fb_rb};
+  VkClearColorValue clear{};
+  clear.uint32[0] = 0xFFFFFFFFu;
+  const VkClearColorValue clears[] = {clear};
+  VT_RETURN_IF_ERROR(s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    s.begin_pass(cmd, targets, s.fb_depth, w, h, clears);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.fb_pipe);
+    for (const auto& m : s.meshes) {
+      Push p{};
+      std::memcpy(p.mvp, mvp.m.data(), sizeof(p.mvp));
+      fill_vt_push(p, s.vt);
+      p.tex[2] = float(w) / float(options_.width);
+      p.tex[3] = -1.0f;
+      p.misc[0] = int32_t(frame & 3);
+      vkCmdPushConstants(cmd, s.fb_layout,
+                         VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(p),
+                         &p);
+      VkDeviceSize offset = 0;
+      VkBuffer vb = m.vertices.handle();
+      vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
+      vkCmdBindIndexBuffer(cmd, m.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
+      vkCmdDrawIndexed(cmd, m.index_count, 1, 0, 0, 0);
+    }
+    s.end_pass(cmd, targets, readbacks, w, h);
+  }));
+  FeedbackImage out;
+  out.width = w;
+  out.height = h;
+  out.requests.resize(size_t(w) * h);
+  std::memcpy(out.requests.data(), s.fb_rb.mapped(), out.requests.size() * 4);
+  return out;
+}
+
+Expected<VirtualFrame> Renderer::render_virtual(const Camera& camera) {
+  Impl& s = *impl_;
+  if (!s.has_vt) return Error(ErrorCode::kInvalidArgument, "render: no virtual texture set");
+  const uint32_t w = options_.width, h = options_.height;
+  const Image* targets[] = {&s.color, &s.status};
+  const Buffer* readbacks[] = {&s.color_rb, &s.status_rb};
+  const VkClearColorValue clears[] = {{{0.0f, 0.0f, 0.0f, 0.0f}}, {}};
+  VT_RETURN_IF_ERROR(s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    s.begin_pass(cmd, targets, s.depth, w, h, clears);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.vt_pipe);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.vt_layout, 0, 1, &s.vt_set, 0,
+                            nullptr);
+    for (const auto& m : s.meshes) {
+      Push p{};
+      std::memcpy(p.mvp, camera.view_proj.m.data(), sizeof(p.mvp));
+      fill_vt_push(p, s.vt);
+      p.tex[2] = 1.0f;
+      p.tex[3] = m.alpha_cutoff;
+      vkCmdPushConstants(cmd, s.vt_layout,
+                         VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(p),
+                         &p);
+      VkDeviceSize offset = 0;
+      VkBuffer vb = m.vertices.handle();
+      vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
+      vkCmdBindIndexBuffer(cmd, m.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
+      vkCmdDrawIndexed(cmd, m.index_count, 1, 0, 0, 0);
+    }
+    s.end_pass(cmd, targets, readbacks, w, h);
+  }));
+  VirtualFrame out;
+  out.color.width = w;
+  out.color.height = h;
+  out.color.texels.assign(s.color_rb.mapped(), s.color_rb.mapped() + size_t(w) * h * 4);
+  out.status.resize(size_t(w) * h);
+  std::memcpy(out.status.data(), s.status_rb.mapped(), out.status.size() * 4);
+  return out;
+}
+
+}  // namespace vt::render

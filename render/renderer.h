@@ -1,0 +1,132 @@
+// The validation renderer's three passes over one set of meshes, headless, read back to the CPU:
+//  - reference: each mesh's own mip-mapped texture, trilinear sampler, 4x anisotropic taps;
+//  - feedback: one uint32 page request per pixel at reduced resolution (runtime/ format:
+//    bits 0-11 page x, 12-23 page y, 24-28 level; 0xFFFFFFFF where nothing was drawn);
+//  - virtual: page-table lookup and bordered physical-cache sampling with the same filtering.
+// Unlit; alpha test where a mesh asks for it. Output is deterministic on lavapipe.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "common/status.h"
+#include "format/page_file.h"
+#include "format/page_geometry.h"
+#include "render/camera.h"
+#include "render/vulkan_context.h"
+
+namespace vt::render {
+
+struct Vertex {
+  float x, y, z;
+  float u, v;
+};
+
+struct MeshData {
+  std::vector<Vertex> vertices;
+  std::vector<uint32_t> indices;   // triangle list
+  uint32_t reference_texture = 0;  // index into the reference textures
+  float alpha_cutoff = -1.0f;      // < 0: no alpha test
+};
+
+// An RGBA8 texture with its whole mip chain in Vulkan's sizes (level L is
+// max(1, width >> L) x max(1, height >> L)), row-major, tightly packed.
+struct ReferenceTexture {
+  uint32_t width = 0;
+  uint32_t height = 0;
+  std::vector<std::vector<uint8_t>> levels;
+  AddressMode address_mode = AddressMode::kClamp;
+  uint32_t max_level = ~0u;  // LOD clamp (the virtual texture's last level, to compare alike)
+};
+
+// Builds a mip chain from level 0 by 2x box filtering (odd sizes: the last row/column is
+// averaged with itself).
+std::vector<std::vector<uint8_t>> box_mip_chain(const uint8_t* rgba, uint32_t width,
+                                                uint32_t height);
+
+// The Vulkan format of a physical cache holding `f` (RGBA8, R8, RG8, BC1/3/4/5/7; float
+// formats are not rendered); VK_FORMAT_UNDEFINED otherwise.
+VkFormat cache_vk_format(RuntimeFormat f);
+// Bytes of one page_size^2 page in the cache format (0 for an unsupported format).
+size_t cache_page_bytes(RuntimeFormat f, uint32_t page_size);
+
+struct VirtualTextureSetup {
+  PageGeometry geometry;
+  AddressMode address_mode = AddressMode::kClamp;
+  RuntimeFormat cache_format = RuntimeFormat::kRgba8;
+  uint32_t slots_x = 16;
+  uint32_t slots_y = 16;
+};
+
+// One page's texels (cache format) to put into a physical slot.
+struct SlotUpload {
+  uint32_t slot_x = 0;
+  uint32_t slot_y = 0;
+  std::span<const uint8_t> bytes;  // cache_page_bytes()
+};
+
+// The page table in runtime/'s layout: per level, pages_x(L) * pages_y(L) RGBA8 entries
+// (R, G slot, B resident level, A flags, bit 0 valid), row-major.
+struct PageTableLevels {
+  std::vector<std::vector<uint8_t>> levels;
+};
+
+struct RenderOptions {
+  uint32_t width = 1280;
+  uint32_t height = 720;
+  uint32_t feedback_divisor = 4;  // feedback resolution = size / divisor per axis
+};
+
+struct Rgba8Image {
+  uint32_t width = 0;
+  uint32_t height = 0;
+  std::vector<uint8_t> texels;  // RGBA8 row-major
+};
+
+struct FeedbackImage {
+  uint32_t width = 0;
+  uint32_t height = 0;
+  std::vector<uint32_t> requests;
+};
+
+struct VirtualFrame {
+  Rgba8Image color;
+  // Per pixel: bit 31 covered, bits 0-7 the level wanted, bits 8-15 the coarsest level a fine
+  // tap actually sampled (31: nothing resident).
+  std::vector<uint32_t> status;
+};
+
+class Renderer {
+ public:
+  static Expected<std::unique_ptr<Renderer>> create(VulkanContext& ctx,
+                                                    const RenderOptions& options);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  const RenderOptions& options() const { return options_; }
+  uint32_t feedback_width() const;
+  uint32_t feedback_height() const;
+
+  Status set_meshes(std::span<const MeshData> meshes);
+  Status set_reference_textures(std::span<const ReferenceTexture> textures);
+  // Creates the physical cache and page-table textures (contents undefined until uploaded).
+  Status set_virtual_texture(const VirtualTextureSetup& setup);
+  Status upload_slots(std::span<const SlotUpload> pages);
+  Status upload_page_table(const PageTableLevels& table);
+
+  Expected<Rgba8Image> render_reference(const Camera& camera);
+  // `frame` rotates which tap each pixel reports and jitters the sub-pixel position.
+  Expected<FeedbackImage> render_feedback(const Camera& camera, uint32_t frame);
+  Expected<VirtualFrame> render_virtual(const Camera& camera);
+
+ private:
+  struct Impl;
+  explicit Renderer(std::unique_ptr<Impl> impl, const RenderOptions& options);
+  std::unique_ptr<Impl> impl_;
+  RenderOptions options_;
+};
+
+}  // namespace vt::render

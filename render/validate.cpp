@@ -1,0 +1,153 @@
+#include "render/validate.h"
+
+#include <chrono>
+
+#include "codec/metrics.h"
+
+namespace vt::render {
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+Status upload_frame(Renderer& renderer, Streamer& streamer, uint32_t layer,
+                    std::vector<PageUpload>& uploads) {
+  if (!uploads.empty()) {
+    std::vector<SlotUpload> slots;
+    slots.reserve(uploads.size());
+    for (const PageUpload& u : uploads) {
+      if (layer >= u.layers.size()) {
+        return Error(ErrorCode::kInternal, "render: an upload lacks the rendered layer");
+      }
+      slots.push_back({u.slot_x, u.slot_y, u.layers[layer]});
+    }
+    VT_RETURN_IF_ERROR(renderer.upload_slots(slots));
+  }
+  // The whole table is a few KiB; uploading it all keeps the GPU copy trivially in sync.
+  PageTable table = streamer.page_table();
+  PageTableLevels levels;
+  for (uint32_t l = 0; l < table.level_count(); ++l) {
+    auto data = table.level_data(l);
+    levels.levels.emplace_back(data.begin(), data.end());
+  }
+  VT_RETURN_IF_ERROR(renderer.upload_page_table(levels));
+  streamer.clear_table_dirty();
+  return Status::Ok();
+}
+
+}  // namespace
+
+Expected<VirtualTextureSetup> virtual_setup_for(const Streamer& streamer, uint32_t layer,
+                                                AddressMode address_mode) {
+  const PageSource& source = streamer.source();
+  if (layer >= source.layer_count()) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "render: layer " + std::to_string(layer) + " does not exist in the page source");
+  }
+  VirtualTextureSetup setup;
+  setup.geometry = source.geometry();
+  setup.address_mode = address_mode;
+  setup.cache_format = source.upload_format(layer);
+  setup.slots_x = streamer.slots_x();
+  setup.slots_y = streamer.slots_y();
+  if (cache_page_bytes(setup.cache_format, setup.geometry.page_size()) == 0 ||
+      cache_page_bytes(setup.cache_format, setup.geometry.page_size()) !=
+          source.upload_bytes(layer)) {
+    return Error(ErrorCode::kUnsupported, std::string("render: cannot render layer ") +
+                                              std::to_string(layer) + " in runtime format " +
+                                              to_string(setup.cache_format));
+  }
+  return setup;
+}
+
+Expected<ConvergeResult> converge_view(Renderer& renderer, Streamer& streamer, const Camera& camera,
+                                       const ConvergeOptions& options) {
+  ConvergeResult result;
+  uint32_t quiet = 0;
+  // The streamer's first upload (the pinned last-level page) may still be waiting.
+  {
+    std::vector<PageUpload> first = streamer.take_uploads();
+    result.pages_uploaded += uint32_t(first.size());
+    VT_RETURN_IF_ERROR(upload_frame(renderer, streamer, options.layer, first));
+  }
+  for (uint32_t frame = 0; frame < options.max_frames; ++frame) {
+    auto t0 = std::chrono::steady_clock::now();
+    VT_ASSIGN_OR_RETURN(FeedbackImage fb, renderer.render_feedback(camera, frame));
+    result.feedback_ms.push_back(ms_since(t0));
+
+    t0 = std::chrono::steady_clock::now();
+    // update() queues the loads; waiting and updating again with the same feedback maps them in
+    // the same frame, so the frame count does not depend on loader timing.
+    FrameStats a = streamer.update(fb.requests);
+    streamer.wait_idle();
+    FrameStats b = streamer.update(fb.requests);
+    std::vector<PageUpload> uploads = streamer.take_uploads();
+    result.pages_uploaded += uint32_t(uploads.size());
+    result.load_errors += a.load_errors + b.load_errors;
+    result.thrashing = result.thrashing || a.thrashing || b.thrashing;
+    VT_RETURN_IF_ERROR(upload_frame(renderer, streamer, options.layer, uploads));
+    result.stream_ms.push_back(ms_since(t0));
+    result.frames_rendered = frame + 1;
+
+    bool news = a.queued + a.mapped + b.queued + b.mapped > 0 || !uploads.empty();
+    if (news) {
+      quiet = 0;
+      result.frames_to_converge = frame + 1;
+    } else if (++quiet >= options.quiet_frames) {
+      result.converged = true;
+      break;
+    }
+  }
+  return result;
+}
+
+Expected<ViewMetrics> compare_view(const Rgba8Image& reference, const VirtualFrame& frame) {
+  const Rgba8Image& test = frame.color;
+  if (reference.width != test.width || reference.height != test.height ||
+      reference.texels.size() != test.texels.size() ||
+      frame.status.size() != size_t(test.width) * test.height) {
+    return Error(ErrorCode::kInvalidArgument, "render: compared images differ in size");
+  }
+  ViewMetrics m;
+  const size_t n = size_t(test.width) * test.height;
+  // PSNR over the pixels either render covers, so an empty background does not inflate it.
+  std::vector<uint8_t> ref_px, test_px;
+  uint64_t covered = 0, coarser = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t st = frame.status[i];
+    const bool cov = (st & 0x80000000u) != 0;
+    const uint8_t* r = &reference.texels[i * 4];
+    const uint8_t* t = &test.texels[i * 4];
+    if (cov) {
+      ++covered;
+      uint32_t wanted = st & 0xFF, sampled = (st >> 8) & 0xFF;
+      if (sampled == 31) ++m.unresident_pixels;
+      if (sampled > wanted) ++coarser;
+    }
+    if (cov || r[0] != t[0] || r[1] != t[1] || r[2] != t[2] || r[3] != t[3]) {
+      ref_px.insert(ref_px.end(), r, r + 4);
+      test_px.insert(test_px.end(), t, t + 4);
+    }
+  }
+  m.pixels = ref_px.size() / 4;
+  m.coarser_share = covered ? double(coarser) / double(covered) : 0.0;
+  if (m.pixels > 0) {
+    VT_ASSIGN_OR_RETURN(ImageError e,
+                        compare_images(ref_px.data(), test_px.data(), int(m.pixels), 1, 4));
+    m.psnr_rgb = e.psnr_rgb;
+    m.psnr_alpha = e.psnr[3];
+    m.max_abs = e.max_abs_all;
+  } else {
+    m.psnr_rgb = m.psnr_alpha = kPsnrIdentical;
+  }
+  if (test.width >= 8 && test.height >= 8) {
+    VT_ASSIGN_OR_RETURN(m.ssim, ssim(reference.texels.data(), test.texels.data(), int(test.width),
+                                     int(test.height), 4));
+  } else {
+    m.ssim = 1.0;
+  }
+  return m;
+}
+
+}  // namespace vt::render

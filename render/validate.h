@@ -1,0 +1,60 @@
+// The virtual-texture loop of the validation renderer, as a game runs it: feedback pass ->
+// read back -> runtime Streamer (resolver, cache, loader, page table) -> copy uploaded pages
+// into the physical cache -> page-table texture update -> repeat until no new page comes;
+// then the final pass, compared with the reference pass.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "common/status.h"
+#include "render/camera.h"
+#include "render/renderer.h"
+#include "runtime/streamer.h"
+
+namespace vt::render {
+
+// The renderer's virtual texture for one layer of a streamer's source (slots, format, geometry).
+// kUnsupported for formats the renderer cannot sample (float layers).
+Expected<VirtualTextureSetup> virtual_setup_for(const Streamer& streamer, uint32_t layer,
+                                                AddressMode address_mode);
+
+struct ConvergeOptions {
+  uint32_t layer = 0;        // the layer the renderer's cache holds
+  uint32_t max_frames = 48;  // give up (converged = false) after this many frames
+  // Consecutive frames that must map nothing new: one cycle of the feedback pass's tap rotation
+  // and jitter, so every tap of every pixel has asked once.
+  uint32_t quiet_frames = 4;
+};
+
+struct ConvergeResult {
+  bool converged = false;
+  uint32_t frames_to_converge = 0;  // frames until the last one that brought a new page
+  uint32_t frames_rendered = 0;     // including the quiet frames
+  uint32_t pages_uploaded = 0;
+  uint32_t load_errors = 0;
+  bool thrashing = false;           // the working set did not fit the cache in some frame
+  std::vector<double> feedback_ms;  // per frame: feedback pass + read back (wall clock)
+  std::vector<double> stream_ms;    // per frame: streamer update + uploads + page table
+};
+
+// Runs the loop for one view. The renderer's virtual texture must come from
+// virtual_setup_for(streamer, options.layer, ...). Deterministic: waits for the loader every
+// frame, so the result does not depend on thread timing.
+Expected<ConvergeResult> converge_view(Renderer& renderer, Streamer& streamer, const Camera& camera,
+                                       const ConvergeOptions& options = {});
+
+// Per-view comparison of the final pass against the reference pass.
+struct ViewMetrics {
+  uint64_t pixels = 0;             // pixels compared: covered in either render
+  double psnr_rgb = 0;             // over the compared pixels, channels 0-2
+  double psnr_alpha = 0;           // channel 3
+  int max_abs = 0;                 // largest channel difference
+  double ssim = 0;                 // whole image, channels 0-2
+  double coarser_share = 0;        // share of covered pixels whose fine taps read a coarser level
+  uint64_t unresident_pixels = 0;  // pixels that found no valid page-table entry at all
+};
+
+Expected<ViewMetrics> compare_view(const Rgba8Image& reference, const VirtualFrame& frame);
+
+}  // namespace vt::render
