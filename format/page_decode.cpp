@@ -10,10 +10,10 @@
 #include "codec/bc.h"
 #include "codec/dct.h"
 
-// The codec decoders are linked in when vt_codec provides them; until then DCT and BC pages
-// report kUnsupported instead of failing to link.
+// A build may define this to 0 to leave the codec decoders out (DCT and BC pages then report
+// kUnsupported).
 #ifndef VTBAKE_HAVE_CODEC_DECODERS
-#define VTBAKE_HAVE_CODEC_DECODERS 0
+#define VTBAKE_HAVE_CODEC_DECODERS 1
 #endif
 
 namespace vt::pagefile {

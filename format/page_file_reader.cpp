@@ -278,6 +278,8 @@ Status PageFileReaderImpl::parse_layers(uint64_t pos, uint64_t end) {
     l.name.assign(reinterpret_cast<const char*>(name), size_t(name_size));
     l.codec_tables.assign(name + name_size, name + name_size + tables_size);
     std::string problem = layer_problem(l);
+    if (problem.empty() && l.codec == PageCodec::kDct && geometry_.page_size() % 8 != 0)
+      problem = "dct pages need a page size that is a multiple of 8";
     for (size_t j = 0; j < i && problem.empty(); ++j)
       if (layers_[j].name == l.name) problem = "name used by layer " + std::to_string(j);
     if (!problem.empty()) return corrupt(which + ": " + problem);

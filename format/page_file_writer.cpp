@@ -406,6 +406,9 @@ Expected<std::unique_ptr<PageFileWriter>> PageFileWriter::create(const std::stri
                                                   std::to_string(desc.layers.size()));
   for (size_t i = 0; i < desc.layers.size(); ++i) {
     std::string problem = layer_problem(desc.layers[i]);
+    if (problem.empty() && desc.layers[i].codec == PageCodec::kDct &&
+        desc.geometry.page_size() % 8 != 0)
+      problem = "dct pages need a page size that is a multiple of 8";
     for (size_t j = 0; j < i && problem.empty(); ++j)
       if (desc.layers[j].name == desc.layers[i].name)
         problem = "name used by layer " + std::to_string(j);

@@ -35,6 +35,12 @@ inline void write_bytes(const std::string& path, const std::vector<uint8_t>& byt
   out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
 }
 
+inline uint64_t le64(const std::vector<uint8_t>& b, size_t at) {
+  uint64_t v = 0;
+  for (int i = 7; i >= 0; --i) v = (v << 8) | b[at + i];
+  return v;
+}
+
 // What one page of one layer holds in a generated file.
 struct ExpectedPage {
   PageId id;

@@ -91,7 +91,7 @@ TEST(PageFileC, ErrorsNameTheFile) {
 
   // A corrupt data byte: the file opens, verify and the page read fail.
   bytes[0] ^= 1;
-  const uint64_t data_offset = uint64_t(bytes[64]) | uint64_t(bytes[65]) << 8;
+  const uint64_t data_offset = le64(bytes, 64);
   bytes[data_offset + 1] ^= 0x10;
   write_bytes(path, bytes);
   vtpf_file* file = vtpf_open(path.c_str(), 1);
