@@ -29,7 +29,14 @@ class CountTable {
  public:
   CountTable() { slots_.resize(1024); }
   void clear() {
-    for (uint32_t k : keys_) slots_[find(k)] = {};
+    // Emptying a slot breaks the probe chains through it, so find every slot first.
+    if (keys_.size() * 8 >= slots_.size()) {
+      std::fill(slots_.begin(), slots_.end(), Slot{});
+    } else {
+      found_.clear();
+      for (uint32_t k : keys_) found_.push_back(find(k));
+      for (uint32_t i : found_) slots_[i] = {};
+    }
     keys_.clear();
   }
   void add(uint32_t key, uint32_t count) {
@@ -60,6 +67,7 @@ class CountTable {
   }
   std::vector<Slot> slots_;
   std::vector<uint32_t> keys_;
+  std::vector<uint32_t> found_;
 };
 
 }  // namespace

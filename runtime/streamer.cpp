@@ -40,6 +40,7 @@ struct Streamer::Impl {
   uint32_t lod_bias = 0;
   uint32_t calm_frames = 0;
   std::vector<PageRequest> needed;
+  std::vector<PageRequest> scratch;
   std::unordered_set<uint64_t> needed_keys;
   std::unordered_map<uint64_t, LoadPriority> requested;  // handed to the loader, not collected
   std::map<uint64_t, PageRequest> explicit_requests;     // request() calls not yet mapped
@@ -169,6 +170,13 @@ struct Streamer::Impl {
     for (size_t i = before; i < ready.size(); ++i) requested.erase(page_key(ready[i].id));
   }
 
+  // Whether the frame's working set one level finer would fill at most 3/4 of the cache (the
+  // margin keeps the bias from flipping back and forth at the boundary).
+  bool finer_fits(std::span<const uint32_t> feedback) {
+    resolver.resolve(feedback, lod_bias - 1, scratch);
+    return uint64_t(scratch.size()) * 4 <= uint64_t(cache.capacity()) * 3;
+  }
+
   FrameStats update(std::span<const uint32_t> feedback) {
     FrameStats stats;
     ++frame;
@@ -209,14 +217,14 @@ struct Streamer::Impl {
     queue_loads(extra, stats);
 
     // Thrash control: one level coarser per frame while the set does not fit; one finer after
-    // a calm stretch in which four times the set (the next finer level) fits in half the cache.
+    // a calm stretch in which the set at the next finer level would fit with a margin.
     const uint32_t cap = cache.capacity();
     const uint32_t max_bias = std::min(options.max_lod_bias, last_level);
     if (stats.needed > cap || stats.thrashing) {
       stats.thrashing = true;
       calm_frames = 0;
       if (lod_bias < max_bias) ++lod_bias;
-    } else if (lod_bias > 0 && uint64_t(stats.needed) * 4 <= cap / 2) {
+    } else if (lod_bias > 0 && finer_fits(feedback)) {
       if (++calm_frames >= options.frames_before_lowering) {
         --lod_bias;
         calm_frames = 0;

@@ -39,7 +39,7 @@ struct StreamerOptions {
   uint64_t upload_byte_limit = 16u << 20;  // per update(); at least one page is always let out
   uint32_t max_lod_bias = 8;
   // The bias is lowered after this many consecutive frames whose working set, at one level
-  // finer, would have fit in half the cache.
+  // finer, would have filled at most 3/4 of the cache.
   uint32_t frames_before_lowering = 30;
 };
 
@@ -81,7 +81,8 @@ class Streamer {
   // Explicit eviction of a resident leaf page that is not pinned. False when not possible.
   bool evict(const PageId& id);
 
-  // This frame's uploads (moved out; empty on the second call).
+  // This frame's uploads (moved out; empty on the second call). Take them every frame: uploads
+  // not taken hold staging memory, and no new load starts while staging is full.
   std::vector<PageUpload> take_uploads();
   // A copy of the page table (for uploads: level_data + dirty rectangles).
   PageTable page_table() const;
