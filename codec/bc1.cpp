@@ -1,0 +1,371 @@
+// BC1 encoder and decoder. The encoder fits endpoints along the principal axis of the block's
+// colours (power iteration on the covariance), insets them, then refines by least squares on
+// the chosen indices; kNormal iterates the refinement, kHigh adds a greedy +-1 endpoint search
+// and the 3-colour mode. Indices are always chosen against the palette the decoder produces
+// (truncating interpolation), so the error the encoder minimises is the error a GPU shows.
+#include "codec/bc1.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace vt {
+namespace {
+
+inline int expand5(int v) {
+  return (v << 3) | (v >> 2);
+}
+inline int expand6(int v) {
+  return (v << 2) | (v >> 4);
+}
+
+inline uint16_t pack565(int r, int g, int b) {
+  return uint16_t((r << 11) | (g << 5) | b);
+}
+
+struct Palette {
+  float r[4], g[4], b[4];
+};
+
+// The palette exactly as the decoder builds it (see bc1.h).
+void decode_palette(uint16_t c0, uint16_t c1, bool four, int out[4][3]) {
+  int a[3] = {expand5(c0 >> 11), expand6((c0 >> 5) & 63), expand5(c0 & 31)};
+  int b[3] = {expand5(c1 >> 11), expand6((c1 >> 5) & 63), expand5(c1 & 31)};
+  for (int c = 0; c < 3; ++c) {
+    out[0][c] = a[c];
+    out[1][c] = b[c];
+    if (four) {
+      out[2][c] = (2 * a[c] + b[c]) / 3;
+      out[3][c] = (a[c] + 2 * b[c]) / 3;
+    } else {
+      out[2][c] = (a[c] + b[c] + 1) / 2;
+      out[3][c] = 0;
+    }
+  }
+}
+
+struct Pixels {
+  float r[16], g[16], b[16];
+};
+
+// Best endpoint pair per 8-bit value for a block of one colour, through index 2.
+struct SingleColourTables {
+  uint8_t e5[256][2];
+  uint8_t e6[256][2];
+};
+
+void build_single(int bits, uint8_t (*table)[2]) {
+  const int levels = 1 << bits;
+  for (int v = 0; v < 256; ++v) {
+    int best_err = 1 << 30, best0 = 0, best1 = 0;
+    for (int e0 = 0; e0 < levels; ++e0) {
+      for (int e1 = 0; e1 < levels; ++e1) {
+        const int x0 = bits == 5 ? expand5(e0) : expand6(e0);
+        const int x1 = bits == 5 ? expand5(e1) : expand6(e1);
+        // Ties prefer the narrowest pair: it degrades least if a neighbour texel differs.
+        const int err = std::abs((2 * x0 + x1) / 3 - v) * 1024 + std::abs(x0 - x1);
+        if (err < best_err) {
+          best_err = err;
+          best0 = e0;
+          best1 = e1;
+        }
+      }
+    }
+    table[v][0] = uint8_t(best0);
+    table[v][1] = uint8_t(best1);
+  }
+}
+
+const SingleColourTables& single_colour_tables() {
+  static const SingleColourTables tables = [] {
+    SingleColourTables t{};
+    build_single(5, t.e5);
+    build_single(6, t.e6);
+    return t;
+  }();
+  return tables;
+}
+
+inline int quantise(float v, int max) {
+  int q = int(v * float(max) / 255.0f + 0.5f);
+  return std::clamp(q, 0, max);
+}
+
+inline uint16_t quantise565(const float c[3]) {
+  return pack565(quantise(c[0], 31), quantise(c[1], 63), quantise(c[2], 31));
+}
+
+// Chooses the nearest palette entry for every texel; returns the summed squared error.
+// `four` is the mode the block will be decoded in; c0 == c1 collapses to one colour.
+float select_indices(const Pixels& px, uint16_t c0, uint16_t c1, bool four, int idx[16]) {
+  int pal[4][3];
+  decode_palette(c0, c1, four, pal);
+  const int entries = (c0 == c1 && four) ? 1 : 4;
+  float best[16];
+  const float r0 = float(pal[0][0]), g0 = float(pal[0][1]), b0 = float(pal[0][2]);
+  for (int i = 0; i < 16; ++i) {
+    const float dr = px.r[i] - r0, dg = px.g[i] - g0, db = px.b[i] - b0;
+    best[i] = dr * dr + dg * dg + db * db;
+    idx[i] = 0;
+  }
+  for (int k = 1; k < entries; ++k) {
+    const float rk = float(pal[k][0]), gk = float(pal[k][1]), bk = float(pal[k][2]);
+    for (int i = 0; i < 16; ++i) {
+      const float dr = px.r[i] - rk, dg = px.g[i] - gk, db = px.b[i] - bk;
+      const float d = dr * dr + dg * dg + db * db;
+      const bool better = d < best[i];
+      best[i] = better ? d : best[i];
+      idx[i] = better ? k : idx[i];
+    }
+  }
+  float err = 0;
+  for (int i = 0; i < 16; ++i) err += best[i];
+  return err;
+}
+
+// Least-squares endpoints for fixed indices. Returns false when the system is singular (all
+// texels on one index), leaving the endpoints alone.
+bool least_squares(const Pixels& px, const int idx[16], bool four, float e0[3], float e1[3]) {
+  static const float kW4[4] = {1.0f, 0.0f, 2.0f / 3.0f, 1.0f / 3.0f};
+  static const float kW3[4] = {1.0f, 0.0f, 0.5f, 0.0f};
+  const float* w = four ? kW4 : kW3;
+  float aa = 0, bb = 0, ab = 0, ax[3] = {0, 0, 0}, bx[3] = {0, 0, 0};
+  for (int i = 0; i < 16; ++i) {
+    if (!four && idx[i] == 3) continue;  // black: fixed, not a function of the endpoints
+    const float a = w[idx[i]], b = 1.0f - a;
+    aa += a * a;
+    bb += b * b;
+    ab += a * b;
+    ax[0] += a * px.r[i];
+    ax[1] += a * px.g[i];
+    ax[2] += a * px.b[i];
+    bx[0] += b * px.r[i];
+    bx[1] += b * px.g[i];
+    bx[2] += b * px.b[i];
+  }
+  const float det = aa * bb - ab * ab;
+  if (!(std::fabs(det) > 1e-3f)) return false;
+  const float inv = 1.0f / det;
+  for (int c = 0; c < 3; ++c) {
+    e0[c] = std::clamp((ax[c] * bb - bx[c] * ab) * inv, 0.0f, 255.0f);
+    e1[c] = std::clamp((bx[c] * aa - ax[c] * ab) * inv, 0.0f, 255.0f);
+  }
+  return true;
+}
+
+struct Candidate {
+  uint16_t c0 = 0, c1 = 0;
+  bool four = true;
+  int idx[16] = {};
+  float err = 1e30f;
+};
+
+inline void consider(const Pixels& px, uint16_t c0, uint16_t c1, bool four, Candidate& best) {
+  Candidate c;
+  c.c0 = c0;
+  c.c1 = c1;
+  c.four = four;
+  c.err = select_indices(px, c0, c1, four, c.idx);
+  if (c.err < best.err) best = c;
+}
+
+// Writes the block, ordering the endpoints so the decoder picks the intended mode.
+void emit(const Candidate& c, uint8_t out[8]) {
+  uint16_t c0 = c.c0, c1 = c.c1;
+  int idx[16];
+  std::memcpy(idx, c.idx, sizeof(idx));
+  if (c.four) {
+    if (c0 < c1) {
+      std::swap(c0, c1);
+      for (int& i : idx) i ^= 1;  // 0<->1 and 2<->3 name the same colours after the swap
+    } else if (c0 == c1) {
+      for (int& i : idx) i = 0;
+    }
+  } else if (c0 > c1) {
+    std::swap(c0, c1);
+    for (int& i : idx) i = i < 2 ? (i ^ 1) : i;  // the midpoint and black do not move
+  }
+  uint32_t bits = 0;
+  for (int i = 0; i < 16; ++i) bits |= uint32_t(idx[i]) << (2 * i);
+  out[0] = uint8_t(c0);
+  out[1] = uint8_t(c0 >> 8);
+  out[2] = uint8_t(c1);
+  out[3] = uint8_t(c1 >> 8);
+  out[4] = uint8_t(bits);
+  out[5] = uint8_t(bits >> 8);
+  out[6] = uint8_t(bits >> 16);
+  out[7] = uint8_t(bits >> 24);
+}
+
+void encode_single_colour(int r, int g, int b, uint8_t out[8]) {
+  const SingleColourTables& t = single_colour_tables();
+  Candidate c;
+  c.c0 = pack565(t.e5[r][0], t.e6[g][0], t.e5[b][0]);
+  c.c1 = pack565(t.e5[r][1], t.e6[g][1], t.e5[b][1]);
+  c.four = true;
+  for (int& i : c.idx) i = 2;
+  if (c.c0 == c.c1) {
+    for (int& i : c.idx) i = 0;
+  }
+  emit(c, out);
+}
+
+// Principal axis of the colours by power iteration on the covariance matrix.
+void principal_axis(const Pixels& px, const float mean[3], float axis[3]) {
+  float cov[6] = {0, 0, 0, 0, 0, 0};
+  for (int i = 0; i < 16; ++i) {
+    const float r = px.r[i] - mean[0], g = px.g[i] - mean[1], b = px.b[i] - mean[2];
+    cov[0] += r * r;
+    cov[1] += r * g;
+    cov[2] += r * b;
+    cov[3] += g * g;
+    cov[4] += g * b;
+    cov[5] += b * b;
+  }
+  // Start from the covariance row of the widest channel: never orthogonal to the axis.
+  float v[3];
+  if (cov[0] >= cov[3] && cov[0] >= cov[5]) {
+    v[0] = cov[0], v[1] = cov[1], v[2] = cov[2];
+  } else if (cov[3] >= cov[5]) {
+    v[0] = cov[1], v[1] = cov[3], v[2] = cov[4];
+  } else {
+    v[0] = cov[2], v[1] = cov[4], v[2] = cov[5];
+  }
+  for (int it = 0; it < 4; ++it) {
+    const float x = cov[0] * v[0] + cov[1] * v[1] + cov[2] * v[2];
+    const float y = cov[1] * v[0] + cov[3] * v[1] + cov[4] * v[2];
+    const float z = cov[2] * v[0] + cov[4] * v[1] + cov[5] * v[2];
+    const float m = std::max(std::fabs(x), std::max(std::fabs(y), std::fabs(z)));
+    if (!(m > 1e-12f)) break;
+    const float s = 1.0f / m;
+    v[0] = x * s, v[1] = y * s, v[2] = z * s;
+  }
+  const float len2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+  if (!(len2 > 1e-12f)) {
+    v[0] = v[1] = v[2] = 1.0f;
+  }
+  const float inv = 1.0f / std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  axis[0] = v[0] * inv, axis[1] = v[1] * inv, axis[2] = v[2] * inv;
+}
+
+// Greedy search: moves each endpoint component by +-1 quantisation step while it helps.
+void refine_search(const Pixels& px, Candidate& best, int max_passes) {
+  for (int pass = 0; pass < max_passes; ++pass) {
+    bool improved = false;
+    for (int e = 0; e < 2; ++e) {
+      for (int ch = 0; ch < 3; ++ch) {
+        static const int kShift[3] = {11, 5, 0};
+        static const int kMax[3] = {31, 63, 31};
+        for (int d = -1; d <= 1; d += 2) {
+          uint16_t c[2] = {best.c0, best.c1};
+          const int v = ((c[e] >> kShift[ch]) & kMax[ch]) + d;
+          if (v < 0 || v > kMax[ch]) continue;
+          c[e] = uint16_t((c[e] & ~(kMax[ch] << kShift[ch])) | (v << kShift[ch]));
+          const float before = best.err;
+          consider(px, c[0], c[1], best.four, best);
+          improved |= best.err < before;
+        }
+      }
+    }
+    if (!improved) break;
+  }
+}
+
+}  // namespace
+
+void bc1_encode_block(const uint8_t rgba[64], BcQuality quality, uint8_t out[8],
+                      bool four_colour_only) {
+  Pixels px;
+  int mn[3] = {255, 255, 255}, mx[3] = {0, 0, 0};
+  for (int i = 0; i < 16; ++i) {
+    const int r = rgba[4 * i], g = rgba[4 * i + 1], b = rgba[4 * i + 2];
+    px.r[i] = float(r), px.g[i] = float(g), px.b[i] = float(b);
+    mn[0] = std::min(mn[0], r), mx[0] = std::max(mx[0], r);
+    mn[1] = std::min(mn[1], g), mx[1] = std::max(mx[1], g);
+    mn[2] = std::min(mn[2], b), mx[2] = std::max(mx[2], b);
+  }
+  if (mn[0] == mx[0] && mn[1] == mx[1] && mn[2] == mx[2]) {
+    encode_single_colour(mn[0], mn[1], mn[2], out);
+    return;
+  }
+
+  float mean[3] = {0, 0, 0};
+  for (int i = 0; i < 16; ++i) mean[0] += px.r[i], mean[1] += px.g[i], mean[2] += px.b[i];
+  for (float& m : mean) m *= 1.0f / 16.0f;
+  float axis[3];
+  principal_axis(px, mean, axis);
+
+  float tmin = 1e30f, tmax = -1e30f;
+  for (int i = 0; i < 16; ++i) {
+    const float t = (px.r[i] - mean[0]) * axis[0] + (px.g[i] - mean[1]) * axis[1] +
+                    (px.b[i] - mean[2]) * axis[2];
+    tmin = std::min(tmin, t);
+    tmax = std::max(tmax, t);
+  }
+  // Inset by 1/16 of the range: the extreme texels are rarely worth an exact palette entry.
+  const float inset = (tmax - tmin) / 16.0f;
+  float e0[3], e1[3];
+  for (int c = 0; c < 3; ++c) {
+    e0[c] = std::clamp(mean[c] + (tmax - inset) * axis[c], 0.0f, 255.0f);
+    e1[c] = std::clamp(mean[c] + (tmin + inset) * axis[c], 0.0f, 255.0f);
+  }
+
+  Candidate best;
+  consider(px, quantise565(e0), quantise565(e1), true, best);
+
+  const int ls_iterations = quality == BcQuality::kRealtime ? 1 : 4;
+  for (int it = 0; it < ls_iterations; ++it) {
+    const float before = best.err;
+    if (!least_squares(px, best.idx, true, e0, e1)) break;
+    consider(px, quantise565(e0), quantise565(e1), true, best);
+    if (!(best.err < before)) break;
+  }
+  if (quality == BcQuality::kRealtime) {
+    emit(best, out);
+    return;
+  }
+
+  // The bounding extremes without inset: better for blocks of few distinct colours.
+  for (int c = 0; c < 3; ++c) {
+    e0[c] = std::clamp(mean[c] + tmax * axis[c], 0.0f, 255.0f);
+    e1[c] = std::clamp(mean[c] + tmin * axis[c], 0.0f, 255.0f);
+  }
+  consider(px, quantise565(e0), quantise565(e1), true, best);
+
+  if (quality == BcQuality::kHigh) {
+    refine_search(px, best, 8);
+    if (!four_colour_only) {
+      // 3-colour mode: a true midpoint and black, fit by least squares from the 4-colour fit.
+      Candidate three;
+      consider(px, best.c0, best.c1, false, three);
+      for (int it = 0; it < 3; ++it) {
+        float a[3], b[3];
+        if (!least_squares(px, three.idx, false, a, b)) break;
+        const float before = three.err;
+        consider(px, quantise565(a), quantise565(b), false, three);
+        if (!(three.err < before)) break;
+      }
+      refine_search(px, three, 4);
+      if (three.err < best.err) best = three;
+    }
+  }
+  emit(best, out);
+}
+
+void bc1_decode_block(const uint8_t block[8], uint8_t rgba[64], bool force_four_colour) {
+  const uint16_t c0 = uint16_t(block[0] | (block[1] << 8));
+  const uint16_t c1 = uint16_t(block[2] | (block[3] << 8));
+  int pal[4][3];
+  decode_palette(c0, c1, force_four_colour || c0 > c1, pal);
+  const uint32_t bits = uint32_t(block[4]) | (uint32_t(block[5]) << 8) |
+                        (uint32_t(block[6]) << 16) | (uint32_t(block[7]) << 24);
+  for (int i = 0; i < 16; ++i) {
+    const int k = (bits >> (2 * i)) & 3;
+    rgba[4 * i] = uint8_t(pal[k][0]);
+    rgba[4 * i + 1] = uint8_t(pal[k][1]);
+    rgba[4 * i + 2] = uint8_t(pal[k][2]);
+    rgba[4 * i + 3] = 255;
+  }
+}
+
+}  // namespace vt

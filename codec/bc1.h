@@ -1,0 +1,28 @@
+// BC1 (DXT1) blocks: 4x4 RGB texels in 8 bytes, two RGB565 endpoints and 2-bit indices.
+// Block-level entry points behind bc_encode_image/bc_decode_image (codec/bc.h), for callers that
+// gather their own blocks (the runtime transcoder, BC3's colour half).
+//
+// Decoding rounds as Mesa's lavapipe samples (bit-exact with it): endpoints expand 565 -> 888 by
+// bit replication; in 4-colour mode (c0 > c1 as 16-bit words) the in-between colours are
+// (2*c0 + c1) / 3 and (c0 + 2*c1) / 3 with the division truncating; in 3-colour mode
+// (c0 <= c1) the midpoint is (c0 + c1 + 1) / 2, rounding up, and index 3 is black. BC1 here is
+// the RGB format: decoded alpha is always 255.
+#pragma once
+
+#include <cstdint>
+
+#include "codec/bc.h"
+
+namespace vt {
+
+// Encodes 16 RGBA texels (64 bytes, row-major; alpha ignored) into one 8-byte block. Always
+// emits a 4-colour block when `four_colour_only` (BC3/DXT5 colour halves decode every block as
+// 4-colour); otherwise kHigh may choose the 3-colour mode where it is closer.
+void bc1_encode_block(const uint8_t rgba[64], BcQuality quality, uint8_t out[8],
+                      bool four_colour_only = false);
+
+// Decodes one block into 16 RGBA texels. `force_four_colour` decodes as the colour half of a
+// BC3 block does (always 4-colour, whatever the endpoint order).
+void bc1_decode_block(const uint8_t block[8], uint8_t rgba[64], bool force_four_colour = false);
+
+}  // namespace vt

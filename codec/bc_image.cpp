@@ -1,0 +1,135 @@
+// Whole-image BC encode/decode: gathers 4x4 blocks and calls the per-format block codecs.
+#include <cstring>
+#include <string>
+
+#include "codec/bc.h"
+#include "codec/bc1.h"
+#include "codec/bc3.h"
+#include "codec/bc4.h"
+#include "codec/bc7.h"
+
+namespace vt {
+namespace {
+
+Status check_image(BcFormat format, const void* a, const void* b, int width, int height,
+                   int channels) {
+  if (int(format) > int(BcFormat::kBc7)) {
+    return Error(ErrorCode::kInvalidArgument, "unknown BC format " + std::to_string(int(format)));
+  }
+  if (a == nullptr || b == nullptr) {
+    return Error(ErrorCode::kInvalidArgument, "null image or block pointer");
+  }
+  if (width <= 0 || height <= 0 || width % 4 != 0 || height % 4 != 0) {
+    return Error(ErrorCode::kInvalidArgument, "image size " + std::to_string(width) + "x" +
+                                                  std::to_string(height) +
+                                                  " is not a positive multiple of 4");
+  }
+  if (channels < 1 || channels > 4) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "channel count " + std::to_string(channels) + " is not 1..4");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+int bc_format_channels(BcFormat f) {
+  switch (f) {
+    case BcFormat::kBc1:
+      return 3;
+    case BcFormat::kBc3:
+    case BcFormat::kBc7:
+      return 4;
+    case BcFormat::kBc4:
+      return 1;
+    case BcFormat::kBc5:
+      return 2;
+  }
+  return 0;
+}
+
+Status bc_encode_image(BcFormat format, BcQuality quality, const uint8_t* texels, int width,
+                       int height, int channels, uint8_t* out) {
+  VT_RETURN_IF_ERROR(check_image(format, texels, out, width, height, channels));
+  const size_t block_bytes = bc_block_bytes(format);
+  const size_t row_stride = size_t(width) * size_t(channels);
+  uint8_t rgba[64];
+  for (int by = 0; by < height / 4; ++by) {
+    for (int bx = 0; bx < width / 4; ++bx) {
+      for (int y = 0; y < 4; ++y) {
+        const uint8_t* src =
+            texels + (size_t(by) * 4 + size_t(y)) * row_stride + size_t(bx) * 4 * size_t(channels);
+        uint8_t* dst = rgba + 16 * y;
+        if (channels == 4) {
+          std::memcpy(dst, src, 16);
+          continue;
+        }
+        for (int x = 0; x < 4; ++x) {
+          for (int c = 0; c < 4; ++c) {
+            dst[4 * x + c] = c < channels ? src[x * channels + c] : (c == 3 ? 255 : 0);
+          }
+        }
+      }
+      uint8_t* block = out + (size_t(by) * size_t(width / 4) + size_t(bx)) * block_bytes;
+      switch (format) {
+        case BcFormat::kBc1:
+          bc1_encode_block(rgba, quality, block);
+          break;
+        case BcFormat::kBc3:
+          bc3_encode_block(rgba, quality, block);
+          break;
+        case BcFormat::kBc4:
+          bc4_encode_block(rgba, 4, quality, block);
+          break;
+        case BcFormat::kBc5:
+          bc5_encode_block(rgba, quality, block);
+          break;
+        case BcFormat::kBc7:
+          bc7_encode_block(rgba, quality, block, /*ignore_alpha=*/channels < 4);
+          break;
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+Status bc_decode_image(BcFormat format, const uint8_t* blocks, int width, int height, int channels,
+                       uint8_t* texels) {
+  VT_RETURN_IF_ERROR(check_image(format, blocks, texels, width, height, channels));
+  const size_t block_bytes = bc_block_bytes(format);
+  const size_t row_stride = size_t(width) * size_t(channels);
+  uint8_t rgba[64];
+  for (int by = 0; by < height / 4; ++by) {
+    for (int bx = 0; bx < width / 4; ++bx) {
+      const uint8_t* block = blocks + (size_t(by) * size_t(width / 4) + size_t(bx)) * block_bytes;
+      switch (format) {
+        case BcFormat::kBc1:
+          bc1_decode_block(block, rgba);
+          break;
+        case BcFormat::kBc3:
+          bc3_decode_block(block, rgba);
+          break;
+        case BcFormat::kBc4:
+          bc4_decode_block(block, rgba, 4);
+          for (int i = 0; i < 16; ++i) rgba[4 * i + 1] = rgba[4 * i + 2] = 0, rgba[4 * i + 3] = 255;
+          break;
+        case BcFormat::kBc5:
+          bc5_decode_block(block, rgba);
+          break;
+        case BcFormat::kBc7:
+          bc7_decode_block(block, rgba);
+          break;
+      }
+      for (int y = 0; y < 4; ++y) {
+        uint8_t* dst =
+            texels + (size_t(by) * 4 + size_t(y)) * row_stride + size_t(bx) * 4 * size_t(channels);
+        for (int x = 0; x < 4; ++x) {
+          for (int c = 0; c < channels; ++c) dst[x * channels + c] = rgba[16 * y + 4 * x + c];
+        }
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace vt
