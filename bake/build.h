@@ -1,0 +1,131 @@
+// The build pipeline: level-0 texels of one or more layers in, a page file out. For each layer
+// it converts the input to linear working space, filters the mip pyramid (pyramid.h), dilates
+// uncovered texels (pull-push), cuts bordered pages (paging.h), encodes them (page_encoder.h)
+// on all cores and streams them to the writer. Memory stays within BuildOptions::memory_limit:
+// level 0 is read in bands of page rows and never held whole (unless a coverage mask asks for
+// pull-push), coarser levels too large for the budget live in scratch files beside the output.
+// The output bytes do not depend on the thread count.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bake/image_source.h"
+#include "bake/page_encoder.h"
+#include "bake/pyramid.h"
+#include "common/status.h"
+#include "format/page_file.h"
+
+namespace vt {
+
+// What happens to NaN/Inf inputs, and to negative values in colour layers.
+enum class NonFinitePolicy : uint8_t {
+  kBlack = 0,  // NaN, Inf and negatives become 0
+  kClamp = 1,  // NaN and negatives become 0, +Inf the largest float
+  kError = 2,  // the build fails naming the first bad texel
+};
+Expected<NonFinitePolicy> parse_non_finite_policy(const std::string& name);
+
+struct LayerInput {
+  LayerSemantic semantic = LayerSemantic::kAlbedo;
+  std::string name;  // "" = the semantic's name
+  std::shared_ptr<ImageSource> source;
+  std::string color_space;  // "" = the source's metadata (ImageInfo::color_space)
+  // Optional level-0 coverage (width * height bytes, non-zero = covered); empty = all covered.
+  // With a mask, every level is dilated by pull-push and pages with no covered payload texel
+  // are absent; the levels must then fit in the memory limit.
+  std::shared_ptr<const std::vector<uint8_t>> coverage;
+  // Normal maps: the input holds xyz (or xy) in [0, 1] as n * 0.5 + 0.5 unless float.
+};
+
+// Progress of the running build, reported from the calling thread after every page row.
+struct BuildProgress {
+  const char* stage = "";  // "pyramid+encode", "finish"
+  uint32_t layer = 0;
+  uint32_t level = 0;
+  uint64_t pages_done = 0;  // over all layers and levels
+  uint64_t pages_total = 0;
+};
+
+struct BuildOptions {
+  std::vector<LayerInput> layers;  // 1..16, all the same size
+  std::string output;              // the .vtpf path
+  PageEncoderOptions codec;
+  uint32_t payload = 120;
+  uint32_t border = 4;
+  MipFilter filter = MipFilter::kKaiser;
+  AddressMode address = AddressMode::kClamp;
+  uint64_t memory_limit = uint64_t(2) << 30;
+  int threads = 0;  // 0 = all cores
+  NonFinitePolicy non_finite = NonFinitePolicy::kBlack;
+  std::string scratch_dir;  // "" = the output's directory
+  std::string metadata_json = "{}";
+  std::function<void(const BuildProgress&)> progress;
+};
+
+struct NonFiniteReport {
+  uint64_t non_finite = 0;  // NaN or Inf channel values
+  uint64_t negative = 0;    // negative channel values in colour layers
+  bool any() const { return non_finite + negative > 0; }
+  // The first bad texel in raster order.
+  uint32_t first_x = 0, first_y = 0, first_channel = 0;
+  float first_value = 0;
+};
+
+struct LevelSummary {
+  uint32_t width = 0, height = 0, pages_x = 0, pages_y = 0;
+  uint64_t stored = 0, constant = 0, absent = 0;  // over all layers
+  uint64_t stored_bytes = 0;
+  bool scratch = false;  // held in a scratch file (for at least one layer)
+};
+
+struct LayerSummary {
+  std::string name;
+  LayerSpec spec;      // as written (codec, runtime format, channels, texel type)
+  double psnr_db = 0;  // stored pages vs unencoded texels; infinite when lossless
+  uint32_t max_error = 0;
+  NonFiniteReport non_finite;
+};
+
+struct StageTime {
+  std::string name;
+  double seconds = 0;
+};
+
+struct BuildSummary {
+  PageGeometry geometry;
+  std::vector<LevelSummary> levels;
+  std::vector<LayerSummary> layers;
+  uint64_t pages = 0, stored = 0, constant = 0, absent = 0;
+  uint64_t stored_bytes = 0;
+  uint64_t file_bytes = 0;
+  uint64_t scratch_bytes = 0;       // largest scratch file use at any time
+  uint64_t level_memory_bytes = 0;  // largest in-memory level storage at any time
+  std::vector<StageTime> stages;
+};
+
+// Receives the pages of a build; PageFileWriter is the usual one, tests collect them.
+class PageSink {
+ public:
+  virtual ~PageSink() = default;
+  virtual Status add_page(const PageId& id, uint32_t layer, std::span<const uint8_t> data) = 0;
+  virtual Status add_constant_page(const PageId& id, uint32_t layer,
+                                   std::span<const uint8_t> texel) = 0;
+};
+
+// Checks the options and works out the file's description (geometry and completed layer specs,
+// codec tables included) without reading any texel.
+Expected<PageFileDesc> plan_build(const BuildOptions& options);
+
+// Runs the pipeline into `sink` (whose file must have been created with plan_build's desc).
+Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDesc& desc,
+                                   PageSink& sink);
+
+// plan_build + a PageFileWriter at options.output + build_pages + finish. Nothing is left under
+// options.output on failure.
+Expected<BuildSummary> build_page_file(const BuildOptions& options);
+
+}  // namespace vt

@@ -1,0 +1,57 @@
+// Level-0 texels for the build: an ImageSource hands out rows of float texels, top to bottom,
+// without ever holding the whole image. Files are read through OpenImageIO by scanlines or by
+// tile rows; MemoryImageSource wraps texels already in memory (the mesh bake, tests).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "common/status.h"
+
+namespace vt {
+
+struct ImageInfo {
+  uint32_t width = 0;
+  uint32_t height = 0;
+  uint32_t channels = 0;    // 1..4 (extra channels of a file are dropped)
+  bool is_float = false;    // half/float data (HDR): values are not limited to [0, 1]
+  int alpha_channel = -1;   // index of the alpha channel or -1
+  std::string color_space;  // from the file's metadata ("sRGB", "linear", ...) or ""
+};
+
+// Rows of texels, `channels` floats per texel, row-major. 8/16-bit files give values in
+// [0, 1] in the file's encoding (no colour conversion happens here).
+class ImageSource {
+ public:
+  virtual ~ImageSource() = default;
+  virtual const ImageInfo& info() const = 0;
+  // Reads rows [y0, y1) into out (width * channels * (y1 - y0) floats). Reads are cheapest in
+  // increasing y; going back may re-decode a file.
+  virtual Status read_rows(uint32_t y0, uint32_t y1, float* out) = 0;
+};
+
+// Opens an image file OpenImageIO can read (first subimage, level 0). Errors name the file.
+Expected<std::unique_ptr<ImageSource>> open_image_file(const std::string& path);
+
+// Texels owned in memory: info.width * info.height * info.channels floats.
+class MemoryImageSource final : public ImageSource {
+ public:
+  MemoryImageSource(ImageInfo info, std::vector<float> texels)
+      : info_(std::move(info)), texels_(std::move(texels)) {}
+  const ImageInfo& info() const override { return info_; }
+  Status read_rows(uint32_t y0, uint32_t y1, float* out) override;
+  const std::vector<float>& texels() const { return texels_; }
+
+ private:
+  ImageInfo info_;
+  std::vector<float> texels_;
+};
+
+// Writes a source to an image file (format from the extension), row band by row band, so a
+// procedural source larger than memory can be written. `tile` > 0 writes a tiled file where the
+// format supports it. 8-bit formats get values rounded from [0, 1].
+Status write_image_file(ImageSource& source, const std::string& path, uint32_t tile = 0);
+
+}  // namespace vt

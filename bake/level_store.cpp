@@ -1,0 +1,82 @@
+#include "bake/level_store.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+namespace vt {
+
+Expected<std::unique_ptr<LevelStore>> LevelStore::create(uint32_t width, uint32_t height,
+                                                         uint32_t channels, bool in_memory,
+                                                         const std::string& scratch_dir) {
+  std::unique_ptr<LevelStore> s(new LevelStore());
+  s->width_ = width;
+  s->height_ = height;
+  s->channels_ = channels;
+  if (in_memory) {
+    s->memory_.resize(size_t(width) * height * channels);
+    return s;
+  }
+  std::string templ =
+      (scratch_dir.empty() ? std::string(".") : scratch_dir) + "/.vtbake-level-XXXXXX";
+  std::vector<char> name(templ.begin(), templ.end());
+  name.push_back('\0');
+  int fd = mkstemp(name.data());
+  if (fd < 0) {
+    return Status(ErrorCode::kIo, templ + ": cannot create scratch file: " + std::strerror(errno));
+  }
+  unlink(name.data());  // the file lives as long as the descriptor
+  s->fd_ = fd;
+  s->path_ = name.data();
+  return s;
+}
+
+LevelStore::~LevelStore() {
+  if (fd_ >= 0) close(fd_);
+}
+
+Status LevelStore::write_rows(uint32_t y0, uint32_t rows, const float* data) {
+  if (uint64_t(y0) + rows > height_) return Error(ErrorCode::kInternal, "level rows past end");
+  if (in_memory()) {
+    std::memcpy(memory_.data() + size_t(y0) * row_floats(), data,
+                size_t(rows) * row_floats() * sizeof(float));
+    return Status::Ok();
+  }
+  const char* p = reinterpret_cast<const char*>(data);
+  size_t left = size_t(rows) * row_floats() * sizeof(float);
+  off_t off = off_t(uint64_t(y0) * row_floats() * sizeof(float));
+  while (left > 0) {
+    ssize_t n = pwrite(fd_, p, left, off);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      return Error(ErrorCode::kIo, path_ + ": scratch write failed: " + std::strerror(errno));
+    }
+    p += n, left -= size_t(n), off += n;
+  }
+  return Status::Ok();
+}
+
+Status LevelStore::read_rows(uint32_t y0, uint32_t rows, float* out) const {
+  if (uint64_t(y0) + rows > height_) return Error(ErrorCode::kInternal, "level rows past end");
+  if (in_memory()) {
+    std::memcpy(out, memory_.data() + size_t(y0) * row_floats(),
+                size_t(rows) * row_floats() * sizeof(float));
+    return Status::Ok();
+  }
+  char* p = reinterpret_cast<char*>(out);
+  size_t left = size_t(rows) * row_floats() * sizeof(float);
+  off_t off = off_t(uint64_t(y0) * row_floats() * sizeof(float));
+  while (left > 0) {
+    ssize_t n = pread(fd_, p, left, off);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      return Error(ErrorCode::kIo, path_ + ": scratch read failed: " + std::strerror(errno));
+    }
+    p += n, left -= size_t(n), off += n;
+  }
+  return Status::Ok();
+}
+
+}  // namespace vt

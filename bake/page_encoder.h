@@ -1,0 +1,67 @@
+// Encoding one layer's pages for the page file: a page whose texels are all one value becomes a
+// constant; other pages are coded with the layer's codec (DCT with tables built once per layer,
+// BC blocks + zstd, raw + zstd). Lossy codecs report the error of the stored page against the
+// texels it was made from.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "codec/bc.h"
+#include "codec/dct.h"
+#include "common/status.h"
+#include "format/page_file.h"
+
+namespace vt {
+
+// The codec a build asks for; the exact PageCodec and runtime format follow from the layer.
+enum class CodecKind : uint8_t { kDct = 0, kBc = 1, kRaw = 2 };
+
+struct PageEncoderOptions {
+  CodecKind codec = CodecKind::kDct;
+  int dct_quality = 75;
+  BcQuality bc_quality = BcQuality::kNormal;
+  int zstd_level = 3;
+};
+
+// The BC format a layer is transcoded to: albedo/emissive RGB BC1, RGBA BC3; normal (XY) BC5;
+// one channel BC4; two channels BC5; other RGB BC1, RGBA BC3.
+BcFormat bc_format_for(LayerSemantic semantic, uint32_t channels);
+
+struct EncodedPage {
+  PageState state = PageState::kStored;
+  std::vector<uint8_t> bytes;  // kStored: the coded page
+  uint8_t constant[16] = {};   // kConstant: the texel value
+  double squared_error = 0.0;  // lossy: sum over channels and texels, in 8-bit units
+  uint32_t max_error = 0;      // lossy: largest absolute channel error (8-bit units)
+  uint64_t samples = 0;        // channel values compared
+};
+
+class PageEncoder {
+ public:
+  // Completes `layer` (codec, runtime_format, codec_tables) for the options; layer.channels,
+  // texel_type and semantic must be set. Float layers always use raw + zstd.
+  static Expected<PageEncoder> create(LayerSpec& layer, const PageEncoderOptions& options,
+                                      uint32_t page_size);
+
+  // Encodes page_size^2 texels of layer.texel_bytes() each. Thread-safe.
+  Status encode(const uint8_t* texels, EncodedPage& out) const;
+  // Decodes a stored page back to texels (tests and verification). Thread-safe.
+  Status decode(std::span<const uint8_t> bytes, uint8_t* texels) const;
+
+  PageCodec codec() const { return codec_; }
+  size_t page_bytes() const { return size_t(page_size_) * page_size_ * texel_bytes_; }
+
+ private:
+  PageCodec codec_ = PageCodec::kRawZstd;
+  BcFormat bc_format_ = BcFormat::kBc1;
+  BcQuality bc_quality_ = BcQuality::kNormal;
+  uint32_t page_size_ = 0;
+  uint32_t channels_ = 0;
+  uint32_t texel_bytes_ = 0;
+  int zstd_level_ = 3;
+  std::shared_ptr<DctTables> dct_;
+};
+
+}  // namespace vt

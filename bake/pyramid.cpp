@@ -1,0 +1,287 @@
+#include "bake/pyramid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace vt {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double sinc(double x) {
+  if (std::abs(x) < 1e-12) return 1.0;
+  return std::sin(kPi * x) / (kPi * x);
+}
+
+// Modified Bessel function of the first kind, order 0 (series; converges fast for alpha <= 8).
+double bessel_i0(double x) {
+  double sum = 1.0, term = 1.0, q = x * x / 4.0;
+  for (int k = 1; k < 50; ++k) {
+    term *= q / (double(k) * k);
+    sum += term;
+    if (term < sum * 1e-17) break;
+  }
+  return sum;
+}
+
+// Filter value at x destination texels from the destination texel's centre.
+double filter_value(MipFilter filter, double x) {
+  double ax = std::abs(x);
+  switch (filter) {
+    case MipFilter::kBox:
+      return ax < 0.5 ? 1.0 : 0.0;
+    case MipFilter::kLanczos3:
+      return ax < 3.0 ? sinc(x) * sinc(x / 3.0) : 0.0;
+    case MipFilter::kKaiser: {
+      // Kaiser-windowed sinc, width 3, alpha 4 (the setting NVTT uses for mipmaps).
+      constexpr double kWidth = 3.0, kAlpha = 4.0;
+      if (ax >= kWidth) return 0.0;
+      double t = x / kWidth;
+      return sinc(x) * bessel_i0(kAlpha * std::sqrt(1.0 - t * t)) / bessel_i0(kAlpha);
+    }
+  }
+  return 0.0;
+}
+
+double support(MipFilter filter) {
+  return filter == MipFilter::kBox ? 0.5 : 3.0;
+}
+
+// Maps a texel coordinate through the address mode (sizes here are <= 2^24).
+inline int64_t addr(int64_t c, int64_t size, AddressMode mode) {
+  if (c >= 0 && c < size) return c;
+  return address_texel(c, size, mode);
+}
+
+// Horizontal pass of one row: (width + 1) / 2 texels of `ch` doubles.
+void filter_row(const DownsampleKernel& k, AddressMode mode, const float* src, uint32_t width,
+                uint32_t ch, double* dst) {
+  const uint32_t dw = (width + 1) / 2;
+  const int taps = k.taps();
+  const double* w = k.weights.data();
+  for (uint32_t i = 0; i < dw; ++i) {
+    int64_t x0 = int64_t(2) * i + k.first;
+    double acc[4] = {0, 0, 0, 0};
+    if (x0 >= 0 && x0 + taps <= int64_t(width)) {
+      const float* s = src + size_t(x0) * ch;
+      for (int t = 0; t < taps; ++t, s += ch) {
+        for (uint32_t c = 0; c < ch; ++c) acc[c] += w[t] * double(s[c]);
+      }
+    } else {
+      for (int t = 0; t < taps; ++t) {
+        const float* s = src + size_t(addr(x0 + t, width, mode)) * ch;
+        for (uint32_t c = 0; c < ch; ++c) acc[c] += w[t] * double(s[c]);
+      }
+    }
+    for (uint32_t c = 0; c < ch; ++c) dst[size_t(i) * ch + c] = acc[c];
+  }
+}
+
+}  // namespace
+
+const char* to_string(MipFilter f) {
+  switch (f) {
+    case MipFilter::kBox:
+      return "box";
+    case MipFilter::kKaiser:
+      return "kaiser";
+    case MipFilter::kLanczos3:
+      return "lanczos3";
+  }
+  return "?";
+}
+
+Expected<MipFilter> parse_mip_filter(const char* name) {
+  std::string n = name ? name : "";
+  if (n == "box") return MipFilter::kBox;
+  if (n == "kaiser") return MipFilter::kKaiser;
+  if (n == "lanczos3" || n == "lanczos") return MipFilter::kLanczos3;
+  return Status(ErrorCode::kInvalidArgument,
+                "unknown filter '" + n + "' (expected box, kaiser or lanczos3)");
+}
+
+DownsampleKernel make_downsample_kernel(MipFilter filter) {
+  // Source texel 2i + t has its centre at (t - 0.5) / 2 destination texels from texel i's.
+  int half = int(std::ceil(2.0 * support(filter) + 0.5)) - 1;  // box 1, 3-lobe filters 6
+  DownsampleKernel k;
+  k.first = 1 - half;
+  double sum = 0.0;
+  for (int t = k.first; t <= half; ++t) {
+    double v = filter_value(filter, (t - 0.5) / 2.0);
+    k.weights.push_back(v);
+    sum += v;
+  }
+  for (double& v : k.weights) v /= sum;
+  return k;
+}
+
+void downsample_rows(const DownsampleKernel& kernel, const DownsampleRules& rules,
+                     const RowBand& src, uint32_t y0, uint32_t y1, float* out) {
+  const uint32_t ch = src.channels;
+  const uint32_t dw = (src.width + 1) / 2;
+  const int taps = kernel.taps();
+  const size_t drow = size_t(dw) * ch;
+  // Output rows are made in chunks so the horizontal pass' double rows stay small.
+  constexpr uint32_t kChunk = 8;
+  std::vector<double> hrows;
+  std::vector<double> acc(drow);
+  for (uint32_t c0 = y0; c0 < y1; c0 += kChunk) {
+    uint32_t c1 = std::min(y1, c0 + kChunk);
+    int64_t s0 = int64_t(2) * c0 + kernel.first;
+    int64_t s1 = int64_t(2) * (c1 - 1) + kernel.first + taps;
+    hrows.resize(size_t(s1 - s0) * drow);
+    for (int64_t y = s0; y < s1; ++y) {
+      filter_row(kernel, rules.address, src.row(y), src.width, ch,
+                 hrows.data() + size_t(y - s0) * drow);
+    }
+    for (uint32_t j = c0; j < c1; ++j) {
+      std::fill(acc.begin(), acc.end(), 0.0);
+      int64_t first_row = int64_t(2) * j + kernel.first - s0;
+      for (int t = 0; t < taps; ++t) {
+        const double* h = hrows.data() + size_t(first_row + t) * drow;
+        double w = kernel.weights[t];
+        for (size_t i = 0; i < drow; ++i) acc[i] += w * h[i];
+      }
+      float* o = out + size_t(j - y0) * drow;
+      for (uint32_t i = 0; i < dw; ++i) {
+        double* a = acc.data() + size_t(i) * ch;
+        if (rules.renormalize_xyz && ch >= 3) {
+          double len = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+          if (len > 1e-30 && std::isfinite(len)) {
+            a[0] /= len, a[1] /= len, a[2] /= len;
+          } else {
+            a[0] = 0, a[1] = 0, a[2] = 1;
+          }
+        }
+        for (uint32_t c = 0; c < ch; ++c) {
+          double v = std::clamp(a[c], double(rules.min_value[c]), double(rules.max_value[c]));
+          o[size_t(i) * ch + c] = float(v);
+        }
+      }
+    }
+  }
+}
+
+std::vector<float> downsample_level(const DownsampleKernel& kernel, const DownsampleRules& rules,
+                                    const float* texels, uint32_t width, uint32_t height,
+                                    uint32_t channels) {
+  // Build an addressed band covering every tap of every output row.
+  const uint32_t dh = (height + 1) / 2, dw = (width + 1) / 2;
+  int64_t b0 = kernel.first;
+  int64_t b1 = int64_t(2) * (dh - 1) + kernel.first + kernel.taps();
+  const size_t row = size_t(width) * channels;
+  std::vector<float> band(size_t(b1 - b0) * row);
+  for (int64_t y = b0; y < b1; ++y) {
+    int64_t sy = addr(y, height, rules.address);
+    std::memcpy(band.data() + size_t(y - b0) * row, texels + size_t(sy) * row, row * sizeof(float));
+  }
+  RowBand src{b0, uint32_t(b1 - b0), width, channels, band.data()};
+  std::vector<float> out(size_t(dw) * dh * channels);
+  downsample_rows(kernel, rules, src, 0, dh, out.data());
+  return out;
+}
+
+void renormalize_normals(float* texels, size_t count, uint32_t channels) {
+  if (channels < 3) return;
+  for (size_t i = 0; i < count; ++i) {
+    float* n = texels + i * channels;
+    double x = n[0], y = n[1], z = n[2];
+    double len = std::sqrt(x * x + y * y + z * z);
+    if (len > 1e-30 && std::isfinite(len)) {
+      n[0] = float(x / len), n[1] = float(y / len), n[2] = float(z / len);
+    } else {
+      n[0] = 0, n[1] = 0, n[2] = 1;
+    }
+  }
+}
+
+std::vector<uint8_t> downsample_coverage(const uint8_t* coverage, uint32_t width, uint32_t height) {
+  const uint32_t dw = (width + 1) / 2, dh = (height + 1) / 2;
+  std::vector<uint8_t> out(size_t(dw) * dh);
+  for (uint32_t j = 0; j < dh; ++j) {
+    uint32_t ya = 2 * j, yb = std::min(2 * j + 1, height - 1);
+    for (uint32_t i = 0; i < dw; ++i) {
+      uint32_t xa = 2 * i, xb = std::min(2 * i + 1, width - 1);
+      bool any = coverage[size_t(ya) * width + xa] || coverage[size_t(ya) * width + xb] ||
+                 coverage[size_t(yb) * width + xa] || coverage[size_t(yb) * width + xb];
+      out[size_t(j) * dw + i] = any ? 1 : 0;
+    }
+  }
+  return out;
+}
+
+uint64_t pull_push(float* texels, const uint8_t* coverage, uint32_t width, uint32_t height,
+                   uint32_t channels) {
+  // Pull: coverage-weighted 2x2 averages down to 1x1, weights and weighted sums in double.
+  struct Level {
+    uint32_t w, h;
+    std::vector<double> sum;     // weighted sums, channels per texel
+    std::vector<double> weight;  // covered-texel counts
+  };
+  std::vector<Level> levels;
+  Level l0{width, height, std::vector<double>(size_t(width) * height * channels),
+           std::vector<double>(size_t(width) * height)};
+  uint64_t uncovered = 0;
+  for (size_t i = 0; i < size_t(width) * height; ++i) {
+    if (coverage[i]) {
+      l0.weight[i] = 1.0;
+      for (uint32_t c = 0; c < channels; ++c) l0.sum[i * channels + c] = texels[i * channels + c];
+    } else {
+      ++uncovered;
+    }
+  }
+  if (uncovered == 0 || uncovered == uint64_t(width) * height) return 0;
+  levels.push_back(std::move(l0));
+  while (levels.back().w > 1 || levels.back().h > 1) {
+    const Level& s = levels.back();
+    Level d{(s.w + 1) / 2, (s.h + 1) / 2, {}, {}};
+    d.sum.assign(size_t(d.w) * d.h * channels, 0.0);
+    d.weight.assign(size_t(d.w) * d.h, 0.0);
+    for (uint32_t y = 0; y < s.h; ++y) {
+      for (uint32_t x = 0; x < s.w; ++x) {
+        size_t si = size_t(y) * s.w + x, di = size_t(y / 2) * d.w + x / 2;
+        d.weight[di] += s.weight[si];
+        for (uint32_t c = 0; c < channels; ++c) {
+          d.sum[di * channels + c] += s.sum[si * channels + c];
+        }
+      }
+    }
+    levels.push_back(std::move(d));
+  }
+  // Push: a texel with no covered texel under it takes its parent's average, coarse to fine.
+  for (size_t li = levels.size() - 1; li-- > 0;) {
+    Level& f = levels[li];
+    const Level& p = levels[li + 1];
+    for (uint32_t y = 0; y < f.h; ++y) {
+      for (uint32_t x = 0; x < f.w; ++x) {
+        size_t fi = size_t(y) * f.w + x;
+        if (f.weight[fi] > 0.0) continue;
+        size_t pi = size_t(y / 2) * p.w + x / 2;
+        double pw = p.weight[pi];  // > 0 after the parent's own push
+        f.weight[fi] = 1.0;
+        for (uint32_t c = 0; c < channels; ++c) {
+          f.sum[fi * channels + c] = p.sum[pi * channels + c] / pw;
+        }
+      }
+    }
+    // Fill in normalised form so children divide by 1.
+    if (li > 0) {
+      for (size_t i = 0; i < size_t(f.w) * f.h; ++i) {
+        double w = f.weight[i];
+        if (w == 1.0) continue;
+        for (uint32_t c = 0; c < channels; ++c) f.sum[i * channels + c] /= w;
+        f.weight[i] = 1.0;
+      }
+    }
+  }
+  const Level& top = levels[0];
+  for (size_t i = 0; i < size_t(width) * height; ++i) {
+    if (coverage[i]) continue;
+    for (uint32_t c = 0; c < channels; ++c)
+      texels[i * channels + c] = float(top.sum[i * channels + c]);
+  }
+  return uncovered;
+}
+
+}  // namespace vt

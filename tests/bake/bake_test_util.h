@@ -1,0 +1,128 @@
+// Helpers for the bake tests: a page sink that keeps pages in memory, and reassembly of level
+// images from the pages' payloads.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <map>
+#include <mutex>
+#include <tuple>
+#include <vector>
+
+#include "bake/build.h"
+#include "bake/page_encoder.h"
+#include "bake/paging.h"
+
+namespace vt::test {
+
+struct StoredPage {
+  PageState state = PageState::kAbsent;
+  std::vector<uint8_t> bytes;  // stored bytes, or the constant texel
+};
+
+class MemorySink final : public PageSink {
+ public:
+  using Key = std::tuple<uint32_t, uint32_t, uint32_t, uint32_t>;  // layer, level, y, x
+  Status add_page(const PageId& id, uint32_t layer, std::span<const uint8_t> data) override {
+    std::lock_guard<std::mutex> lock(mu_);
+    auto& p = pages[{layer, id.level, id.y, id.x}];
+    if (p.state != PageState::kAbsent) return Error(ErrorCode::kInternal, "page given twice");
+    p.state = PageState::kStored;
+    p.bytes.assign(data.begin(), data.end());
+    return Status::Ok();
+  }
+  Status add_constant_page(const PageId& id, uint32_t layer,
+                           std::span<const uint8_t> texel) override {
+    std::lock_guard<std::mutex> lock(mu_);
+    auto& p = pages[{layer, id.level, id.y, id.x}];
+    if (p.state != PageState::kAbsent) return Error(ErrorCode::kInternal, "page given twice");
+    p.state = PageState::kConstant;
+    p.bytes.assign(texel.begin(), texel.end());
+    return Status::Ok();
+  }
+  std::map<Key, StoredPage> pages;
+
+ private:
+  std::mutex mu_;
+};
+
+struct BuiltPages {
+  PageFileDesc desc;
+  BuildSummary summary;
+  MemorySink sink;
+};
+
+inline std::unique_ptr<BuiltPages> build_in_memory(const BuildOptions& options) {
+  auto out = std::make_unique<BuiltPages>();
+  auto desc = plan_build(options);
+  EXPECT_TRUE(desc.ok()) << desc.status().message();
+  if (!desc.ok()) return nullptr;
+  out->desc = *desc;
+  auto sum = build_pages(options, out->desc, out->sink);
+  EXPECT_TRUE(sum.ok()) << sum.status().message();
+  if (!sum.ok()) return nullptr;
+  out->summary = *sum;
+  return out;
+}
+
+// Decoded texels (page_size^2 * texel_bytes) of a page, or empty when absent.
+inline std::vector<uint8_t> page_texels(const BuiltPages& b, uint32_t layer, const PageId& id,
+                                        const PageEncoder& enc) {
+  auto it = b.sink.pages.find({layer, id.level, id.y, id.x});
+  if (it == b.sink.pages.end()) return {};
+  std::vector<uint8_t> t(enc.page_bytes());
+  if (it->second.state == PageState::kConstant) {
+    size_t tb = it->second.bytes.size();
+    for (size_t i = 0; i < t.size(); i += tb) std::memcpy(&t[i], it->second.bytes.data(), tb);
+  } else {
+    Status s = enc.decode(it->second.bytes, t.data());
+    EXPECT_TRUE(s.ok()) << s.message();
+  }
+  return t;
+}
+
+inline PageEncoder encoder_for(const BuiltPages& b, uint32_t layer, const BuildOptions& o) {
+  LayerSpec spec = b.desc.layers[layer];
+  auto enc = PageEncoder::create(spec, o.codec, b.desc.geometry.page_size());
+  EXPECT_TRUE(enc.ok());
+  return std::move(enc).value();
+}
+
+// Level image (level_width x level_height texels of texel_bytes) from the pages' payloads.
+// Texels of absent pages stay zero; `present` marks which texels came from a page.
+inline std::vector<uint8_t> reassemble_level(const BuiltPages& b, uint32_t layer, uint32_t level,
+                                             const PageEncoder& enc,
+                                             std::vector<uint8_t>* present = nullptr) {
+  const PageGeometry& g = b.desc.geometry;
+  const uint32_t tb = b.desc.layers[layer].texel_bytes();
+  const uint32_t lw = g.level_width(level), lh = g.level_height(level), S = g.page_size();
+  std::vector<uint8_t> img(size_t(lw) * lh * tb);
+  if (present) present->assign(size_t(lw) * lh, 0);
+  for (uint32_t py = 0; py < g.pages_y(level); ++py) {
+    for (uint32_t px = 0; px < g.pages_x(level); ++px) {
+      auto t = page_texels(b, layer, {level, px, py}, enc);
+      if (t.empty()) continue;
+      for (uint32_t j = 0; j < g.payload; ++j) {
+        uint32_t y = py * g.payload + j;
+        if (y >= lh) break;
+        for (uint32_t i = 0; i < g.payload; ++i) {
+          uint32_t x = px * g.payload + i;
+          if (x >= lw) break;
+          size_t src = (size_t(j + g.border) * S + i + g.border) * tb;
+          std::memcpy(&img[(size_t(y) * lw + x) * tb], &t[src], tb);
+          if (present) (*present)[size_t(y) * lw + x] = 1;
+        }
+      }
+    }
+  }
+  return img;
+}
+
+inline std::vector<float> as_floats(const std::vector<uint8_t>& bytes) {
+  std::vector<float> f(bytes.size() / 4);
+  std::memcpy(f.data(), bytes.data(), f.size() * 4);
+  return f;
+}
+
+}  // namespace vt::test
