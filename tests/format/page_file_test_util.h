@@ -156,3 +156,36 @@ inline GeneratedFile small_file() {
 }
 
 }  // namespace vt::testing
+
+namespace vt::testing {
+
+// Cuts page (id) out of a level image (width x height texels of tb bytes) with its border,
+// clamping at the image edge as the format's clamp address mode says.
+inline std::vector<uint8_t> cut_page(const std::vector<uint8_t>& image, uint32_t width,
+                                     uint32_t height, size_t tb, const PageGeometry& g,
+                                     const PageId& id) {
+  const uint32_t size = g.page_size();
+  std::vector<uint8_t> page(size_t(size) * size * tb);
+  for (uint32_t j = 0; j < size; ++j)
+    for (uint32_t i = 0; i < size; ++i) {
+      const int64_t tx = address_texel(g.page_origin_x(id) + i, width, AddressMode::kClamp);
+      const int64_t ty = address_texel(g.page_origin_y(id) + j, height, AddressMode::kClamp);
+      std::memcpy(&page[(size_t(j) * size + i) * tb], &image[(size_t(ty) * width + tx) * tb], tb);
+    }
+  return page;
+}
+
+// Random level images for every level of `g` (tb bytes per texel), level 0 first.
+inline std::vector<std::vector<uint8_t>> random_levels(const PageGeometry& g, size_t tb,
+                                                       uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::vector<std::vector<uint8_t>> levels;
+  for (uint32_t l = 0; l < g.level_count(); ++l) {
+    std::vector<uint8_t> img(size_t(g.level_width(l)) * g.level_height(l) * tb);
+    for (auto& b : img) b = uint8_t(rng());
+    levels.push_back(std::move(img));
+  }
+  return levels;
+}
+
+}  // namespace vt::testing
