@@ -86,8 +86,8 @@ std::vector<Camera> orbit_views(Vec3 lo, Vec3 hi, int count, float aspect) {
   for (int i = 0; i < count; ++i) {
     // Cycle through distance (frontal, close-up, distant) and elevation (grazing at low angles).
     float azimuth = 0.7f + 2.399963f * float(i);  // golden angle: no two views alike
-    static const float kDist[] = {2.2f, 1.2f, 6.0f, 2.0f};
-    static const float kElev[] = {0.5f, 0.9f, 0.4f, 0.08f};
+    static const float kDist[] = {1.6f, 0.8f, 4.0f, 1.5f};
+    static const float kElev[] = {0.6f, 0.9f, 0.5f, 0.12f};
     float d = radius * kDist[i % 4];
     float e = kElev[i % 4];
     Vec3 eye{c.x + d * std::cos(e) * std::cos(azimuth), c.y + d * std::sin(e),

@@ -1,0 +1,465 @@
+// The validation renderer on a synthetic scene (a ground quad and a cube sharing one procedural
+// virtual texture): the page file is written here with the format writer (raw codec, levels by
+// a 2x box filter, borders from the level images), streamed through the runtime and rendered
+// both ways. Skips cleanly where no Vulkan device exists.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "format/page_file.h"
+#include "render/renderer.h"
+#include "render/validate.h"
+#include "render/vulkan_context.h"
+#include "runtime/page_source.h"
+#include "runtime/streamer.h"
+
+namespace vt::render {
+namespace {
+
+// Measured on lavapipe (docs/bench/render.md): the correct bake scores 44-50 dB (RGBA8 cache)
+// and 37-40 dB (BC1 cache) on these views; every broken bake scores below 25 dB.
+constexpr double kMinPsnrRgba8 = 40.0;
+constexpr double kMinPsnrBc1 = 33.0;
+constexpr uint32_t kWidth = 256;
+constexpr uint32_t kHeight = 192;
+
+VulkanContext* vulkan() {
+  static Expected<std::unique_ptr<VulkanContext>> ctx = VulkanContext::create();
+  return ctx.ok() ? ctx->get() : nullptr;
+}
+
+std::string vulkan_error() {
+  auto ctx = VulkanContext::create();
+  return ctx.ok() ? "" : ctx.status().message();
+}
+
+#define REQUIRE_VULKAN() \
+  if (!vulkan()) GTEST_SKIP() << "no Vulkan device: " << vulkan_error()
+
+PageGeometry test_geometry() {
+  PageGeometry g;
+  g.width = 1024;
+  g.height = 1024;
+  g.payload = 120;
+  g.border = 4;
+  return g;
+}
+
+uint32_t hash2(uint32_t x, uint32_t y) {
+  uint32_t h = x * 0x8da6b343u ^ y * 0xd8163841u;
+  h ^= h >> 13;
+  h *= 0x5bd1e995u;
+  return h ^ (h >> 15);
+}
+
+// Smooth ramps (so a wrong level or offset shows) plus 8-texel value-noise cells (so any page
+// differs from any other), opaque.
+std::vector<uint8_t> make_texture(uint32_t w, uint32_t h) {
+  std::vector<uint8_t> t(size_t(w) * h * 4);
+  for (uint32_t y = 0; y < h; ++y) {
+    for (uint32_t x = 0; x < w; ++x) {
+      uint8_t* p = &t[(size_t(y) * w + x) * 4];
+      uint32_t n = hash2(x / 8, y / 8);
+      p[0] = uint8_t(std::min(255u, x * 200 / w + (n & 31)));
+      p[1] = uint8_t(std::min(255u, y * 200 / h + ((n >> 8) & 31)));
+      p[2] = uint8_t(64 + ((n >> 16) & 127));
+      p[3] = 255;
+    }
+  }
+  return t;
+}
+
+struct Levels {
+  std::vector<std::vector<uint8_t>> images;  // full Vulkan mip chain, RGBA8
+};
+
+const Levels& levels() {
+  static Levels l = [] {
+    PageGeometry g = test_geometry();
+    std::vector<uint8_t> base = make_texture(g.width, g.height);
+    return Levels{box_mip_chain(base.data(), g.width, g.height)};
+  }();
+  return l;
+}
+
+enum class Fault { kNone, kZeroBorders, kSwappedPages, kSwappedChannels };
+
+// Page texels (RGBA8, page_size^2) cut from the level images, borders from the true neighbours.
+std::vector<uint8_t> page_texels(const PageGeometry& g, const PageId& id, Fault fault) {
+  const uint32_t ps = g.page_size();
+  const uint32_t lw = g.level_width(id.level), lh = g.level_height(id.level);
+  const std::vector<uint8_t>& img = levels().images[id.level];
+  std::vector<uint8_t> out(size_t(ps) * ps * 4);
+  for (uint32_t j = 0; j < ps; ++j) {
+    int64_t ty = address_texel(g.page_origin_y(id) + j, lh, AddressMode::kClamp);
+    for (uint32_t i = 0; i < ps; ++i) {
+      int64_t tx = address_texel(g.page_origin_x(id) + i, lw, AddressMode::kClamp);
+      const uint8_t* s = &img[(size_t(ty) * lw + size_t(tx)) * 4];
+      uint8_t* d = &out[(size_t(j) * ps + i) * 4];
+      bool border = i < g.border || j < g.border || i >= ps - g.border || j >= ps - g.border;
+      for (int c = 0; c < 4; ++c) d[c] = s[c];
+      if (fault == Fault::kZeroBorders && border) d[0] = d[1] = d[2] = 0;
+      if (fault == Fault::kSwappedChannels) std::swap(d[0], d[2]);
+    }
+  }
+  return out;
+}
+
+std::string temp_path(const std::string& name) {
+  return (std::filesystem::path(testing::TempDir()) / ("vt_render_" + name + ".vtpf")).string();
+}
+
+// Writes the synthetic bake (raw codec) with an optional fault.
+std::string write_bake(const std::string& name, RuntimeFormat runtime, Fault fault) {
+  PageFileDesc desc;
+  desc.geometry = test_geometry();
+  LayerSpec layer;
+  layer.name = "albedo";
+  layer.channels = 4;
+  layer.codec = PageCodec::kRaw;
+  layer.runtime_format = runtime;
+  desc.layers.push_back(layer);
+  const std::string path = temp_path(name);
+  auto writer = PageFileWriter::create(path, desc);
+  EXPECT_TRUE(writer.ok()) << writer.status().message();
+  const PageGeometry& g = desc.geometry;
+  for (uint32_t l = 0; l < g.level_count(); ++l) {
+    for (uint32_t y = 0; y < g.pages_y(l); ++y) {
+      for (uint32_t x = 0; x < g.pages_x(l); ++x) {
+        PageId id{l, x, y};
+        PageId src = id;
+        // A wrong page in the index: at every level, the page a quarter across and half down
+        // (on the ground quad) holds its right neighbour's data.
+        if (fault == Fault::kSwappedPages && x == g.pages_x(l) / 4 && y == g.pages_y(l) / 2 &&
+            g.pages_x(l) > 1) {
+          src.x = x + 1;
+        }
+        EXPECT_TRUE((*writer)->add_page(id, 0, page_texels(g, src, fault)).ok());
+      }
+    }
+  }
+  Status s = (*writer)->finish();
+  EXPECT_TRUE(s.ok()) << s.message();
+  return path;
+}
+
+Vertex vtx(float x, float y, float z, float u, float v) {
+  return {x, y, z, u, v};
+}
+
+// Ground quad on u in [0, 0.5]; a unit cube whose faces fill a 2 x 3 grid of cells on
+// u in [0.5, 1].
+std::vector<MeshData> make_scene() {
+  std::vector<MeshData> meshes(2);
+  MeshData& quad = meshes[0];
+  quad.vertices = {vtx(-2, 0, -2, 0, 0), vtx(2, 0, -2, 0.5f, 0), vtx(2, 0, 2, 0.5f, 1),
+                   vtx(-2, 0, 2, 0, 1)};
+  quad.indices = {0, 1, 2, 0, 2, 3};
+  MeshData& cube = meshes[1];
+  // Each face: origin corner, two edge vectors (unit cube from (-0.5, 0, -0.5)).
+  const float faces[6][9] = {
+      {-0.5f, 0, 0.5f, 1, 0, 0, 0, 1, 0},  {0.5f, 0, -0.5f, -1, 0, 0, 0, 1, 0},
+      {0.5f, 0, 0.5f, 0, 0, -1, 0, 1, 0},  {-0.5f, 0, -0.5f, 0, 0, 1, 0, 1, 0},
+      {-0.5f, 1, 0.5f, 1, 0, 0, 0, 0, -1}, {-0.5f, 0, -0.5f, 1, 0, 0, 0, 0, 1}};
+  for (uint32_t f = 0; f < 6; ++f) {
+    const float* o = faces[f];
+    float u0 = 0.5f + 0.25f * float(f % 2), v0 = float(f / 2) / 3.0f;
+    uint32_t base = uint32_t(cube.vertices.size());
+    for (int c = 0; c < 4; ++c) {
+      float a = (c == 1 || c == 2) ? 1.0f : 0.0f, b = (c >= 2) ? 1.0f : 0.0f;
+      cube.vertices.push_back(vtx(o[0] + a * o[3] + b * o[6], o[1] + a * o[4] + b * o[7],
+                                  o[2] + a * o[5] + b * o[8], u0 + a * 0.25f, v0 + b / 3.0f));
+    }
+    for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) cube.indices.push_back(base + i);
+  }
+  return meshes;
+}
+
+std::vector<Camera> views() {
+  return orbit_views({-2, 0, -2}, {2, 1, 2}, 4, float(kWidth) / float(kHeight));
+}
+
+std::unique_ptr<Renderer> make_renderer() {
+  RenderOptions o;
+  o.width = kWidth;
+  o.height = kHeight;
+  auto r = Renderer::create(*vulkan(), o);
+  EXPECT_TRUE(r.ok()) << r.status().message();
+  if (!r.ok()) return nullptr;
+  std::vector<MeshData> scene = make_scene();
+  EXPECT_TRUE((*r)->set_meshes(scene).ok());
+  ReferenceTexture tex;
+  tex.width = test_geometry().width;
+  tex.height = test_geometry().height;
+  tex.levels = levels().images;
+  tex.max_level = test_geometry().level_count() - 1;
+  Status s = (*r)->set_reference_textures(std::span(&tex, 1));
+  EXPECT_TRUE(s.ok()) << s.message();
+  return std::move(*r);
+}
+
+struct Bake {
+  std::shared_ptr<const PageFileReader> reader;
+  std::shared_ptr<const PageSource> source;
+  std::unique_ptr<Streamer> streamer;
+};
+
+Bake open_bake(const std::string& path) {
+  Bake b;
+  auto reader = PageFileReader::open(path);
+  EXPECT_TRUE(reader.ok()) << reader.status().message();
+  b.reader = std::shared_ptr<const PageFileReader>(std::move(*reader));
+  auto source = make_page_file_source(b.reader);
+  EXPECT_TRUE(source.ok()) << source.status().message();
+  b.source = std::shared_ptr<const PageSource>(std::move(*source));
+  StreamerOptions so;
+  so.slots_x = 16;
+  so.slots_y = 16;
+  auto streamer = Streamer::create(b.source, so);
+  EXPECT_TRUE(streamer.ok()) << streamer.status().message();
+  b.streamer = std::move(*streamer);
+  return b;
+}
+
+struct ViewRun {
+  ConvergeResult converge;
+  ViewMetrics metrics;
+  Rgba8Image reference;
+  VirtualFrame frame;
+};
+
+// Converges every view on a fresh streamer over `path` and compares with the reference.
+// `tamper` may alter the page table before the final pass.
+std::vector<ViewRun> run_views(const std::string& path,
+                               void (*tamper)(Renderer&, const Streamer&) = nullptr) {
+  std::vector<ViewRun> runs;
+  std::unique_ptr<Renderer> renderer = make_renderer();
+  if (!renderer) return runs;
+  for (const Camera& cam : views()) {
+    // A cold cache per view, so frames-to-converge measures each view alone.
+    Bake bake = open_bake(path);
+    if (!bake.streamer) return runs;
+    auto setup = virtual_setup_for(*bake.streamer, 0, AddressMode::kClamp);
+    EXPECT_TRUE(setup.ok()) << setup.status().message();
+    Status s = renderer->set_virtual_texture(*setup);
+    EXPECT_TRUE(s.ok()) << s.message();
+    ViewRun run;
+    auto c = converge_view(*renderer, *bake.streamer, cam);
+    EXPECT_TRUE(c.ok()) << c.status().message();
+    if (!c.ok()) return runs;
+    run.converge = *c;
+    if (tamper) tamper(*renderer, *bake.streamer);
+    auto frame = renderer->render_virtual(cam);
+    auto ref = renderer->render_reference(cam);
+    EXPECT_TRUE(frame.ok() && ref.ok());
+    if (!frame.ok() || !ref.ok()) return runs;
+    run.frame = std::move(*frame);
+    run.reference = std::move(*ref);
+    auto m = compare_view(run.reference, run.frame);
+    EXPECT_TRUE(m.ok());
+    run.metrics = *m;
+    runs.push_back(std::move(run));
+  }
+  return runs;
+}
+
+double min_psnr(const std::vector<ViewRun>& runs) {
+  double m = 1e9;
+  for (const ViewRun& r : runs) m = std::min(m, r.metrics.psnr_rgb);
+  return m;
+}
+
+void print_runs(const char* name, const std::vector<ViewRun>& runs) {
+  for (size_t i = 0; i < runs.size(); ++i) {
+    const ViewRun& r = runs[i];
+    std::printf("%s view %zu: psnr %.2f dB ssim %.4f coarser %.4f frames %u pages %u px %llu\n",
+                name, i, r.metrics.psnr_rgb, r.metrics.ssim, r.metrics.coarser_share,
+                r.converge.frames_to_converge, r.converge.pages_uploaded,
+                (unsigned long long)r.metrics.pixels);
+  }
+}
+
+TEST(RenderContext, CreatesOrExplains) {
+  auto ctx = VulkanContext::create();
+  if (!ctx.ok()) {
+    EXPECT_EQ(ctx.status().code(), ErrorCode::kUnsupported) << ctx.status().message();
+    EXPECT_NE(ctx.status().message().find("vulkan"), std::string::npos);
+    GTEST_SKIP() << ctx.status().message();
+  }
+  EXPECT_FALSE((*ctx)->device_name().empty());
+  ImageDesc bad;
+  bad.width = 0;
+  EXPECT_EQ((*ctx)->create_image(bad).status().code(), ErrorCode::kInvalidArgument);
+}
+
+TEST(Renderer, RejectsBadOptionsAndMeshes) {
+  REQUIRE_VULKAN();
+  RenderOptions o;
+  o.width = 0;
+  EXPECT_EQ(Renderer::create(*vulkan(), o).status().code(), ErrorCode::kInvalidArgument);
+  o.width = 64;
+  o.height = 64;
+  auto r = Renderer::create(*vulkan(), o);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  MeshData m;
+  m.vertices = {vtx(0, 0, 0, 0, 0)};
+  m.indices = {0, 0, 1};
+  EXPECT_EQ((*r)->set_meshes(std::span(&m, 1)).code(), ErrorCode::kInvalidArgument);
+  // No reference texture set for the mesh: a clear error, not a crash.
+  m.indices = {0, 0, 0};
+  ASSERT_TRUE((*r)->set_meshes(std::span(&m, 1)).ok());
+  EXPECT_FALSE((*r)->render_reference(Camera{}).ok());
+  EXPECT_FALSE((*r)->render_virtual(Camera{}).ok());  // no virtual texture yet
+}
+
+// A full-screen quad showing uv [0, 0.75]^2 at 3 level-0 texels per pixel wants level 1
+// (log2 3 = 1.58) everywhere, and over the screen asks for exactly the 4 x 4 pages of level 1
+// that cover level-1 texels [0, 384).
+TEST(Renderer, FeedbackRequestsTheAnalyticLevel) {
+  REQUIRE_VULKAN();
+  RenderOptions o;
+  o.width = 256;
+  o.height = 256;
+  o.feedback_divisor = 4;
+  auto r = Renderer::create(*vulkan(), o);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  MeshData quad;
+  quad.vertices = {vtx(-1, -1, 0.5f, 0, 0), vtx(1, -1, 0.5f, 0.75f, 0),
+                   vtx(1, 1, 0.5f, 0.75f, 0.75f), vtx(-1, 1, 0.5f, 0, 0.75f)};
+  quad.indices = {0, 1, 2, 0, 2, 3};
+  ASSERT_TRUE((*r)->set_meshes(std::span(&quad, 1)).ok());
+  VirtualTextureSetup setup;
+  setup.geometry = test_geometry();
+  ASSERT_TRUE((*r)->set_virtual_texture(setup).ok());
+  for (uint32_t frame = 0; frame < 4; ++frame) {
+    auto fb = (*r)->render_feedback(Camera{}, frame);
+    ASSERT_TRUE(fb.ok()) << fb.status().message();
+    ASSERT_EQ(fb->requests.size(), 64u * 64u);
+    std::vector<int> seen(16, 0);
+    for (uint32_t v : fb->requests) {
+      ASSERT_NE(v, 0xFFFFFFFFu);
+      ASSERT_EQ(v >> 24, 1u) << std::hex << v;
+      uint32_t x = v & 0xFFF, y = (v >> 12) & 0xFFF;
+      ASSERT_LT(x, 4u);
+      ASSERT_LT(y, 4u);
+      seen[y * 4 + x]++;
+    }
+    for (int s : seen) EXPECT_GT(s, 0);
+  }
+}
+
+TEST(Renderer, NothingResidentIsLoudNotUndefined) {
+  REQUIRE_VULKAN();
+  std::unique_ptr<Renderer> r = make_renderer();
+  ASSERT_TRUE(r);
+  VirtualTextureSetup setup;
+  setup.geometry = test_geometry();
+  ASSERT_TRUE(r->set_virtual_texture(setup).ok());
+  auto frame = r->render_virtual(views()[0]);
+  ASSERT_TRUE(frame.ok()) << frame.status().message();
+  uint64_t covered = 0, unresident = 0;
+  for (size_t i = 0; i < frame->status.size(); ++i) {
+    if (!(frame->status[i] & 0x80000000u)) continue;
+    ++covered;
+    if (((frame->status[i] >> 8) & 0xFF) == 31) ++unresident;
+  }
+  EXPECT_GT(covered, 1000u);
+  EXPECT_EQ(unresident, covered);
+}
+
+TEST(Validate, CorrectBakeMatchesReference) {
+  REQUIRE_VULKAN();
+  auto runs = run_views(write_bake("good", RuntimeFormat::kRgba8, Fault::kNone));
+  ASSERT_EQ(runs.size(), 4u);
+  print_runs("rgba8", runs);
+  for (const ViewRun& r : runs) {
+    EXPECT_TRUE(r.converge.converged);
+    EXPECT_GT(r.converge.frames_to_converge, 0u);
+    EXPECT_EQ(r.converge.load_errors, 0u);
+    EXPECT_GT(r.metrics.pixels, 2000u);
+    EXPECT_GE(r.metrics.psnr_rgb, kMinPsnrRgba8);
+    EXPECT_GT(r.metrics.ssim, 0.97);
+    EXPECT_LT(r.metrics.coarser_share, 0.02);
+    EXPECT_EQ(r.metrics.unresident_pixels, 0u);
+  }
+}
+
+TEST(Validate, Bc1CacheMatchesReference) {
+  REQUIRE_VULKAN();
+  auto runs = run_views(write_bake("good_bc1", RuntimeFormat::kBc1, Fault::kNone));
+  ASSERT_EQ(runs.size(), 4u);
+  print_runs("bc1", runs);
+  EXPECT_GE(min_psnr(runs), kMinPsnrBc1);
+}
+
+TEST(Validate, RendersAreBitIdentical) {
+  REQUIRE_VULKAN();
+  const std::string path = write_bake("determinism", RuntimeFormat::kRgba8, Fault::kNone);
+  auto a = run_views(path);
+  auto b = run_views(path);
+  ASSERT_EQ(a.size(), 4u);
+  ASSERT_EQ(b.size(), 4u);
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].frame.color.texels, b[i].frame.color.texels) << "view " << i;
+    EXPECT_EQ(a[i].frame.status, b[i].frame.status) << "view " << i;
+    EXPECT_EQ(a[i].reference.texels, b[i].reference.texels) << "view " << i;
+    EXPECT_EQ(a[i].converge.frames_to_converge, b[i].converge.frames_to_converge);
+  }
+}
+
+TEST(Validate, ZeroedBordersFail) {
+  REQUIRE_VULKAN();
+  auto runs = run_views(write_bake("zero_borders", RuntimeFormat::kRgba8, Fault::kZeroBorders));
+  ASSERT_EQ(runs.size(), 4u);
+  print_runs("zero-borders", runs);
+  EXPECT_LT(min_psnr(runs), kMinPsnrRgba8);
+}
+
+TEST(Validate, WrongPageInIndexFails) {
+  REQUIRE_VULKAN();
+  auto runs = run_views(write_bake("wrong_page", RuntimeFormat::kRgba8, Fault::kSwappedPages));
+  ASSERT_EQ(runs.size(), 4u);
+  print_runs("wrong-page", runs);
+  EXPECT_LT(min_psnr(runs), kMinPsnrRgba8);
+}
+
+TEST(Validate, SwappedBcChannelsFail) {
+  REQUIRE_VULKAN();
+  auto runs = run_views(write_bake("swapped_bc1", RuntimeFormat::kBc1, Fault::kSwappedChannels));
+  ASSERT_EQ(runs.size(), 4u);
+  print_runs("swapped-bc1", runs);
+  for (const ViewRun& r : runs) EXPECT_LT(r.metrics.psnr_rgb, kMinPsnrBc1);
+}
+
+// The page table claims each entry's page is one level coarser than the one in its slot.
+void off_by_one_level(Renderer& renderer, const Streamer& streamer) {
+  PageTable table = streamer.page_table();
+  PageTableLevels levels;
+  for (uint32_t l = 0; l < table.level_count(); ++l) {
+    auto d = table.level_data(l);
+    std::vector<uint8_t> level(d.begin(), d.end());
+    for (size_t i = 0; i + 3 < level.size(); i += 4) {
+      if (level[i + 2] + 1u < table.level_count()) level[i + 2]++;
+    }
+    levels.levels.push_back(std::move(level));
+  }
+  EXPECT_TRUE(renderer.upload_page_table(levels).ok());
+}
+
+TEST(Validate, OffByOnePageTableLevelFails) {
+  REQUIRE_VULKAN();
+  auto runs =
+      run_views(write_bake("off_by_one", RuntimeFormat::kRgba8, Fault::kNone), off_by_one_level);
+  ASSERT_EQ(runs.size(), 4u);
+  print_runs("off-by-one", runs);
+  EXPECT_LT(min_psnr(runs), kMinPsnrRgba8);
+}
+
+}  // namespace
+}  // namespace vt::render
