@@ -1,0 +1,138 @@
+// load_scene dispatch and the file helpers the importers share.
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+
+#include "bake/scene/scene.h"
+#include "bake/scene/scene_io_util.h"
+
+namespace vt::scene {
+namespace detail {
+
+Expected<std::vector<uint8_t>> read_file(const std::string& path) {
+  std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
+  if (!f) return Error(ErrorCode::kNotFound, path + ": cannot open file");
+  if (std::fseek(f.get(), 0, SEEK_END) != 0) return Error(ErrorCode::kIo, path + ": cannot seek");
+  long size = std::ftell(f.get());
+  if (size < 0) return Error(ErrorCode::kIo, path + ": cannot tell size");
+  std::fseek(f.get(), 0, SEEK_SET);
+  std::vector<uint8_t> bytes(static_cast<size_t>(size));
+  if (size > 0 && std::fread(bytes.data(), 1, bytes.size(), f.get()) != bytes.size())
+    return Error(ErrorCode::kIo, path + ": short read");
+  return bytes;
+}
+
+std::string lower_extension(const std::string& path) {
+  size_t slash = path.find_last_of("/\\");
+  size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot + 1);
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+std::string parent_folder(const std::string& path) {
+  size_t slash = path.find_last_of("/\\");
+  return slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
+}
+
+std::string percent_decode(const std::string& uri) {
+  std::string out;
+  for (size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit((unsigned char)uri[i + 1]) &&
+        std::isxdigit((unsigned char)uri[i + 2])) {
+      out.push_back(static_cast<char>(std::stoi(uri.substr(i + 1, 2), nullptr, 16)));
+      i += 2;
+    } else {
+      out.push_back(uri[i]);
+    }
+  }
+  return out;
+}
+
+static int base64_value(char c) {
+  if (c >= 'A' && c <= 'Z') return c - 'A';
+  if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+  if (c >= '0' && c <= '9') return c - '0' + 52;
+  if (c == '+' || c == '-') return 62;
+  if (c == '/' || c == '_') return 63;
+  return -1;
+}
+
+Expected<std::vector<uint8_t>> decode_data_uri(const std::string& uri, std::string* mime) {
+  size_t comma = uri.find(',');
+  if (uri.rfind("data:", 0) != 0 || comma == std::string::npos)
+    return Error(ErrorCode::kCorrupt, "malformed data URI");
+  std::string header = uri.substr(5, comma - 5);
+  bool base64 = header.size() >= 7 && header.substr(header.size() - 7) == ";base64";
+  if (mime) *mime = header.substr(0, header.find(';'));
+  std::vector<uint8_t> out;
+  if (!base64) {
+    std::string text = percent_decode(uri.substr(comma + 1));
+    return std::vector<uint8_t>(text.begin(), text.end());
+  }
+  out.reserve((uri.size() - comma) * 3 / 4);
+  uint32_t acc = 0;
+  int bits = 0;
+  for (size_t i = comma + 1; i < uri.size(); ++i) {
+    char c = uri[i];
+    if (c == '=' || c == '\n' || c == '\r' || c == ' ') continue;
+    int v = base64_value(c);
+    if (v < 0) return Error(ErrorCode::kCorrupt, "invalid base64 character in data URI");
+    acc = (acc << 6) | static_cast<uint32_t>(v);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out.push_back(static_cast<uint8_t>((acc >> bits) & 0xff));
+    }
+  }
+  return out;
+}
+
+std::string base64_encode(const uint8_t* data, size_t size) {
+  static const char* kTable = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((size + 2) / 3 * 4);
+  for (size_t i = 0; i < size; i += 3) {
+    uint32_t v = static_cast<uint32_t>(data[i]) << 16;
+    if (i + 1 < size) v |= static_cast<uint32_t>(data[i + 1]) << 8;
+    if (i + 2 < size) v |= data[i + 2];
+    out.push_back(kTable[(v >> 18) & 63]);
+    out.push_back(kTable[(v >> 12) & 63]);
+    out.push_back(i + 1 < size ? kTable[(v >> 6) & 63] : '=');
+    out.push_back(i + 2 < size ? kTable[v & 63] : '=');
+  }
+  return out;
+}
+
+Scene single_mesh_scene(const std::string& path, std::string name, std::vector<Primitive> prims,
+                        std::vector<Material> materials) {
+  Scene scene;
+  scene.source_path = path;
+  Mesh mesh;
+  mesh.name = std::move(name);
+  mesh.primitives = std::move(prims);
+  scene.meshes.push_back(std::move(mesh));
+  scene.materials = std::move(materials);
+  Node node;
+  node.name = scene.meshes[0].name;
+  node.mesh = 0;
+  scene.nodes.push_back(node);
+  scene.roots.push_back(0);
+  return scene;
+}
+
+}  // namespace detail
+
+Expected<Scene> load_scene(const std::string& path) {
+  std::string ext = detail::lower_extension(path);
+  if (ext == "gltf" || ext == "glb") return detail::load_gltf(path);
+  if (ext == "obj") return detail::load_obj(path);
+  if (ext == "ply") return detail::load_ply(path);
+  if (ext == "drc") return detail::load_drc(path);
+  return Error(ErrorCode::kUnsupported,
+               path + ": unknown scene format (expected .gltf, .glb, .obj, .ply or .drc)");
+}
+
+}  // namespace vt::scene

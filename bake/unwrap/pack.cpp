@@ -1,0 +1,219 @@
+// Chart packing: each chart's conservative texel footprint (every texel any triangle touches)
+// is dropped onto a skyline in each of four quarter-turn rotations, keeping the spot with the
+// lowest top, then the least wasted space under it. Quarter turns never mirror a chart.
+// The gutter is exact: a placed chart's footprint dilated by `padding` (Chebyshev) must lie
+// above the skyline of raw footprints, so any two charts have `padding` empty texels between.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <thread>
+
+#include "bake/unwrap/unwrap_internal.h"
+
+namespace vt::unwrap::detail {
+namespace {
+
+struct Grid {
+  int gx = 1, gy = 1;
+};
+
+Grid grid_of(const PackChart& c) {
+  return {std::max(1, static_cast<int>(std::ceil(c.width))),
+          std::max(1, static_cast<int>(std::ceil(c.height)))};
+}
+
+// Conservative triangle / axis-aligned box overlap (separating axis test), slightly inflated
+// so that touching counts as overlapping.
+bool triangle_touches_box(const P2& a, const P2& b, const P2& c, double x0, double y0, double x1,
+                          double y1) {
+  const double eps = 1e-6;
+  x0 -= eps, y0 -= eps, x1 += eps, y1 += eps;
+  if (std::max({a[0], b[0], c[0]}) < x0 || std::min({a[0], b[0], c[0]}) > x1) return false;
+  if (std::max({a[1], b[1], c[1]}) < y0 || std::min({a[1], b[1], c[1]}) > y1) return false;
+  const P2* v[3] = {&a, &b, &c};
+  for (int e = 0; e < 3; ++e) {
+    const P2& p = *v[e];
+    const P2& q = *v[(e + 1) % 3];
+    const P2& r = *v[(e + 2) % 3];
+    double nx = q[1] - p[1], ny = p[0] - q[0];  // edge normal
+    double tri_side = nx * (r[0] - p[0]) + ny * (r[1] - p[1]);
+    if (tri_side == 0) continue;  // degenerate edge direction: the other axes decide
+    double corners[4] = {nx * (x0 - p[0]) + ny * (y0 - p[1]), nx * (x1 - p[0]) + ny * (y0 - p[1]),
+                         nx * (x0 - p[0]) + ny * (y1 - p[1]), nx * (x1 - p[0]) + ny * (y1 - p[1])};
+    double lo = *std::min_element(corners, corners + 4);
+    double hi = *std::max_element(corners, corners + 4);
+    double tol = 1e-9 * (std::abs(nx) + std::abs(ny)) * std::max(1.0, std::abs(x1 - x0));
+    if (tri_side > 0 && hi < -tol) return false;
+    if (tri_side < 0 && lo > tol) return false;
+  }
+  return true;
+}
+
+// Footprint cells (i, j) of a chart in its unrotated grid.
+std::vector<char> footprint(const PackChart& chart, const Grid& g) {
+  std::vector<char> cells(static_cast<size_t>(g.gx) * g.gy, 0);
+  for (const auto& t : chart.tris) {
+    const P2& a = chart.points[t[0]];
+    const P2& b = chart.points[t[1]];
+    const P2& c = chart.points[t[2]];
+    int i0 =
+        std::clamp(static_cast<int>(std::floor(std::min({a[0], b[0], c[0]}))) - 1, 0, g.gx - 1);
+    int i1 =
+        std::clamp(static_cast<int>(std::floor(std::max({a[0], b[0], c[0]}))) + 1, 0, g.gx - 1);
+    int j0 =
+        std::clamp(static_cast<int>(std::floor(std::min({a[1], b[1], c[1]}))) - 1, 0, g.gy - 1);
+    int j1 =
+        std::clamp(static_cast<int>(std::floor(std::max({a[1], b[1], c[1]}))) + 1, 0, g.gy - 1);
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        char& cell = cells[static_cast<size_t>(j) * g.gx + i];
+        if (!cell && triangle_touches_box(a, b, c, i, j, i + 1, j + 1)) cell = 1;
+      }
+  }
+  return cells;
+}
+
+// Column profiles of one rotation of a footprint.
+struct Profile {
+  int width = 0, height = 0;  // rotated grid
+  std::vector<int> top;       // per raw column: highest occupied row + 1 (0 = empty column)
+  std::vector<int> low;       // per dilated column (width + 2 * padding): lowest row - padding
+  int min_low = 0;
+};
+
+constexpr int kEmpty = std::numeric_limits<int>::max();
+
+Profile profile(const std::vector<char>& cells, const Grid& g, int rotation, int padding) {
+  Profile pr;
+  bool swap = rotation & 1;
+  pr.width = swap ? g.gy : g.gx;
+  pr.height = swap ? g.gx : g.gy;
+  std::vector<int> bottom(pr.width, kEmpty);
+  pr.top.assign(pr.width, 0);
+  for (int j = 0; j < g.gy; ++j)
+    for (int i = 0; i < g.gx; ++i) {
+      if (!cells[static_cast<size_t>(j) * g.gx + i]) continue;
+      int x, y;  // rotated cell, matching place_point
+      switch (rotation) {
+        case 0:
+          x = i, y = j;
+          break;
+        case 1:
+          x = g.gy - 1 - j, y = i;
+          break;
+        case 2:
+          x = g.gx - 1 - i, y = g.gy - 1 - j;
+          break;
+        default:
+          x = j, y = g.gx - 1 - i;
+          break;
+      }
+      bottom[x] = std::min(bottom[x], y);
+      pr.top[x] = std::max(pr.top[x], y + 1);
+    }
+  pr.low.assign(pr.width + 2 * padding, kEmpty);
+  for (int x = 0; x < pr.width; ++x) {
+    if (bottom[x] == kEmpty) continue;
+    for (int d = 0; d <= 2 * padding; ++d)
+      pr.low[x + d] = std::min(pr.low[x + d], bottom[x] - padding);
+  }
+  pr.min_low = kEmpty;
+  for (int v : pr.low) pr.min_low = std::min(pr.min_low, v);
+  return pr;
+}
+
+}  // namespace
+
+P2 place_point(const PackChart& chart, const Placement& pl, const P2& p) {
+  Grid g = grid_of(chart);
+  P2 r;
+  switch (pl.rotation) {
+    case 0:
+      r = p;
+      break;
+    case 1:
+      r = {g.gy - p[1], p[0]};
+      break;
+    case 2:
+      r = {g.gx - p[0], g.gy - p[1]};
+      break;
+    default:
+      r = {p[1], g.gx - p[0]};
+      break;
+  }
+  return {r[0] + pl.x, r[1] + pl.y};
+}
+
+PackResult pack_charts(const std::vector<PackChart>& charts, int width, int padding, int threads) {
+  PackResult result;
+  result.placements.resize(charts.size());
+  result.width = width;
+  // Profiles are independent per chart: build them in parallel, place serially (deterministic).
+  std::vector<std::array<Profile, 4>> profiles(charts.size());
+  int workers = std::max(1, std::min<int>(threads, static_cast<int>(charts.size() / 64 + 1)));
+  auto build = [&](int w) {
+    for (size_t c = w; c < charts.size(); c += workers) {
+      Grid g = grid_of(charts[c]);
+      auto cells = footprint(charts[c], g);
+      for (int r = 0; r < 4; ++r) profiles[c][r] = profile(cells, g, r, padding);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int w = 1; w < workers; ++w) pool.emplace_back(build, w);
+  build(0);
+  for (auto& t : pool) t.join();
+
+  std::vector<size_t> order(charts.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    Grid ga = grid_of(charts[a]), gb = grid_of(charts[b]);
+    int ha = std::min(ga.gx, ga.gy), hb = std::min(gb.gx, gb.gy);
+    if (ha != hb) return ha > hb;
+    return static_cast<int64_t>(ga.gx) * ga.gy > static_cast<int64_t>(gb.gx) * gb.gy;
+  });
+
+  std::vector<int> sky(width, 0);
+  int top_all = 0;
+  for (size_t c : order) {
+    int64_t best_top = std::numeric_limits<int64_t>::max(), best_waste = 0;
+    Placement best;
+    for (int r = 0; r < 4; ++r) {
+      const Profile& pr = profiles[c][r];
+      if (pr.width > width && r > 0) continue;  // the caller makes sure rotation 0 or 1 fits
+      int x_max = width - pr.width;
+      for (int x = 0; x <= std::max(0, x_max); ++x) {
+        int64_t y = 0;
+        bool pruned = false;
+        for (int d = 0; d < static_cast<int>(pr.low.size()); ++d) {
+          int ax = x + d - padding;
+          if (ax < 0 || ax >= width || pr.low[d] == kEmpty) continue;
+          y = std::max<int64_t>(y, sky[ax] - pr.low[d]);
+          if (y + pr.height > best_top) {
+            pruned = true;
+            break;
+          }
+        }
+        if (pruned) continue;
+        int64_t top = y + pr.height;
+        int64_t waste = 0;
+        for (int d = 0; d < pr.width && x + d < width; ++d)
+          if (pr.top[d] > 0) waste += y + pr.low[d + padding] + padding - sky[x + d];
+        if (top < best_top || (top == best_top && waste < best_waste)) {
+          best_top = top;
+          best_waste = waste;
+          best = {r, x, static_cast<int>(y)};
+        }
+      }
+    }
+    const Profile& pr = profiles[c][best.rotation];
+    for (int d = 0; d < pr.width && best.x + d < width; ++d)
+      if (pr.top[d] > 0) sky[best.x + d] = std::max(sky[best.x + d], best.y + pr.top[d]);
+    top_all = std::max(top_all, best.y + pr.height);
+    result.placements[c] = best;
+  }
+  result.height = top_all;
+  return result;
+}
+
+}  // namespace vt::unwrap::detail

@@ -1,0 +1,128 @@
+// The unwrap report (JSON) and the atlas picture (PNG through OpenImageIO).
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "bake/unwrap/unwrap.h"
+
+namespace vt::unwrap {
+
+std::string report_json(const UnwrapStats& s) {
+  nlohmann::json j = {{"faces", s.faces},
+                      {"degenerate_faces", s.degenerate_faces},
+                      {"charts", s.charts},
+                      {"charts_split", s.charts_split},
+                      {"split_rounds", s.split_rounds},
+                      {"atlas",
+                       {{"width", s.atlas_width},
+                        {"height", s.atlas_height},
+                        {"pages_x", s.pages_x},
+                        {"pages_y", s.pages_y}}},
+                      {"texels_per_unit", s.texels_per_unit},
+                      {"utilisation", s.utilisation},
+                      {"stretch", {{"l2", s.stretch_l2}, {"linf", s.stretch_linf}}},
+                      {"flipped_triangles", s.flipped_triangles},
+                      {"overlapping_triangles", s.overlapping_triangles},
+                      {"overlapping_texels", s.overlapping_texels},
+                      {"unmapped_faces", s.unmapped_faces},
+                      {"seconds",
+                       {{"segment", s.seconds.segment},
+                        {"parameterize", s.seconds.parameterize},
+                        {"pack", s.seconds.pack},
+                        {"output", s.seconds.output},
+                        {"check", s.seconds.check}}}};
+  return j.dump(2);
+}
+
+namespace {
+
+std::array<uint8_t, 3> chart_colour(int32_t chart) {
+  uint32_t h = static_cast<uint32_t>(chart) * 2654435761u;
+  h ^= h >> 15;
+  // Bright, saturated colours: never near the dark background.
+  return {static_cast<uint8_t>(80 + (h & 0xff) % 176),
+          static_cast<uint8_t>(80 + ((h >> 8) & 0xff) % 176),
+          static_cast<uint8_t>(80 + ((h >> 16) & 0xff) % 176)};
+}
+
+std::array<uint8_t, 3> stretch_colour(float l2) {
+  // 1 -> blue, 2 or more -> red, through green.
+  double t = std::clamp((static_cast<double>(l2) - 1.0), 0.0, 1.0);
+  if (!std::isfinite(l2)) t = 1;
+  double r = std::clamp(2 * t, 0.0, 1.0), g = 1 - std::abs(2 * t - 1),
+         b = std::clamp(1 - 2 * t, 0.0, 1.0);
+  return {static_cast<uint8_t>(255 * r), static_cast<uint8_t>(255 * g),
+          static_cast<uint8_t>(255 * b)};
+}
+
+}  // namespace
+
+Status write_atlas_picture(const UnwrapResult& result, const std::string& path, int max_side) {
+  int aw = std::max(1, result.stats.atlas_width), ah = std::max(1, result.stats.atlas_height);
+  double scale = std::min(1.0, static_cast<double>(max_side) / std::max(aw, ah));
+  int w = std::max(1, static_cast<int>(std::ceil(aw * scale)));
+  int h = std::max(1, static_cast<int>(std::ceil(ah * scale)));
+  int gap = 8;
+  int pw = 2 * w + gap;
+  std::vector<uint8_t> pixels(static_cast<size_t>(pw) * h * 3, 0);
+  for (size_t i = 0; i < pixels.size(); i += 3) pixels[i] = pixels[i + 1] = pixels[i + 2] = 24;
+  for (int y = 0; y < h; ++y)
+    for (int x = w; x < w + gap; ++x) {
+      size_t o = (static_cast<size_t>(y) * pw + x) * 3;
+      pixels[o] = pixels[o + 1] = pixels[o + 2] = 255;
+    }
+  // Page grid lines in the chart panel, so the artist sees page boundaries.
+  int page = result.stats.pages_x > 0 ? aw / result.stats.pages_x : 120;
+  for (const AtlasTriangle& t : result.triangles) {
+    double x[3], y[3];
+    for (int k = 0; k < 3; ++k) x[k] = t.uv[2 * k] * scale, y[k] = t.uv[2 * k + 1] * scale;
+    int x0 = std::max(0, static_cast<int>(std::floor(std::min({x[0], x[1], x[2]}))));
+    int x1 = std::min(w - 1, static_cast<int>(std::floor(std::max({x[0], x[1], x[2]}))));
+    int y0 = std::max(0, static_cast<int>(std::floor(std::min({y[0], y[1], y[2]}))));
+    int y1 = std::min(h - 1, static_cast<int>(std::floor(std::max({y[0], y[1], y[2]}))));
+    double area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
+    auto cc = chart_colour(t.chart);
+    auto sc = stretch_colour(t.stretch_l2);
+    for (int py = y0; py <= y1; ++py)
+      for (int px = x0; px <= x1; ++px) {
+        double cx = px + 0.5, cy = py + 0.5;
+        bool inside = true;
+        for (int e = 0; e < 3 && inside; ++e) {
+          int a = e, b = (e + 1) % 3;
+          double ef = (x[b] - x[a]) * (cy - y[a]) - (y[b] - y[a]) * (cx - x[a]);
+          inside = area >= 0 ? ef >= 0 : ef <= 0;
+        }
+        // Tiny triangles still show: always paint the pixel holding their first corner.
+        if (!inside && !(px == static_cast<int>(x[0]) && py == static_cast<int>(y[0]))) continue;
+        size_t o = (static_cast<size_t>(py) * pw + px) * 3;
+        std::copy(cc.begin(), cc.end(), pixels.begin() + o);
+        size_t o2 = (static_cast<size_t>(py) * pw + px + w + gap) * 3;
+        std::copy(sc.begin(), sc.end(), pixels.begin() + o2);
+      }
+  }
+  for (int p = page; p < std::max(aw, ah); p += page) {
+    int g = static_cast<int>(p * scale);
+    for (int i = 0; i < std::max(w, h); ++i) {
+      if (g < w && i < h) {
+        size_t o = (static_cast<size_t>(i) * pw + g) * 3;
+        pixels[o] = pixels[o + 1] = pixels[o + 2] = 90;
+      }
+      if (g < h && i < w) {
+        size_t o = (static_cast<size_t>(g) * pw + i) * 3;
+        pixels[o] = pixels[o + 1] = pixels[o + 2] = 90;
+      }
+    }
+  }
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out)
+    return Error(ErrorCode::kIo, path + ": cannot create image writer: " + OIIO::geterror());
+  OIIO::ImageSpec spec(pw, h, 3, OIIO::TypeDesc::UINT8);
+  if (!out->open(path, spec)) return Error(ErrorCode::kIo, path + ": " + out->geterror());
+  if (!out->write_image(OIIO::TypeDesc::UINT8, pixels.data()) || !out->close())
+    return Error(ErrorCode::kIo, path + ": " + out->geterror());
+  return Status::Ok();
+}
+
+}  // namespace vt::unwrap

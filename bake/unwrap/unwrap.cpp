@@ -1,0 +1,912 @@
+// unwrap_scene: surfaces (one per primitive and instance) are welded, segmented into charts,
+// parameterised (parameterize.cpp), checked and split until every chart is a valid injective
+// map, scaled to one texel density, packed (pack.cpp) and written back as a new UV set.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <limits>
+#include <numeric>
+#include <queue>
+#include <thread>
+#include <unordered_map>
+
+#include "bake/unwrap/unwrap.h"
+#include "bake/unwrap/unwrap_internal.h"
+
+namespace vt::unwrap {
+namespace {
+
+using detail::P2;
+using detail::P3;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+P3 sub(const P3& a, const P3& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+P3 cross(const P3& a, const P3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double dot(const P3& a, const P3& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+double norm(const P3& a) {
+  return std::sqrt(dot(a, a));
+}
+double cross2(const P2& a, const P2& b, const P2& c) {
+  return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+// One primitive of one instance (or of one mesh with share_instances), in world space.
+struct Surface {
+  int out_mesh = 0, out_prim = 0;
+  std::vector<P3> pos;         // welded vertices, world space minus `origin`
+  std::vector<uint32_t> weld;  // source vertex -> welded vertex
+  std::vector<uint32_t> tri;   // welded corners, 3 per face
+  std::vector<int32_t> adj;    // per corner e: face across edge (e, e+1), or -1
+  std::vector<P3> normal;      // unit face normals
+  std::vector<double> area;    // face areas
+  std::vector<char> degenerate;
+};
+
+struct Chart {
+  uint32_t surface = 0;
+  std::vector<uint32_t> faces;
+  bool degenerate = false;
+  int round = 0;  // stretch split rounds this chart descends from
+  // Filled by parameterisation:
+  std::vector<uint32_t> corner_local;  // per face corner: local vertex
+  std::vector<P3> local_pos;
+  std::vector<P2> uv;
+  double area3d = 0, area_uv = 0, l2 = 1;
+};
+
+// ---- surfaces -------------------------------------------------------------------------
+
+void weld(const scene::Primitive& p, Surface* s, const scene::Mat4& world) {
+  size_t n = p.positions.size();
+  std::vector<uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  // Vertices weld when position and every UV set match bit for bit: different UVs are an
+  // original seam, which always cuts.
+  auto less = [&](uint32_t a, uint32_t b) {
+    int c = std::memcmp(p.positions[a].data(), p.positions[b].data(), sizeof(scene::Vec3));
+    if (c != 0) return c < 0;
+    for (const auto& set : p.uvs) {
+      c = std::memcmp(set[a].data(), set[b].data(), sizeof(scene::Vec2));
+      if (c != 0) return c < 0;
+    }
+    return a < b;
+  };
+  auto equal = [&](uint32_t a, uint32_t b) {
+    if (std::memcmp(p.positions[a].data(), p.positions[b].data(), sizeof(scene::Vec3)))
+      return false;
+    for (const auto& set : p.uvs)
+      if (std::memcmp(set[a].data(), set[b].data(), sizeof(scene::Vec2))) return false;
+    return true;
+  };
+  std::sort(order.begin(), order.end(), less);
+  s->weld.assign(n, 0);
+  std::vector<uint32_t> rep;
+  for (size_t i = 0; i < n; ++i) {
+    if (i == 0 || !equal(order[i - 1], order[i])) rep.push_back(order[i]);
+    s->weld[order[i]] = static_cast<uint32_t>(rep.size() - 1);
+  }
+  // Renumber welded vertices in source order for determinism independent of sort details.
+  std::vector<uint32_t> first(rep.size(), UINT32_MAX), remap(rep.size());
+  for (size_t i = 0; i < n; ++i) first[s->weld[i]] = std::min<uint32_t>(first[s->weld[i]], i);
+  std::vector<uint32_t> ids(rep.size());
+  std::iota(ids.begin(), ids.end(), 0u);
+  std::sort(ids.begin(), ids.end(), [&](uint32_t a, uint32_t b) { return first[a] < first[b]; });
+  for (size_t k = 0; k < ids.size(); ++k) remap[ids[k]] = static_cast<uint32_t>(k);
+  for (auto& w : s->weld) w = remap[w];
+  std::vector<P3> world_pos(rep.size());
+  for (size_t k = 0; k < rep.size(); ++k)
+    world_pos[remap[k]] = scene::transform_point(world, p.positions[rep[k]]);
+  // Work relative to the surface's bounding-box centre so large offsets cost no precision.
+  P3 lo = {1e300, 1e300, 1e300}, hi = {-1e300, -1e300, -1e300};
+  for (const P3& q : world_pos)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], q[k]), hi[k] = std::max(hi[k], q[k]);
+  P3 centre = {(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2};
+  s->pos.resize(world_pos.size());
+  for (size_t k = 0; k < world_pos.size(); ++k) s->pos[k] = sub(world_pos[k], centre);
+  s->tri.resize(p.indices.size());
+  for (size_t i = 0; i < p.indices.size(); ++i) s->tri[i] = s->weld[p.indices[i]];
+}
+
+void build_topology(Surface* s) {
+  size_t faces = s->tri.size() / 3;
+  s->normal.resize(faces);
+  s->area.resize(faces);
+  s->degenerate.assign(faces, 0);
+  for (size_t f = 0; f < faces; ++f) {
+    const P3& a = s->pos[s->tri[3 * f]];
+    const P3& b = s->pos[s->tri[3 * f + 1]];
+    const P3& c = s->pos[s->tri[3 * f + 2]];
+    P3 n = cross(sub(b, a), sub(c, a));
+    double len = norm(n);
+    double longest =
+        std::max({dot(sub(b, a), sub(b, a)), dot(sub(c, b), sub(c, b)), dot(sub(a, c), sub(a, c))});
+    s->area[f] = len / 2;
+    bool same = s->tri[3 * f] == s->tri[3 * f + 1] || s->tri[3 * f + 1] == s->tri[3 * f + 2] ||
+                s->tri[3 * f] == s->tri[3 * f + 2];
+    if (same || !(len > 1e-10 * longest) || !std::isfinite(len)) {
+      s->degenerate[f] = 1;
+      s->normal[f] = {0, 0, 0};
+    } else {
+      s->normal[f] = {n[0] / len, n[1] / len, n[2] / len};
+    }
+  }
+  // Faces are neighbours across an edge used by exactly two faces in opposite directions
+  // (consistent winding). Non-manifold and inconsistently wound edges cut.
+  struct Edge {
+    uint64_t key;
+    uint32_t corner;
+    bool forward;
+  };
+  std::vector<Edge> edges;
+  edges.reserve(s->tri.size());
+  for (size_t f = 0; f < faces; ++f) {
+    if (s->degenerate[f]) continue;
+    for (int e = 0; e < 3; ++e) {
+      uint32_t a = s->tri[3 * f + e], b = s->tri[3 * f + (e + 1) % 3];
+      uint64_t key = (static_cast<uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+      edges.push_back({key, static_cast<uint32_t>(3 * f + e), a < b});
+    }
+  }
+  std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) {
+    return x.key != y.key ? x.key < y.key : x.corner < y.corner;
+  });
+  s->adj.assign(s->tri.size(), -1);
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    while (j < edges.size() && edges[j].key == edges[i].key) ++j;
+    if (j - i == 2 && edges[i].forward != edges[i + 1].forward) {
+      s->adj[edges[i].corner] = static_cast<int32_t>(edges[i + 1].corner / 3);
+      s->adj[edges[i + 1].corner] = static_cast<int32_t>(edges[i].corner / 3);
+    }
+    i = j;
+  }
+}
+
+// ---- segmentation ---------------------------------------------------------------------
+
+void segment(const Surface& s, uint32_t surface_index, double max_angle_deg,
+             std::vector<Chart>* charts) {
+  size_t faces = s.tri.size() / 3;
+  const double cos_max = std::cos(max_angle_deg * M_PI / 180.0);
+  std::vector<int32_t> chart_of(faces, -1);
+  std::vector<P3> centroid(faces);
+  for (size_t f = 0; f < faces; ++f) {
+    const P3& a = s.pos[s.tri[3 * f]];
+    const P3& b = s.pos[s.tri[3 * f + 1]];
+    const P3& c = s.pos[s.tri[3 * f + 2]];
+    centroid[f] = {(a[0] + b[0] + c[0]) / 3, (a[1] + b[1] + c[1]) / 3, (a[2] + b[2] + c[2]) / 3};
+  }
+  using Item = std::pair<double, uint32_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
+  for (size_t seed = 0; seed < faces; ++seed) {
+    if (chart_of[seed] >= 0) continue;
+    Chart chart;
+    chart.surface = surface_index;
+    int32_t id = static_cast<int32_t>(charts->size());
+    chart_of[seed] = id;
+    chart.faces.push_back(static_cast<uint32_t>(seed));
+    if (s.degenerate[seed]) {
+      chart.degenerate = true;
+      charts->push_back(std::move(chart));
+      continue;
+    }
+    P3 nsum = {s.normal[seed][0] * s.area[seed], s.normal[seed][1] * s.area[seed],
+               s.normal[seed][2] * s.area[seed]};
+    double area = s.area[seed];
+    P3 seed_c = centroid[seed];
+    auto push_neighbours = [&](uint32_t f) {
+      P3 n = nsum;
+      double len = norm(n);
+      if (len > 0) n = {n[0] / len, n[1] / len, n[2] / len};
+      double radius = std::sqrt(area / M_PI) + 1e-300;
+      for (int e = 0; e < 3; ++e) {
+        int32_t g = s.adj[3 * f + e];
+        if (g < 0 || chart_of[g] >= 0) continue;
+        double cost = (1.0 - dot(s.normal[g], n)) + 0.05 * norm(sub(centroid[g], seed_c)) / radius;
+        heap.push({cost, static_cast<uint32_t>(g)});
+      }
+    };
+    push_neighbours(static_cast<uint32_t>(seed));
+    while (!heap.empty()) {
+      uint32_t f = heap.top().second;
+      heap.pop();
+      if (chart_of[f] >= 0) continue;
+      P3 n = nsum;
+      double len = norm(n);
+      if (len > 0) n = {n[0] / len, n[1] / len, n[2] / len};
+      if (dot(s.normal[f], n) < cos_max || dot(s.normal[f], s.normal[seed]) < cos_max) continue;
+      chart_of[f] = id;
+      chart.faces.push_back(f);
+      for (int k = 0; k < 3; ++k) nsum[k] += s.normal[f][k] * s.area[f];
+      area += s.area[f];
+      push_neighbours(f);
+    }
+    charts->push_back(std::move(chart));
+  }
+}
+
+// Splits a chart into two connected halves grown from two far-apart faces.
+std::pair<Chart, Chart> split_chart(const Surface& s, const Chart& chart) {
+  std::vector<uint32_t> local(chart.faces.size());
+  std::vector<int32_t> index_of;  // face -> position in chart, via sorted lookup
+  std::vector<std::pair<uint32_t, uint32_t>> sorted(chart.faces.size());
+  for (size_t i = 0; i < chart.faces.size(); ++i)
+    sorted[i] = {chart.faces[i], static_cast<uint32_t>(i)};
+  std::sort(sorted.begin(), sorted.end());
+  auto find = [&](int32_t f) -> int32_t {
+    auto it = std::lower_bound(sorted.begin(), sorted.end(),
+                               std::make_pair(static_cast<uint32_t>(f), 0u));
+    return (it != sorted.end() && it->first == static_cast<uint32_t>(f))
+               ? static_cast<int32_t>(it->second)
+               : -1;
+  };
+  size_t n = chart.faces.size();
+  std::vector<std::array<int32_t, 3>> nb(n);
+  for (size_t i = 0; i < n; ++i)
+    for (int e = 0; e < 3; ++e) {
+      int32_t g = s.adj[3 * chart.faces[i] + e];
+      nb[i][e] = g < 0 ? -1 : find(g);
+    }
+  auto bfs = [&](std::vector<uint32_t> sources, std::vector<int32_t>* label) {
+    std::vector<uint32_t> queue = sources;
+    label->assign(n, -1);
+    for (size_t k = 0; k < sources.size(); ++k) (*label)[sources[k]] = static_cast<int32_t>(k);
+    uint32_t last = sources.back();
+    for (size_t head = 0; head < queue.size(); ++head) {
+      uint32_t i = queue[head];
+      last = i;
+      for (int32_t j : nb[i])
+        if (j >= 0 && (*label)[j] < 0) {
+          (*label)[j] = (*label)[i];
+          queue.push_back(static_cast<uint32_t>(j));
+        }
+    }
+    return last;
+  };
+  std::vector<int32_t> label;
+  uint32_t a = bfs({0}, &label);
+  uint32_t b = bfs({a}, &label);
+  if (a == b) b = (a + 1) % n;
+  bfs({a, b}, &label);
+  std::pair<Chart, Chart> halves;
+  halves.first.surface = halves.second.surface = chart.surface;
+  halves.first.round = halves.second.round = chart.round;
+  for (size_t i = 0; i < n; ++i) {
+    // Faces the BFS did not reach (cannot happen for a connected chart) go to the first half.
+    (label[i] == 1 ? halves.second : halves.first).faces.push_back(chart.faces[i]);
+  }
+  if (halves.second.faces.empty()) {  // keep both halves non-empty
+    halves.second.faces.push_back(halves.first.faces.back());
+    halves.first.faces.pop_back();
+  }
+  return halves;
+}
+
+// ---- parameterisation and checks --------------------------------------------------------
+
+enum class ChartVerdict { kOk, kSplit, kStretch };
+
+// Local vertices: corners joined across the chart's internal edges (non-manifold vertices
+// thereby split into one vertex per fan).
+void build_local(const Surface& s, Chart* c) {
+  size_t n = c->faces.size();
+  std::vector<std::pair<uint32_t, uint32_t>> sorted(n);
+  for (size_t i = 0; i < n; ++i) sorted[i] = {c->faces[i], static_cast<uint32_t>(i)};
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<uint32_t> parent(3 * n);
+  std::iota(parent.begin(), parent.end(), 0u);
+  std::function<uint32_t(uint32_t)> root = [&](uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  auto unite = [&](uint32_t x, uint32_t y) {
+    x = root(x), y = root(y);
+    if (x != y) parent[std::max(x, y)] = std::min(x, y);
+  };
+  for (size_t i = 0; i < n; ++i) {
+    uint32_t f = c->faces[i];
+    for (int e = 0; e < 3; ++e) {
+      int32_t g = s.adj[3 * f + e];
+      if (g < 0) continue;
+      auto it = std::lower_bound(sorted.begin(), sorted.end(),
+                                 std::make_pair(static_cast<uint32_t>(g), 0u));
+      if (it == sorted.end() || it->first != static_cast<uint32_t>(g)) continue;
+      uint32_t j = it->second;
+      uint32_t a = s.tri[3 * f + e], b = s.tri[3 * f + (e + 1) % 3];
+      for (int k = 0; k < 3; ++k) {
+        uint32_t v = s.tri[3 * g + k];
+        if (v == a) unite(3 * i + e, 3 * j + k);
+        if (v == b) unite(3 * i + (e + 1) % 3, 3 * j + k);
+      }
+    }
+  }
+  c->corner_local.assign(3 * n, 0);
+  c->local_pos.clear();
+  std::vector<uint32_t> id(3 * n, UINT32_MAX);
+  for (size_t k = 0; k < 3 * n; ++k) {
+    uint32_t r = root(static_cast<uint32_t>(k));
+    if (id[r] == UINT32_MAX) {
+      id[r] = static_cast<uint32_t>(c->local_pos.size());
+      c->local_pos.push_back(s.pos[s.tri[3 * c->faces[k / 3] + k % 3]]);
+    }
+    c->corner_local[k] = id[r];
+  }
+}
+
+bool segments_cross(const P2& a, const P2& b, const P2& c, const P2& d) {
+  double o1 = cross2(a, b, c), o2 = cross2(a, b, d), o3 = cross2(c, d, a), o4 = cross2(c, d, b);
+  if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0)))
+    return true;
+  auto on = [](const P2& p, const P2& q, const P2& r, double o) {  // r on segment pq
+    return o == 0 && std::min(p[0], q[0]) <= r[0] && r[0] <= std::max(p[0], q[0]) &&
+           std::min(p[1], q[1]) <= r[1] && r[1] <= std::max(p[1], q[1]);
+  };
+  return on(a, b, c, o1) || on(a, b, d, o2) || on(c, d, a, o3) || on(c, d, b, o4);
+}
+
+// True when the chart's boundary crosses itself (the only way a flip-free disk map overlaps).
+bool boundary_self_intersects(const Chart& c) {
+  std::vector<std::pair<uint64_t, uint32_t>> directed;
+  size_t n = c.faces.size();
+  for (size_t i = 0; i < n; ++i)
+    for (int e = 0; e < 3; ++e)
+      directed.push_back({(static_cast<uint64_t>(c.corner_local[3 * i + e]) << 32) |
+                              c.corner_local[3 * i + (e + 1) % 3],
+                          0});
+  std::sort(directed.begin(), directed.end());
+  std::vector<std::array<uint32_t, 2>> seg;
+  for (const auto& d : directed) {
+    uint32_t a = static_cast<uint32_t>(d.first >> 32), b = static_cast<uint32_t>(d.first);
+    uint64_t rev = (static_cast<uint64_t>(b) << 32) | a;
+    if (!std::binary_search(directed.begin(), directed.end(), std::make_pair(rev, 0u)))
+      seg.push_back({a, b});
+  }
+  if (seg.size() < 3) return false;
+  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  for (const P2& p : c.uv)
+    for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  int g = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(seg.size()))));
+  double cw = std::max(hi[0] - lo[0], 1e-300) / g, ch = std::max(hi[1] - lo[1], 1e-300) / g;
+  std::vector<std::vector<uint32_t>> cells(static_cast<size_t>(g) * g);
+  auto cell = [&](double v, double l, double w) {
+    return std::clamp(static_cast<int>((v - l) / w), 0, g - 1);
+  };
+  for (size_t k = 0; k < seg.size(); ++k) {
+    const P2& a = c.uv[seg[k][0]];
+    const P2& b = c.uv[seg[k][1]];
+    int x0 = cell(std::min(a[0], b[0]), lo[0], cw), x1 = cell(std::max(a[0], b[0]), lo[0], cw);
+    int y0 = cell(std::min(a[1], b[1]), lo[1], ch), y1 = cell(std::max(a[1], b[1]), lo[1], ch);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x)
+        cells[static_cast<size_t>(y) * g + x].push_back(static_cast<uint32_t>(k));
+  }
+  for (const auto& list : cells)
+    for (size_t i = 0; i < list.size(); ++i)
+      for (size_t j = i + 1; j < list.size(); ++j) {
+        const auto& s1 = seg[list[i]];
+        const auto& s2 = seg[list[j]];
+        if (s1[0] == s2[0] || s1[0] == s2[1] || s1[1] == s2[0] || s1[1] == s2[1]) continue;
+        if (segments_cross(c.uv[s1[0]], c.uv[s1[1]], c.uv[s2[0]], c.uv[s2[1]])) return true;
+      }
+  return false;
+}
+
+// Sander et al. stretch of one triangle: returns {L2^2, Linf} for 3D q and 2D p.
+std::pair<double, double> triangle_stretch(const P3& q1, const P3& q2, const P3& q3, const P2& p1,
+                                           const P2& p2, const P2& p3) {
+  double a2 = cross2(p1, p2, p3);  // twice the signed UV area
+  if (!(std::abs(a2) > 0))
+    return {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  P3 ss, st;
+  for (int k = 0; k < 3; ++k) {
+    ss[k] = (q1[k] * (p2[1] - p3[1]) + q2[k] * (p3[1] - p1[1]) + q3[k] * (p1[1] - p2[1])) / a2;
+    st[k] = (q1[k] * (p3[0] - p2[0]) + q2[k] * (p1[0] - p3[0]) + q3[k] * (p2[0] - p1[0])) / a2;
+  }
+  double a = dot(ss, ss), b = dot(ss, st), c = dot(st, st);
+  double root = std::sqrt((a - c) * (a - c) + 4 * b * b);
+  return {(a + c) / 2, std::sqrt(std::max(0.0, (a + c + root) / 2))};
+}
+
+ChartVerdict parameterize(const Surface& s, Chart* c, const UnwrapOptions& opt) {
+  build_local(s, c);
+  size_t n = c->faces.size();
+  c->area3d = 0;
+  for (uint32_t f : c->faces) c->area3d += s.area[f];
+  if (c->degenerate) {
+    // Zero-area face: a tiny triangle of its own, so it still owns (part of) a texel.
+    c->uv.assign(c->local_pos.size(), {0, 0});
+    c->uv[c->corner_local[1]] = {1, 0};
+    c->uv[c->corner_local[2]] = {0, 1};
+    c->area_uv = 0.5;
+    c->l2 = 1;
+    return ChartVerdict::kOk;
+  }
+  if (n == 1) {
+    // One face: an exact isometric placement, longest edge first for accuracy.
+    const P3* q[3] = {&c->local_pos[c->corner_local[0]], &c->local_pos[c->corner_local[1]],
+                      &c->local_pos[c->corner_local[2]]};
+    int e = 0;
+    double best = -1;
+    for (int k = 0; k < 3; ++k) {
+      double l = norm(sub(*q[(k + 1) % 3], *q[k]));
+      if (l > best) best = l, e = k;
+    }
+    P3 ab = sub(*q[(e + 1) % 3], *q[e]), ac = sub(*q[(e + 2) % 3], *q[e]);
+    double len = norm(ab);
+    double x = dot(ac, ab) / len, y = norm(cross(ab, ac)) / len;
+    c->uv.assign(3, {0, 0});
+    c->uv[c->corner_local[e]] = {0, 0};
+    c->uv[c->corner_local[(e + 1) % 3]] = {len, 0};
+    c->uv[c->corner_local[(e + 2) % 3]] = {x, y};
+  } else {
+    // Normalise the chart to unit size for the solver; scale back afterwards.
+    P3 lo = {1e300, 1e300, 1e300}, hi = {-1e300, -1e300, -1e300};
+    for (const P3& p : c->local_pos)
+      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+    double scale = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+    if (!(scale > 0)) return ChartVerdict::kSplit;
+    std::vector<P3> unit(c->local_pos.size());
+    for (size_t v = 0; v < unit.size(); ++v)
+      for (int k = 0; k < 3; ++k) unit[v][k] = (c->local_pos[v][k] - lo[k]) / scale;
+    std::vector<std::array<uint32_t, 3>> faces(n);
+    for (size_t i = 0; i < n; ++i)
+      faces[i] = {c->corner_local[3 * i], c->corner_local[3 * i + 1], c->corner_local[3 * i + 2]};
+    auto status = detail::parameterize_chart(unit, faces, opt.method, &c->uv);
+    if (status != detail::ParamStatus::kOk) return ChartVerdict::kSplit;
+    for (P2& p : c->uv) {
+      if (!std::isfinite(p[0]) || !std::isfinite(p[1])) return ChartVerdict::kSplit;
+      p[0] *= scale, p[1] *= scale;
+    }
+  }
+  // Orientation: the chart's total signed area is made positive (never mirrored later), and
+  // then every face must be positive too.
+  double total = 0;
+  for (size_t i = 0; i < n; ++i)
+    total += cross2(c->uv[c->corner_local[3 * i]], c->uv[c->corner_local[3 * i + 1]],
+                    c->uv[c->corner_local[3 * i + 2]]);
+  if (total < 0)
+    for (P2& p : c->uv) p[0] = -p[0];
+  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  for (const P2& p : c->uv)
+    for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  double extent2 = std::max(hi[0] - lo[0], hi[1] - lo[1]);
+  extent2 *= extent2;
+  c->area_uv = 0;
+  double l2sum = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const P2& a = c->uv[c->corner_local[3 * i]];
+    const P2& b = c->uv[c->corner_local[3 * i + 1]];
+    const P2& d = c->uv[c->corner_local[3 * i + 2]];
+    double a2 = cross2(a, b, d);
+    // Strictly positive with margin: the map must survive rounding to float atlas UVs.
+    if (!(a2 > 1e-12 * extent2)) return n > 1 ? ChartVerdict::kSplit : ChartVerdict::kOk;
+    c->area_uv += a2 / 2;
+    auto [l2sq, linf] = triangle_stretch(c->local_pos[c->corner_local[3 * i]],
+                                         c->local_pos[c->corner_local[3 * i + 1]],
+                                         c->local_pos[c->corner_local[3 * i + 2]], a, b, d);
+    (void)linf;
+    l2sum += l2sq * s.area[c->faces[i]];
+  }
+  if (n > 1 && boundary_self_intersects(*c)) return ChartVerdict::kSplit;
+  c->l2 = c->area3d > 0 ? std::sqrt(l2sum / c->area3d) * std::sqrt(c->area_uv / c->area3d) : 1.0;
+  if (!std::isfinite(c->l2)) return ChartVerdict::kSplit;
+  if (n > 1 && c->l2 > opt.max_chart_stretch) return ChartVerdict::kStretch;
+  return ChartVerdict::kOk;
+}
+
+template <typename Fn>
+void parallel_for(size_t count, int threads, Fn fn) {
+  std::atomic<size_t> next{0};
+  auto work = [&] {
+    for (size_t i; (i = next.fetch_add(1)) < count;) fn(i);
+  };
+  std::vector<std::thread> pool;
+  int n = std::max(1, std::min<int>(threads, static_cast<int>(count)));
+  for (int t = 1; t < n; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+}
+
+// ---- scaling and rotation ---------------------------------------------------------------
+
+// Rotates chart-local points to the smallest-area bounding box (hull edge directions), then
+// moves the box's corner to the origin.
+void fit_box(detail::PackChart* pc) {
+  std::vector<P2> pts = pc->points;
+  std::sort(pts.begin(), pts.end());
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  std::vector<P2> hull;
+  if (pts.size() >= 3) {
+    std::vector<P2> h(2 * pts.size());
+    size_t k = 0;
+    for (size_t i = 0; i < pts.size(); ++i) {
+      while (k >= 2 && cross2(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
+      h[k++] = pts[i];
+    }
+    for (size_t i = pts.size() - 1, t = k + 1; i > 0; --i) {
+      while (k >= t && cross2(h[k - 2], h[k - 1], pts[i - 1]) <= 0) --k;
+      h[k++] = pts[i - 1];
+    }
+    h.resize(k - 1);
+    hull = h;
+  } else {
+    hull = pts;
+  }
+  double best_area = std::numeric_limits<double>::infinity(), best_c = 1, best_s = 0;
+  for (size_t i = 0; i < hull.size(); ++i) {
+    const P2& a = hull[i];
+    const P2& b = hull[(i + 1) % hull.size()];
+    double dx = b[0] - a[0], dy = b[1] - a[1], len = std::hypot(dx, dy);
+    if (!(len > 0)) continue;
+    double cs = dx / len, sn = dy / len;
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    for (const P2& p : hull) {
+      double x = p[0] * cs + p[1] * sn, y = -p[0] * sn + p[1] * cs;
+      lo[0] = std::min(lo[0], x), hi[0] = std::max(hi[0], x), lo[1] = std::min(lo[1], y),
+      hi[1] = std::max(hi[1], y);
+    }
+    double area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
+    if (area < best_area * (1 - 1e-9)) best_area = area, best_c = cs, best_s = sn;
+  }
+  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  for (P2& p : pc->points) {
+    p = {p[0] * best_c + p[1] * best_s, -p[0] * best_s + p[1] * best_c};
+    lo[0] = std::min(lo[0], p[0]), hi[0] = std::max(hi[0], p[0]), lo[1] = std::min(lo[1], p[1]),
+    hi[1] = std::max(hi[1], p[1]);
+  }
+  for (P2& p : pc->points) p = {p[0] - lo[0], p[1] - lo[1]};
+  pc->width = hi[0] - lo[0];
+  pc->height = hi[1] - lo[1];
+}
+
+}  // namespace
+
+Expected<UnwrapResult> unwrap_scene(const scene::Scene& in, const UnwrapOptions& opt) {
+  if (opt.padding < 0 || opt.padding > 1024)
+    return Error(ErrorCode::kInvalidArgument, "padding must be in [0, 1024]");
+  if (opt.page_payload <= 0)
+    return Error(ErrorCode::kInvalidArgument, "page payload must be positive");
+  if (!(opt.texels_per_unit >= 0) || !std::isfinite(opt.texels_per_unit))
+    return Error(ErrorCode::kInvalidArgument, "texels per unit must be a finite positive number");
+  if (opt.texels_per_unit == 0 && opt.size_pages <= 0)
+    return Error(ErrorCode::kInvalidArgument, "give texels per unit or a positive size in pages");
+  VT_RETURN_IF_ERROR(scene::validate_geometry(in));
+  int threads = opt.threads > 0 ? opt.threads : std::max(1u, std::thread::hardware_concurrency());
+
+  UnwrapResult result;
+  UnwrapStats& st = result.stats;
+  scene::Scene& out = result.scene;
+  out = in;
+  auto t0 = Clock::now();
+
+  // Which meshes to unwrap, with which world matrix.
+  std::vector<std::pair<int, scene::Mat4>> jobs;  // output mesh -> (source mesh, world)
+  std::vector<scene::Instance> instances = in.instances();
+  if (opt.share_instances) {
+    for (size_t m = 0; m < in.meshes.size(); ++m) {
+      scene::Mat4 world = scene::kIdentity;
+      for (const auto& inst : instances)
+        if (inst.mesh == static_cast<int>(m)) {
+          world = inst.world;
+          break;
+        }
+      jobs.push_back({static_cast<int>(m), world});
+    }
+  } else {
+    out.meshes.clear();
+    for (auto& node : out.nodes) node.mesh = -1;  // nodes outside the scene keep no mesh
+    for (const auto& inst : instances) {
+      out.nodes[inst.node].mesh = static_cast<int>(out.meshes.size());
+      out.meshes.push_back(in.meshes[inst.mesh]);
+      jobs.push_back({inst.mesh, inst.world});
+    }
+  }
+  std::vector<Surface> surfaces;
+  for (size_t j = 0; j < jobs.size(); ++j) {
+    const scene::Mesh& mesh = in.meshes[jobs[j].first];
+    for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+      if (mesh.primitives[p].indices.empty()) continue;
+      Surface s;
+      s.out_mesh = static_cast<int>(j);
+      s.out_prim = static_cast<int>(p);
+      surfaces.push_back(std::move(s));
+    }
+  }
+  for (const auto& s : surfaces) {
+    // World matrices can still overflow a finite mesh into inf: name the instance.
+    const auto& world = jobs[s.out_mesh].second;
+    for (double v : world)
+      if (!std::isfinite(v))
+        return Error(
+            ErrorCode::kInvalidArgument,
+            "mesh '" + in.meshes[jobs[s.out_mesh].first].name + "': non-finite node transform");
+  }
+  parallel_for(surfaces.size(), threads, [&](size_t i) {
+    Surface& s = surfaces[i];
+    weld(in.meshes[jobs[s.out_mesh].first].primitives[s.out_prim], &s, jobs[s.out_mesh].second);
+    build_topology(&s);
+  });
+  for (const auto& s : surfaces)
+    for (const P3& p : s.pos)
+      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+        return Error(ErrorCode::kInvalidArgument, "mesh '" +
+                                                      in.meshes[jobs[s.out_mesh].first].name +
+                                                      "': world position overflows double");
+  std::vector<Chart> charts;
+  {
+    std::vector<std::vector<Chart>> per(surfaces.size());
+    parallel_for(surfaces.size(), threads, [&](size_t i) {
+      segment(surfaces[i], static_cast<uint32_t>(i), opt.max_chart_angle_deg, &per[i]);
+    });
+    for (auto& v : per)
+      for (auto& c : v) charts.push_back(std::move(c));
+  }
+  for (const auto& s : surfaces) {
+    st.faces += static_cast<int64_t>(s.tri.size() / 3);
+    for (char d : s.degenerate) st.degenerate_faces += d;
+  }
+  if (st.faces == 0) return Error(ErrorCode::kInvalidArgument, "scene has no triangles to unwrap");
+  st.seconds.segment = seconds_since(t0);
+
+  // Parameterise; charts that fail are split and redone until every chart is valid. A
+  // one-face chart always succeeds, so this terminates.
+  t0 = Clock::now();
+  std::vector<Chart> done;
+  std::vector<Chart> pending = std::move(charts);
+  while (!pending.empty()) {
+    std::vector<ChartVerdict> verdict(pending.size());
+    parallel_for(pending.size(), threads, [&](size_t i) {
+      verdict[i] = parameterize(surfaces[pending[i].surface], &pending[i], opt);
+    });
+    std::vector<Chart> next;
+    bool stretch_round = false;
+    for (size_t i = 0; i < pending.size(); ++i) {
+      Chart& c = pending[i];
+      bool split = verdict[i] == ChartVerdict::kSplit ||
+                   (verdict[i] == ChartVerdict::kStretch && c.round < opt.max_split_rounds);
+      if (!split) {
+        done.push_back(std::move(c));
+        continue;
+      }
+      if (verdict[i] == ChartVerdict::kStretch) {
+        stretch_round = true;
+        ++c.round;
+      }
+      ++st.charts_split;
+      auto halves = split_chart(surfaces[c.surface], c);
+      next.push_back(std::move(halves.first));
+      next.push_back(std::move(halves.second));
+    }
+    st.split_rounds += stretch_round;
+    pending = std::move(next);
+  }
+  // Deterministic chart order: by surface, then by first face.
+  std::stable_sort(done.begin(), done.end(), [](const Chart& a, const Chart& b) {
+    return a.surface != b.surface ? a.surface < b.surface : a.faces[0] < b.faces[0];
+  });
+  charts = std::move(done);
+  st.charts = static_cast<int64_t>(charts.size());
+  st.seconds.parameterize = seconds_since(t0);
+
+  // Scale to the texel density, fit boxes, pack. With a target size the density is searched
+  // so that the packed atlas fits size_pages × size_pages pages.
+  t0 = Clock::now();
+  double area3d = 0;
+  for (const auto& c : charts) area3d += c.area3d;
+  const int page = opt.page_payload;
+  auto make_pack_charts = [&](double tpu) {
+    std::vector<detail::PackChart> pcs(charts.size());
+    parallel_for(charts.size(), threads, [&](size_t i) {
+      const Chart& c = charts[i];
+      double k = (c.degenerate || !(c.area3d > 0) || !(c.area_uv > 0))
+                     ? (c.degenerate ? 0.5 : tpu)
+                     : std::sqrt(c.area3d / c.area_uv) * tpu;
+      if (!std::isfinite(k)) k = 0.5;
+      detail::PackChart& pc = pcs[i];
+      pc.points.resize(c.uv.size());
+      for (size_t v = 0; v < c.uv.size(); ++v) pc.points[v] = {c.uv[v][0] * k, c.uv[v][1] * k};
+      for (size_t f = 0; f < c.faces.size(); ++f)
+        pc.tris.push_back(
+            {c.corner_local[3 * f], c.corner_local[3 * f + 1], c.corner_local[3 * f + 2]});
+      fit_box(&pc);
+    });
+    return pcs;
+  };
+  auto choose_width = [&](const std::vector<detail::PackChart>& pcs) {
+    double box = 0, need = 1;
+    for (const auto& pc : pcs) {
+      box += (std::ceil(pc.width) + opt.padding) * (std::ceil(pc.height) + opt.padding);
+      need = std::max(need, std::ceil(std::min(pc.width, pc.height)) + 1);
+    }
+    double side = std::max(need, std::sqrt(box));
+    return static_cast<int>(std::ceil(side / page) * page);
+  };
+  double tpu = opt.texels_per_unit;
+  std::vector<detail::PackChart> pcs;
+  detail::PackResult packed;
+  int width = 0;
+  if (tpu > 0) {
+    pcs = make_pack_charts(tpu);
+    width = choose_width(pcs);
+    if (static_cast<int64_t>(width) * width > opt.max_atlas_texels)
+      return Error(ErrorCode::kResourceLimit, "atlas of " + std::to_string(width) +
+                                                  " texels wide at " + std::to_string(tpu) +
+                                                  " texels per unit exceeds the atlas limit");
+    packed = detail::pack_charts(pcs, width, opt.padding, threads);
+  } else {
+    width = opt.size_pages * page;
+    if (static_cast<int64_t>(width) * width > opt.max_atlas_texels)
+      return Error(ErrorCode::kResourceLimit,
+                   "atlas of " + std::to_string(opt.size_pages) + " pages exceeds the atlas limit");
+    // Start from an optimistic fill and search the density (bisection on the scale).
+    double lo = 0, hi = 0;
+    tpu = std::sqrt(0.7 * static_cast<double>(width) * width / std::max(area3d, 1e-300));
+    if (!(area3d > 0)) tpu = 1;
+    bool have_fit = false;
+    std::vector<detail::PackChart> best_pcs;
+    detail::PackResult best_pack;
+    double best_tpu = 0;
+    for (int iter = 0; iter < 10; ++iter) {
+      auto trial = make_pack_charts(tpu);
+      int w = choose_width(trial);
+      bool fits = false;
+      detail::PackResult pr;
+      if (w <= 2 * width) {  // hopeless widths are skipped: their charts cannot fit
+        pr = detail::pack_charts(trial, width, opt.padding, threads);
+        double max_w = 0;
+        for (const auto& pc : trial) max_w = std::max(max_w, std::min(pc.width, pc.height));
+        fits = pr.height <= width && max_w < width;
+      }
+      if (fits) {
+        if (!have_fit || tpu > best_tpu)
+          best_tpu = tpu, best_pcs = trial, best_pack = pr, have_fit = true;
+        lo = tpu;
+      } else {
+        hi = tpu;
+      }
+      double next = hi > 0 ? (lo > 0 ? std::sqrt(lo * hi) : tpu * 0.7) : tpu * 1.3;
+      if (lo > 0 && hi > 0 && hi / lo < 1.02) break;
+      tpu = next;
+    }
+    if (!have_fit)
+      return Error(ErrorCode::kResourceLimit,
+                   "charts do not fit in " + std::to_string(opt.size_pages) + " pages");
+    tpu = best_tpu;
+    pcs = std::move(best_pcs);
+    packed = std::move(best_pack);
+  }
+  st.texels_per_unit = tpu;
+  st.atlas_width = width;
+  st.atlas_height = std::max(page, (packed.height + page - 1) / page * page);
+  if (opt.texels_per_unit == 0) st.atlas_height = width;  // a requested size is a square
+  st.pages_x = st.atlas_width / page;
+  st.pages_y = st.atlas_height / page;
+  st.seconds.pack = seconds_since(t0);
+
+  // Output: every chart-local vertex becomes a vertex per source vertex it came from.
+  t0 = Clock::now();
+  const double W = st.atlas_width, H = st.atlas_height;
+  std::vector<std::vector<uint32_t>> charts_of(surfaces.size());
+  for (size_t c = 0; c < charts.size(); ++c)
+    charts_of[charts[c].surface].push_back(static_cast<uint32_t>(c));
+  result.triangles.resize(0);
+  std::vector<std::vector<AtlasTriangle>> tri_out(surfaces.size());
+  std::vector<double> l2_num(surfaces.size(), 0), a3_sum(surfaces.size(), 0),
+      auv_sum(surfaces.size(), 0), linf(surfaces.size(), 0);
+  parallel_for(surfaces.size(), threads, [&](size_t si) {
+    const Surface& s = surfaces[si];
+    const scene::Primitive& src = in.meshes[jobs[s.out_mesh].first].primitives[s.out_prim];
+    scene::Primitive& dst = out.meshes[s.out_mesh].primitives[s.out_prim];
+    size_t faces = s.tri.size() / 3;
+    std::vector<uint32_t> new_index(s.tri.size());
+    std::vector<scene::Vec2> atlas_uv;
+    std::vector<uint32_t> source_of;
+    std::vector<int32_t> face_chart(faces, -1);
+    for (uint32_t ci : charts_of[si]) {
+      const Chart& c = charts[ci];
+      const auto& pc = pcs[ci];
+      const auto& pl = packed.placements[ci];
+      std::vector<scene::Vec2> local_uv(c.uv.size());
+      for (size_t v = 0; v < c.uv.size(); ++v) {
+        P2 p = detail::place_point(pc, pl, pc.points[v]);
+        local_uv[v] = {static_cast<float>(p[0] / W), static_cast<float>(1.0 - p[1] / H)};
+      }
+      std::unordered_map<uint64_t, uint32_t> made;  // (local vertex, source vertex) -> new
+      for (size_t i = 0; i < c.faces.size(); ++i) {
+        uint32_t f = c.faces[i];
+        face_chart[f] = static_cast<int32_t>(ci);
+        for (int k = 0; k < 3; ++k) {
+          uint32_t local = c.corner_local[3 * i + k];
+          uint32_t source = src.indices[3 * f + k];
+          uint64_t key = (static_cast<uint64_t>(local) << 32) | source;
+          auto [it, inserted] = made.try_emplace(key, static_cast<uint32_t>(source_of.size()));
+          if (inserted) {
+            source_of.push_back(source);
+            atlas_uv.push_back(local_uv[local]);
+          }
+          uint32_t id = it->second;
+          new_index[3 * f + k] = id;
+        }
+      }
+    }
+    // Rebuild the primitive's vertex arrays from source_of.
+    auto gather = [&](const auto& from, auto& to) {
+      if (from.empty()) return;
+      std::remove_reference_t<decltype(to)> v(source_of.size());
+      for (size_t i = 0; i < source_of.size(); ++i) v[i] = from[source_of[i]];
+      to = std::move(v);
+    };
+    gather(src.positions, dst.positions);
+    gather(src.normals, dst.normals);
+    gather(src.tangents, dst.tangents);
+    gather(src.colors, dst.colors);
+    dst.uvs.resize(src.uvs.size());
+    for (size_t n = 0; n < src.uvs.size(); ++n) gather(src.uvs[n], dst.uvs[n]);
+    dst.uvs.push_back(atlas_uv);
+    dst.indices = new_index;
+    // Atlas triangles (from the float UVs actually written) and stretch against world space.
+    auto& tris = tri_out[si];
+    tris.resize(faces);
+    for (size_t f = 0; f < faces; ++f) {
+      AtlasTriangle& t = tris[f];
+      P2 p[3];
+      for (int k = 0; k < 3; ++k) {
+        const auto& uv = atlas_uv[new_index[3 * f + k]];
+        p[k] = {static_cast<double>(uv[0]) * W, static_cast<double>(uv[1]) * H};
+        t.uv[2 * k] = static_cast<float>(p[k][0]);
+        t.uv[2 * k + 1] = static_cast<float>(p[k][1]);
+      }
+      t.chart = face_chart[f];
+      if (s.degenerate[f]) continue;
+      // y down in the atlas: flip y so front faces are positive for the stretch formula.
+      P2 q[3] = {{p[0][0], -p[0][1]}, {p[1][0], -p[1][1]}, {p[2][0], -p[2][1]}};
+      auto [l2sq, li] = triangle_stretch(s.pos[s.tri[3 * f]], s.pos[s.tri[3 * f + 1]],
+                                         s.pos[s.tri[3 * f + 2]], q[0], q[1], q[2]);
+      double a_uv = std::abs(cross2(q[0], q[1], q[2])) / 2;
+      l2_num[si] += l2sq * s.area[f];
+      a3_sum[si] += s.area[f];
+      auv_sum[si] += a_uv;
+      if (std::isfinite(li)) linf[si] = std::max(linf[si], li);
+      t.stretch_l2 = static_cast<float>(std::sqrt(l2sq) * std::sqrt(a_uv / s.area[f]));
+    }
+  });
+  double num = 0, a3 = 0, auv = 0, li = 0;
+  for (size_t si = 0; si < surfaces.size(); ++si) {
+    num += l2_num[si], a3 += a3_sum[si], auv += auv_sum[si], li = std::max(li, linf[si]);
+    for (auto& t : tri_out[si]) result.triangles.push_back(t);
+  }
+  double normalise = a3 > 0 ? std::sqrt(auv / a3) : 1.0;
+  st.stretch_l2 = a3 > 0 ? std::sqrt(num / a3) * normalise : 1.0;
+  st.stretch_linf = li * normalise;
+  for (const auto& t : result.triangles)
+    for (float v : t.uv)
+      if (!std::isfinite(v)) {
+        ++st.unmapped_faces;
+        break;
+      }
+  st.seconds.output = seconds_since(t0);
+
+  t0 = Clock::now();
+  AtlasCheck check = check_atlas(result.triangles, st.atlas_width, st.atlas_height);
+  st.utilisation = check.utilisation;
+  st.flipped_triangles = check.flipped_triangles;
+  st.overlapping_triangles = check.overlapping_triangles;
+  st.overlapping_texels = check.overlapping_texels;
+  st.seconds.check = seconds_since(t0);
+  return result;
+}
+
+}  // namespace vt::unwrap

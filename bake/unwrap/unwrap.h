@@ -1,0 +1,95 @@
+// vtbake's unwrapper: gives every triangle of a scene its own texels in one atlas.
+// Charts are grown on normal deviation (material boundaries and original UV seams always cut),
+// cut to disks, parameterised with CGAL (LSCM or ARAP), checked for flips, self-overlap and
+// stretch (failing charts are split and redone), scaled to one world texel density and packed
+// with rotation and a gutter into an atlas that is a whole number of pages.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bake/scene/scene.h"
+#include "common/status.h"
+
+namespace vt::unwrap {
+
+enum class Method { kLscm, kArap };
+
+struct UnwrapOptions {
+  // World texel density. 0 = derive it so the atlas fits `size_pages` × `size_pages` pages.
+  double texels_per_unit = 0.0;
+  int size_pages = 16;     // target atlas side in pages when texels_per_unit is 0
+  int page_payload = 120;  // the atlas is a whole number of pages of this many texels
+  int padding = 4;         // empty texels kept between any two charts (the gutter)
+  Method method = Method::kLscm;
+  bool share_instances = false;       // false: every instance gets its own texels (megatexture)
+  double max_chart_angle_deg = 50.0;  // a face joins a chart only within this cone of normals
+  double max_chart_stretch = 1.05;    // chart L2 stretch above this is split and redone
+  int max_split_rounds = 4;           // stretch-driven split rounds (disk/flip splits always run)
+  int threads = 0;                    // 0 = hardware concurrency
+  int64_t max_atlas_texels = int64_t{16384} * 16384;  // larger atlases are a resource error
+};
+
+// Time spent per stage, seconds.
+struct StageTimes {
+  double segment = 0, parameterize = 0, pack = 0, check = 0, output = 0;
+};
+
+struct UnwrapStats {
+  int64_t faces = 0;             // triangles unwrapped (instances counted separately)
+  int64_t degenerate_faces = 0;  // zero-area triangles (mapped to a tiny chart of their own)
+  int64_t charts = 0;
+  int split_rounds = 0;      // stretch split-and-redo rounds that found work
+  int64_t charts_split = 0;  // charts split for non-disk topology, flips, overlap or stretch
+  int atlas_width = 0, atlas_height = 0;  // texels
+  int pages_x = 0, pages_y = 0;
+  double texels_per_unit = 0;
+  double utilisation = 0;  // texel centres covered by a triangle / atlas texels
+  double stretch_l2 = 0;   // Sander et al., area weighted, normalised so UV area = 3D area
+  double stretch_linf = 0;
+  int64_t flipped_triangles = 0;      // UV orientation opposite to the chart's (must be 0)
+  int64_t overlapping_triangles = 0;  // triangles sharing a covered texel centre (must be 0)
+  int64_t overlapping_texels = 0;     // texels touched by two charts, conservatively (must be 0)
+  int64_t unmapped_faces = 0;         // faces with non-finite atlas UVs (must be 0)
+  StageTimes seconds;
+};
+
+// One triangle as laid out in the atlas, for pictures and checks.
+struct AtlasTriangle {
+  std::array<float, 6> uv;  // atlas texel coordinates (x right, y down) of its three corners
+  int32_t chart = 0;
+  float stretch_l2 = 1.0f;  // this triangle's Sander L2 stretch (normalised)
+};
+
+struct UnwrapResult {
+  scene::Scene scene;  // the input with a new TEXCOORD_n (n = old UV set count) per primitive
+  UnwrapStats stats;
+  std::vector<AtlasTriangle> triangles;  // every unwrapped triangle
+};
+
+// Unwraps every mesh instance of `scene`. With share_instances false each instance becomes a
+// mesh of its own in the output. Errors: non-finite positions or bad indices (naming the mesh
+// and vertex), an atlas over max_atlas_texels, an invalid option.
+Expected<UnwrapResult> unwrap_scene(const scene::Scene& scene, const UnwrapOptions& options);
+
+// Exact texel-space checks of a laid-out atlas (used by unwrap_scene; exposed for tests):
+// utilisation, overlapping triangles (texel centres covered twice, top-left fill rule on a
+// fixed-point grid) and overlapping texels (texels any part of two charts touches).
+struct AtlasCheck {
+  double utilisation = 0;
+  int64_t covered_texels = 0;
+  int64_t overlapping_triangles = 0;
+  int64_t overlapping_texels = 0;
+  int64_t flipped_triangles = 0;  // clockwise (x right, y down) triangles of nonzero area
+};
+AtlasCheck check_atlas(const std::vector<AtlasTriangle>& triangles, int width, int height);
+
+// The unwrap report as JSON text.
+std::string report_json(const UnwrapStats& stats);
+// A PNG of the atlas: left half charts in distinct colours, right half L2 stretch (blue = 1,
+// red >= 2), background dark. At most max_side pixels per half-side (the atlas is scaled down).
+Status write_atlas_picture(const UnwrapResult& result, const std::string& path,
+                           int max_side = 2048);
+
+}  // namespace vt::unwrap

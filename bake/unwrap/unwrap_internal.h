@@ -1,0 +1,52 @@
+// Internal pieces of vt_unwrap shared between its source files (not installed, not for callers).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "bake/unwrap/unwrap.h"
+
+namespace vt::unwrap::detail {
+
+using P2 = std::array<double, 2>;
+using P3 = std::array<double, 3>;
+
+enum class ParamStatus { kOk, kNotDisk, kFailed };
+
+// Parameterises one chart (a connected manifold face set with local vertices) with CGAL.
+// Returns kNotDisk when the faces do not form one disk, kFailed when the solver fails; on kOk
+// `uv` holds one point per vertex (not yet checked for flips: the caller does that).
+// This is the only function that touches CGAL, so CGAL is compiled once.
+ParamStatus parameterize_chart(const std::vector<P3>& vertices,
+                               const std::vector<std::array<uint32_t, 3>>& faces, Method method,
+                               std::vector<P2>* uv);
+
+// A chart ready to pack: triangles in chart-local texel coordinates (already scaled to the
+// texel density and rotated to a small bounding box), origin at the box's minimum corner.
+struct PackChart {
+  std::vector<P2> points;                     // local texel coordinates
+  std::vector<std::array<uint32_t, 3>> tris;  // into points
+  double width = 0, height = 0;               // bounding box
+};
+
+// Where a chart went: rotation by quarter turns (counter-clockwise in x-right/y-up), then an
+// integer texel offset.
+struct Placement {
+  int rotation = 0;
+  int x = 0, y = 0;
+};
+
+struct PackResult {
+  std::vector<Placement> placements;
+  int width = 0, height = 0;  // used extent in texels (height = top of the skyline)
+};
+
+// Skyline packing of conservative chart footprints, `padding` empty texels between charts,
+// into an atlas `width` texels wide. Deterministic.
+PackResult pack_charts(const std::vector<PackChart>& charts, int width, int padding, int threads);
+
+// Applies a placement to a local point (the inverse of nothing: used to write atlas UVs).
+P2 place_point(const PackChart& chart, const Placement& placement, const P2& p);
+
+}  // namespace vt::unwrap::detail
