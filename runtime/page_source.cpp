@@ -6,6 +6,7 @@
 #include <optional>
 #include <vector>
 
+#include "codec/dct.h"
 #include "runtime/feedback.h"
 
 namespace vt {
@@ -44,9 +45,11 @@ struct LayerPlan {
   RuntimeFormat upload = RuntimeFormat::kRgba8;
   size_t upload_bytes = 0;
   size_t decoded_bytes = 0;
-  uint32_t channels = 4;     // stored channels
-  bool passthrough = false;  // kBcZstd pages whose blocks are already the upload format
-  bool float_copy = false;   // float layers delivered as they are
+  uint32_t channels = 4;              // stored channels
+  bool passthrough = false;           // stored BC blocks are already the upload format
+  bool float_copy = false;            // float layers delivered as they are
+  std::optional<BcFormat> stored_bc;  // the layer's BC format (kBcZstd pages' blocks)
+  std::shared_ptr<DctTables> dct;     // parsed once from the layer's codec tables
 };
 
 class PageFileSource final : public PageSource {
@@ -81,29 +84,47 @@ class PageFileSource final : public PageSource {
     const std::string where = reader_->path() + ": page (" + std::to_string(id.level) + ", " +
                               std::to_string(id.x) + ", " + std::to_string(id.y) + ") layer " +
                               std::to_string(layer);
-    if (plan.passthrough) {
-      auto entry = reader_->entry(id, layer);
-      if (!entry.ok()) return entry.status().with_context(where);
-      if (entry->state == PageState::kStored) {
-        auto stored = reader_->read_stored(id, layer);
-        if (!stored.ok()) return stored.status().with_context(where);
-        const unsigned long long size = ZSTD_getFrameContentSize(stored->data(), stored->size());
-        if (size != out.size())
-          return Error(ErrorCode::kCorrupt, where + ": BC page decompresses to the wrong size");
-        const size_t got = ZSTD_decompress(out.data(), out.size(), stored->data(), stored->size());
-        if (ZSTD_isError(got) || got != out.size())
-          return Error(ErrorCode::kCorrupt, where + ": zstd: " + ZSTD_getErrorName(got));
-        return Status::Ok();
-      }
-      // Constant pages fall through: decoded texels encoded below.
-    }
+    auto entry = reader_->entry(id, layer);
+    if (!entry.ok()) return entry.status().with_context(where);
     std::vector<uint8_t> texels(plan.decoded_bytes);
-    VT_RETURN_IF_ERROR(reader_->read_texels(id, layer, texels).with_context(where));
+    const int ps = int(geometry().page_size());
+    if (entry->state == PageState::kStored &&
+        (entry->codec == PageCodec::kBcZstd || entry->codec == PageCodec::kDct)) {
+      // Decoded here rather than by the reader, so BC blocks can skip a decode/re-encode.
+      auto stored = reader_->read_stored(id, layer);
+      if (!stored.ok()) return stored.status().with_context(where);
+      if (entry->codec == PageCodec::kDct) {
+        if (!plan.dct) return Error(ErrorCode::kCorrupt, where + ": DCT page without tables");
+        VT_RETURN_IF_ERROR(
+            dct_decode_page(*plan.dct, *stored, ps, ps, texels.data()).with_context(where));
+      } else {
+        if (!plan.stored_bc)
+          return Error(ErrorCode::kCorrupt, where + ": BC page in a layer with no BC format");
+        std::vector<uint8_t> local;
+        std::span<uint8_t> blocks = out;
+        if (!plan.passthrough) {
+          local.resize(bc_image_bytes(*plan.stored_bc, ps, ps));
+          blocks = local;
+        }
+        const unsigned long long size = ZSTD_getFrameContentSize(stored->data(), stored->size());
+        if (size != blocks.size())
+          return Error(ErrorCode::kCorrupt, where + ": BC page decompresses to the wrong size");
+        const size_t got =
+            ZSTD_decompress(blocks.data(), blocks.size(), stored->data(), stored->size());
+        if (ZSTD_isError(got) || got != blocks.size())
+          return Error(ErrorCode::kCorrupt, where + ": zstd: " + ZSTD_getErrorName(got));
+        if (plan.passthrough) return Status::Ok();
+        VT_RETURN_IF_ERROR(bc_decode_image(*plan.stored_bc, blocks.data(), ps, ps,
+                                           int(plan.channels), texels.data())
+                               .with_context(where));
+      }
+    } else {
+      VT_RETURN_IF_ERROR(reader_->read_texels(id, layer, texels).with_context(where));
+    }
     if (plan.float_copy) {
       std::memcpy(out.data(), texels.data(), out.size());
       return Status::Ok();
     }
-    const int ps = int(geometry().page_size());
     if (auto bc = bc_format_of(plan.upload)) {
       return bc_encode_image(*bc, options_.bc_quality, texels.data(), ps, ps, int(plan.channels),
                              out.data())
@@ -187,7 +208,15 @@ Expected<std::unique_ptr<PageSource>> make_page_file_source(
     } else if (plan.upload == RuntimeFormat::kRgba16f || plan.upload == RuntimeFormat::kRgba32f) {
       return Error(ErrorCode::kUnsupported, where + ": 8-bit texels with a float runtime format");
     }
-    plan.passthrough = spec.codec == PageCodec::kBcZstd && plan.upload == spec.runtime_format;
+    plan.stored_bc = bc_format_of(spec.runtime_format);
+    plan.passthrough = plan.stored_bc && plan.upload == spec.runtime_format;
+    if (spec.codec == PageCodec::kDct) {
+      if (spec.texel_type != TexelType::kU8)
+        return Error(ErrorCode::kCorrupt, where + ": DCT layer with float texels");
+      auto tables = dct_parse_tables(spec.codec_tables);
+      if (!tables.ok()) return tables.status().with_context(where + ": DCT tables");
+      plan.dct = std::shared_ptr<DctTables>(tables->release(), DctTablesDeleter());
+    }
     plan.upload_bytes = runtime_format_page_bytes(plan.upload, g.page_size());
     if (plan.float_copy && plan.decoded_bytes != plan.upload_bytes)
       return Error(ErrorCode::kCorrupt, where + ": decoded page size does not match its format");
