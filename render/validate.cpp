@@ -1,6 +1,8 @@
 #include "render/validate.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 
 #include "codec/metrics.h"
 
@@ -131,6 +133,30 @@ Expected<ViewMetrics> compare_view(const Rgba8Image& reference, const VirtualFra
     }
   }
   m.pixels = ref_px.size() / 4;
+  {
+    constexpr uint32_t kTile = 16;
+    const uint32_t tx = (test.width + kTile - 1) / kTile, ty = (test.height + kTile - 1) / kTile;
+    std::vector<double> sse(size_t(tx) * ty, 0.0);
+    std::vector<uint32_t> count(size_t(tx) * ty, 0);
+    for (uint32_t y = 0; y < test.height; ++y) {
+      for (uint32_t x = 0; x < test.width; ++x) {
+        size_t i = size_t(y) * test.width + x;
+        const uint8_t* r = &reference.texels[i * 4];
+        const uint8_t* t = &test.texels[i * 4];
+        bool cov = (frame.status[i] & 0x80000000u) != 0;
+        if (!cov && r[0] == t[0] && r[1] == t[1] && r[2] == t[2] && r[3] == t[3]) continue;
+        size_t k = size_t(y / kTile) * tx + x / kTile;
+        for (int c = 0; c < 3; ++c)
+          sse[k] += double(int(r[c]) - int(t[c])) * (int(r[c]) - int(t[c]));
+        count[k]++;
+      }
+    }
+    m.worst_tile_psnr = kPsnrIdentical;
+    for (size_t k = 0; k < sse.size(); ++k) {
+      if (count[k] < 32) continue;
+      m.worst_tile_psnr = std::min(m.worst_tile_psnr, psnr_from_mse(sse[k] / (3.0 * count[k])));
+    }
+  }
   m.coarser_share = covered ? double(coarser) / double(covered) : 0.0;
   if (m.pixels > 0) {
     VT_ASSIGN_OR_RETURN(ImageError e,
@@ -148,6 +174,48 @@ Expected<ViewMetrics> compare_view(const Rgba8Image& reference, const VirtualFra
     m.ssim = 1.0;
   }
   return m;
+}
+
+Thresholds default_thresholds(RuntimeFormat cache_format) {
+  Thresholds t;
+  switch (cache_format) {
+    case RuntimeFormat::kBc1:
+    case RuntimeFormat::kBc3:
+    case RuntimeFormat::kBc4:
+    case RuntimeFormat::kBc5:
+    case RuntimeFormat::kBc7:
+      t.min_psnr = 30.0;
+      t.min_tile_psnr = 30.0;
+      break;
+    default:
+      break;
+  }
+  return t;
+}
+
+std::vector<std::string> check_view(const ViewMetrics& m, const Thresholds& t) {
+  std::vector<std::string> why;
+  char line[160];
+  if (m.unresident_pixels > 0) {
+    std::snprintf(line, sizeof(line), "%llu pixels found no resident page",
+                  (unsigned long long)m.unresident_pixels);
+    why.push_back(line);
+  }
+  if (m.psnr_rgb < t.min_psnr) {
+    std::snprintf(line, sizeof(line), "PSNR %.2f dB below %.2f dB", m.psnr_rgb, t.min_psnr);
+    why.push_back(line);
+  }
+  if (m.worst_tile_psnr < t.min_tile_psnr) {
+    std::snprintf(line, sizeof(line), "worst tile PSNR %.2f dB below %.2f dB", m.worst_tile_psnr,
+                  t.min_tile_psnr);
+    why.push_back(line);
+  }
+  if (m.coarser_share > t.max_coarser_share) {
+    std::snprintf(line, sizeof(line), "%.1f%% of pixels sampled a coarser level than wanted",
+                  100.0 * m.coarser_share);
+    why.push_back(line);
+  }
+  return why;
 }
 
 }  // namespace vt::render
