@@ -1,0 +1,333 @@
+// The build pipeline end to end: non-finite policies, coverage and absent pages, determinism
+// across thread counts, the out-of-core path, codecs, and a file written and read back.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "bake/procedural.h"
+#include "bake_test_util.h"
+#include "format/page_file.h"
+
+namespace vt {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::shared_ptr<ImageSource> procedural(uint32_t w, uint32_t h, uint32_t ch = 3,
+                                        ProceduralPattern p = ProceduralPattern::kAlbedo) {
+  return std::make_shared<ProceduralImageSource>(p, w, h, ch, 11);
+}
+
+std::shared_ptr<ImageSource> memory_image(uint32_t w, uint32_t h, uint32_t ch,
+                                          std::vector<float> texels, bool is_float) {
+  ImageInfo info;
+  info.width = w, info.height = h, info.channels = ch, info.is_float = is_float;
+  info.color_space = is_float ? "linear" : "sRGB";
+  return std::make_shared<MemoryImageSource>(info, std::move(texels));
+}
+
+fs::path temp_dir() {
+  fs::path d =
+      fs::temp_directory_path() / ("vt_bake_tests_" + std::to_string(getpid()) + "_" +
+                                   testing::UnitTest::GetInstance()->current_test_info()->name());
+  fs::create_directories(d);
+  return d;
+}
+
+// An 8-bit level-0 texel of page (0,0,0) at level texel (x, y) (payload 8, border 4).
+uint8_t texel0(const test::BuiltPages& b, const BuildOptions& o, uint32_t x, uint32_t y,
+               uint32_t c) {
+  PageEncoder enc = test::encoder_for(b, 0, o);
+  auto level = test::reassemble_level(b, 0, 0, enc);
+  uint32_t tb = b.desc.layers[0].texel_bytes();
+  return level[(size_t(y) * b.desc.geometry.width + x) * tb + c];
+}
+
+class NonFinite : public testing::Test {
+ protected:
+  BuildOptions options(NonFinitePolicy policy) {
+    const uint32_t w = 20, h = 12;
+    std::vector<float> t(w * h * 3, 0.5f);
+    t[(3 * w + 5) * 3 + 1] = std::numeric_limits<float>::quiet_NaN();
+    t[(3 * w + 7) * 3 + 0] = std::numeric_limits<float>::infinity();
+    t[(10 * w + 2) * 3 + 2] = -1.0f;
+    t[(11 * w + 19) * 3 + 0] = -std::numeric_limits<float>::infinity();
+    BuildOptions o;
+    o.layers.push_back({LayerSemantic::kAlbedo, "", memory_image(w, h, 3, t, true)});
+    o.codec.codec = CodecKind::kRaw;
+    o.payload = 8;
+    o.non_finite = policy;
+    return o;
+  }
+};
+
+TEST_F(NonFinite, BlackReportsAndZeroes) {
+  BuildOptions o = options(NonFinitePolicy::kBlack);
+  auto b = test::build_in_memory(o);
+  ASSERT_TRUE(b);
+  const NonFiniteReport& r = b->summary.layers[0].non_finite;
+  EXPECT_EQ(r.non_finite, 3u);
+  EXPECT_EQ(r.negative, 1u);
+  EXPECT_EQ(r.first_x, 5u);
+  EXPECT_EQ(r.first_y, 3u);
+  EXPECT_EQ(r.first_channel, 1u);
+  auto level = test::as_floats(test::reassemble_level(*b, 0, 0, test::encoder_for(*b, 0, o)));
+  EXPECT_EQ(level[(3 * 20 + 5) * 3 + 1], 0.0f);
+  EXPECT_EQ(level[(3 * 20 + 7) * 3 + 0], 0.0f);
+  EXPECT_EQ(level[(10 * 20 + 2) * 3 + 2], 0.0f);
+  for (uint32_t l = 0; l < b->desc.geometry.level_count(); ++l) {
+    for (float v : test::as_floats(test::reassemble_level(*b, 0, l, test::encoder_for(*b, 0, o)))) {
+      ASSERT_TRUE(std::isfinite(v) && v >= 0);
+    }
+  }
+}
+
+TEST_F(NonFinite, ClampKeepsInfinityAsLargestFloat) {
+  BuildOptions o = options(NonFinitePolicy::kClamp);
+  auto b = test::build_in_memory(o);
+  ASSERT_TRUE(b);
+  auto enc = test::encoder_for(*b, 0, o);
+  auto level = test::as_floats(test::reassemble_level(*b, 0, 0, enc));
+  EXPECT_EQ(level[(3 * 20 + 7) * 3 + 0], std::numeric_limits<float>::max());
+  EXPECT_EQ(level[(3 * 20 + 5) * 3 + 1], 0.0f);
+  EXPECT_EQ(level[(11 * 20 + 19) * 3 + 0], 0.0f);
+  for (uint32_t l = 1; l < b->desc.geometry.level_count(); ++l) {
+    for (float v : test::as_floats(test::reassemble_level(*b, 0, l, enc))) {
+      ASSERT_TRUE(std::isfinite(v));  // float max through a filter never overflows
+    }
+  }
+}
+
+TEST_F(NonFinite, ErrorNamesTheFirstTexel) {
+  BuildOptions o = options(NonFinitePolicy::kError);
+  auto desc = plan_build(o);
+  ASSERT_TRUE(desc.ok());
+  test::MemorySink sink;
+  auto sum = build_pages(o, *desc, sink);
+  ASSERT_FALSE(sum.ok());
+  EXPECT_EQ(sum.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(sum.status().message().find("(5, 3)"), std::string::npos) << sum.status().message();
+  EXPECT_FALSE(parse_non_finite_policy("zero").ok());
+}
+
+TEST(Build, IdenticalForAnyThreadCountAndOutOfCore) {
+  BuildOptions o;
+  o.layers.push_back({LayerSemantic::kAlbedo, "", procedural(203, 150, 4)});
+  o.payload = 24;
+  o.codec.codec = CodecKind::kDct;
+  o.threads = 1;
+  auto one = test::build_in_memory(o);
+  o.threads = 5;
+  auto five = test::build_in_memory(o);
+  o.memory_limit = 1;  // every level past 0 goes to a scratch file
+  o.scratch_dir = fs::temp_directory_path().string();
+  auto ooc = test::build_in_memory(o);
+  ASSERT_TRUE(one && five && ooc);
+  EXPECT_FALSE(one->summary.levels[1].scratch);
+  EXPECT_TRUE(ooc->summary.levels[1].scratch);
+  EXPECT_GT(ooc->summary.scratch_bytes, 0u);
+  EXPECT_EQ(one->sink.pages.size(), one->summary.stored + one->summary.constant);
+  for (const auto* other : {five.get(), ooc.get()}) {
+    ASSERT_EQ(one->sink.pages.size(), other->sink.pages.size());
+    for (const auto& [key, page] : one->sink.pages) {
+      auto it = other->sink.pages.find(key);
+      ASSERT_NE(it, other->sink.pages.end());
+      ASSERT_EQ(page.state, it->second.state);
+      ASSERT_EQ(page.bytes, it->second.bytes);
+    }
+  }
+  EXPECT_EQ(one->desc.layers[0].codec_tables, five->desc.layers[0].codec_tables);
+}
+
+TEST(Build, WrapOutOfCoreMatchesInMemory) {
+  BuildOptions o;
+  o.layers.push_back({LayerSemantic::kAlbedo, "", procedural(77, 131, 3)});
+  o.payload = 8;
+  o.codec.codec = CodecKind::kRaw;
+  o.address = AddressMode::kWrap;
+  o.filter = MipFilter::kLanczos3;
+  auto mem = test::build_in_memory(o);
+  o.memory_limit = 1;
+  o.scratch_dir = fs::temp_directory_path().string();
+  auto ooc = test::build_in_memory(o);
+  ASSERT_TRUE(mem && ooc);
+  for (const auto& [key, page] : mem->sink.pages) {
+    ASSERT_EQ(page.bytes, ooc->sink.pages.at(key).bytes);
+  }
+}
+
+TEST(Build, ConstantPagesFoldedAndCoverageMakesAbsentPages) {
+  const uint32_t w = 64, h = 32;
+  std::vector<float> t(w * h * 3, 0.25f);
+  auto cov = std::make_shared<std::vector<uint8_t>>(w * h, 0);
+  for (uint32_t y = 2; y < 10; ++y) {
+    for (uint32_t x = 3; x < 12; ++x) {
+      (*cov)[y * w + x] = 1;
+      t[(y * w + x) * 3 + 1] = 0.75f;  // the chart is greener than the background
+    }
+  }
+  BuildOptions o;
+  LayerInput in{LayerSemantic::kAlbedo, "", memory_image(w, h, 3, t, false)};
+  in.coverage = cov;
+  o.layers.push_back(in);
+  o.payload = 8;
+  o.codec.codec = CodecKind::kRaw;
+  auto b = test::build_in_memory(o);
+  ASSERT_TRUE(b);
+  const PageGeometry& g = b->desc.geometry;
+  EXPECT_GT(b->summary.absent, 0u);
+  EXPECT_EQ(b->summary.levels[0].stored + b->summary.levels[0].constant,
+            4u);  // pages over x 0-1, y 0-1
+  EXPECT_EQ(b->summary.pages, g.total_pages());
+  // Pull-push: the background colour (green 0.25) never appears in a stored page.
+  auto enc = test::encoder_for(*b, 0, o);
+  for (const auto& [key, page] : b->sink.pages) {
+    PageId id{std::get<1>(key), std::get<3>(key), std::get<2>(key)};
+    auto tex = test::page_texels(*b, 0, id, enc);
+    for (size_t i = 0; i < tex.size(); i += 3) {
+      ASSERT_EQ(tex[i + 1], tex[1]) << "page " << id.level << "," << id.x << "," << id.y;
+    }
+  }
+  // A plain constant image folds to constants only.
+  BuildOptions c;
+  c.layers.push_back({LayerSemantic::kAlbedo, "",
+                      memory_image(w, h, 3, std::vector<float>(w * h * 3, 0.5f), false)});
+  c.payload = 8;
+  auto cb = test::build_in_memory(c);
+  ASSERT_TRUE(cb);
+  EXPECT_EQ(cb->summary.constant, g.total_pages());
+  EXPECT_EQ(cb->summary.stored, 0u);
+}
+
+TEST(Build, CodecsAndLayers) {
+  BuildOptions o;
+  o.layers.push_back({LayerSemantic::kAlbedo, "", procedural(96, 96, 3)});
+  o.layers.push_back(
+      {LayerSemantic::kNormal, "", procedural(96, 96, 3, ProceduralPattern::kNormal)});
+  o.payload = 24;
+  for (CodecKind k : {CodecKind::kDct, CodecKind::kBc}) {
+    o.codec.codec = k;
+    auto b = test::build_in_memory(o);
+    ASSERT_TRUE(b);
+    ASSERT_EQ(b->summary.layers.size(), 2u);
+    EXPECT_EQ(b->desc.layers[0].color_space, ColorSpace::kSrgb);
+    EXPECT_EQ(b->desc.layers[1].channels, 2);
+    EXPECT_EQ(b->desc.layers[1].runtime_format, RuntimeFormat::kBc5);
+    EXPECT_EQ(b->desc.layers[0].runtime_format, RuntimeFormat::kBc1);
+    EXPECT_EQ(b->desc.layers[0].codec, k == CodecKind::kDct ? PageCodec::kDct : PageCodec::kBcZstd);
+    for (const auto& l : b->summary.layers) {
+      EXPECT_GT(l.psnr_db, 25.0) << l.name;
+      EXPECT_LT(l.psnr_db, 80.0) << l.name;  // lossy codecs do lose something
+    }
+  }
+  // Normal layer texels decode to unit-ish vectors with z >= 0.
+  o.codec.codec = CodecKind::kRaw;
+  auto b = test::build_in_memory(o);
+  ASSERT_TRUE(b);
+  auto enc = test::encoder_for(*b, 1, o);
+  for (uint32_t l = 0; l < b->desc.geometry.level_count(); ++l) {
+    auto lvl = test::reassemble_level(*b, 1, l, enc);
+    for (size_t i = 0; i < lvl.size(); i += 2) {
+      double x = lvl[i] / 127.5 - 1, y = lvl[i + 1] / 127.5 - 1;
+      ASSERT_LE(x * x + y * y, 1.0 + 2 * 2.0 / 255);
+    }
+  }
+}
+
+TEST(Build, RejectsBadOptions) {
+  BuildOptions o;
+  EXPECT_FALSE(plan_build(o).ok());
+  o.layers.push_back({LayerSemantic::kAlbedo, "", procedural(16, 16)});
+  o.layers.push_back({LayerSemantic::kOrm, "", procedural(17, 16)});
+  EXPECT_EQ(plan_build(o).status().code(), ErrorCode::kInvalidArgument);
+  o.layers.pop_back();
+  o.payload = 9;  // page size not a multiple of 4
+  EXPECT_FALSE(plan_build(o).ok());
+  o.payload = 8;
+  o.layers[0].color_space = "ProPhoto";
+  EXPECT_EQ(plan_build(o).status().code(), ErrorCode::kNotFound);
+}
+
+TEST(Build, FileWrittenAndReadBack) {
+  fs::path dir = temp_dir();
+  // A PNG and a tiled EXR through OpenImageIO.
+  ProceduralImageSource png_src(ProceduralPattern::kAlbedo, 150, 90, 4, 5);
+  ASSERT_TRUE(write_image_file(png_src, (dir / "in.png").string()).ok());
+  ProceduralImageSource exr_src(ProceduralPattern::kAlbedo, 150, 90, 3, 5);
+  ImageInfo exr_info = exr_src.info();
+  std::vector<float> exr_texels(150 * 90 * 3);
+  ASSERT_TRUE(exr_src.read_rows(0, 90, exr_texels.data()).ok());
+  exr_info.is_float = true;
+  exr_info.color_space = "linear";
+  MemoryImageSource exr_mem(exr_info, exr_texels);
+  ASSERT_TRUE(write_image_file(exr_mem, (dir / "in.exr").string(), 32).ok());
+
+  for (const char* name : {"in.png", "in.exr"}) {
+    auto src = open_image_file((dir / name).string());
+    ASSERT_TRUE(src.ok()) << src.status().message();
+    BuildOptions o;
+    o.layers.push_back(
+        {LayerSemantic::kAlbedo, "", std::shared_ptr<ImageSource>(std::move(src).value())});
+    o.payload = 24;
+    o.codec.codec = CodecKind::kRaw;
+    o.output = (dir / (std::string(name) + ".vtpf")).string();
+    auto sum = build_page_file(o);
+    ASSERT_TRUE(sum.ok()) << sum.status().message();
+    EXPECT_GT(sum->file_bytes, 0u);
+
+    // Same pages as an in-memory build of the same input.
+    auto src2 = open_image_file((dir / name).string());
+    ASSERT_TRUE(src2.ok());
+    o.layers[0].source = std::shared_ptr<ImageSource>(std::move(src2).value());
+    auto mem = test::build_in_memory(o);
+    ASSERT_TRUE(mem);
+    auto reader = PageFileReader::open(o.output);
+    ASSERT_TRUE(reader.ok()) << reader.status().message();
+    ASSERT_TRUE((*reader)->verify().ok());
+    EXPECT_EQ((*reader)->geometry().width, 150u);
+    EXPECT_EQ((*reader)->layers()[0].channels, std::string(name) == "in.png" ? 4 : 3);
+    auto enc = test::encoder_for(*mem, 0, o);
+    std::vector<uint8_t> got((*reader)->decoded_page_bytes(0));
+    const PageGeometry& g = (*reader)->geometry();
+    for (uint32_t l = 0; l < g.level_count(); ++l) {
+      for (uint32_t y = 0; y < g.pages_y(l); ++y) {
+        for (uint32_t x = 0; x < g.pages_x(l); ++x) {
+          PageId id{l, x, y};
+          ASSERT_TRUE((*reader)->read_texels(id, 0, got).ok());
+          ASSERT_EQ(got, test::page_texels(*mem, 0, id, enc)) << name << " " << l;
+        }
+      }
+    }
+    // The PNG is sRGB 8-bit with alpha: a raw build keeps its opaque texels exactly.
+    if (std::string(name) == "in.png") {
+      std::vector<float> src_rows(150 * 90 * 4);
+      ASSERT_TRUE(png_src.read_rows(0, 90, src_rows.data()).ok());
+      auto lvl0 = test::reassemble_level(*mem, 0, 0, enc);
+      size_t exact = 0, opaque = 0;
+      for (size_t i = 0; i < 150 * 90; ++i) {
+        if (src_rows[i * 4 + 3] < 1.0f) continue;
+        ++opaque;
+        bool same = true;
+        for (int c = 0; c < 4; ++c)
+          same &= lvl0[i * 4 + c] == uint8_t(std::lround(src_rows[i * 4 + c] * 255));
+        exact += same;
+      }
+      EXPECT_GT(opaque, 0u);
+      EXPECT_EQ(exact, opaque);
+    }
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Build, MissingFileIsAClearError) {
+  auto src = open_image_file("/nonexistent/dir/missing.exr");
+  ASSERT_FALSE(src.ok());
+  EXPECT_NE(src.status().message().find("missing.exr"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace vt

@@ -1,0 +1,186 @@
+// Filters and pull-push: constant stays constant, a checkerboard averages to its mean, a ramp's
+// energy is preserved, normals stay unit length, uncovered colour never reaches covered texels.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "bake/pyramid.h"
+
+namespace vt {
+namespace {
+
+const MipFilter kFilters[] = {MipFilter::kBox, MipFilter::kKaiser, MipFilter::kLanczos3};
+const AddressMode kModes[] = {AddressMode::kClamp, AddressMode::kWrap};
+
+TEST(Kernel, NormalisedAndSymmetric) {
+  for (MipFilter f : kFilters) {
+    DownsampleKernel k = make_downsample_kernel(f);
+    double sum = 0, even = 0;
+    for (int t = 0; t < k.taps(); ++t) {
+      sum += k.weights[t];
+      if ((k.first + t) % 2 == 0) even += k.weights[t];
+      EXPECT_NEAR(k.weights[t], k.weights[k.taps() - 1 - t], 1e-15) << to_string(f);
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-14);
+    EXPECT_NEAR(even, 0.5, 1e-14);  // every source texel gives half its weight: energy kept
+  }
+  EXPECT_EQ(make_downsample_kernel(MipFilter::kBox).taps(), 2);
+  EXPECT_EQ(make_downsample_kernel(MipFilter::kLanczos3).taps(), 12);
+  EXPECT_FALSE(parse_mip_filter("bicubic").ok());
+  EXPECT_EQ(*parse_mip_filter("kaiser"), MipFilter::kKaiser);
+}
+
+TEST(Filters, ConstantStaysConstantAtEveryLevel) {
+  const float kValues[] = {0.3f, 1.0f, std::numeric_limits<float>::max()};
+  for (MipFilter f : kFilters) {
+    for (AddressMode m : kModes) {
+      for (float v : kValues) {
+        DownsampleKernel k = make_downsample_kernel(f);
+        DownsampleRules rules;
+        rules.address = m;
+        uint32_t w = 37, h = 21;
+        std::vector<float> img(size_t(w) * h * 3, v);
+        while (w > 1 || h > 1) {
+          img = downsample_level(k, rules, img.data(), w, h, 3);
+          w = (w + 1) / 2, h = (h + 1) / 2;
+          for (float t : img) ASSERT_EQ(t, v) << to_string(f) << " " << w << "x" << h;
+        }
+      }
+    }
+  }
+}
+
+TEST(Filters, CheckerboardAveragesToItsMean) {
+  for (MipFilter f : kFilters) {
+    DownsampleKernel k = make_downsample_kernel(f);
+    DownsampleRules rules;
+    rules.address = AddressMode::kWrap;  // no edge: every texel sees the pattern
+    const uint32_t n = 32;
+    std::vector<float> img(n * n);
+    for (uint32_t y = 0; y < n; ++y) {
+      for (uint32_t x = 0; x < n; ++x) img[y * n + x] = ((x + y) & 1) ? 0.9f : 0.1f;
+    }
+    auto half = downsample_level(k, rules, img.data(), n, n, 1);
+    for (float t : half) ASSERT_NEAR(t, 0.5f, 1e-6f) << to_string(f);
+  }
+}
+
+TEST(Filters, LinearRampEnergyPreserved) {
+  for (MipFilter f : kFilters) {
+    DownsampleKernel k = make_downsample_kernel(f);
+    DownsampleRules rules;
+    rules.address = AddressMode::kWrap;
+    const uint32_t w = 64, h = 16;
+    std::vector<float> img(w * h);
+    double sum0 = 0;
+    for (uint32_t y = 0; y < h; ++y) {
+      for (uint32_t x = 0; x < w; ++x) sum0 += img[y * w + x] = 0.25f + 0.5f * x / (w - 1);
+    }
+    auto half = downsample_level(k, rules, img.data(), w, h, 1);
+    double sum1 = 0;
+    for (float t : half) sum1 += t;
+    EXPECT_NEAR(sum1 * 4, sum0, 1e-4) << to_string(f);
+    // Interior texels of a ramp stay on the ramp (the filters are symmetric).
+    uint32_t x = 8;
+    EXPECT_NEAR(half[2 * (w / 2) + x], 0.25 + 0.5 * (2 * x + 0.5) / (w - 1), 1e-5);
+  }
+}
+
+TEST(Filters, HdrExtremesNeverOverflow) {
+  const float big = std::numeric_limits<float>::max();
+  for (MipFilter f : kFilters) {
+    DownsampleKernel k = make_downsample_kernel(f);
+    DownsampleRules rules;
+    std::vector<float> img(16 * 16);
+    for (size_t i = 0; i < img.size(); ++i) img[i] = (i * 7 % 3) ? big : 0.0f;
+    auto half = downsample_level(k, rules, img.data(), 16, 16, 1);
+    for (float t : half) ASSERT_TRUE(std::isfinite(t)) << to_string(f);
+  }
+}
+
+TEST(Filters, NormalsStayUnitLength) {
+  std::mt19937 rng(3);
+  std::normal_distribution<float> nd;
+  const uint32_t w = 40, h = 24;
+  std::vector<float> img(w * h * 3);
+  for (size_t i = 0; i < w * h; ++i) {
+    float x = nd(rng), y = nd(rng), z = std::abs(nd(rng)) + 0.1f;
+    img[i * 3] = x, img[i * 3 + 1] = y, img[i * 3 + 2] = z;
+  }
+  renormalize_normals(img.data(), w * h, 3);
+  img[5 * 3] = -img[4 * 3], img[5 * 3 + 1] = -img[4 * 3 + 1], img[5 * 3 + 2] = -img[4 * 3 + 2];
+  for (MipFilter f : kFilters) {
+    DownsampleKernel k = make_downsample_kernel(f);
+    DownsampleRules rules;
+    rules.renormalize_xyz = true;
+    for (int c = 0; c < 3; ++c) rules.min_value[c] = -1, rules.max_value[c] = 1;
+    std::vector<float> lvl = img;
+    uint32_t lw = w, lh = h;
+    while (lw > 1 || lh > 1) {
+      lvl = downsample_level(k, rules, lvl.data(), lw, lh, 3);
+      lw = (lw + 1) / 2, lh = (lh + 1) / 2;
+      for (size_t i = 0; i < size_t(lw) * lh; ++i) {
+        double len =
+            std::sqrt(double(lvl[i * 3]) * lvl[i * 3] + double(lvl[i * 3 + 1]) * lvl[i * 3 + 1] +
+                      double(lvl[i * 3 + 2]) * lvl[i * 3 + 2]);
+        ASSERT_NEAR(len, 1.0, 1e-6) << to_string(f);
+      }
+    }
+  }
+}
+
+TEST(PullPush, UncoveredColourNeverReachesCoveredTexels) {
+  const uint32_t w = 53, h = 41;
+  std::vector<float> img(w * h * 3);
+  std::vector<uint8_t> cov(w * h);
+  for (uint32_t y = 0; y < h; ++y) {
+    for (uint32_t x = 0; x < w; ++x) {
+      float dx = x - 20.0f, dy = y - 18.0f;
+      bool in = dx * dx + dy * dy < 120.0f || (x > 40 && y > 30);
+      cov[y * w + x] = in;
+      float* t = &img[(y * w + x) * 3];
+      // Background is pure red; charts have no red at all.
+      t[0] = in ? 0.0f : 1000.0f, t[1] = in ? 0.2f + 0.01f * x : 0.0f, t[2] = in ? 0.5f : 0.0f;
+    }
+  }
+  auto before = img;
+  uint64_t filled = pull_push(img.data(), cov.data(), w, h, 3);
+  uint64_t uncovered = 0;
+  for (uint8_t c : cov) uncovered += !c;
+  EXPECT_EQ(filled, uncovered);
+  for (size_t i = 0; i < w * h; ++i) {
+    if (cov[i]) {
+      ASSERT_EQ(img[i * 3 + 1], before[i * 3 + 1]);  // covered texels unchanged
+    }
+    ASSERT_EQ(img[i * 3], 0.0f) << "red reached texel " << i;
+    ASSERT_GE(img[i * 3 + 1], 0.2f);  // fill is an average of chart colours
+  }
+  // The whole pyramid stays red-free, whatever the filter.
+  for (MipFilter f : kFilters) {
+    DownsampleKernel k = make_downsample_kernel(f);
+    DownsampleRules rules;
+    std::vector<float> lvl = img;
+    std::vector<uint8_t> c = cov;
+    uint32_t lw = w, lh = h;
+    while (lw > 1 || lh > 1) {
+      lvl = downsample_level(k, rules, lvl.data(), lw, lh, 3);
+      c = downsample_coverage(c.data(), lw, lh);
+      lw = (lw + 1) / 2, lh = (lh + 1) / 2;
+      pull_push(lvl.data(), c.data(), lw, lh, 3);
+      for (size_t i = 0; i < size_t(lw) * lh; ++i) ASSERT_EQ(lvl[i * 3], 0.0f);
+    }
+  }
+}
+
+TEST(PullPush, NothingOrEverythingCoveredIsLeftAlone) {
+  std::vector<float> img = {1, 2, 3, 4};
+  std::vector<uint8_t> none(4, 0), all(4, 1);
+  EXPECT_EQ(pull_push(img.data(), none.data(), 2, 2, 1), 0u);
+  EXPECT_EQ(pull_push(img.data(), all.data(), 2, 2, 1), 0u);
+  EXPECT_EQ(img, (std::vector<float>{1, 2, 3, 4}));
+}
+
+}  // namespace
+}  // namespace vt
