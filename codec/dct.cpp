@@ -189,6 +189,7 @@ namespace {
 struct BlockInfo {
   int16_t dc;
   uint8_t nz;
+  uint8_t last;  // zigzag index of the last nonzero coefficient, 0 when only DC
 };
 
 // Codes one plane's blocks. Encoding reads `coefs` (quantised, zigzag order, one block after
@@ -268,7 +269,7 @@ void code_plane(Coder& c, BitModel* m, int bw, int bh, int16_t* coefs, BlockInfo
 
       // AC coefficients.
       if constexpr (Coder::kDecoding) std::memset(z + 1, 0, 63 * sizeof(int16_t));
-      int rem = nz;
+      int rem = nz, last = 0;
       for (int k = 1; k < 64 && rem > 0; k++) {
         int nb_sum = 0;
         if (left) nb_sum = std::abs(left[k]) + std::abs(up[k]);
@@ -280,6 +281,7 @@ void code_plane(Coder& c, BitModel* m, int bw, int bh, int16_t* coefs, BlockInfo
           if (!c.bit(zm, v != 0)) continue;
         }
         rem--;
+        last = k;
         const int neg = c.direct(v < 0, 1);
         int mag = std::abs(v);
         const int band = kBuckets.band[k];
@@ -303,6 +305,7 @@ void code_plane(Coder& c, BitModel* m, int bw, int bh, int16_t* coefs, BlockInfo
       }
       info[index].dc = z[0];
       info[index].nz = uint8_t(nz);
+      info[index].last = uint8_t(last);
     }
   }
 }
@@ -431,24 +434,17 @@ struct DecodeScratch {
   std::vector<int16_t> coefs;
   std::vector<BlockInfo> info;
   std::vector<int16_t> samples[4];
-  std::vector<int16_t> full_chroma[2];  // 4:2:0 chroma brought to full resolution
   std::vector<int32_t> row;
   std::vector<BitModel> models;
 };
 
 void reconstruct_plane(const PlaneDims& d, const uint8_t* quant, const int16_t* coefs,
-                       int16_t* samples) {
+                       const BlockInfo* info, int16_t* samples) {
   for (int by = 0; by < d.bh; by++) {
     for (int bx = 0; bx < d.bw; bx++) {
       const int16_t* z = coefs + (size_t(by) * d.bw + bx) * 64;
       int16_t* out = samples + size_t(by) * 8 * d.w + bx * 8;
-      int last = 0;
-      for (int k = 63; k > 0; k--) {
-        if (z[k] != 0) {
-          last = k;
-          break;
-        }
-      }
+      const int last = info[size_t(by) * d.bw + bx].last;
       int32_t f[64];
       if (last == 0) {
         // DC only: the same arithmetic as idct_block, without the loops.
@@ -473,23 +469,42 @@ inline uint8_t to_u8(int v8) {
   return uint8_t(std::clamp((v8 + 4) >> 3, 0, 255));
 }
 
-// 4:2:0 chroma to full resolution with the 9-3-3-1 triangle filter (chroma sited at block
-// centres, edges clamped). Output in 1/8 units like the input.
-void upsample_420(const PlaneDims& d, const int16_t* src, int width, int height, int16_t* dst,
-                  std::vector<int32_t>& row) {
-  const int cw = (width + 1) / 2, ch = (height + 1) / 2;
-  row.resize(size_t(cw));
+inline void put_ycocg(uint8_t* o, int y8, int co8, int cg8) {
+  const int yy = y8 + 1024, t = yy - cg8;
+  o[0] = to_u8(t + co8);
+  o[1] = to_u8(yy + cg8);
+  o[2] = to_u8(t - co8);
+}
+
+// YCoCg with 4:2:0 chroma to interleaved RGB(A). Chroma comes back to full resolution with the
+// 9-3-3-1 triangle filter (chroma sited at 2x2 centres, edges clamped), computed as a vertical
+// 3:1 blend and then a horizontal 3:1 blend with one rounding, all in 1/8 units.
+void ycocg420_to_rgb(const int16_t* yp, int ystride, const int16_t* co, const int16_t* cg,
+                     int cstride, int width, int height, int ch, uint8_t* texels,
+                     std::vector<int32_t>& rows) {
+  const int cw = width / 2, chh = height / 2;
+  rows.resize(size_t(cw) * 2);
+  int32_t* vco = rows.data();
+  int32_t* vcg = rows.data() + cw;
   for (int y = 0; y < height; y++) {
     const int cy = y >> 1;
-    const int ny = std::clamp((y & 1) ? cy + 1 : cy - 1, 0, ch - 1);
-    const int16_t* a = src + size_t(cy) * d.w;
-    const int16_t* b = src + size_t(ny) * d.w;
-    for (int x = 0; x < cw; x++) row[x] = 3 * a[x] + b[x];
-    int16_t* o = dst + size_t(y) * width;
-    for (int x = 0; x < width; x++) {
-      const int cx = x >> 1;
-      const int nx = std::clamp((x & 1) ? cx + 1 : cx - 1, 0, cw - 1);
-      o[x] = int16_t((3 * row[cx] + row[nx] + 8) >> 4);
+    const int ny = std::clamp((y & 1) ? cy + 1 : cy - 1, 0, chh - 1);
+    const int16_t* a0 = co + size_t(cy) * cstride;
+    const int16_t* a1 = co + size_t(ny) * cstride;
+    const int16_t* b0 = cg + size_t(cy) * cstride;
+    const int16_t* b1 = cg + size_t(ny) * cstride;
+    for (int x = 0; x < cw; x++) {
+      vco[x] = 3 * a0[x] + a1[x];
+      vcg[x] = 3 * b0[x] + b1[x];
+    }
+    const int16_t* yr = yp + size_t(y) * ystride;
+    uint8_t* o = texels + size_t(y) * width * ch;
+    for (int cx = 0; cx < cw; cx++) {
+      const int l = cx > 0 ? cx - 1 : 0, r = cx + 1 < cw ? cx + 1 : cw - 1;
+      const int co3 = 3 * vco[cx] + 8, cg3 = 3 * vcg[cx] + 8;
+      put_ycocg(o + size_t(2 * cx) * ch, yr[2 * cx], (co3 + vco[l]) >> 4, (cg3 + vcg[l]) >> 4);
+      put_ycocg(o + size_t(2 * cx + 1) * ch, yr[2 * cx + 1], (co3 + vco[r]) >> 4,
+                (cg3 + vcg[r]) >> 4);
     }
   }
 }
@@ -696,10 +711,10 @@ Status dct_decode_page(const DctTables& tables, std::span<const uint8_t> data, i
                                             std::to_string(data.size()) + " bytes, plane " +
                                             std::to_string(p) + ")");
     }
-    reconstruct_plane(d, tables.quant[p], scratch.coefs.data(), scratch.samples[p].data());
+    reconstruct_plane(d, tables.quant[p], scratch.coefs.data(), scratch.info.data(),
+                      scratch.samples[p].data());
   }
 
-  const size_t count = size_t(width) * height;
   if (s.layout == DctPlaneLayout::kPlanes) {
     for (int p = 0; p < n; p++) {
       const int w = plane_dims(s, p, width, height).w;
@@ -713,30 +728,20 @@ Status dct_decode_page(const DctTables& tables, std::span<const uint8_t> data, i
     return Status::Ok();
   }
 
-  const int16_t* co = scratch.samples[1].data();
-  const int16_t* cg = scratch.samples[2].data();
-  int cstride = plane_dims(s, 1, width, height).w;
-  if (s.layout == DctPlaneLayout::kYCoCg420) {
-    const PlaneDims d = plane_dims(s, 1, width, height);
-    for (auto& v : scratch.full_chroma) v.resize(count);
-    upsample_420(d, co, width, height, scratch.full_chroma[0].data(), scratch.row);
-    upsample_420(d, cg, width, height, scratch.full_chroma[1].data(), scratch.row);
-    co = scratch.full_chroma[0].data();
-    cg = scratch.full_chroma[1].data();
-    cstride = width;
-  }
   const int16_t* yp = scratch.samples[0].data();
   const int ystride = plane_dims(s, 0, width, height).w;
-  for (int y = 0; y < height; y++) {
-    uint8_t* o = texels + size_t(y) * width * ch;
-    const int16_t* yr = yp + size_t(y) * ystride;
-    const int16_t* cor = co + size_t(y) * cstride;
-    const int16_t* cgr = cg + size_t(y) * cstride;
-    for (int x = 0; x < width; x++) {
-      const int yy = yr[x] + 1024, g = yy + cgr[x], t = yy - cgr[x];
-      o[x * ch + 0] = to_u8(t + cor[x]);
-      o[x * ch + 1] = to_u8(g);
-      o[x * ch + 2] = to_u8(t - cor[x]);
+  const int16_t* co = scratch.samples[1].data();
+  const int16_t* cg = scratch.samples[2].data();
+  const int cstride = plane_dims(s, 1, width, height).w;
+  if (s.layout == DctPlaneLayout::kYCoCg420) {
+    ycocg420_to_rgb(yp, ystride, co, cg, cstride, width, height, ch, texels, scratch.row);
+  } else {
+    for (int y = 0; y < height; y++) {
+      uint8_t* o = texels + size_t(y) * width * ch;
+      const int16_t* yr = yp + size_t(y) * ystride;
+      const int16_t* cor = co + size_t(y) * cstride;
+      const int16_t* cgr = cg + size_t(y) * cstride;
+      for (int x = 0; x < width; x++) put_ycocg(o + size_t(x) * ch, yr[x], cor[x], cgr[x]);
     }
   }
   if (ch == 4) {

@@ -26,12 +26,11 @@ inline constexpr uint8_t kRateShift[kRateCap + 1] = {1, 2, 2, 3, 3, 3, 3, 3, 4, 
 
 inline void adapt(BitModel& m, int bit) {
   const int shift = kRateShift[m.n];
-  if (m.n < kRateCap) m.n++;
-  if (bit) {
-    m.p = uint16_t(m.p - (m.p >> shift));
-  } else {
-    m.p = uint16_t(m.p + ((kProbOne - m.p) >> shift));
-  }
+  m.n = uint8_t(m.n + (m.n < kRateCap));
+  const int p = m.p;
+  // Both candidates computed so the compiler can select without a branch.
+  const int down = p - (p >> shift), up = p + ((int(kProbOne) - p) >> shift);
+  m.p = uint16_t(bit ? down : up);
 }
 
 class RangeEncoder {
@@ -141,15 +140,9 @@ class RangeDecoder {
 
   int bit(BitModel& m, int = 0) {
     const uint32_t bound = (range_ >> kProbBits) * m.p;
-    int bit;
-    if (code_ < bound) {
-      range_ = bound;
-      bit = 0;
-    } else {
-      code_ -= bound;
-      range_ -= bound;
-      bit = 1;
-    }
+    const int bit = code_ >= bound;
+    code_ -= bit ? bound : 0;
+    range_ = bit ? range_ - bound : bound;
     adapt(m, bit);
     while (range_ < kRangeTop) {
       range_ <<= 8;

@@ -1,0 +1,629 @@
+// Page DCT codec against libjpeg-turbo abbreviated per-page streams (one shared table set, the
+// strongest JPEG a page store can use), on 128x128 pages cut from real images.
+//
+//   dct_bench --report [KODAK_DIR [TEXTURE_DIR]]   rate-distortion and speed table (markdown)
+//   dct_bench --speed [KODAK_DIR]                   decode speed against JPEG, interleaved
+//   dct_bench [google benchmark flags]             per-page decode / encode timings
+//
+// Report: bits per texel, PSNR (RGB, per page), single-thread encode / decode Mtexel/s (median
+// of 5 passes over all pages), bytes ratio against JPEG at equal PSNR (log-rate interpolated),
+// and the runtime path DCT decode + BC1 (real-time level) in pages/s.
+#include <benchmark/benchmark.h>
+#include <jpeglib.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <csetjmp>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "codec/bc1.h"
+#include "codec/dct.h"
+
+#define STB_IMAGE_STATIC
+#define STB_IMAGE_IMPLEMENTATION
+#include <stb/stb_image.h>
+
+namespace {
+
+using namespace vt;
+using Page = std::vector<uint8_t>;
+constexpr int kPage = 128;
+
+std::string g_kodak_dir = "/work/shared/testdata/images/kodak";
+std::string g_texture_dir = "/work/shared/testdata/images/textures";
+
+// Thread CPU time: the benchmark machine is shared, and wall time would count other work.
+double now_s() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+// Cuts an image into whole 128x128 pages of `channels` channels (the first ones of the file).
+std::vector<Page> load_pages(const std::string& path, int channels, int max_pages = 1 << 30) {
+  int w, h, c;
+  uint8_t* img = stbi_load(path.c_str(), &w, &h, &c, 4);
+  std::vector<Page> pages;
+  if (!img) return pages;
+  for (int py = 0; py + kPage <= h; py += kPage) {
+    for (int px = 0; px + kPage <= w && int(pages.size()) < max_pages; px += kPage) {
+      Page p(size_t(kPage) * kPage * channels);
+      for (int y = 0; y < kPage; y++)
+        for (int x = 0; x < kPage; x++)
+          for (int ch = 0; ch < channels; ch++)
+            p[(size_t(y) * kPage + x) * channels + ch] =
+                img[(size_t(py + y) * w + px + x) * 4 + ch];
+      pages.push_back(std::move(p));
+    }
+  }
+  stbi_image_free(img);
+  return pages;
+}
+
+std::vector<std::string> list_pngs(const std::string& dir, const std::string& contains = "") {
+  std::vector<std::string> files;
+  if (!std::filesystem::is_directory(dir)) return files;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (e.path().extension() == ".png" && name.find(contains) != std::string::npos) {
+      files.push_back(e.path().string());
+    }
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+double squared_error(const Page& a, const Page& b) {
+  double se = 0;
+  for (size_t i = 0; i < a.size(); i++) {
+    const double d = double(a[i]) - double(b[i]);
+    se += d * d;
+  }
+  return se;
+}
+
+double psnr_from(double se, double samples) {
+  return se == 0 ? 99.0 : 10.0 * std::log10(255.0 * 255.0 * samples / se);
+}
+
+template <class F>
+double median_seconds(int runs, F&& f) {
+  std::vector<double> t;
+  for (int r = 0; r < runs; r++) {
+    const double t0 = now_s();
+    f();
+    t.push_back(now_s() - t0);
+  }
+  std::sort(t.begin(), t.end());
+  return t[t.size() / 2];
+}
+
+// ---- libjpeg-turbo abbreviated streams ----
+
+struct JpegError {
+  jpeg_error_mgr mgr;
+  jmp_buf jump;
+};
+void jpeg_fail(j_common_ptr cinfo) {
+  longjmp(reinterpret_cast<JpegError*>(cinfo->err)->jump, 1);
+}
+
+struct JpegCoded {
+  std::vector<uint8_t> tables;  // tables-only stream, shared by every page
+  std::vector<std::vector<uint8_t>> pages;
+};
+
+JpegCoded jpeg_encode(const std::vector<Page>& pages, int quality, bool subsample) {
+  JpegCoded out;
+  jpeg_compress_struct c;
+  JpegError err;
+  c.err = jpeg_std_error(&err.mgr);
+  err.mgr.error_exit = jpeg_fail;
+  if (setjmp(err.jump)) {
+    jpeg_destroy_compress(&c);
+    return {};
+  }
+  jpeg_create_compress(&c);
+  c.image_width = kPage;
+  c.image_height = kPage;
+  c.input_components = 3;
+  c.in_color_space = JCS_RGB;
+  jpeg_set_defaults(&c);
+  jpeg_set_quality(&c, quality, TRUE);
+  const int h = subsample ? 2 : 1;
+  c.comp_info[0].h_samp_factor = h;
+  c.comp_info[0].v_samp_factor = h;
+  unsigned char* buf = nullptr;
+  unsigned long size = 0;
+  jpeg_mem_dest(&c, &buf, &size);
+  jpeg_write_tables(&c);
+  out.tables.assign(buf, buf + size);
+  free(buf);
+  for (const Page& p : pages) {
+    buf = nullptr;
+    size = 0;
+    jpeg_mem_dest(&c, &buf, &size);
+    jpeg_suppress_tables(&c, TRUE);
+    jpeg_start_compress(&c, FALSE);  // abbreviated: no tables in the page
+    for (int y = 0; y < kPage; y++) {
+      JSAMPROW row = const_cast<JSAMPROW>(p.data() + size_t(y) * kPage * 3);
+      jpeg_write_scanlines(&c, &row, 1);
+    }
+    jpeg_finish_compress(&c);
+    out.pages.emplace_back(buf, buf + size);
+    free(buf);
+  }
+  jpeg_destroy_compress(&c);
+  return out;
+}
+
+class JpegDecoder {
+ public:
+  explicit JpegDecoder(const std::vector<uint8_t>& tables) {
+    d_.err = jpeg_std_error(&err_.mgr);
+    err_.mgr.error_exit = jpeg_fail;
+    jpeg_create_decompress(&d_);
+    if (setjmp(err_.jump)) return;
+    jpeg_mem_src(&d_, tables.data(), tables.size());
+    jpeg_read_header(&d_, FALSE);  // tables only: kept for the pages
+  }
+  ~JpegDecoder() { jpeg_destroy_decompress(&d_); }
+  bool decode(const std::vector<uint8_t>& data, uint8_t* rgb) {
+    if (setjmp(err_.jump)) {
+      jpeg_abort_decompress(&d_);
+      return false;
+    }
+    jpeg_mem_src(&d_, data.data(), data.size());
+    jpeg_read_header(&d_, TRUE);
+    d_.out_color_space = JCS_RGB;
+    jpeg_start_decompress(&d_);
+    while (d_.output_scanline < d_.output_height) {
+      JSAMPROW row = rgb + size_t(d_.output_scanline) * kPage * 3;
+      jpeg_read_scanlines(&d_, &row, 1);
+    }
+    jpeg_finish_decompress(&d_);
+    return true;
+  }
+
+ private:
+  jpeg_decompress_struct d_;
+  JpegError err_;
+};
+
+// ---- measurements ----
+
+struct Point {
+  std::string codec;
+  std::string setting;
+  double bpt = 0;
+  double psnr = 0;
+  double enc_mtex = 0;
+  double dec_mtex = 0;
+  size_t table_bytes = 0;
+};
+
+Point measure_jpeg(const std::vector<Page>& pages, int quality, bool subsample) {
+  Point pt;
+  pt.codec = "libjpeg-turbo abbreviated";
+  pt.setting = "q" + std::to_string(quality) + (subsample ? " 4:2:0" : " 4:4:4");
+  JpegCoded coded;
+  const double enc = median_seconds(3, [&] { coded = jpeg_encode(pages, quality, subsample); });
+  pt.table_bytes = coded.tables.size();
+  JpegDecoder dec(coded.tables);
+  Page out(size_t(kPage) * kPage * 3);
+  double se = 0, bytes = 0;
+  for (size_t i = 0; i < pages.size(); i++) {
+    dec.decode(coded.pages[i], out.data());
+    se += squared_error(pages[i], out);
+    bytes += double(coded.pages[i].size());
+  }
+  const double d = median_seconds(5, [&] {
+    for (const auto& c : coded.pages) dec.decode(c, out.data());
+  });
+  const double texels = double(pages.size()) * kPage * kPage;
+  pt.bpt = bytes * 8 / texels;
+  pt.psnr = psnr_from(se, texels * 3);
+  pt.enc_mtex = texels / enc / 1e6;
+  pt.dec_mtex = texels / d / 1e6;
+  return pt;
+}
+
+// Tables trained two-fold: pages of even-numbered images are coded with tables trained on the
+// odd ones and vice versa, so no page is coded with tables that saw it.
+struct Folds {
+  std::vector<Page> pages[2];
+};
+
+Point measure_dct(const Folds& folds, const DctSettings& s, bool trained, int channels_measured,
+                  std::vector<std::vector<uint8_t>>* coded_out = nullptr,
+                  DctTablesPtr* tables_out = nullptr) {
+  Point pt;
+  pt.codec = trained ? "vtbake DCT (trained tables)" : "vtbake DCT (untrained tables)";
+  const char* names[] = {"planes", "YCoCg", "YCoCg 4:2:0"};
+  pt.setting = "q" + std::to_string(s.quality) + " " + names[int(s.layout)];
+  double se = 0, bytes = 0, texels = 0, enc_s = 0, dec_s = 0;
+  for (int f = 0; f < 2; f++) {
+    const auto& pages = folds.pages[f];
+    if (pages.empty()) continue;
+    std::vector<std::span<const uint8_t>> training;
+    if (trained) {
+      for (const Page& p : folds.pages[1 - f]) training.push_back(p);
+    }
+    auto tables = dct_make_tables(s, kPage, kPage, training);
+    if (!tables.ok()) {
+      std::fprintf(stderr, "%s\n", tables.status().message().c_str());
+      std::exit(1);
+    }
+    pt.table_bytes = dct_serialize_tables(**tables).size();
+    std::vector<std::vector<uint8_t>> coded(pages.size());
+    enc_s += median_seconds(3, [&] {
+      for (size_t i = 0; i < pages.size(); i++) {
+        (void)dct_encode_page(**tables, pages[i].data(), kPage, kPage, coded[i]);
+      }
+    });
+    Page out(pages[0].size());
+    for (size_t i = 0; i < pages.size(); i++) {
+      if (!dct_decode_page(**tables, coded[i], kPage, kPage, out.data()).ok()) std::exit(2);
+      for (size_t j = 0; j < out.size(); j++) {
+        if (int(j % s.channels) >= channels_measured) continue;
+        const double d = double(out[j]) - double(pages[i][j]);
+        se += d * d;
+      }
+      bytes += double(coded[i].size());
+    }
+    dec_s += median_seconds(5, [&] {
+      for (const auto& c : coded) (void)dct_decode_page(**tables, c, kPage, kPage, out.data());
+    });
+    texels += double(pages.size()) * kPage * kPage;
+    if (coded_out && f == 0) *coded_out = std::move(coded);
+    if (tables_out && f == 0) *tables_out = std::move(tables).value();
+  }
+  pt.bpt = bytes * 8 / texels;
+  pt.psnr = psnr_from(se, texels * channels_measured);
+  pt.enc_mtex = texels / enc_s / 1e6;
+  pt.dec_mtex = texels / dec_s / 1e6;
+  return pt;
+}
+
+// Bits per texel of a rate-distortion curve at `psnr`, interpolating log(rate) linearly
+// between the measured points; negative when `psnr` lies outside the curve.
+double rate_at(std::vector<Point> curve, double psnr) {
+  std::sort(curve.begin(), curve.end(),
+            [](const Point& a, const Point& b) { return a.psnr < b.psnr; });
+  for (size_t i = 1; i < curve.size(); i++) {
+    const Point &a = curve[i - 1], &b = curve[i];
+    if (psnr >= a.psnr && psnr <= b.psnr && b.psnr > a.psnr) {
+      const double t = (psnr - a.psnr) / (b.psnr - a.psnr);
+      return std::exp(std::log(a.bpt) + t * (std::log(b.bpt) - std::log(a.bpt)));
+    }
+  }
+  return -1;
+}
+
+void print_points(const std::vector<Point>& pts) {
+  std::printf(
+      "| codec | setting | bits/texel | PSNR dB | encode Mtex/s | decode Mtex/s | decode pages/s | "
+      "tables B |\n");
+  std::printf("|---|---|---|---|---|---|---|---|\n");
+  for (const Point& p : pts) {
+    std::printf("| %s | %s | %.3f | %.2f | %.1f | %.1f | %.0f | %zu |\n", p.codec.c_str(),
+                p.setting.c_str(), p.bpt, p.psnr, p.enc_mtex, p.dec_mtex,
+                p.dec_mtex * 1e6 / (kPage * kPage), p.table_bytes);
+  }
+}
+
+void print_ratios(const char* title, const std::vector<Point>& dct,
+                  const std::vector<Point>& jpeg) {
+  std::printf(
+      "\n%s: bits at equal PSNR\n\n| PSNR dB | DCT bits/texel | JPEG bits/texel | ratio "
+      "|\n|---|---|---|---|\n",
+      title);
+  for (double db = 30; db <= 42; db += 1) {
+    const double a = rate_at(dct, db), b = rate_at(jpeg, db);
+    if (a > 0 && b > 0) std::printf("| %.0f | %.3f | %.3f | %.3f |\n", db, a, b, a / b);
+  }
+}
+
+int report() {
+  // ---- Kodak: photographs, RGB ----
+  Folds kodak;
+  std::vector<Page> all;
+  const auto files = list_pngs(g_kodak_dir);
+  for (size_t i = 0; i < files.size(); i++) {
+    for (Page& p : load_pages(files[i], 3)) {
+      all.push_back(p);
+      kodak.pages[i % 2].push_back(std::move(p));
+    }
+  }
+  if (all.empty()) {
+    std::fprintf(stderr, "no images in %s\n", g_kodak_dir.c_str());
+    return 1;
+  }
+  std::printf("## Kodak (%zu images, %zu pages of 128x128)\n\n", files.size(), all.size());
+  std::vector<Point> jpeg420, jpeg444, dct420, dct444, points;
+  for (int q : {30, 40, 50, 60, 75, 85, 90, 95}) jpeg420.push_back(measure_jpeg(all, q, true));
+  for (int q : {50, 75, 90, 95}) jpeg444.push_back(measure_jpeg(all, q, false));
+  for (int q : {20, 30, 40, 50, 60, 75, 90}) {
+    DctSettings s;
+    s.quality = q;
+    s.channels = 3;
+    s.layout = DctPlaneLayout::kYCoCg420;
+    dct420.push_back(measure_dct(kodak, s, true, 3));
+    s.layout = DctPlaneLayout::kYCoCg;
+    dct444.push_back(measure_dct(kodak, s, true, 3));
+  }
+  for (int q : {50, 75}) {
+    DctSettings s;
+    s.quality = q;
+    s.channels = 3;
+    s.layout = DctPlaneLayout::kYCoCg420;
+    points.push_back(measure_dct(kodak, s, false, 3));
+  }
+  std::vector<Point> table;
+  table.insert(table.end(), jpeg420.begin(), jpeg420.end());
+  table.insert(table.end(), jpeg444.begin(), jpeg444.end());
+  table.insert(table.end(), dct420.begin(), dct420.end());
+  table.insert(table.end(), dct444.begin(), dct444.end());
+  table.insert(table.end(), points.begin(), points.end());
+  print_points(table);
+  std::vector<Point> jpeg_best = jpeg420;  // lower envelope: JPEG's best subsampling per rate
+  jpeg_best.insert(jpeg_best.end(), jpeg444.begin(), jpeg444.end());
+  print_ratios("DCT 4:2:0 vs JPEG 4:2:0", dct420, jpeg420);
+  print_ratios("DCT full-res chroma vs JPEG 4:4:4", dct444, jpeg444);
+
+  // ---- runtime path: DCT decode + BC1 real-time encode ----
+  std::printf(
+      "\n## Runtime path on Kodak pages (one core)\n\n| path | bits/texel | PSNR after "
+      "decode dB | PSNR after BC1 dB | pages/s |\n|---|---|---|---|---|\n");
+  for (int q : {40, 50, 75}) {
+    DctSettings s;
+    s.quality = q;
+    s.channels = 3;
+    s.layout = DctPlaneLayout::kYCoCg420;
+    std::vector<std::vector<uint8_t>> coded;
+    DctTablesPtr tables;
+    const Point pt = measure_dct(kodak, s, true, 3, &coded, &tables);
+    const auto& pages = kodak.pages[0];
+    Page rgb(size_t(kPage) * kPage * 3);
+    std::vector<uint8_t> bc(size_t(kPage / 4) * (kPage / 4) * 8);
+    uint8_t block[64], decoded[64];
+    auto transcode = [&](size_t i, Page* check, double* se) {
+      (void)dct_decode_page(*tables, coded[i], kPage, kPage, rgb.data());
+      for (int by = 0; by < kPage / 4; by++) {
+        for (int bx = 0; bx < kPage / 4; bx++) {
+          for (int y = 0; y < 4; y++)
+            for (int x = 0; x < 4; x++) {
+              const uint8_t* s3 = rgb.data() + (size_t(by * 4 + y) * kPage + bx * 4 + x) * 3;
+              uint8_t* d4 = block + (y * 4 + x) * 4;
+              d4[0] = s3[0], d4[1] = s3[1], d4[2] = s3[2], d4[3] = 255;
+            }
+          uint8_t* out = bc.data() + (size_t(by) * (kPage / 4) + bx) * 8;
+          bc1_encode_block(block, BcQuality::kRealtime, out);
+          if (check) {
+            bc1_decode_block(out, decoded);
+            for (int y = 0; y < 4; y++)
+              for (int x = 0; x < 4; x++)
+                for (int c = 0; c < 3; c++) {
+                  const double d =
+                      double(decoded[(y * 4 + x) * 4 + c]) -
+                      double((*check)[(size_t(by * 4 + y) * kPage + bx * 4 + x) * 3 + c]);
+                  *se += d * d;
+                }
+          }
+        }
+      }
+    };
+    double se = 0, se_dec = 0, bytes = 0;
+    for (size_t i = 0; i < pages.size(); i++) {
+      Page p = pages[i];
+      transcode(i, &p, &se);
+      se_dec += squared_error(pages[i], rgb);
+      bytes += double(coded[i].size());
+    }
+    const double t = median_seconds(5, [&] {
+      for (size_t i = 0; i < pages.size(); i++) transcode(i, nullptr, nullptr);
+    });
+    const double samples = double(pages.size()) * kPage * kPage * 3;
+    std::printf("| DCT q%d 4:2:0 + BC1 real-time | %.3f | %.2f | %.2f | %.0f |\n", q,
+                bytes * 8 / (samples / 3), psnr_from(se_dec, samples), psnr_from(se, samples),
+                double(pages.size()) / t);
+    (void)pt;
+  }
+
+  // ---- PBR textures: colour maps as RGB, normal maps as XY planes, packed maps as planes ----
+  std::printf("\n## PBR textures (%s, first 64 pages of each map)\n\n", g_texture_dir.c_str());
+  std::vector<Point> tex;
+  struct Kind {
+    const char* contains;
+    int channels;
+    DctPlaneLayout layout;
+    int measured;
+  };
+  const Kind kinds[] = {{"baseColor", 3, DctPlaneLayout::kYCoCg420, 3},
+                        {"normal", 2, DctPlaneLayout::kPlanes, 2},
+                        {"oughness", 3, DctPlaneLayout::kPlanes, 3}};
+  for (const Kind& k : kinds) {
+    for (const auto& file : list_pngs(g_texture_dir, k.contains)) {
+      Folds f;
+      auto pages = load_pages(file, k.channels, 64);
+      for (size_t i = 0; i < pages.size(); i++) f.pages[i % 2].push_back(pages[i]);
+      for (int q : {50, 75, 90}) {
+        DctSettings s;
+        s.quality = q;
+        s.channels = k.channels;
+        s.layout = k.layout;
+        Point pt = measure_dct(f, s, true, k.measured);
+        pt.codec = std::filesystem::path(file).stem().string();
+        tex.push_back(pt);
+      }
+      if (k.channels == 3) {
+        std::vector<Page> rgb(pages.begin(), pages.end());
+        for (int q : {50, 75, 90}) {
+          Point pt = measure_jpeg(rgb, q, k.layout == DctPlaneLayout::kYCoCg420);
+          pt.codec = std::filesystem::path(file).stem().string() + " JPEG";
+          tex.push_back(pt);
+        }
+      }
+    }
+  }
+  print_points(tex);
+  return 0;
+}
+
+// Decode speed side by side: DCT and JPEG passes over the same pages alternate, so load from
+// other processes hits both alike; medians of thread CPU time over `rounds`.
+int speed(int rounds) {
+  std::vector<Page> pages;
+  for (const auto& f : list_pngs(g_kodak_dir)) {
+    for (Page& p : load_pages(f, 3)) pages.push_back(std::move(p));
+  }
+  if (pages.empty()) return 1;
+  std::printf(
+      "| pair | DCT bits/texel | DCT PSNR | DCT decode pages/s | JPEG bits/texel | JPEG PSNR | "
+      "JPEG decode pages/s | DCT / JPEG speed |\n|---|---|---|---|---|---|---|---|\n");
+  const int pairs[][2] = {{40, 50}, {50, 75}, {75, 90}};
+  for (const auto& pr : pairs) {
+    DctSettings s;
+    s.quality = pr[0];
+    s.channels = 3;
+    s.layout = DctPlaneLayout::kYCoCg420;
+    std::vector<std::span<const uint8_t>> training;
+    for (size_t i = 0; i < pages.size(); i += 2) training.push_back(pages[i]);
+    auto tables = dct_make_tables(s, kPage, kPage, training);
+    std::vector<std::vector<uint8_t>> coded(pages.size());
+    double dbytes = 0, dse = 0;
+    Page out(pages[0].size());
+    for (size_t i = 0; i < pages.size(); i++) {
+      (void)dct_encode_page(**tables, pages[i].data(), kPage, kPage, coded[i]);
+      (void)dct_decode_page(**tables, coded[i], kPage, kPage, out.data());
+      dbytes += double(coded[i].size());
+      dse += squared_error(pages[i], out);
+    }
+    const JpegCoded jc = jpeg_encode(pages, pr[1], true);
+    JpegDecoder jd(jc.tables);
+    double jbytes = 0, jse = 0;
+    for (size_t i = 0; i < pages.size(); i++) {
+      jd.decode(jc.pages[i], out.data());
+      jbytes += double(jc.pages[i].size());
+      jse += squared_error(pages[i], out);
+    }
+    std::vector<double> td, tj;
+    for (int r = 0; r < rounds; r++) {
+      double t0 = now_s();
+      for (const auto& c : coded) (void)dct_decode_page(**tables, c, kPage, kPage, out.data());
+      double t1 = now_s();
+      for (const auto& c : jc.pages) jd.decode(c, out.data());
+      double t2 = now_s();
+      td.push_back(t1 - t0);
+      tj.push_back(t2 - t1);
+    }
+    std::sort(td.begin(), td.end());
+    std::sort(tj.begin(), tj.end());
+    const double n = double(pages.size()), texels = n * kPage * kPage;
+    const double dps = n / td[td.size() / 2], jps = n / tj[tj.size() / 2];
+    std::printf(
+        "| DCT q%d 4:2:0 / JPEG q%d 4:2:0 | %.3f | %.2f | %.0f | %.3f | %.2f | %.0f | %.2f |\n",
+        pr[0], pr[1], dbytes * 8 / texels, psnr_from(dse, texels * 3), dps, jbytes * 8 / texels,
+        psnr_from(jse, texels * 3), jps, dps / jps);
+  }
+  return 0;
+}
+
+// ---- Google Benchmark timings: one page at a time ----
+
+struct Fixture {
+  std::vector<Page> pages;
+  Fixture() {
+    for (const auto& f : list_pngs(g_kodak_dir)) {
+      for (Page& p : load_pages(f, 3)) pages.push_back(std::move(p));
+      if (pages.size() >= 96) break;
+    }
+  }
+};
+Fixture& fixture() {
+  static Fixture f;
+  return f;
+}
+
+void BM_DctDecode(benchmark::State& state) {
+  const auto& pages = fixture().pages;
+  if (pages.empty()) return state.SkipWithError("no Kodak images");
+  DctSettings s;
+  s.quality = int(state.range(0));
+  s.layout = DctPlaneLayout(state.range(1));
+  std::vector<std::span<const uint8_t>> training(pages.begin(), pages.end());
+  auto tables = dct_make_tables(s, kPage, kPage, training);
+  std::vector<std::vector<uint8_t>> coded(pages.size());
+  for (size_t i = 0; i < pages.size(); i++) {
+    (void)dct_encode_page(**tables, pages[i].data(), kPage, kPage, coded[i]);
+  }
+  Page out(pages[0].size());
+  size_t i = 0;
+  for (auto _ : state) {
+    (void)dct_decode_page(**tables, coded[i], kPage, kPage, out.data());
+    benchmark::DoNotOptimize(out.data());
+    i = (i + 1) % coded.size();
+  }
+  state.counters["pages/s"] =
+      benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_DctDecode)->Args({50, 2})->Args({75, 2})->Args({90, 2})->Args({75, 1});
+
+void BM_DctEncode(benchmark::State& state) {
+  const auto& pages = fixture().pages;
+  if (pages.empty()) return state.SkipWithError("no Kodak images");
+  DctSettings s;
+  s.quality = int(state.range(0));
+  auto tables = dct_make_tables(s, kPage, kPage);
+  std::vector<uint8_t> coded;
+  size_t i = 0;
+  for (auto _ : state) {
+    (void)dct_encode_page(**tables, pages[i].data(), kPage, kPage, coded);
+    benchmark::DoNotOptimize(coded.data());
+    i = (i + 1) % pages.size();
+  }
+  state.counters["pages/s"] =
+      benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_DctEncode)->Arg(75);
+
+void BM_JpegDecode(benchmark::State& state) {
+  const auto& pages = fixture().pages;
+  if (pages.empty()) return state.SkipWithError("no Kodak images");
+  const JpegCoded coded = jpeg_encode(pages, int(state.range(0)), true);
+  JpegDecoder dec(coded.tables);
+  Page out(pages[0].size());
+  size_t i = 0;
+  for (auto _ : state) {
+    dec.decode(coded.pages[i], out.data());
+    benchmark::DoNotOptimize(out.data());
+    i = (i + 1) % coded.pages.size();
+  }
+  state.counters["pages/s"] =
+      benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_JpegDecode)->Arg(50)->Arg(75);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc > 1 && std::strcmp(argv[1], "--report") == 0) {
+    if (argc > 2) g_kodak_dir = argv[2];
+    if (argc > 3) g_texture_dir = argv[3];
+    return report();
+  }
+  if (argc > 1 && std::strcmp(argv[1], "--speed") == 0) {
+    if (argc > 2) g_kodak_dir = argv[2];
+    return speed(7);
+  }
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
