@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "codec/metrics.h"
+#include "render/report.h"
 
 namespace vt::render {
 namespace {
@@ -216,6 +217,64 @@ std::vector<std::string> check_view(const ViewMetrics& m, const Thresholds& t) {
     why.push_back(line);
   }
   return why;
+}
+
+Expected<ValidationReport> validate_views(Renderer& renderer,
+                                          std::shared_ptr<const PageSource> source,
+                                          std::span<const Camera> cameras,
+                                          const ValidateOptions& options) {
+  if (!source) return Error(ErrorCode::kInvalidArgument, "render: no page source");
+  if (cameras.empty()) return Error(ErrorCode::kInvalidArgument, "render: no camera views");
+  ValidationReport report;
+  report.layer = options.layer;
+  report.width = renderer.options().width;
+  report.height = renderer.options().height;
+  ConvergeOptions converge = options.converge;
+  converge.layer = options.layer;
+  for (uint32_t v = 0; v < cameras.size(); ++v) {
+    // A cold cache per view: frames-to-converge then measures the view alone.
+    VT_ASSIGN_OR_RETURN(std::unique_ptr<Streamer> streamer,
+                        Streamer::create(source, options.streamer));
+    VT_ASSIGN_OR_RETURN(VirtualTextureSetup setup,
+                        virtual_setup_for(*streamer, options.layer, options.address_mode));
+    if (v == 0) {
+      report.cache_format = to_string(setup.cache_format);
+      report.thresholds = options.thresholds.value_or(default_thresholds(setup.cache_format));
+    }
+    VT_RETURN_IF_ERROR(renderer.set_virtual_texture(setup));
+    ViewReport view;
+    view.view = v;
+    VT_ASSIGN_OR_RETURN(view.converge, converge_view(renderer, *streamer, cameras[v], converge));
+    auto t0 = std::chrono::steady_clock::now();
+    VT_ASSIGN_OR_RETURN(VirtualFrame frame, renderer.render_virtual(cameras[v]));
+    view.virtual_ms = ms_since(t0);
+    t0 = std::chrono::steady_clock::now();
+    VT_ASSIGN_OR_RETURN(Rgba8Image reference, renderer.render_reference(cameras[v]));
+    view.reference_ms = ms_since(t0);
+    VT_ASSIGN_OR_RETURN(view.metrics, compare_view(reference, frame));
+    view.failures = check_view(view.metrics, report.thresholds);
+    if (!view.converge.converged) {
+      view.failures.push_back("did not converge in " + std::to_string(converge.max_frames) +
+                              " frames");
+    }
+    if (view.converge.load_errors > 0) {
+      view.failures.push_back(std::to_string(view.converge.load_errors) + " pages failed to load");
+    }
+    if (!options.out_dir.empty()) {
+      const std::string base = options.out_dir + "/view_" + std::to_string(v) + "_";
+      const std::pair<const char*, Rgba8Image> images[] = {
+          {"reference.png", reference},
+          {"virtual.png", frame.color},
+          {"diff.png", difference_map(reference, frame.color)},
+          {"residency.png", residency_heat_map(frame)}};
+      for (const auto& [name, image] : images) {
+        VT_RETURN_IF_ERROR(write_png(base + name, image));
+        view.images.push_back(base + name);
+      }
+    }
+    report.views.push_back(std::move(view));
+  }
+  return report;
 }
 
 }  // namespace vt::render

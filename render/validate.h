@@ -5,6 +5,9 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -75,5 +78,44 @@ struct Thresholds {
 Thresholds default_thresholds(RuntimeFormat cache_format);
 // Why the view fails (one line per broken bound); empty when it passes.
 std::vector<std::string> check_view(const ViewMetrics& metrics, const Thresholds& thresholds);
+
+struct ViewReport {
+  uint32_t view = 0;
+  ViewMetrics metrics;
+  ConvergeResult converge;
+  double reference_ms = 0;            // one reference pass with read back
+  double virtual_ms = 0;              // one final pass with read back
+  std::vector<std::string> failures;  // check_view(); empty when the view passes
+  std::vector<std::string> images;    // files written for this view
+};
+
+struct ValidationReport {
+  std::string page_file;
+  uint32_t layer = 0;
+  std::string cache_format;
+  std::string device;
+  uint32_t width = 0, height = 0;
+  Thresholds thresholds;
+  std::vector<ViewReport> views;
+  bool passed() const;
+};
+
+struct ValidateOptions {
+  uint32_t layer = 0;
+  AddressMode address_mode = AddressMode::kClamp;  // the layer's, from the page file
+  StreamerOptions streamer;
+  ConvergeOptions converge;              // its layer is set from `layer`
+  std::optional<Thresholds> thresholds;  // default_thresholds(cache format) when unset
+  std::string
+      out_dir;  // where PNGs go (view_<i>_{reference,virtual,diff,residency}.png); "" = none
+};
+
+// Validates one layer over `cameras`: per view a cold streamer over `source`, the loop to
+// convergence, the final and reference passes, metrics, pass/fail and (optionally) images.
+// The renderer's meshes and reference textures must already be set.
+Expected<ValidationReport> validate_views(Renderer& renderer,
+                                          std::shared_ptr<const PageSource> source,
+                                          std::span<const Camera> cameras,
+                                          const ValidateOptions& options);
 
 }  // namespace vt::render

@@ -2,11 +2,16 @@
 // virtual texture): the page file is written here with the format writer (raw codec, levels by
 // a 2x box filter, borders from the level images), streamed through the runtime and rendered
 // both ways. Skips cleanly where no Vulkan device exists.
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -14,6 +19,7 @@
 
 #include "format/page_file.h"
 #include "render/renderer.h"
+#include "render/report.h"
 #include "render/validate.h"
 #include "render/vulkan_context.h"
 #include "runtime/page_source.h"
@@ -470,6 +476,113 @@ TEST(Validate, OffByOnePageTableLevelFails) {
   ASSERT_EQ(runs.size(), 4u);
   print_runs("off-by-one", runs);
   EXPECT_EQ(failing_views(runs, RuntimeFormat::kRgba8), 4);
+}
+
+std::shared_ptr<const PageSource> open_source(const std::string& path) {
+  auto reader = PageFileReader::open(path);
+  EXPECT_TRUE(reader.ok()) << reader.status().message();
+  if (!reader.ok()) return nullptr;
+  auto source = make_page_file_source(std::shared_ptr<const PageFileReader>(std::move(*reader)));
+  EXPECT_TRUE(source.ok()) << source.status().message();
+  if (!source.ok()) return nullptr;
+  return std::shared_ptr<const PageSource>(std::move(*source));
+}
+
+TEST(Validate, WritesImagesAndReport) {
+  REQUIRE_VULKAN();
+  std::unique_ptr<Renderer> renderer = make_renderer();
+  ASSERT_TRUE(renderer);
+  auto source = open_source(write_bake("report", RuntimeFormat::kRgba8, Fault::kNone));
+  ASSERT_TRUE(source);
+  const char* keep = std::getenv("VT_RENDER_KEEP_IMAGES");  // a folder to inspect the images
+  const std::string dir =
+      keep ? keep : (std::filesystem::path(testing::TempDir()) / "vt_render_report").string();
+  std::filesystem::create_directories(dir);
+  ValidateOptions options;
+  options.streamer.slots_x = options.streamer.slots_y = 16;
+  options.out_dir = dir;
+  std::vector<Camera> cams = views();
+  auto report = validate_views(*renderer, source, std::span(cams).first(2), options);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  EXPECT_TRUE(report->passed());
+  ASSERT_EQ(report->views.size(), 2u);
+  EXPECT_EQ(report->cache_format, "rgba8");
+  for (const ViewReport& v : report->views) {
+    EXPECT_TRUE(v.failures.empty());
+    ASSERT_EQ(v.images.size(), 4u);
+    for (const std::string& file : v.images) {
+      auto in = OIIO::ImageInput::open(file);
+      ASSERT_TRUE(in) << file;
+      EXPECT_EQ(in->spec().width, int(kWidth));
+      EXPECT_EQ(in->spec().height, int(kHeight));
+      EXPECT_EQ(in->spec().nchannels, 3);
+    }
+  }
+  // PNGs are lossless and keep the channel order: the reference on disk is the render.
+  {
+    auto in = OIIO::ImageInput::open(report->views[0].images[0]);
+    ASSERT_TRUE(in);
+    std::vector<uint8_t> rgb(size_t(kWidth) * kHeight * 3);
+    ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, rgb.data()));
+    auto ref = renderer->render_reference(cams[0]);
+    ASSERT_TRUE(ref.ok());
+    for (size_t i = 0; i < size_t(kWidth) * kHeight; ++i) {
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(rgb[i * 3 + c], ref->texels[i * 4 + c]) << i;
+    }
+  }
+  const std::string json_path = dir + "/report.json";
+  ASSERT_TRUE(write_report_json(json_path, *report).ok());
+  std::ifstream f(json_path);
+  nlohmann::json doc = nlohmann::json::parse(f);
+  EXPECT_EQ(doc["passed"], true);
+  ASSERT_EQ(doc["views"].size(), 2u);
+  EXPECT_DOUBLE_EQ(doc["views"][0]["psnr_rgb"].get<double>(), report->views[0].metrics.psnr_rgb);
+  EXPECT_EQ(doc["views"][1]["frames_to_converge"].get<uint32_t>(),
+            report->views[1].converge.frames_to_converge);
+}
+
+TEST(Validate, ReportFailsABrokenBake) {
+  REQUIRE_VULKAN();
+  std::unique_ptr<Renderer> renderer = make_renderer();
+  ASSERT_TRUE(renderer);
+  auto source = open_source(write_bake("report_bad", RuntimeFormat::kRgba8, Fault::kZeroBorders));
+  ASSERT_TRUE(source);
+  ValidateOptions options;
+  options.streamer.slots_x = options.streamer.slots_y = 16;
+  std::vector<Camera> cams = views();
+  auto report = validate_views(*renderer, source, std::span(cams).first(1), options);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  EXPECT_FALSE(report->passed());
+  bool tile = false;
+  for (const std::string& why : report->views[0].failures)
+    tile |= why.find("tile") != std::string::npos;
+  EXPECT_TRUE(tile);
+}
+
+TEST(Report, HeatMapAndDifferenceMap) {
+  VirtualFrame f;
+  f.color.width = 4;
+  f.color.height = 1;
+  f.color.texels.assign(16, 0);
+  // background, level 0 as wanted, level 2 where level 1 was wanted, nothing resident
+  f.status = {0u, 0x80000000u, 0x80000000u | 1u | (2u << 8), 0x80000000u | (31u << 8)};
+  Rgba8Image h = residency_heat_map(f);
+  ASSERT_EQ(h.texels.size(), 16u);
+  EXPECT_EQ(h.texels[0], 0);    // background black
+  EXPECT_EQ(h.texels[4], 255);  // level 0 white
+  EXPECT_EQ(h.texels[5], 255);
+  EXPECT_EQ(h.texels[8], 255);  // coarser: red tint
+  EXPECT_LT(h.texels[9], 100);
+  EXPECT_EQ(h.texels[12], 255);  // unresident: magenta
+  EXPECT_EQ(h.texels[13], 0);
+  EXPECT_EQ(h.texels[14], 255);
+  Rgba8Image a = f.color, b = f.color;
+  b.texels[4 + 1] = 3;    // pixel 1, green off by 3
+  b.texels[8 + 2] = 200;  // pixel 2, blue off by 200
+  Rgba8Image d = difference_map(a, b, 8);
+  EXPECT_EQ(d.texels[0], 0);
+  EXPECT_EQ(d.texels[4], 24);
+  EXPECT_EQ(d.texels[8], 255);
 }
 
 }  // namespace

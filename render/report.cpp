@@ -1,0 +1,139 @@
+#include "render/report.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+namespace vt::render {
+
+Rgba8Image difference_map(const Rgba8Image& a, const Rgba8Image& b, int gain) {
+  Rgba8Image out;
+  out.width = a.width;
+  out.height = a.height;
+  out.texels.assign(a.texels.size(), 255);
+  if (a.texels.size() != b.texels.size()) return out;
+  for (size_t i = 0; i + 3 < a.texels.size(); i += 4) {
+    int d = 0;
+    for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(int(a.texels[i + c]) - b.texels[i + c]));
+    uint8_t v = uint8_t(std::min(255, d * gain));
+    out.texels[i] = out.texels[i + 1] = out.texels[i + 2] = v;
+  }
+  return out;
+}
+
+Rgba8Image residency_heat_map(const VirtualFrame& frame) {
+  static const uint8_t kPalette[8][3] = {{255, 255, 255}, {255, 230, 60}, {80, 220, 80},
+                                         {60, 220, 230},  {60, 110, 255}, {170, 80, 255},
+                                         {120, 120, 120}, {60, 60, 60}};
+  Rgba8Image out;
+  out.width = frame.color.width;
+  out.height = frame.color.height;
+  out.texels.assign(frame.status.size() * 4, 0);
+  for (size_t i = 0; i < frame.status.size(); ++i) {
+    uint8_t* p = &out.texels[i * 4];
+    p[3] = 255;
+    uint32_t s = frame.status[i];
+    if (!(s & 0x80000000u)) continue;
+    uint32_t wanted = s & 0xFF, sampled = (s >> 8) & 0xFF;
+    if (sampled == 31) {
+      p[0] = 255, p[1] = 0, p[2] = 255;
+      continue;
+    }
+    const uint8_t* c = kPalette[std::min<uint32_t>(sampled, 7)];
+    for (int k = 0; k < 3; ++k) p[k] = c[k];
+    if (sampled > wanted) {
+      p[0] = 255;
+      p[1] = uint8_t(p[1] / 3);
+      p[2] = uint8_t(p[2] / 3);
+    }
+  }
+  return out;
+}
+
+Status write_png(const std::string& path, const Rgba8Image& image) {
+  if (image.texels.size() != size_t(image.width) * image.height * 4 || image.width == 0) {
+    return Error(ErrorCode::kInvalidArgument, path + ": empty or malformed image");
+  }
+  std::vector<uint8_t> rgb(size_t(image.width) * image.height * 3);
+  for (size_t i = 0, n = size_t(image.width) * image.height; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = image.texels[i * 4 + c];
+  }
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out) return Error(ErrorCode::kIo, path + ": cannot create image: " + OIIO::geterror());
+  OIIO::ImageSpec spec(int(image.width), int(image.height), 3, OIIO::TypeDesc::UINT8);
+  if (!out->open(path, spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) ||
+      !out->close()) {
+    return Error(ErrorCode::kIo, path + ": " + out->geterror());
+  }
+  return Status::Ok();
+}
+
+bool ValidationReport::passed() const {
+  if (views.empty()) return false;
+  for (const ViewReport& v : views) {
+    if (!v.failures.empty()) return false;
+  }
+  return true;
+}
+
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+Status write_report_json(const std::string& path, const ValidationReport& r) {
+  using nlohmann::json;
+  json views = json::array();
+  for (const ViewReport& v : r.views) {
+    const ViewMetrics& m = v.metrics;
+    views.push_back({{"view", v.view},
+                     {"passed", v.failures.empty()},
+                     {"failures", v.failures},
+                     {"psnr_rgb", m.psnr_rgb},
+                     {"psnr_alpha", m.psnr_alpha},
+                     {"worst_tile_psnr", m.worst_tile_psnr},
+                     {"ssim", m.ssim},
+                     {"max_abs_error", m.max_abs},
+                     {"pixels_compared", m.pixels},
+                     {"coarser_share", m.coarser_share},
+                     {"unresident_pixels", m.unresident_pixels},
+                     {"converged", v.converge.converged},
+                     {"frames_to_converge", v.converge.frames_to_converge},
+                     {"frames_rendered", v.converge.frames_rendered},
+                     {"pages_uploaded", v.converge.pages_uploaded},
+                     {"load_errors", v.converge.load_errors},
+                     {"thrashing", v.converge.thrashing},
+                     {"feedback_ms_median", median(v.converge.feedback_ms)},
+                     {"stream_ms_median", median(v.converge.stream_ms)},
+                     {"virtual_ms", v.virtual_ms},
+                     {"reference_ms", v.reference_ms},
+                     {"images", v.images}});
+  }
+  json doc = {{"page_file", r.page_file},
+              {"layer", r.layer},
+              {"cache_format", r.cache_format},
+              {"device", r.device},
+              {"width", r.width},
+              {"height", r.height},
+              {"thresholds",
+               {{"min_psnr", r.thresholds.min_psnr},
+                {"min_tile_psnr", r.thresholds.min_tile_psnr},
+                {"max_coarser_share", r.thresholds.max_coarser_share}}},
+              {"passed", r.passed()},
+              {"views", views}};
+  std::ofstream f(path, std::ios::binary | std::ios::trunc);
+  if (!f) return Error(ErrorCode::kIo, path + ": cannot open for writing");
+  f << doc.dump(2) << '\n';
+  f.close();
+  if (!f) return Error(ErrorCode::kIo, path + ": write failed");
+  return Status::Ok();
+}
+
+}  // namespace vt::render

@@ -1,0 +1,25 @@
+// What `vtbake validate` leaves behind: per view the reference and virtual renders, a
+// difference map and a residency heat map as PNGs (OpenImageIO), and report.json.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "common/status.h"
+#include "render/renderer.h"
+#include "render/validate.h"
+
+namespace vt::render {
+
+// Largest |a - b| over RGB per pixel times `gain` (clamped), grey. Same-size images.
+Rgba8Image difference_map(const Rgba8Image& a, const Rgba8Image& b, int gain = 8);
+// The level each pixel's fine taps sampled: level 0 white, then yellow, green, cyan, blue,
+// purple... by level; pixels that sampled coarser than they wanted are tinted red, pixels with
+// nothing resident are magenta, background black.
+Rgba8Image residency_heat_map(const VirtualFrame& frame);
+// Writes RGB (alpha dropped: renders clear to transparent black) PNG. Errors name the file.
+Status write_png(const std::string& path, const Rgba8Image& image);
+
+Status write_report_json(const std::string& path, const ValidationReport& report);
+
+}  // namespace vt::render
