@@ -180,7 +180,7 @@ PackResult pack_charts(const std::vector<PackChart>& charts, int width, int padd
     Placement best;
     for (int r = 0; r < 4; ++r) {
       const Profile& pr = profiles[c][r];
-      if (pr.width > width && r > 0) continue;  // the caller makes sure rotation 0 or 1 fits
+      if (pr.width > width) continue;
       int x_max = width - pr.width;
       for (int x = 0; x <= std::max(0, x_max); ++x) {
         int64_t y = 0;
@@ -205,6 +205,11 @@ PackResult pack_charts(const std::vector<PackChart>& charts, int width, int padd
           best = {r, x, static_cast<int>(y)};
         }
       }
+    }
+    if (best_top == std::numeric_limits<int64_t>::max()) {
+      // No rotation fits the width: report it; the caller picks a wider atlas or lower density.
+      result.overflow = true;
+      best = {0, 0, top_all + padding};
     }
     const Profile& pr = profiles[c][best.rotation];
     for (int d = 0; d < pr.width && best.x + d < width; ++d)

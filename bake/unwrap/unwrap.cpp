@@ -567,9 +567,17 @@ void fit_box(detail::PackChart* pc) {
     lo[0] = std::min(lo[0], p[0]), hi[0] = std::max(hi[0], p[0]), lo[1] = std::min(lo[1], p[1]),
     hi[1] = std::max(hi[1], p[1]);
   }
-  for (P2& p : pc->points) p = {p[0] - lo[0], p[1] - lo[1]};
-  pc->width = hi[0] - lo[0];
-  pc->height = hi[1] - lo[1];
+  // Centre the box in whole texels with at least kMargin texel around it: a vertex on a texel
+  // line would conservatively touch the texel beyond the footprint grid, and float atlas UVs
+  // move vertices by up to ~1e-3 texel in a 16k atlas.
+  const double kMargin = 1.0 / 64;
+  double w = hi[0] - lo[0], h = hi[1] - lo[1];
+  double gx = std::max(1.0, std::ceil(w + 2 * kMargin)),
+         gy = std::max(1.0, std::ceil(h + 2 * kMargin));
+  double ox = (gx - w) / 2 - lo[0], oy = (gy - h) / 2 - lo[1];
+  for (P2& p : pc->points) p = {p[0] + ox, p[1] + oy};
+  pc->width = gx;
+  pc->height = gy;
 }
 
 }  // namespace
@@ -768,7 +776,7 @@ Expected<UnwrapResult> unwrap_scene(const scene::Scene& in, const UnwrapOptions&
         pr = detail::pack_charts(trial, width, opt.padding, threads);
         double max_w = 0;
         for (const auto& pc : trial) max_w = std::max(max_w, std::min(pc.width, pc.height));
-        fits = pr.height <= width && max_w < width;
+        fits = !pr.overflow && pr.height <= width && max_w < width;
       }
       if (fits) {
         if (!have_fit || tpu > best_tpu)

@@ -40,6 +40,7 @@ struct Placement {
 struct PackResult {
   std::vector<Placement> placements;
   int width = 0, height = 0;  // used extent in texels (height = top of the skyline)
+  bool overflow = false;      // some chart was wider than the atlas in every rotation
 };
 
 // Skyline packing of conservative chart footprints, `padding` empty texels between charts,

@@ -1,0 +1,193 @@
+// unwrap_scene on procedural meshes: validity (no flip, no overlap, every face mapped, UVs in
+// [0, 1]), stretch, seams, instances and determinism.
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "mesh_gen.h"
+
+namespace vt::test {
+namespace {
+
+unwrap::UnwrapOptions small_options() {
+  unwrap::UnwrapOptions o;
+  o.size_pages = 4;
+  o.threads = 2;
+  return o;
+}
+
+TEST(Unwrap, FlatGridIsOneIsometricChart) {
+  Scene s = scene_of(flat_grid(20, 10, 2.0, 1.0));
+  auto r = unwrap::unwrap_scene(s, small_options());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  expect_valid(s, *r, 4);
+  EXPECT_EQ(r->stats.charts, 1);
+  EXPECT_NEAR(r->stats.stretch_l2, 1.0, 1e-4);
+  EXPECT_NEAR(r->stats.stretch_linf, 1.0, 1e-3);
+  // A 2:1 rectangle in a 480×480 atlas: the density search fills the width (rotation allowed).
+  EXPECT_GT(r->stats.utilisation, 0.3);
+}
+
+TEST(Unwrap, SphereHasLowStretchAndFullCoverageOfFaces) {
+  Scene s = scene_of(sphere(48, 24));
+  auto r = unwrap::unwrap_scene(s, small_options());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  expect_valid(s, *r, 4);
+  EXPECT_GT(r->stats.charts, 1);  // a closed surface can never be one disk
+  EXPECT_LT(r->stats.stretch_l2, 1.05);
+  EXPECT_GT(r->stats.utilisation, 0.3);
+}
+
+TEST(Unwrap, NewUvSetIsAppendedAfterExistingSets) {
+  Primitive p = flat_grid(4, 4);
+  p.uvs.resize(2);
+  for (auto& set : p.uvs)
+    for (const auto& v : p.positions) set.push_back({v[0], v[1]});
+  Scene s = scene_of(p);
+  auto r = unwrap::unwrap_scene(s, small_options());
+  ASSERT_TRUE(r.ok());
+  const auto& out = r->scene.meshes[0].primitives[0];
+  ASSERT_EQ(out.uvs.size(), 3u);  // TEXCOORD_2 is the atlas
+  // Old UV sets are carried per vertex: each output vertex's old UV equals its position here.
+  for (size_t v = 0; v < out.positions.size(); ++v) {
+    EXPECT_EQ(out.uvs[0][v][0], out.positions[v][0]);
+    EXPECT_EQ(out.uvs[1][v][1], out.positions[v][1]);
+  }
+}
+
+TEST(Unwrap, OriginalUvSeamsAlwaysCut) {
+  // A flat grid whose left and right halves have different UV islands (duplicated seam
+  // vertices with different UVs): the seam must separate charts even though it is flat.
+  Primitive p;
+  auto half = flat_grid(5, 5, 1.0, 1.0);
+  for (int side = 0; side < 2; ++side) {
+    uint32_t base = static_cast<uint32_t>(p.positions.size());
+    for (const auto& v : half.positions) p.positions.push_back({v[0] + side, v[1], 0});
+    for (uint32_t i : half.indices) p.indices.push_back(base + i);
+  }
+  p.uvs.resize(1);
+  for (size_t v = 0; v < p.positions.size(); ++v)
+    p.uvs[0].push_back({v < half.positions.size() ? 0.0f : 0.5f, 0.0f});
+  Scene s = scene_of(p);
+  auto r = unwrap::unwrap_scene(s, small_options());
+  ASSERT_TRUE(r.ok());
+  expect_valid(s, *r, 4);
+  EXPECT_EQ(r->stats.charts, 2);
+  // Without the UV difference the two halves weld into one chart.
+  p.uvs.clear();
+  Scene s2 = scene_of(p);
+  auto r2 = unwrap::unwrap_scene(s2, small_options());
+  ASSERT_TRUE(r2.ok());
+  EXPECT_EQ(r2->stats.charts, 1);
+}
+
+TEST(Unwrap, MaterialBoundariesCut) {
+  Primitive a = flat_grid(4, 4), b = flat_grid(4, 4);
+  for (auto& v : b.positions) v[0] += 1.0f;  // shares the x = 1 edge geometrically
+  a.material = 0;
+  b.material = 1;
+  std::vector<Primitive> prims = {a, b};
+  Scene s = scene_of(prims);
+  s.materials.resize(2);
+  auto r = unwrap::unwrap_scene(s, small_options());
+  ASSERT_TRUE(r.ok());
+  expect_valid(s, *r, 4);
+  EXPECT_EQ(r->stats.charts, 2);
+}
+
+TEST(Unwrap, InstancesGetUniqueTexelsOrShare) {
+  Scene s = scene_of(sphere(16, 8));
+  scene::Node second;
+  second.mesh = 0;
+  second.local[12] = 5.0;  // translated copy
+  s.nodes.push_back(second);
+  s.roots.push_back(1);
+  auto r = unwrap::unwrap_scene(s, small_options());
+  ASSERT_TRUE(r.ok());
+  expect_valid(s, *r, 4);
+  ASSERT_EQ(r->scene.meshes.size(), 2u);
+  EXPECT_EQ(r->scene.nodes[0].mesh, 0);
+  EXPECT_EQ(r->scene.nodes[1].mesh, 1);
+  EXPECT_EQ(r->stats.faces, 2 * static_cast<int64_t>(s.triangle_count()));
+  // The two instances' charts do not share texels: the overlap check covers all triangles.
+  auto o = small_options();
+  o.share_instances = true;
+  auto shared = unwrap::unwrap_scene(s, o);
+  ASSERT_TRUE(shared.ok());
+  EXPECT_EQ(shared->scene.meshes.size(), 1u);
+  EXPECT_EQ(shared->stats.faces, static_cast<int64_t>(s.triangle_count()));
+}
+
+TEST(Unwrap, TexelsPerUnitSetsTheScale) {
+  Scene s = scene_of(flat_grid(4, 4, 1.0, 1.0));
+  unwrap::UnwrapOptions o;
+  o.texels_per_unit = 100.0;
+  o.padding = 2;
+  auto r = unwrap::unwrap_scene(s, o);
+  ASSERT_TRUE(r.ok());
+  expect_valid(s, *r, 2);
+  EXPECT_EQ(r->stats.atlas_width, 120);
+  EXPECT_EQ(r->stats.atlas_height, 120);
+  // A 1×1 square at 100 texels/unit covers 100×100 = 10,000 texel centres (± one row/column
+  // per edge because the square sits at an integer offset).
+  int64_t covered = static_cast<int64_t>(std::llround(r->stats.utilisation * 120 * 120));
+  EXPECT_NEAR(covered, 10000, 201);
+}
+
+TEST(Unwrap, ArapMethodIsValid) {
+  Scene s = scene_of(grid(
+      16, 16, 1, 1, [](double x, double y) { return 0.3 * std::sin(3 * x) * std::cos(2 * y); }));
+  auto o = small_options();
+  o.method = unwrap::Method::kArap;
+  auto r = unwrap::unwrap_scene(s, o);
+  ASSERT_TRUE(r.ok());
+  expect_valid(s, *r, 4);
+  EXPECT_LT(r->stats.stretch_l2, 1.05);
+}
+
+TEST(Unwrap, Deterministic) {
+  Scene s = scene_of(sphere(32, 16));
+  auto o = small_options();
+  auto a = unwrap::unwrap_scene(s, o);
+  o.threads = 1;
+  auto b = unwrap::unwrap_scene(s, o);
+  ASSERT_TRUE(a.ok() && b.ok());
+  const auto& pa = a->scene.meshes[0].primitives[0];
+  const auto& pb = b->scene.meshes[0].primitives[0];
+  EXPECT_EQ(pa.indices, pb.indices);
+  EXPECT_EQ(pa.uvs.back(), pb.uvs.back());
+}
+
+TEST(Unwrap, RejectsBadOptions) {
+  Scene s = scene_of(flat_grid(1, 1));
+  unwrap::UnwrapOptions o;
+  o.padding = -1;
+  EXPECT_EQ(unwrap::unwrap_scene(s, o).status().code(), ErrorCode::kInvalidArgument);
+  o = {};
+  o.texels_per_unit = std::nan("");
+  EXPECT_EQ(unwrap::unwrap_scene(s, o).status().code(), ErrorCode::kInvalidArgument);
+  o = {};
+  o.texels_per_unit = 1e9;  // a 1e9-texel-wide atlas
+  EXPECT_EQ(unwrap::unwrap_scene(s, o).status().code(), ErrorCode::kResourceLimit);
+}
+
+TEST(Unwrap, ReportAndPicture) {
+  Scene s = scene_of(sphere(16, 8));
+  auto r = unwrap::unwrap_scene(s, small_options());
+  ASSERT_TRUE(r.ok());
+  std::string json = unwrap::report_json(r->stats);
+  EXPECT_NE(json.find("\"utilisation\""), std::string::npos);
+  EXPECT_NE(json.find("\"overlapping_texels\": 0"), std::string::npos);
+  std::string png = ::testing::TempDir() + "unwrap_atlas.png";
+  ASSERT_TRUE(unwrap::write_atlas_picture(*r, png, 256).ok());
+  FILE* f = std::fopen(png.c_str(), "rb");
+  ASSERT_NE(f, nullptr);
+  unsigned char sig[8] = {};
+  EXPECT_EQ(std::fread(sig, 1, 8, f), 8u);
+  std::fclose(f);
+  EXPECT_EQ(sig[1], 'P');
+  EXPECT_EQ(sig[2], 'N');
+}
+
+}  // namespace
+}  // namespace vt::test
