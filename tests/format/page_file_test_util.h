@@ -5,6 +5,7 @@
 #include <zstd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -17,11 +18,23 @@
 
 namespace vt::testing {
 
+// Removes the test's temporary folders when the test executable exits.
+struct TempDirs {
+  std::vector<std::filesystem::path> dirs;
+  ~TempDirs() {
+    std::error_code ec;
+    for (auto& d : dirs) std::filesystem::remove_all(d, ec);
+  }
+};
+inline TempDirs temp_dirs;
+
+// A path in a fresh folder of its own (so tests can check what else appears beside it).
 inline std::string temp_path(const std::string& name) {
-  static int counter = 0;
+  static std::atomic<int> counter{0};
   auto dir = std::filesystem::temp_directory_path() /
              ("vtbake_format_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
   std::filesystem::create_directories(dir);
+  temp_dirs.dirs.push_back(dir);
   return (dir / name).string();
 }
 

@@ -1,0 +1,205 @@
+// End-to-end: `vtbake info --json`, `verify` and `extract` on page files written by the library.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "format/page_file.h"
+#include "tests/format/page_file_test_util.h"
+
+namespace vt {
+namespace {
+
+using namespace vt::testing;
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out;
+};
+
+RunResult run(const std::string& args) {
+  RunResult r;
+  const std::string command = std::string(VTBAKE_BINARY) + " " + args + " 2>/dev/null";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) return r;
+  char buf[4096];
+  for (size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;) r.out.append(buf, n);
+  const int status = ::pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+// A two-layer file with every page of every level cut from known level images; level 1 of
+// the albedo layer has one absent and one constant page.
+struct TestFile {
+  PageFileDesc desc;
+  std::vector<std::vector<uint8_t>> albedo, height;
+  std::string path;
+};
+
+TestFile make_file() {
+  TestFile t;
+  t.desc.geometry = {45, 30, 12, 2};  // 4x3 -> 2x2 -> 1x1 pages
+  t.desc.layers = {layer("albedo", 3, TexelType::kU8, PageCodec::kRawZstd),
+                   layer("height", 1, TexelType::kF32, PageCodec::kRaw)};
+  t.desc.layers[0].runtime_format = RuntimeFormat::kBc1;
+  t.desc.layers[0].color_space = ColorSpace::kSrgb;
+  t.desc.layers[1].semantic = LayerSemantic::kCustom;
+  t.desc.metadata_json = R"({"tool":"test","settings":{"quality":75}})";
+  const PageGeometry& g = t.desc.geometry;
+  t.albedo = random_levels(g, 3, 1);
+  t.height = random_levels(g, 4, 2);
+  // Finite floats only: the EXR round trip compares bits.
+  for (auto& level : t.height)
+    for (size_t i = 3; i < level.size(); i += 4) level[i] &= 0x3F;
+  t.path = temp_path("cli.vtpf");
+  auto w = PageFileWriter::create(t.path, t.desc);
+  EXPECT_TRUE(w.ok());
+  for (uint32_t l = 0; l < g.level_count(); ++l)
+    for (uint32_t y = 0; y < g.pages_y(l); ++y)
+      for (uint32_t x = 0; x < g.pages_x(l); ++x) {
+        const PageId id{l, x, y};
+        if (l == 1 && x == 0 && y == 1) {
+          const uint8_t grey[3] = {9, 8, 7};
+          EXPECT_TRUE((*w)->add_constant_page(id, 0, grey).ok());
+        } else if (!(l == 1 && x == 1 && y == 1)) {  // (1, 1, 1) stays absent
+          auto a = cut_page(t.albedo[l], g.level_width(l), g.level_height(l), 3, g, id);
+          std::vector<uint8_t> z(ZSTD_compressBound(a.size()));
+          z.resize(ZSTD_compress(z.data(), z.size(), a.data(), a.size(), 1));
+          EXPECT_TRUE((*w)->add_page(id, 0, z).ok());
+        }
+        auto h = cut_page(t.height[l], g.level_width(l), g.level_height(l), 4, g, id);
+        EXPECT_TRUE((*w)->add_page(id, 1, h).ok());
+      }
+  EXPECT_TRUE((*w)->finish().ok());
+  return t;
+}
+
+TEST(CliInfo, JsonDescribesTheFile) {
+  TestFile t = make_file();
+  RunResult r = run("info --json " + t.path);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["payload"], 12);
+  EXPECT_EQ(j["border"], 2);
+  EXPECT_EQ(j["width"], 45);
+  EXPECT_EQ(j["height"], 30);
+  EXPECT_EQ(j["version"], 1);
+  ASSERT_EQ(j["layers"].size(), 2u);
+  EXPECT_EQ(j["layers"][0]["semantic"], "albedo");
+  EXPECT_EQ(j["layers"][0]["name"], "albedo");
+  EXPECT_EQ(j["layers"][0]["channels"], 3);
+  EXPECT_EQ(j["layers"][0]["codec"], "raw+zstd");
+  EXPECT_EQ(j["layers"][0]["runtime_format"], "bc1");
+  EXPECT_EQ(j["layers"][0]["color_space"], "srgb");
+  EXPECT_EQ(j["layers"][1]["texel_type"], "f32");
+  EXPECT_EQ(j["layers"][1]["codec"], "raw");
+  ASSERT_EQ(j["levels"].size(), 3u);
+  EXPECT_EQ(j["levels"][0]["pages_x"], 4);
+  EXPECT_EQ(j["levels"][0]["pages_y"], 3);
+  EXPECT_EQ(j["levels"][0]["stored_pages"], 24);  // 12 pages x 2 layers
+  EXPECT_EQ(j["levels"][1]["stored_pages"], 6);   // 4 height + 2 albedo
+  EXPECT_EQ(j["levels"][1]["constant_pages"], 1);
+  EXPECT_EQ(j["levels"][1]["absent_pages"], 1);
+  EXPECT_EQ(j["levels"][1]["bytes"].get<uint64_t>() > 3 * 16 * 16 * 4, true);
+  EXPECT_EQ(j["metadata"]["settings"]["quality"], 75);
+  uint64_t bytes = 0;
+  for (auto& level : j["levels"]) bytes += level["bytes"].get<uint64_t>();
+  EXPECT_EQ(j["stored_bytes"].get<uint64_t>(), bytes);
+
+  RunResult text = run("info " + t.path);
+  EXPECT_EQ(text.exit_code, 0);
+  EXPECT_NE(text.out.find("compression ratio"), std::string::npos);
+  EXPECT_EQ(run("info " + t.path + ".missing").exit_code, 2);
+}
+
+TEST(CliVerify, ExitStatusSaysTheResult) {
+  TestFile t = make_file();
+  RunResult ok = run("verify " + t.path);
+  EXPECT_EQ(ok.exit_code, 0) << ok.out;
+  RunResult json = run("--json verify " + t.path);
+  ASSERT_EQ(json.exit_code, 0);
+  auto j = nlohmann::json::parse(json.out);
+  EXPECT_EQ(j["ok"], true);
+  EXPECT_EQ(j["pages_checked"], 24 + 6 + 2);
+
+  // One flipped data byte: a bad page, exit 1, and the page is named.
+  std::vector<uint8_t> bytes = read_bytes(t.path);
+  bytes[le64(bytes, 64) + 5] ^= 0x40;
+  const std::string bad = temp_path("bad.vtpf");
+  write_bytes(bad, bytes);
+  RunResult r = run("verify --json " + bad);
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  auto jb = nlohmann::json::parse(r.out);
+  EXPECT_EQ(jb["ok"], false);
+  ASSERT_EQ(jb["bad_pages"].size(), 1u);
+  EXPECT_EQ(jb["bad_pages"][0]["level"], 2);  // the coarsest level's pages come first
+
+  // Not a page file at all: exit 2.
+  write_bytes(bad, {'n', 'o', 'p', 'e'});
+  EXPECT_EQ(run("verify " + bad).exit_code, 2);
+  bytes = read_bytes(t.path);
+  bytes[20] ^= 1;  // header bit: the file cannot be trusted at all
+  write_bytes(bad, bytes);
+  EXPECT_EQ(run("verify " + bad).exit_code, 2);
+}
+
+TEST(CliExtract, RoundTripsEveryLevelExactly) {
+  TestFile t = make_file();
+  const PageGeometry& g = t.desc.geometry;
+  for (uint32_t l = 0; l < g.level_count(); ++l) {
+    if (l == 1) continue;  // level 1 has an absent and a constant page, checked below
+    const std::string png = temp_path("level.png");
+    RunResult r = run("extract " + t.path + " --level " + std::to_string(l) + " -o " + png);
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    auto in = OIIO::ImageInput::open(png);
+    ASSERT_TRUE(in);
+    const OIIO::ImageSpec& spec = in->spec();
+    ASSERT_EQ(uint32_t(spec.width), g.level_width(l));
+    ASSERT_EQ(uint32_t(spec.height), g.level_height(l));
+    ASSERT_EQ(spec.nchannels, 3);
+    std::vector<uint8_t> pixels(t.albedo[l].size());
+    ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, pixels.data()));
+    EXPECT_EQ(pixels, t.albedo[l]) << "level " << l;
+
+    const std::string exr = temp_path("level.exr");
+    r = run("extract " + t.path + " --level " + std::to_string(l) + " --layer 1 -o " + exr);
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    auto fin = OIIO::ImageInput::open(exr);
+    ASSERT_TRUE(fin);
+    ASSERT_EQ(fin->spec().format, OIIO::TypeDesc::FLOAT);
+    std::vector<uint8_t> floats(t.height[l].size());
+    ASSERT_TRUE(fin->read_image(0, 0, 0, 1, OIIO::TypeDesc::FLOAT, floats.data()));
+    EXPECT_EQ(floats, t.height[l]) << "level " << l;
+  }
+
+  // Level 1: stored pages exact, the constant page its value, the absent page (1, 1) nearest-
+  // upsampled from level 2.
+  const std::string png = temp_path("level1.png");
+  ASSERT_EQ(run("extract " + t.path + " --level 1 -o " + png).exit_code, 0);
+  auto in = OIIO::ImageInput::open(png);
+  ASSERT_TRUE(in);
+  const uint32_t w = g.level_width(1), h = g.level_height(1), w2 = g.level_width(2);
+  std::vector<uint8_t> pixels(size_t(w) * h * 3);
+  ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, pixels.data()));
+  for (uint32_t y = 0; y < h; ++y)
+    for (uint32_t x = 0; x < w; ++x)
+      for (uint32_t c = 0; c < 3; ++c) {
+        const uint32_t px = x / 12, py = y / 12;
+        uint8_t expected = t.albedo[1][(size_t(y) * w + x) * 3 + c];
+        if (px == 0 && py == 1) expected = uint8_t(9 - c);
+        if (px == 1 && py == 1) expected = t.albedo[2][(size_t(y / 2) * w2 + x / 2) * 3 + c];
+        ASSERT_EQ(pixels[(size_t(y) * w + x) * 3 + c], expected) << x << "," << y << "," << c;
+      }
+
+  EXPECT_EQ(run("extract " + t.path + " --level 9 -o " + png).exit_code, 2);
+  EXPECT_EQ(run("extract " + t.path + " --level 0 --layer 5 -o " + png).exit_code, 2);
+  EXPECT_EQ(run("extract " + t.path + ".missing --level 0 -o " + png).exit_code, 2);
+  EXPECT_EQ(run("extract " + t.path + " -o " + png).exit_code, 2);  // --level is required
+}
+
+}  // namespace
+}  // namespace vt
