@@ -3,17 +3,13 @@
 // by the value. Only the few thousand distinct values then go through validation, the LOD
 // bias, the presence map and the ancestor chain, into a second flat table keyed by page index.
 #include <algorithm>
+#include <utility>
 
 #include "runtime/feedback.h"
 
 namespace vt {
 
 namespace {
-
-struct Slot {
-  uint32_t key = 0;  // value + 1; 0 = empty
-  uint32_t count = 0;
-};
 
 inline uint32_t hash32(uint32_t x) {
   x ^= x >> 16;
@@ -24,34 +20,47 @@ inline uint32_t hash32(uint32_t x) {
   return x;
 }
 
-// Flat hash map uint32 -> count with insertion-order list, cleared in O(used).
+// Flat open-addressing map uint32 -> count: one 8-byte slot per probe (key + 1, 0 = empty,
+// and the count), plus dense lists of the entries' keys and slots so that iterating and
+// clearing cost O(entries), not O(slots).
 class CountTable {
  public:
   CountTable() { slots_.resize(1024); }
   void clear() {
-    // Emptying a slot breaks the probe chains through it, so find every slot first.
-    if (keys_.size() * 8 >= slots_.size()) {
-      std::fill(slots_.begin(), slots_.end(), Slot{});
-    } else {
-      found_.clear();
-      for (uint32_t k : keys_) found_.push_back(find(k));
-      for (uint32_t i : found_) slots_[i] = {};
-    }
+    // By recorded slot: emptying slots while looking keys up would cut probe chains.
+    for (uint32_t i : entry_slot_) slots_[i] = {};
     keys_.clear();
+    entry_slot_.clear();
   }
-  void add(uint32_t key, uint32_t count) {
-    if ((keys_.size() + 1) * 2 > slots_.size()) grow();
+  // Adds `count` to `key`; returns the entry's dense index and whether it is new.
+  std::pair<uint32_t, bool> add(uint32_t key, uint32_t count) {
     uint32_t i = find(key);
-    if (slots_[i].key == 0) {
-      slots_[i].key = key + 1;
-      keys_.push_back(key);
+    if (slots_[i].key != 0) {
+      slots_[i].count += count;
+      return {slots_[i].index, false};
     }
-    slots_[i].count += count;
+    if ((keys_.size() + 1) * 2 > slots_.size()) {
+      grow();
+      i = find(key);
+    }
+    const uint32_t index = uint32_t(keys_.size());
+    slots_[i] = {key + 1, count, index};
+    keys_.push_back(key);
+    entry_slot_.push_back(i);
+    return {index, true};
   }
-  uint32_t count(uint32_t key) const { return slots_[find(key)].count; }
-  const std::vector<uint32_t>& keys() const { return keys_; }
+  // Hot path for runs: only the count.
+  void add_count(uint32_t key, uint32_t count) { add(key, count); }
+  size_t size() const { return keys_.size(); }
+  uint32_t key(uint32_t index) const { return keys_[index]; }
+  uint32_t count(uint32_t index) const { return slots_[entry_slot_[index]].count; }
 
  private:
+  struct Slot {
+    uint32_t key = 0;
+    uint32_t count = 0;
+    uint32_t index = 0;
+  };
   uint32_t find(uint32_t key) const {
     const uint32_t mask = uint32_t(slots_.size() - 1);
     uint32_t i = hash32(key) & mask;
@@ -62,12 +71,16 @@ class CountTable {
     std::vector<Slot> old;
     old.swap(slots_);
     slots_.assign(old.size() * 2, {});
-    for (const Slot& s : old)
-      if (s.key != 0) slots_[find(s.key - 1)] = s;
+    for (uint32_t e = 0; e < keys_.size(); ++e) {
+      const Slot& o = old[entry_slot_[e]];
+      const uint32_t i = find(keys_[e]);
+      slots_[i] = o;
+      entry_slot_[e] = i;
+    }
   }
   std::vector<Slot> slots_;
   std::vector<uint32_t> keys_;
-  std::vector<uint32_t> found_;
+  std::vector<uint32_t> entry_slot_;
 };
 
 }  // namespace
@@ -79,6 +92,7 @@ struct FeedbackResolver::Impl {
   std::vector<uint32_t> level_base;
   CountTable values;
   CountTable pages;
+  std::vector<std::vector<std::pair<PageId, uint32_t>>> buckets;  // per level: page, entry
 
   explicit Impl(const PageSource& s) : source(s), geometry(s.geometry()) {
     levels = geometry.level_count();
@@ -90,14 +104,6 @@ struct FeedbackResolver::Impl {
   }
   uint32_t key(const PageId& id) const {
     return level_base[id.level] + id.y * geometry.pages_x(id.level) + id.x;
-  }
-  PageId from_key(uint32_t k) const {
-    uint32_t l =
-        uint32_t(std::upper_bound(level_base.begin(), level_base.end(), k) - level_base.begin()) -
-        1;
-    const uint32_t i = k - level_base[l];
-    const uint32_t w = geometry.pages_x(l);
-    return PageId{l, i % w, i / w};
   }
   PageId nearest_present(PageId id) const {
     while (id.level + 1 < levels && !source.present(id)) {
@@ -136,11 +142,17 @@ ResolveStats FeedbackResolver::resolve(std::span<const uint32_t> feedback, uint3
     if (v != kFeedbackNone) m.values.add(v, uint32_t(std::min<size_t>(j - i, UINT32_MAX)));
     i = j;
   }
-  stats.unique_values = uint32_t(m.values.keys().size());
+  stats.unique_values = uint32_t(m.values.size());
 
+  // Each distinct request lands on its nearest present page; then counts flow up one level at
+  // a time (a parent collects its children's pixels), so each page is visited once instead of
+  // once per descendant request.
   const uint32_t last = m.levels - 1;
-  for (uint32_t v : m.values.keys()) {
-    const uint32_t count = m.values.count(v);
+  for (auto& b : m.buckets) b.clear();
+  m.buckets.resize(m.levels);
+  for (uint32_t e = 0; e < m.values.size(); ++e) {
+    const uint32_t v = m.values.key(e);
+    const uint32_t count = m.values.count(e);
     stats.pixels += count;
     const PageId req = feedback_unpack(v);
     if ((v >> 29) != 0 || !m.geometry.contains(req)) {
@@ -149,17 +161,21 @@ ResolveStats FeedbackResolver::resolve(std::span<const uint32_t> feedback, uint3
     }
     const uint32_t level = std::min(req.level + std::min(lod_bias, last), last);
     const uint32_t shift = level - req.level;
-    PageId id = m.nearest_present(PageId{level, req.x >> shift, req.y >> shift});
-    // The page and its present ancestors; every one gets the pixels of its descendants.
-    for (;;) {
-      m.pages.add(m.key(id), count);
-      if (id.level >= last) break;
-      id = m.nearest_present(PageId{id.level + 1, id.x / 2, id.y / 2});
+    const PageId id = m.nearest_present(PageId{level, req.x >> shift, req.y >> shift});
+    auto [index, inserted] = m.pages.add(m.key(id), count);
+    if (inserted) m.buckets[id.level].push_back({id, index});
+  }
+  for (uint32_t l = 0; l < last; ++l) {
+    for (const auto& [id, index] : m.buckets[l]) {
+      const PageId parent = m.nearest_present(PageId{l + 1, id.x / 2, id.y / 2});
+      auto [pi, inserted] = m.pages.add(m.key(parent), m.pages.count(index));
+      if (inserted) m.buckets[parent.level].push_back({parent, pi});
     }
   }
 
-  out.reserve(m.pages.keys().size());
-  for (uint32_t k : m.pages.keys()) out.push_back({m.from_key(k), m.pages.count(k)});
+  out.reserve(m.pages.size());
+  for (const auto& bucket : m.buckets)
+    for (const auto& [id, index] : bucket) out.push_back({id, m.pages.count(index)});
   std::sort(out.begin(), out.end(), [](const PageRequest& a, const PageRequest& b) {
     if (a.id.level != b.id.level) return a.id.level > b.id.level;
     if (a.pixels != b.pixels) return a.pixels > b.pixels;
