@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -583,6 +584,78 @@ TEST(Report, HeatMapAndDifferenceMap) {
   EXPECT_EQ(d.texels[0], 0);
   EXPECT_EQ(d.texels[4], 24);
   EXPECT_EQ(d.texels[8], 255);
+}
+
+double median_of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+// Figures for docs/bench/render.md, not a test (no assertion on time): run with
+//   vt_render_tests --gtest_also_run_disabled_tests --gtest_filter='*Bench*'
+// 1280x720, feedback at 320x180, the synthetic bake, per view: medians of 9 passes after warm-up.
+TEST(DISABLED_RenderBench, FrameTimes1280x720) {
+  REQUIRE_VULKAN();
+  std::printf("device: %s\n", vulkan()->device_name().c_str());
+  for (RuntimeFormat format : {RuntimeFormat::kRgba8, RuntimeFormat::kBc1}) {
+    RenderOptions o;
+    o.width = 1280;
+    o.height = 720;
+    auto r = Renderer::create(*vulkan(), o);
+    ASSERT_TRUE(r.ok());
+    Renderer& renderer = **r;
+    std::vector<MeshData> scene = make_scene();
+    ASSERT_TRUE(renderer.set_meshes(scene).ok());
+    ReferenceTexture tex;
+    tex.width = tex.height = 1024;
+    tex.levels = levels().images;
+    tex.max_level = test_geometry().level_count() - 1;
+    ASSERT_TRUE(renderer.set_reference_textures(std::span(&tex, 1)).ok());
+    auto source =
+        open_source(write_bake(std::string("bench_") + to_string(format), format, Fault::kNone));
+    ASSERT_TRUE(source);
+    std::vector<Camera> cams = orbit_views({-2, 0, -2}, {2, 1, 2}, 4, 1280.0f / 720.0f);
+    std::printf(
+        "| cache | view | feedback ms | stream ms/frame | final ms | reference ms | "
+        "frames to converge | pages | PSNR dB | worst tile dB | SSIM | coarser |\n");
+    for (size_t v = 0; v < cams.size(); ++v) {
+      StreamerOptions so;
+      so.slots_x = so.slots_y = 16;
+      auto streamer = Streamer::create(source, so);
+      ASSERT_TRUE(streamer.ok());
+      auto setup = virtual_setup_for(**streamer, 0, AddressMode::kClamp);
+      ASSERT_TRUE(setup.ok());
+      ASSERT_TRUE(renderer.set_virtual_texture(*setup).ok());
+      auto c = converge_view(renderer, **streamer, cams[v]);
+      ASSERT_TRUE(c.ok());
+      std::vector<double> fb, fin, ref;
+      VirtualFrame frame;
+      Rgba8Image reference;
+      for (int i = 0; i < 10; ++i) {
+        auto t0 = std::chrono::steady_clock::now();
+        auto f = renderer.render_feedback(cams[v], uint32_t(i));
+        auto t1 = std::chrono::steady_clock::now();
+        auto vf = renderer.render_virtual(cams[v]);
+        auto t2 = std::chrono::steady_clock::now();
+        auto rf = renderer.render_reference(cams[v]);
+        auto t3 = std::chrono::steady_clock::now();
+        ASSERT_TRUE(f.ok() && vf.ok() && rf.ok());
+        if (i == 0) continue;  // warm-up: first use compiles the shaders
+        fb.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+        fin.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
+        ref.push_back(std::chrono::duration<double, std::milli>(t3 - t2).count());
+        frame = std::move(*vf);
+        reference = std::move(*rf);
+      }
+      auto m = compare_view(reference, frame);
+      ASSERT_TRUE(m.ok());
+      std::printf(
+          "| %s | %zu | %.1f | %.1f | %.1f | %.1f | %u | %u | %.2f | %.2f | %.4f | %.4f |\n",
+          to_string(format), v, median_of(fb), median_of(c->stream_ms), median_of(fin),
+          median_of(ref), c->frames_to_converge, c->pages_uploaded, m->psnr_rgb, m->worst_tile_psnr,
+          m->ssim, m->coarser_share);
+    }
+  }
 }
 
 }  // namespace
