@@ -1,0 +1,104 @@
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "format/page_file.h"
+#include "runtime/feedback.h"
+#include "runtime/vt_runtime_c.h"
+
+namespace vt {
+namespace {
+
+// 4 x 3 pages of 8 + 2 * 4 texels, raw RGBA8; every texel of a page is (level, x, y, 255).
+std::string write_marked_file() {
+  PageFileDesc desc;
+  desc.geometry.width = 32;
+  desc.geometry.height = 24;
+  desc.geometry.payload = 8;
+  desc.geometry.border = 4;
+  LayerSpec layer;
+  layer.name = "albedo";
+  layer.codec = PageCodec::kRaw;
+  desc.layers = {layer};
+  auto dir =
+      std::filesystem::temp_directory_path() / ("vtbake_runtime_c_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "c.vtpf").string();
+  auto w = PageFileWriter::create(path, desc);
+  EXPECT_TRUE(w.ok());
+  const PageGeometry& g = desc.geometry;
+  for (uint32_t l = 0; l < g.level_count(); ++l)
+    for (uint32_t y = 0; y < g.pages_y(l); ++y)
+      for (uint32_t x = 0; x < g.pages_x(l); ++x) {
+        std::vector<uint8_t> page(16 * 16 * 4);
+        for (size_t i = 0; i < page.size(); i += 4) {
+          page[i] = uint8_t(l);
+          page[i + 1] = uint8_t(x);
+          page[i + 2] = uint8_t(y);
+          page[i + 3] = 255;
+        }
+        EXPECT_TRUE((*w)->add_page({l, x, y}, 0, page).ok());
+      }
+  EXPECT_TRUE((*w)->finish().ok());
+  return path;
+}
+
+TEST(RuntimeCApi, OpenStreamAndReadTable) {
+  const std::string path = write_marked_file();
+  vtrt_options o;
+  vtrt_default_options(&o);
+  o.slots_x = 5;  // 20 slots for 12 + 4 + 1 pages
+  o.slots_y = 4;
+  vtrt_streamer* h = nullptr;
+  char msg[256] = {};
+  ASSERT_EQ(vtrt_open(path.c_str(), &o, &h, msg, sizeof msg), VTRT_OK) << msg;
+  vtrt_geometry g;
+  ASSERT_EQ(vtrt_geometry_get(h, &g), VTRT_OK);
+  EXPECT_EQ(g.page_size, 16u);
+  EXPECT_EQ(g.level_count, 3u);  // 4x3, 2x2, 1x1
+  uint32_t format = 99;
+  size_t bytes = 0;
+  ASSERT_EQ(vtrt_layer_upload_format(h, 0, &format, &bytes), VTRT_OK);
+  EXPECT_EQ(format, uint32_t(RuntimeFormat::kRgba8));
+  EXPECT_EQ(bytes, 16u * 16u * 4u);
+
+  std::vector<uint32_t> fb;
+  for (uint32_t y = 0; y < 3; ++y)
+    for (uint32_t x = 0; x < 4; ++x) fb.push_back(feedback_pack(0, x, y));
+  uint32_t uploads = 0;
+  vtrt_frame_stats st{};
+  for (int f = 0; f < 20; ++f) {
+    ASSERT_EQ(vtrt_update(h, fb.data(), fb.size(), &st), VTRT_OK);
+    for (uint32_t i = 0; i < vtrt_upload_count(h); ++i) {
+      vtrt_upload u;
+      ASSERT_EQ(vtrt_upload_get(h, i, 0, &u), VTRT_OK);
+      ASSERT_EQ(u.size, bytes);
+      EXPECT_EQ(u.data[0], u.level);
+      EXPECT_EQ(u.data[1], u.page_x);
+      EXPECT_EQ(u.data[2], u.page_y);
+      ++uploads;
+    }
+    vtrt_wait_idle(h);
+    if (st.needed == st.resident_hits && vtrt_idle(h)) break;
+  }
+  EXPECT_EQ(uploads, 12u + 4u + 1u);  // the root comes with the first update
+  const uint8_t* data = nullptr;
+  uint32_t w = 0, hgt = 0, dirty[4];
+  ASSERT_EQ(vtrt_page_table_level(h, 0, &data, &w, &hgt, dirty), VTRT_OK);
+  EXPECT_EQ(w, 4u);
+  EXPECT_EQ(hgt, 3u);
+  EXPECT_EQ(data[3] & 1, 1);
+  vtrt_upload u;
+  EXPECT_NE(vtrt_upload_get(h, 9999, 0, &u), VTRT_OK);
+  EXPECT_NE(std::string(vtrt_last_error(h)), "");
+  vtrt_close(h);
+
+  EXPECT_NE(vtrt_open("/nonexistent/x.vtpf", nullptr, &h, msg, sizeof msg), VTRT_OK);
+  EXPECT_EQ(h, nullptr);
+  EXPECT_NE(std::string(msg).find("/nonexistent/x.vtpf"), std::string::npos) << msg;
+}
+
+}  // namespace
+}  // namespace vt
