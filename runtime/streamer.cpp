@@ -114,6 +114,8 @@ struct Streamer::Impl {
         if (!page.status.ok() || cache.resident(page.id) || !wanted) {
           stats.load_errors += !page.status.ok();
           stats.dropped += !page.status.ok();
+          // A failed prefetch is not retried forever; feedback may ask again.
+          if (!page.status.ok()) explicit_requests.erase(page_key(page.id));
           ready.erase(ready.begin() + i);
           continue;
         }
@@ -345,6 +347,11 @@ std::vector<PageUpload> Streamer::take_uploads() {
 PageTable Streamer::page_table() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->table;
+}
+
+void Streamer::with_page_table(const std::function<void(const PageTable&)>& fn) const {
+  std::lock_guard lock(impl_->mutex);
+  fn(impl_->table);
 }
 
 void Streamer::clear_table_dirty() {

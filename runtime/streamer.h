@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -86,6 +87,9 @@ class Streamer {
   std::vector<PageUpload> take_uploads();
   // A copy of the page table (for uploads: level_data + dirty rectangles).
   PageTable page_table() const;
+  // Calls `fn` with the live table under the streamer's lock (no copy: for large tables,
+  // copy just the dirty rectangles). `fn` must not call back into the streamer.
+  void with_page_table(const std::function<void(const PageTable&)>& fn) const;
   void clear_table_dirty();
 
   uint32_t lod_bias() const;

@@ -13,7 +13,9 @@ struct vtrt_streamer {
   std::unique_ptr<vt::Streamer> streamer;
   mutable std::mutex mutex;  // guards the fields below (the streamer locks itself)
   std::vector<vt::PageUpload> uploads;
-  vt::PageTable table{vt::PageGeometry{}};
+  // The caller's view of the page table, refreshed by dirty rectangles at each update.
+  std::vector<std::vector<uint8_t>> table;
+  std::vector<uint32_t> table_w, table_h;
   std::vector<vt::TableRect> dirty;
   std::string error;
 };
@@ -112,7 +114,16 @@ int vtrt_open(const char* path, const vtrt_options* options, vtrt_streamer** out
   auto* h = new vtrt_streamer;
   h->source = shared;
   h->streamer = std::move(streamer).value();
-  h->table = h->streamer->page_table();
+  h->streamer->with_page_table([&](const vt::PageTable& t) {
+    for (uint32_t l = 0; l < t.level_count(); ++l) {
+      auto d = t.level_data(l);
+      h->table.emplace_back(d.begin(), d.end());
+      h->table_w.push_back(t.width(l));
+      h->table_h.push_back(t.height(l));
+      h->dirty.push_back({0, 0, t.width(l), t.height(l)});
+    }
+  });
+  h->streamer->clear_table_dirty();
   *out = h;
   return VTRT_OK;
 }
@@ -150,11 +161,23 @@ int vtrt_layer_upload_format(const vtrt_streamer* h, uint32_t layer, uint32_t* f
 int vtrt_update(vtrt_streamer* h, const uint32_t* feedback, size_t count, vtrt_frame_stats* stats) {
   if (!h) return VTRT_INVALID_ARGUMENT;
   if (!feedback && count != 0) return fail(h, VTRT_INVALID_ARGUMENT, "vtrt_update: no feedback");
+  // Held across update, copy and clear so that no other caller's update slips in between.
+  std::lock_guard lock(h->mutex);
   const vt::FrameStats s =
       h->streamer->update(std::span<const uint32_t>(feedback, feedback ? count : 0));
-  std::lock_guard lock(h->mutex);
   h->uploads = h->streamer->take_uploads();
-  h->table = h->streamer->page_table();
+  h->streamer->with_page_table([&](const vt::PageTable& t) {
+    for (uint32_t l = 0; l < t.level_count(); ++l) {
+      const vt::TableRect r = t.dirty(l);
+      h->dirty[l] = r;
+      if (r.empty()) continue;
+      const auto src = t.level_data(l);
+      const size_t row = size_t(t.width(l)) * 4;
+      for (uint32_t y = r.y0; y < r.y1; ++y)
+        std::memcpy(&h->table[l][y * row + r.x0 * 4], &src[y * row + r.x0 * 4],
+                    size_t(r.x1 - r.x0) * 4);
+    }
+  });
   h->streamer->clear_table_dirty();
   if (stats) {
     stats->frame = s.frame;
@@ -198,13 +221,13 @@ int vtrt_page_table_level(const vtrt_streamer* h, uint32_t level, const uint8_t*
                           uint32_t* width, uint32_t* height, uint32_t dirty[4]) {
   if (!h || !data || !width || !height) return VTRT_INVALID_ARGUMENT;
   std::lock_guard lock(h->mutex);
-  if (level >= h->table.level_count())
+  if (level >= h->table.size())
     return fail(h, VTRT_INVALID_ARGUMENT, "vtrt_page_table_level: no such level");
-  *data = h->table.level_data(level).data();
-  *width = h->table.width(level);
-  *height = h->table.height(level);
+  *data = h->table[level].data();
+  *width = h->table_w[level];
+  *height = h->table_h[level];
   if (dirty) {
-    const vt::TableRect r = h->table.dirty(level);
+    const vt::TableRect r = h->dirty[level];
     dirty[0] = r.x0;
     dirty[1] = r.y0;
     dirty[2] = r.x1;

@@ -198,7 +198,9 @@ TEST(ReferenceSampler, BitExactAtEveryLevelClamp) {
     const auto used = compare(s, AddressMode::kClamp, level);
     EXPECT_GT(used[level], 0) << level;  // everything resident: the wanted level itself
     for (uint32_t k = 0; k < used.size(); ++k) {
-      if (k != level) EXPECT_EQ(used[k], 0);
+      if (k != level) {
+        EXPECT_EQ(used[k], 0);
+      }
     }
   }
 }
