@@ -1,0 +1,325 @@
+// `vtbake build IMAGE... -o FILE.vtpf`: images (any size, any format OpenImageIO reads) into a
+// page file: mip pyramid, bordered pages, per-layer codec. Flags map onto vt::BuildOptions.
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "bake/build.h"
+#include "cli/command.h"
+
+namespace {
+
+using vt::cli::kExitBadInput;
+using vt::cli::kExitFailure;
+using vt::cli::kExitOk;
+
+struct BuildFlags {
+  std::vector<std::string> images;
+  std::vector<std::string> layers;  // SEMANTIC=PATH or NAME=PATH
+  std::string output;
+  std::string codec = "dct";
+  uint32_t payload = 120;
+  uint32_t border = 4;
+  std::string filter = "kaiser";
+  std::string address = "clamp";
+  std::string memory_limit = "2G";
+  std::string colorspace;
+  std::string fix_nonfinite = "black";
+  std::string scratch_dir;
+};
+
+bool parse_size(const std::string& s, uint64_t* out) {
+  char* end = nullptr;
+  double v = std::strtod(s.c_str(), &end);
+  if (end == s.c_str() || !(v > 0)) return false;
+  std::string unit(end);
+  double mul = 1;
+  if (unit == "K" || unit == "k" || unit == "KiB")
+    mul = 1024.0;
+  else if (unit == "M" || unit == "m" || unit == "MiB")
+    mul = 1024.0 * 1024;
+  else if (unit == "G" || unit == "g" || unit == "GiB")
+    mul = 1024.0 * 1024 * 1024;
+  else if (!unit.empty())
+    return false;
+  *out = uint64_t(v * mul);
+  return true;
+}
+
+bool parse_semantic(const std::string& s, vt::LayerSemantic* sem) {
+  static const std::pair<const char*, vt::LayerSemantic> kNames[] = {
+      {"albedo", vt::LayerSemantic::kAlbedo},
+      {"normal", vt::LayerSemantic::kNormal},
+      {"orm", vt::LayerSemantic::kOrm},
+      {"emissive", vt::LayerSemantic::kEmissive},
+      {"custom", vt::LayerSemantic::kCustom}};
+  for (auto& [name, value] : kNames) {
+    if (s == name) {
+      *sem = value;
+      return true;
+    }
+  }
+  return false;
+}
+
+int bad(const std::string& msg) {
+  std::fprintf(stderr, "vtbake build: %s\n", msg.c_str());
+  return kExitBadInput;
+}
+
+int exit_code_for(const vt::Status& s) {
+  switch (s.code()) {
+    case vt::ErrorCode::kInvalidArgument:
+    case vt::ErrorCode::kNotFound:
+    case vt::ErrorCode::kCorrupt:
+    case vt::ErrorCode::kUnsupported:
+      return kExitBadInput;
+    default:
+      return kExitFailure;
+  }
+}
+
+// One line on a terminal, redrawn at most 5 times a second: stage, pages, rate and ETA.
+class ProgressLine {
+ public:
+  explicit ProgressLine(bool enabled) : enabled_(enabled), start_(Clock::now()) {}
+  void update(const vt::BuildProgress& p) {
+    if (!enabled_) return;
+    auto now = Clock::now();
+    bool final = p.pages_done >= p.pages_total;
+    if (!final && now - last_ < std::chrono::milliseconds(200)) return;
+    last_ = now;
+    double t = std::chrono::duration<double>(now - start_).count();
+    double rate = t > 0 ? double(p.pages_done) / t : 0;
+    double eta = rate > 0 ? double(p.pages_total - p.pages_done) / rate : 0;
+    std::fprintf(stderr, "\r%-15s layer %u level %2u  %llu/%llu pages  %.0f pages/s  ETA %.0f s  ",
+                 p.stage, p.layer, p.level, (unsigned long long)p.pages_done,
+                 (unsigned long long)p.pages_total, rate, eta);
+    std::fflush(stderr);
+  }
+  void done() {
+    if (enabled_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  bool enabled_;
+  Clock::time_point start_, last_{};
+};
+
+nlohmann::json summary_json(const vt::BuildOptions& o, const vt::BuildSummary& s, double wall) {
+  nlohmann::json j;
+  j["output"] = o.output;
+  j["width"] = s.geometry.width;
+  j["height"] = s.geometry.height;
+  j["payload"] = s.geometry.payload;
+  j["border"] = s.geometry.border;
+  j["pages"] = s.pages;
+  j["stored_pages"] = s.stored;
+  j["constant_pages"] = s.constant;
+  j["absent_pages"] = s.absent;
+  j["stored_bytes"] = s.stored_bytes;
+  j["file_bytes"] = s.file_bytes;
+  j["scratch_bytes"] = s.scratch_bytes;
+  j["level_memory_bytes"] = s.level_memory_bytes;
+  j["levels"] = nlohmann::json::array();
+  for (size_t l = 0; l < s.levels.size(); ++l) {
+    const vt::LevelSummary& v = s.levels[l];
+    j["levels"].push_back({{"level", l},
+                           {"width", v.width},
+                           {"height", v.height},
+                           {"pages_x", v.pages_x},
+                           {"pages_y", v.pages_y},
+                           {"stored", v.stored},
+                           {"constant", v.constant},
+                           {"absent", v.absent},
+                           {"bytes", v.stored_bytes},
+                           {"scratch", v.scratch}});
+  }
+  j["layers"] = nlohmann::json::array();
+  for (const vt::LayerSummary& l : s.layers) {
+    nlohmann::json lj = {{"name", l.name},
+                         {"semantic", vt::to_string(l.spec.semantic)},
+                         {"channels", l.spec.channels},
+                         {"texel_type", vt::to_string(l.spec.texel_type)},
+                         {"codec", vt::to_string(l.spec.codec)},
+                         {"runtime_format", vt::to_string(l.spec.runtime_format)},
+                         {"color_space", vt::to_string(l.spec.color_space)},
+                         {"max_error", l.max_error},
+                         {"non_finite", l.non_finite.non_finite},
+                         {"negative", l.non_finite.negative}};
+    // JSON has no infinity: a lossless layer's PSNR is null.
+    lj["psnr_db"] = std::isfinite(l.psnr_db) ? nlohmann::json(l.psnr_db) : nlohmann::json();
+    if (l.non_finite.any()) {
+      lj["first_bad_texel"] = {l.non_finite.first_x, l.non_finite.first_y,
+                               l.non_finite.first_channel};
+    }
+    j["layers"].push_back(lj);
+  }
+  j["stages"] = nlohmann::json::object();
+  for (const vt::StageTime& t : s.stages) j["stages"][t.name] = t.seconds;
+  j["wall_seconds"] = wall;
+  return j;
+}
+
+void print_text(const vt::BuildOptions& o, const vt::BuildSummary& s, double wall) {
+  std::printf(
+      "%s: %u x %u texels, %zu levels, %llu pages (%llu stored, %llu constant, %llu "
+      "absent), %.1f MiB in %.2f s\n",
+      o.output.c_str(), s.geometry.width, s.geometry.height, s.levels.size(),
+      (unsigned long long)s.pages, (unsigned long long)s.stored, (unsigned long long)s.constant,
+      (unsigned long long)s.absent, double(s.file_bytes) / (1 << 20), wall);
+  for (const vt::LayerSummary& l : s.layers) {
+    std::printf("  layer \"%s\": %u x %s, %s -> %s, ", l.name.c_str(), l.spec.channels,
+                vt::to_string(l.spec.texel_type), vt::to_string(l.spec.codec),
+                vt::to_string(l.spec.runtime_format));
+    if (std::isfinite(l.psnr_db)) {
+      std::printf("PSNR %.2f dB, max error %u\n", l.psnr_db, l.max_error);
+    } else {
+      std::printf("lossless\n");
+    }
+    if (l.non_finite.any()) {
+      std::printf(
+          "  warning: %llu non-finite and %llu negative values, first at texel (%u, %u) "
+          "channel %u; fixed as --fix-nonfinite says\n",
+          (unsigned long long)l.non_finite.non_finite, (unsigned long long)l.non_finite.negative,
+          l.non_finite.first_x, l.non_finite.first_y, l.non_finite.first_channel);
+    }
+  }
+  std::printf("  stages:");
+  for (const vt::StageTime& t : s.stages) std::printf(" %s %.2f s", t.name.c_str(), t.seconds);
+  std::printf("\n");
+}
+
+int run_build(const BuildFlags& f, const vt::cli::GlobalOptions& global) {
+  vt::BuildOptions o;
+  o.output = f.output;
+  o.payload = f.payload;
+  o.border = f.border;
+  o.threads = global.threads;
+  o.scratch_dir = f.scratch_dir;
+  // --codec dct[:QUALITY] | bc | raw
+  std::string codec = f.codec, quality;
+  if (auto colon = codec.find(':'); colon != std::string::npos) {
+    quality = codec.substr(colon + 1);
+    codec = codec.substr(0, colon);
+  }
+  if (codec == "dct") {
+    o.codec.codec = vt::CodecKind::kDct;
+    if (!quality.empty()) {
+      char* end = nullptr;
+      long q = std::strtol(quality.c_str(), &end, 10);
+      if (*end != '\0' || q < 1 || q > 100) return bad("--codec dct:QUALITY needs 1..100");
+      o.codec.dct_quality = int(q);
+    }
+  } else if (codec == "bc" && quality.empty()) {
+    o.codec.codec = vt::CodecKind::kBc;
+  } else if (codec == "raw" && quality.empty()) {
+    o.codec.codec = vt::CodecKind::kRaw;
+  } else {
+    return bad("unknown --codec '" + f.codec + "' (expected dct[:QUALITY], bc or raw)");
+  }
+  auto filter = vt::parse_mip_filter(f.filter.c_str());
+  if (!filter.ok()) return bad(filter.status().message());
+  o.filter = *filter;
+  if (f.address == "clamp") {
+    o.address = vt::AddressMode::kClamp;
+  } else if (f.address == "wrap") {
+    o.address = vt::AddressMode::kWrap;
+  } else {
+    return bad("unknown --address '" + f.address + "' (expected clamp or wrap)");
+  }
+  if (!parse_size(f.memory_limit, &o.memory_limit)) {
+    return bad("bad --memory-limit '" + f.memory_limit + "' (e.g. 512M, 2G)");
+  }
+  auto policy = vt::parse_non_finite_policy(f.fix_nonfinite);
+  if (!policy.ok()) return bad(policy.status().message());
+  o.non_finite = *policy;
+
+  // Positional images: the first is the albedo, the others custom layers named by file.
+  std::vector<std::pair<std::string, std::string>> inputs;  // layer name, path
+  for (size_t i = 0; i < f.images.size(); ++i) {
+    inputs.emplace_back(i == 0 ? "albedo" : std::filesystem::path(f.images[i]).stem().string(),
+                        f.images[i]);
+  }
+  for (const std::string& spec : f.layers) {
+    auto eq = spec.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size()) {
+      return bad("--layer expects NAME=PATH, got '" + spec + "'");
+    }
+    inputs.emplace_back(spec.substr(0, eq), spec.substr(eq + 1));
+  }
+  if (inputs.empty()) return bad("no input image (give IMAGE or --layer NAME=PATH)");
+  for (auto& [name, path] : inputs) {
+    auto src = vt::open_image_file(path);
+    if (!src.ok()) return bad(src.status().message());
+    vt::LayerInput in;
+    vt::LayerSemantic sem;
+    if (parse_semantic(name, &sem)) {
+      in.semantic = sem;
+    } else {
+      in.semantic = vt::LayerSemantic::kCustom;
+      in.name = name;
+    }
+    // A positional albedo that is not colour (one or two channels of data) stays custom.
+    in.source = std::shared_ptr<vt::ImageSource>(std::move(src).value());
+    in.color_space = f.colorspace;
+    o.layers.push_back(std::move(in));
+  }
+
+  nlohmann::json meta;
+  meta["tool"] = "vtbake " VTBAKE_VERSION;
+  meta["sources"] = nlohmann::json::array();
+  for (auto& [name, path] : inputs) meta["sources"].push_back({{"layer", name}, {"path", path}});
+  o.metadata_json = meta.dump();
+
+  ProgressLine line(!global.quiet && isatty(STDERR_FILENO));
+  o.progress = [&line](const vt::BuildProgress& p) { line.update(p); };
+  auto start = std::chrono::steady_clock::now();
+  auto summary = vt::build_page_file(o);
+  line.done();
+  double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!summary.ok()) {
+    std::fprintf(stderr, "vtbake build: %s\n", summary.status().message().c_str());
+    return exit_code_for(summary.status());
+  }
+  if (global.json) {
+    std::printf("%s\n", summary_json(o, *summary, wall).dump(2).c_str());
+  } else if (!global.quiet) {
+    print_text(o, *summary, wall);
+  }
+  return kExitOk;
+}
+
+vt::cli::CommandRunner make_build(CLI::App& sub) {
+  auto f = std::make_shared<BuildFlags>();
+  sub.add_option("images", f->images, "Input images (the first becomes the albedo layer)");
+  sub.add_option("-o,--output", f->output, "Output page file (.vtpf)")->required();
+  sub.add_option("--layer", f->layers,
+                 "A layer NAME=PATH; NAME albedo, normal, orm, emissive or any custom name");
+  sub.add_option("--codec", f->codec, "dct[:QUALITY] (default, quality 75), bc or raw (lossless)");
+  sub.add_option("--payload", f->payload, "Payload texels per page side")->capture_default_str();
+  sub.add_option("--border", f->border, "Border texels per page side")->capture_default_str();
+  sub.add_option("--filter", f->filter, "Mip filter: kaiser, box or lanczos3")
+      ->capture_default_str();
+  sub.add_option("--address", f->address, "Edge rule for borders: clamp or wrap")
+      ->capture_default_str();
+  sub.add_option("--memory-limit", f->memory_limit, "Memory budget, e.g. 512M, 2G")
+      ->capture_default_str();
+  sub.add_option("--colorspace", f->colorspace,
+                 "Colour space of the inputs (linear, sRGB, raw); default from file metadata");
+  sub.add_option("--fix-nonfinite", f->fix_nonfinite,
+                 "NaN/Inf/negative colour values: black, clamp or error")
+      ->capture_default_str();
+  sub.add_option("--scratch-dir", f->scratch_dir,
+                 "Where levels larger than memory go (default: beside the output)");
+  return [f](const vt::cli::GlobalOptions& global) { return run_build(*f, global); };
+}
+
+const vt::cli::CommandRegistration kBuild{"build", "Build a page file from images", make_build};
+
+}  // namespace
