@@ -23,11 +23,12 @@ Grid grid_of(const PackChart& c) {
           std::max(1, static_cast<int>(std::ceil(c.height)))};
 }
 
-// Conservative triangle / axis-aligned box overlap (separating axis test), slightly inflated
-// so that touching counts as overlapping.
+// Conservative triangle / axis-aligned box overlap (separating axis test). The box is
+// inflated by 1/32 texel: atlas UVs are rounded to float afterwards (up to ~1e-3 texel in a
+// 16k atlas), and an edge through a texel corner must not slip into a neighbour's gutter.
 bool triangle_touches_box(const P2& a, const P2& b, const P2& c, double x0, double y0, double x1,
                           double y1) {
-  const double eps = 1e-6;
+  const double eps = 1.0 / 32;
   x0 -= eps, y0 -= eps, x1 += eps, y1 += eps;
   if (std::max({a[0], b[0], c[0]}) < x0 || std::min({a[0], b[0], c[0]}) > x1) return false;
   if (std::max({a[1], b[1], c[1]}) < y0 || std::min({a[1], b[1], c[1]}) > y1) return false;

@@ -570,7 +570,7 @@ void fit_box(detail::PackChart* pc) {
   // Centre the box in whole texels with at least kMargin texel around it: a vertex on a texel
   // line would conservatively touch the texel beyond the footprint grid, and float atlas UVs
   // move vertices by up to ~1e-3 texel in a 16k atlas.
-  const double kMargin = 1.0 / 64;
+  const double kMargin = 1.0 / 16;  // > pack.cpp's 1/32 texel inflation
   double w = hi[0] - lo[0], h = hi[1] - lo[1];
   double gx = std::max(1.0, std::ceil(w + 2 * kMargin)),
          gy = std::max(1.0, std::ceil(h + 2 * kMargin));

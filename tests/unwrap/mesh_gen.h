@@ -100,6 +100,7 @@ inline void expect_valid(const Scene& in, const unwrap::UnwrapResult& r,
   for (const auto& mesh : r.scene.meshes)
     for (const auto& p : mesh.primitives) {
       faces += static_cast<int64_t>(p.triangle_count());
+      if (p.triangle_count() == 0) continue;  // empty primitives are left as they were
       ASSERT_FALSE(p.uvs.empty());
       const auto& uv = p.uvs.back();
       ASSERT_EQ(uv.size(), p.positions.size());
