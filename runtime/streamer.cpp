@@ -45,6 +45,7 @@ struct Streamer::Impl {
   std::unordered_map<uint64_t, LoadPriority> requested;  // handed to the loader, not collected
   std::map<uint64_t, PageRequest> explicit_requests;     // request() calls not yet mapped
   std::vector<LoadedPage> ready;                         // collected, waiting for a slot/parent
+  std::unordered_set<uint64_t> ready_keys;
   std::vector<PageUpload> uploads;
   std::vector<CacheEvent> events;
 
@@ -116,13 +117,13 @@ struct Streamer::Impl {
           stats.dropped += !page.status.ok();
           // A failed prefetch is not retried forever; feedback may ask again.
           if (!page.status.ok()) explicit_requests.erase(page_key(page.id));
-          ready.erase(ready.begin() + i);
+          erase_ready(i);
           continue;
         }
         if (parent && !cache.resident(*parent)) {
           // The parent is not coming (cancelled, dropped): let this one go too.
           if (!requested.count(page_key(*parent)) && !has_ready(*parent)) {
-            ready.erase(ready.begin() + i);
+            erase_ready(i);
             ++stats.dropped;
             continue;
           }
@@ -137,15 +138,15 @@ struct Streamer::Impl {
           bytes += slot_bytes;
           progress = true;
         }
-        ready.erase(ready.begin() + i);
+        erase_ready(i);
       }
     }
   }
 
-  bool has_ready(const PageId& id) const {
-    for (const LoadedPage& p : ready)
-      if (p.id == id) return true;
-    return false;
+  bool has_ready(const PageId& id) const { return ready_keys.count(page_key(id)) != 0; }
+  void erase_ready(size_t i) {
+    ready_keys.erase(page_key(ready[i].id));
+    ready.erase(ready.begin() + std::ptrdiff_t(i));
   }
 
   void queue_loads(const std::vector<PageRequest>& list, FrameStats& stats) {
@@ -169,7 +170,10 @@ struct Streamer::Impl {
   void collect() {
     const size_t before = ready.size();
     loader->collect(ready);
-    for (size_t i = before; i < ready.size(); ++i) requested.erase(page_key(ready[i].id));
+    for (size_t i = before; i < ready.size(); ++i) {
+      requested.erase(page_key(ready[i].id));
+      ready_keys.insert(page_key(ready[i].id));
+    }
   }
 
   // Whether the frame's working set one level finer would fill at most 3/4 of the cache (the
