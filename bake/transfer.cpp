@@ -1,0 +1,889 @@
+// Material transfer (see transfer.h). Work is split into bands of atlas rows; each band walks
+// the triangles that overlap it in index order, so the result does not depend on threads.
+#include "bake/transfer.h"
+
+#include <OpenImageIO/texture.h>
+
+#include <unistd.h>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <mutex>
+#include <thread>
+
+namespace vt {
+namespace {
+
+constexpr uint32_t kBandRows = 16;
+constexpr float kOpaque = 1.0f - 0.5f / 255.0f;  // alpha at or above this is stored as opaque
+
+using scene::Vec2;
+using scene::Vec3;
+using scene::Vec4;
+
+struct V3 {
+  double x = 0, y = 0, z = 0;
+};
+V3 operator+(V3 a, V3 b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+V3 operator-(V3 a, V3 b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+V3 operator*(V3 a, double s) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+double dot(V3 a, V3 b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+V3 cross(V3 a, V3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+V3 normalized(V3 a, V3 fallback) {
+  double l = std::sqrt(dot(a, a));
+  if (!(l > 1e-30) || !std::isfinite(l)) return fallback;
+  return a * (1.0 / l);
+}
+V3 v3(const Vec3& a) {
+  return {a[0], a[1], a[2]};
+}
+
+// A triangle in atlas texel space, positively oriented (vertices reordered if needed), with its
+// edges in canonical form: an edge shared by two triangles is evaluated from the same endpoint
+// by both, so the two edge functions are exact negatives and no sample is claimed twice.
+struct RasterTri {
+  double x[3], y[3];
+  double area2 = 0;
+  struct Edge {
+    double ax, ay, dx, dy, sign;
+    bool include_zero;  // top-left rule
+  } e[3];               // e[k] is the edge opposite vertex k (from vertex k+1 to k+2)
+  int32_t chart = 0;
+  uint8_t order[3] = {0, 1, 2};  // original vertex index of each reordered vertex
+
+  double edge(int k, double px, double py) const {
+    const Edge& g = e[k];
+    return g.sign * (g.dx * (py - g.ay) - g.dy * (px - g.ax));
+  }
+  bool contains(double px, double py, double lambda[3]) const {
+    for (int k = 0; k < 3; ++k) {
+      double v = edge(k, px, py);
+      if (v < 0 || (v == 0 && !e[k].include_zero)) return false;
+      lambda[k] = v;
+    }
+    for (int k = 0; k < 3; ++k) lambda[k] /= area2;
+    return true;
+  }
+};
+
+RasterTri make_raster_tri(const std::array<double, 6>& p, int32_t chart) {
+  RasterTri t;
+  t.chart = chart;
+  for (int k = 0; k < 3; ++k) t.x[k] = p[2 * k], t.y[k] = p[2 * k + 1];
+  double a2 = (t.x[1] - t.x[0]) * (t.y[2] - t.y[0]) - (t.y[1] - t.y[0]) * (t.x[2] - t.x[0]);
+  if (a2 < 0) {
+    std::swap(t.x[1], t.x[2]);
+    std::swap(t.y[1], t.y[2]);
+    std::swap(t.order[1], t.order[2]);
+    a2 = -a2;
+  }
+  t.area2 = a2;
+  for (int k = 0; k < 3; ++k) {
+    int i = (k + 1) % 3, j = (k + 2) % 3;  // edge i -> j
+    bool forward = std::make_pair(t.x[i], t.y[i]) < std::make_pair(t.x[j], t.y[j]);
+    int a = forward ? i : j, b = forward ? j : i;
+    RasterTri::Edge& g = t.e[k];
+    g.ax = t.x[a], g.ay = t.y[a], g.dx = t.x[b] - t.x[a], g.dy = t.y[b] - t.y[a];
+    g.sign = forward ? 1.0 : -1.0;
+    double ex = t.x[j] - t.x[i], ey = t.y[j] - t.y[i];
+    g.include_zero = ey > 0 || (ey == 0 && ex < 0);
+  }
+  return t;
+}
+
+// Closest point of the (closed) triangle to p, as barycentrics of the reordered vertices.
+void closest_barycentrics(const RasterTri& t, double px, double py, double lambda[3]) {
+  double inside[3];
+  bool in = true;
+  for (int k = 0; k < 3; ++k) {
+    inside[k] = t.edge(k, px, py) / t.area2;
+    if (inside[k] < 0) in = false;
+  }
+  if (in) {
+    for (int k = 0; k < 3; ++k) lambda[k] = inside[k];
+    return;
+  }
+  double best = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    int i = (k + 1) % 3, j = (k + 2) % 3;
+    double ex = t.x[j] - t.x[i], ey = t.y[j] - t.y[i];
+    double len2 = ex * ex + ey * ey;
+    double s = len2 > 0 ? ((px - t.x[i]) * ex + (py - t.y[i]) * ey) / len2 : 0.0;
+    s = std::clamp(s, 0.0, 1.0);
+    double qx = t.x[i] + s * ex - px, qy = t.y[i] + s * ey - py;
+    double d = qx * qx + qy * qy;
+    if (d < best) {
+      best = d;
+      lambda[k] = 0, lambda[i] = 1 - s, lambda[j] = s;
+    }
+  }
+}
+
+double distance2_to(const RasterTri& t, double px, double py) {
+  double l[3];
+  closest_barycentrics(t, px, py, l);
+  double qx = l[0] * t.x[0] + l[1] * t.x[1] + l[2] * t.x[2] - px;
+  double qy = l[0] * t.y[0] + l[1] * t.y[1] + l[2] * t.y[2] - py;
+  return qx * qx + qy * qy;
+}
+
+// Runs `body(band)` for every band on `threads` threads; the calling thread reports progress.
+template <class Body>
+void for_each_band(uint32_t bands, int threads, const std::function<void(double)>& progress,
+                   Body&& body) {
+  unsigned n = threads > 0 ? unsigned(threads) : std::max(1u, std::thread::hardware_concurrency());
+  n = std::min<unsigned>(n, std::max<uint32_t>(bands, 1));
+  std::atomic<uint32_t> next{0}, done{0};
+  auto work = [&](bool report) {
+    for (uint32_t b; (b = next.fetch_add(1)) < bands;) {
+      body(b);
+      uint32_t d = done.fetch_add(1) + 1;
+      if (report && progress) progress(double(d) / bands);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned i = 1; i < n; ++i) pool.emplace_back(work, false);
+  work(true);
+  for (auto& t : pool) t.join();
+  if (progress) progress(1.0);
+}
+
+// Per-texel state of the rasteriser inside one band.
+struct BandRaster {
+  uint32_t width = 0, y0 = 0, y1 = 0;
+  std::vector<int32_t> best_tri;   // closest touching triangle
+  std::vector<double> best_dist;   // its squared distance from the texel centre
+  std::vector<int32_t> chart;      // first chart touching the texel
+  std::vector<uint8_t> contested;  // touched by a second chart
+  std::vector<uint16_t> claimed;   // sub-samples already inside some triangle
+  std::vector<uint8_t> inside;     // count of sub-samples inside
+  void reset(uint32_t w, uint32_t a, uint32_t b) {
+    width = w, y0 = a, y1 = b;
+    size_t n = size_t(w) * (b - a);
+    best_tri.assign(n, -1);
+    best_dist.assign(n, std::numeric_limits<double>::infinity());
+    chart.assign(n, -1);
+    contested.assign(n, 0);
+    claimed.assign(n, 0);
+    inside.assign(n, 0);
+  }
+};
+
+// Rasterises `tri` (index t) into the band. on_sample(texel index in band, lambda) is called for
+// each sub-sample inside the triangle. Returns sub-samples claimed twice.
+template <class OnSample>
+uint64_t raster_triangle(const RasterTri& tri, int32_t t, BandRaster& band,
+                         const std::vector<std::array<double, 2>>& pattern, uint32_t height,
+                         OnSample&& on_sample) {
+  if (!(tri.area2 > 0) || !std::isfinite(tri.area2)) return 0;
+  double minx = std::min({tri.x[0], tri.x[1], tri.x[2]}),
+         maxx = std::max({tri.x[0], tri.x[1], tri.x[2]});
+  double miny = std::min({tri.y[0], tri.y[1], tri.y[2]}),
+         maxy = std::max({tri.y[0], tri.y[1], tri.y[2]});
+  // Texels whose open square meets the triangle: i in (min - 1, max).
+  int64_t xa = std::max<int64_t>(0, int64_t(std::floor(minx)));
+  int64_t xb = std::min<int64_t>(int64_t(band.width) - 1, int64_t(std::ceil(maxx)) - 1);
+  int64_t ya = std::max<int64_t>(band.y0, int64_t(std::floor(miny)));
+  int64_t yb =
+      std::min<int64_t>(std::min<int64_t>(band.y1, height) - 1, int64_t(std::ceil(maxy)) - 1);
+  uint64_t twice = 0;
+  // Half extent of an edge function over a texel square, for the conservative test.
+  double reach[3];
+  for (int k = 0; k < 3; ++k) reach[k] = 0.5 * (std::abs(tri.e[k].dx) + std::abs(tri.e[k].dy));
+  for (int64_t y = ya; y <= yb; ++y) {
+    for (int64_t x = xa; x <= xb; ++x) {
+      double cx = x + 0.5, cy = y + 0.5;
+      bool touch = true;
+      for (int k = 0; k < 3 && touch; ++k) touch = tri.edge(k, cx, cy) + reach[k] > 0;
+      if (!touch) continue;
+      size_t i = size_t(y - band.y0) * band.width + size_t(x);
+      if (band.chart[i] < 0) {
+        band.chart[i] = tri.chart;
+      } else if (band.chart[i] != tri.chart) {
+        band.contested[i] = 1;
+      }
+      bool any = false;
+      for (size_t s = 0; s < pattern.size(); ++s) {
+        double lambda[3];
+        if (!tri.contains(x + pattern[s][0], y + pattern[s][1], lambda)) continue;
+        if (band.claimed[i] & (1u << s)) ++twice;
+        band.claimed[i] |= uint16_t(1u << s);
+        band.inside[i]++;
+        any = true;
+        on_sample(i, lambda);
+      }
+      double d = any ? 0.0 : distance2_to(tri, cx, cy);
+      if (d < band.best_dist[i]) band.best_dist[i] = d, band.best_tri[i] = t;
+    }
+  }
+  return twice;
+}
+
+std::vector<std::vector<uint32_t>> bin_triangles(const std::vector<RasterTri>& tris,
+                                                 uint32_t height, uint32_t bands) {
+  std::vector<std::vector<uint32_t>> bins(bands);
+  for (uint32_t t = 0; t < tris.size(); ++t) {
+    const RasterTri& r = tris[t];
+    double miny = std::min({r.y[0], r.y[1], r.y[2]}), maxy = std::max({r.y[0], r.y[1], r.y[2]});
+    if (!std::isfinite(miny) || !std::isfinite(maxy)) continue;
+    int64_t ya = std::max<int64_t>(0, int64_t(std::floor(miny)));
+    int64_t yb = std::min<int64_t>(int64_t(height) - 1, int64_t(std::ceil(maxy)) - 1);
+    if (yb < ya) continue;
+    for (int64_t b = ya / kBandRows; b <= yb / kBandRows; ++b) bins[b].push_back(t);
+  }
+  return bins;
+}
+
+// ---- Materials -------------------------------------------------------------------------------
+
+float srgb_to_linear(float v) {
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
+struct ImageSlot {
+  OIIO::TextureSystem::TextureHandle* handle = nullptr;
+  int channels = 0;
+  bool linear = false;  // float data or tagged linear: never sRGB-decoded
+  std::string name;
+};
+
+// One primitive as the transfer sees it.
+struct PrimInfo {
+  const scene::Primitive* prim = nullptr;
+  const scene::Material* mat = nullptr;
+  int atlas_set = 0;
+  std::vector<Vec3> normals;   // given or area-weighted from faces
+  std::vector<Vec4> tangents;  // for the normal map's UV set: given or computed
+};
+
+// Per-triangle quantities for material evaluation.
+struct TriEval {
+  const PrimInfo* p = nullptr;
+  uint32_t v[3];                           // vertex indices in the raster triangle's order
+  std::vector<std::array<double, 4>> duv;  // per UV set: ds/dx, dt/dx, ds/dy, dt/dy per texel
+  V3 dpdx, dpdy;                           // object-space position per atlas texel
+  V3 face_normal;
+};
+
+struct Sample {
+  float albedo[4];
+  float normal[3];
+  float orm[3];
+  float emissive[3];
+};
+
+V3 lerp3(const std::vector<Vec3>& a, const uint32_t v[3], const double l[3]) {
+  return v3(a[v[0]]) * l[0] + v3(a[v[1]]) * l[1] + v3(a[v[2]]) * l[2];
+}
+
+// Tangents from the UV set `set` per vertex (MikkTSpace-like: area-weighted per-face tangents,
+// Gram-Schmidt against the normal, handedness from the bitangent sum; glTF: v points down,
+// the bitangent points up the image).
+std::vector<Vec4> compute_tangents(const scene::Primitive& p, const std::vector<Vec3>& normals,
+                                   int set) {
+  size_t n = p.positions.size();
+  std::vector<V3> tsum(n), bsum(n);
+  const auto& uv = p.uvs[set];
+  for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
+    uint32_t i0 = p.indices[f], i1 = p.indices[f + 1], i2 = p.indices[f + 2];
+    V3 e1 = v3(p.positions[i1]) - v3(p.positions[i0]),
+       e2 = v3(p.positions[i2]) - v3(p.positions[i0]);
+    double du1 = uv[i1][0] - uv[i0][0], dv1 = uv[i1][1] - uv[i0][1];
+    double du2 = uv[i2][0] - uv[i0][0], dv2 = uv[i2][1] - uv[i0][1];
+    double det = du1 * dv2 - du2 * dv1;
+    if (!(std::abs(det) > 1e-20)) continue;
+    V3 dpdu = (e1 * dv2 - e2 * dv1) * (1.0 / det);
+    V3 dpdv = (e2 * du1 - e1 * du2) * (1.0 / det);
+    double area = std::sqrt(dot(cross(e1, e2), cross(e1, e2)));
+    V3 tu = normalized(dpdu, {}) * area, tv = normalized(dpdv, {}) * area;
+    for (uint32_t i : {i0, i1, i2}) tsum[i] = tsum[i] + tu, bsum[i] = bsum[i] - tv;
+  }
+  std::vector<Vec4> out(n);
+  for (size_t i = 0; i < n; ++i) {
+    V3 nn = normalized(v3(normals[i]), {0, 0, 1});
+    V3 t = normalized(tsum[i] - nn * dot(nn, tsum[i]), {});
+    if (dot(t, t) == 0) {  // no UV gradient: any tangent perpendicular to the normal
+      t = normalized(cross(std::abs(nn.x) < 0.9 ? V3{1, 0, 0} : V3{0, 1, 0}, nn), {1, 0, 0});
+    }
+    double w = dot(cross(nn, t), bsum[i]) < 0 ? -1.0 : 1.0;
+    out[i] = {float(t.x), float(t.y), float(t.z), float(w)};
+  }
+  return out;
+}
+
+std::vector<Vec3> compute_normals(const scene::Primitive& p) {
+  std::vector<V3> sum(p.positions.size());
+  for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
+    uint32_t i0 = p.indices[f], i1 = p.indices[f + 1], i2 = p.indices[f + 2];
+    V3 n =
+        cross(v3(p.positions[i1]) - v3(p.positions[i0]), v3(p.positions[i2]) - v3(p.positions[i0]));
+    for (uint32_t i : {i0, i1, i2}) sum[i] = sum[i] + n;
+  }
+  std::vector<Vec3> out(sum.size());
+  for (size_t i = 0; i < sum.size(); ++i) {
+    V3 n = normalized(sum[i], {0, 0, 1});
+    out[i] = {float(n.x), float(n.y), float(n.z)};
+  }
+  return out;
+}
+
+bool material_has_orm(const scene::Material& m) {
+  return m.metallic_roughness_texture.valid() || m.occlusion_texture.valid() ||
+         m.metallic_factor != 1.0f || m.roughness_factor != 1.0f;
+}
+bool material_has_emissive(const scene::Material& m) {
+  return m.emissive_texture.valid() || m.emissive_factor[0] > 0 || m.emissive_factor[1] > 0 ||
+         m.emissive_factor[2] > 0;
+}
+
+class Transfer {
+ public:
+  Transfer(const scene::Scene& scene, const TransferOptions& opt) : scene_(scene), opt_(opt) {}
+  ~Transfer() {
+    if (ts_) OIIO::TextureSystem::destroy(ts_);
+    for (const auto& f : temp_files_) {
+      std::error_code ec;
+      std::filesystem::remove(f, ec);
+    }
+  }
+
+  Expected<TransferResult> run();
+
+ private:
+  Status setup_images();
+  Status setup_prims();
+  bool sample_texture(OIIO::TextureSystem::Perthread* pt, const scene::TextureRef& ref,
+                      const TriEval& te, const double l[3], float out[4]) const;
+  void evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, const double l[3],
+                Sample& s) const;
+  void make_eval(uint32_t t, TriEval& te) const;
+
+  const scene::Scene& scene_;
+  const TransferOptions& opt_;
+  OIIO::TextureSystem* ts_ = nullptr;
+  std::vector<ImageSlot> images_;
+  std::vector<std::string> temp_files_;
+  std::vector<PrimInfo> prims_;
+  std::vector<RasterTri> tris_;
+  std::vector<std::pair<uint32_t, uint32_t>> tri_src_;  // (prim info, face)
+  scene::Material default_material_;
+  bool want_[5] = {};  // by LayerSemantic
+  double sub_scale_ = 1.0;
+  mutable std::atomic<bool> lookup_failed_{false};
+  mutable std::mutex error_mutex_;
+  mutable std::string lookup_error_;
+};
+
+Status Transfer::setup_images() {
+  std::vector<bool> used(scene_.images.size(), false);
+  for (const auto& m : scene_.materials) {
+    for (const auto* r : {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture,
+                          &m.occlusion_texture, &m.emissive_texture}) {
+      if (!r->valid()) continue;
+      if (size_t(r->image) >= scene_.images.size()) {
+        return Error(ErrorCode::kCorrupt, "material '" + m.name + "' names image " +
+                                              std::to_string(r->image) + ", which does not exist");
+      }
+      used[r->image] = true;
+    }
+  }
+  ts_ = OIIO::TextureSystem::create(false);
+  ts_->attribute("automip", 1);
+  ts_->attribute("max_memory_MB", 2048.0f);
+  images_.resize(scene_.images.size());
+  namespace fs = std::filesystem;
+  fs::path scratch =
+      opt_.scratch_dir.empty() ? fs::temp_directory_path() : fs::path(opt_.scratch_dir);
+  for (size_t i = 0; i < scene_.images.size(); ++i) {
+    if (!used[i]) continue;
+    const scene::Image& img = scene_.images[i];
+    ImageSlot& slot = images_[i];
+    std::string path = img.path;
+    slot.name =
+        img.embedded() ? "embedded image " + std::to_string(i) + " '" + img.name + "'" : img.path;
+    if (img.embedded()) {
+      // OpenImageIO's texture cache reads by file name: a private copy is the robust way.
+      std::string ext = ".png";
+      if (img.mime_type == "image/jpeg")
+        ext = ".jpg";
+      else if (img.mime_type == "image/x-exr")
+        ext = ".exr";
+      else if (img.mime_type == "image/webp")
+        ext = ".webp";
+      path = (scratch /
+              ("vtbake-transfer-" + std::to_string(getpid()) + "-" + std::to_string(i) + ext))
+                 .string();
+      std::ofstream f(path, std::ios::binary);
+      f.write(reinterpret_cast<const char*>(img.bytes.data()), std::streamsize(img.bytes.size()));
+      f.close();
+      if (!f) return Error(ErrorCode::kIo, path + ": cannot write a copy of " + slot.name);
+      temp_files_.push_back(path);
+    }
+    OIIO::ustring name(path);
+    const OIIO::ImageSpec* spec = ts_->imagespec(name, 0);
+    if (!spec) {
+      std::string err = ts_->geterror();
+      return Error(ErrorCode::kNotFound, slot.name + ": cannot read image (" + err + ")");
+    }
+    slot.handle = ts_->get_texture_handle(name);
+    slot.channels = std::min(spec->nchannels, 4);
+    std::string cs = spec->get_string_attribute("oiio:ColorSpace");
+    std::transform(cs.begin(), cs.end(), cs.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
+    bool is_float = spec->format.basetype == OIIO::TypeDesc::FLOAT ||
+                    spec->format.basetype == OIIO::TypeDesc::HALF ||
+                    spec->format.basetype == OIIO::TypeDesc::DOUBLE;
+    slot.linear = is_float || cs == "linear" || cs == "scene_linear" || cs == "lin_srgb";
+  }
+  return Status::Ok();
+}
+
+Status Transfer::setup_prims() {
+  bool any_normal = false, any_orm = false, any_emissive = false;
+  for (size_t m = 0; m < scene_.meshes.size(); ++m) {
+    const scene::Mesh& mesh = scene_.meshes[m];
+    for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
+      const scene::Primitive& p = mesh.primitives[pi];
+      if (p.indices.empty()) continue;
+      std::string where = "mesh '" + mesh.name + "' primitive " + std::to_string(pi);
+      if (p.uvs.empty()) return Error(ErrorCode::kInvalidArgument, where + ": no atlas UVs");
+      PrimInfo info;
+      info.prim = &p;
+      info.atlas_set = opt_.atlas_uv_set < 0 ? int(p.uvs.size()) - 1 : opt_.atlas_uv_set;
+      if (size_t(info.atlas_set) >= p.uvs.size() ||
+          p.uvs[info.atlas_set].size() != p.positions.size()) {
+        return Error(ErrorCode::kInvalidArgument,
+                     where + ": no atlas UV set " + std::to_string(info.atlas_set));
+      }
+      if (p.material >= 0 && size_t(p.material) >= scene_.materials.size()) {
+        return Error(ErrorCode::kCorrupt,
+                     where + ": material " + std::to_string(p.material) + " does not exist");
+      }
+      info.mat = p.material >= 0 ? &scene_.materials[p.material] : &default_material_;
+      const scene::Material& mat = *info.mat;
+      for (const auto* r : {&mat.base_color_texture, &mat.metallic_roughness_texture,
+                            &mat.normal_texture, &mat.occlusion_texture, &mat.emissive_texture}) {
+        if (r->valid() && (size_t(r->texcoord) >= p.uvs.size() ||
+                           p.uvs[r->texcoord].size() != p.positions.size())) {
+          return Error(ErrorCode::kInvalidArgument,
+                       where + ": material '" + mat.name + "' reads TEXCOORD_" +
+                           std::to_string(r->texcoord) + ", which it lacks");
+        }
+      }
+      for (uint32_t idx : p.indices) {
+        if (idx >= p.positions.size())
+          return Error(ErrorCode::kCorrupt, where + ": index out of range");
+      }
+      any_normal |= mat.normal_texture.valid();
+      any_orm |= material_has_orm(mat);
+      any_emissive |= material_has_emissive(mat);
+      info.normals = p.normals.size() == p.positions.size() ? p.normals : compute_normals(p);
+      if (mat.normal_texture.valid()) {
+        info.tangents = p.tangents.size() == p.positions.size()
+                            ? p.tangents
+                            : compute_tangents(p, info.normals, mat.normal_texture.texcoord);
+      }
+      prims_.push_back(std::move(info));
+    }
+  }
+  want_[size_t(LayerSemantic::kAlbedo)] = true;
+  want_[size_t(LayerSemantic::kNormal)] = any_normal;
+  want_[size_t(LayerSemantic::kOrm)] = any_orm;
+  want_[size_t(LayerSemantic::kEmissive)] = any_emissive;
+
+  const double W = opt_.width, H = opt_.height;
+  int64_t chart_base = 0;  // chart ids: vertex-component roots, offset per primitive
+  for (uint32_t pi = 0; pi < prims_.size(); ++pi) {
+    const scene::Primitive& p = *prims_[pi].prim;
+    const auto& uv = p.uvs[prims_[pi].atlas_set];
+    // Charts = connected components of atlas vertices (the unwrapper gives each chart its own).
+    std::vector<uint32_t> parent(p.positions.size());
+    for (uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
+    auto find = [&](uint32_t a) {
+      while (parent[a] != a) a = parent[a] = parent[parent[a]];
+      return a;
+    };
+    for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
+      uint32_t a = find(p.indices[f]);
+      for (int k = 1; k < 3; ++k) {
+        uint32_t b = find(p.indices[f + k]);
+        if (a != b) parent[b] = a;
+      }
+    }
+    for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
+      std::array<double, 6> q;
+      for (int k = 0; k < 3; ++k) {
+        const Vec2& a = uv[p.indices[f + k]];
+        q[2 * k] = double(a[0]) * W, q[2 * k + 1] = double(a[1]) * H;
+      }
+      tris_.push_back(make_raster_tri(q, int32_t(chart_base + find(p.indices[f]))));
+      tri_src_.push_back({pi, uint32_t(f / 3)});
+    }
+    chart_base += p.positions.size();
+  }
+  return Status::Ok();
+}
+
+void Transfer::make_eval(uint32_t t, TriEval& te) const {
+  const RasterTri& r = tris_[t];
+  const PrimInfo& pi = prims_[tri_src_[t].first];
+  const scene::Primitive& p = *pi.prim;
+  size_t f = tri_src_[t].second;
+  te.p = &pi;
+  for (int k = 0; k < 3; ++k) te.v[k] = p.indices[3 * f + r.order[k]];
+  // Inverse of the atlas edge matrix: maps per-vertex differences to d/dx, d/dy.
+  double ex1 = r.x[1] - r.x[0], ey1 = r.y[1] - r.y[0], ex2 = r.x[2] - r.x[0], ey2 = r.y[2] - r.y[0];
+  double det = ex1 * ey2 - ex2 * ey1;
+  double inv = det != 0 ? 1.0 / det : 0.0;
+  auto grad = [&](double f0, double f1, double f2, double& dx, double& dy) {
+    double d1 = f1 - f0, d2 = f2 - f0;
+    dx = (d1 * ey2 - d2 * ey1) * inv;
+    dy = (d2 * ex1 - d1 * ex2) * inv;
+  };
+  te.duv.resize(p.uvs.size());
+  for (size_t s = 0; s < p.uvs.size(); ++s) {
+    const auto& uv = p.uvs[s];
+    auto& d = te.duv[s];
+    grad(uv[te.v[0]][0], uv[te.v[1]][0], uv[te.v[2]][0], d[0], d[2]);
+    grad(uv[te.v[0]][1], uv[te.v[1]][1], uv[te.v[2]][1], d[1], d[3]);
+    for (double& c : d) c = std::isfinite(c) ? c * sub_scale_ : 0.0;
+  }
+  V3 P0 = v3(p.positions[te.v[0]]), P1 = v3(p.positions[te.v[1]]), P2 = v3(p.positions[te.v[2]]);
+  grad(P0.x, P1.x, P2.x, te.dpdx.x, te.dpdy.x);
+  grad(P0.y, P1.y, P2.y, te.dpdx.y, te.dpdy.y);
+  grad(P0.z, P1.z, P2.z, te.dpdx.z, te.dpdy.z);
+  te.face_normal = normalized(cross(P1 - P0, P2 - P0), {0, 0, 1});
+}
+
+bool Transfer::sample_texture(OIIO::TextureSystem::Perthread* pt, const scene::TextureRef& ref,
+                              const TriEval& te, const double l[3], float out[4]) const {
+  const ImageSlot& slot = images_[ref.image];
+  const auto& uv = te.p->prim->uvs[ref.texcoord];
+  double s = uv[te.v[0]][0] * l[0] + uv[te.v[1]][0] * l[1] + uv[te.v[2]][0] * l[2];
+  double t = uv[te.v[0]][1] * l[0] + uv[te.v[1]][1] * l[1] + uv[te.v[2]][1] * l[2];
+  const auto& d = te.duv[ref.texcoord];
+  auto wrap = [](scene::WrapMode m) {
+    switch (m) {
+      case scene::WrapMode::kClampToEdge:
+        return OIIO::TextureOpt::WrapClamp;
+      case scene::WrapMode::kMirroredRepeat:
+        return OIIO::TextureOpt::WrapMirror;
+      default:
+        return OIIO::TextureOpt::WrapPeriodic;
+    }
+  };
+  OIIO::TextureOpt opt;
+  opt.swrap = wrap(ref.wrap_s);
+  opt.twrap = wrap(ref.wrap_t);
+  opt.interpmode = OIIO::TextureOpt::InterpBilinear;
+  opt.mipmode = OIIO::TextureOpt::MipModeAniso;
+  opt.anisotropic = 16;
+  float r[4] = {0, 0, 0, 1};
+  if (!ts_->texture(slot.handle, pt, opt, float(s), float(t), float(d[0]), float(d[1]), float(d[2]),
+                    float(d[3]), slot.channels, r)) {
+    if (!lookup_failed_.exchange(true)) {
+      std::lock_guard<std::mutex> lock(error_mutex_);
+      lookup_error_ = slot.name + ": texture lookup failed (" + ts_->geterror() + ")";
+    }
+    return false;
+  }
+  switch (slot.channels) {
+    case 1:
+      out[0] = out[1] = out[2] = r[0], out[3] = 1;
+      break;
+    case 2:
+      out[0] = out[1] = out[2] = r[0], out[3] = r[1];
+      break;
+    case 3:
+      out[0] = r[0], out[1] = r[1], out[2] = r[2], out[3] = 1;
+      break;
+    default:
+      for (int c = 0; c < 4; ++c) out[c] = r[c];
+  }
+  return true;
+}
+
+void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, const double l[3],
+                        Sample& s) const {
+  const scene::Material& m = *te.p->mat;
+  const scene::Primitive& p = *te.p->prim;
+  float tex[4];
+  auto colour = [&](const scene::TextureRef& ref, float* rgb) {
+    if (!ref.valid() || !sample_texture(pt, ref, te, l, tex)) return false;
+    bool srgb = !images_[ref.image].linear;
+    for (int c = 0; c < 3; ++c)
+      rgb[c] = srgb ? srgb_to_linear(std::clamp(tex[c], 0.0f, 1.0f)) : tex[c];
+    rgb[3] = tex[3];
+    return true;
+  };
+  // Albedo: factor x texture x vertex colour (glTF).
+  float a[4] = {1, 1, 1, 1};
+  colour(m.base_color_texture, a);
+  for (int c = 0; c < 4; ++c) s.albedo[c] = a[c] * m.base_color_factor[c];
+  if (!p.colors.empty()) {
+    for (int c = 0; c < 4; ++c) {
+      s.albedo[c] *= float(p.colors[te.v[0]][c] * l[0] + p.colors[te.v[1]][c] * l[1] +
+                           p.colors[te.v[2]][c] * l[2]);
+    }
+  }
+  if (m.alpha_mode == scene::AlphaMode::kOpaque) s.albedo[3] = 1;
+  if (want_[size_t(LayerSemantic::kEmissive)]) {
+    float e[4] = {1, 1, 1, 1};
+    colour(m.emissive_texture, e);
+    for (int c = 0; c < 3; ++c) s.emissive[c] = e[c] * m.emissive_factor[c];
+  }
+  if (want_[size_t(LayerSemantic::kOrm)]) {
+    float occ = 1, rough = m.roughness_factor, metal = m.metallic_factor;
+    if (m.occlusion_texture.valid() && sample_texture(pt, m.occlusion_texture, te, l, tex)) {
+      occ = 1.0f + m.occlusion_strength * (tex[0] - 1.0f);
+    }
+    if (m.metallic_roughness_texture.valid() &&
+        sample_texture(pt, m.metallic_roughness_texture, te, l, tex)) {
+      rough *= tex[1], metal *= tex[2];
+    }
+    s.orm[0] = occ, s.orm[1] = rough, s.orm[2] = metal;
+  }
+  if (want_[size_t(LayerSemantic::kNormal)]) {
+    V3 n = normalized(lerp3(te.p->normals, te.v, l), te.face_normal);
+    V3 world = n;
+    if (m.normal_texture.valid() && sample_texture(pt, m.normal_texture, te, l, tex)) {
+      const auto& tg = te.p->tangents;
+      V3 t = {tg[te.v[0]][0] * l[0] + tg[te.v[1]][0] * l[1] + tg[te.v[2]][0] * l[2],
+              tg[te.v[0]][1] * l[0] + tg[te.v[1]][1] * l[1] + tg[te.v[2]][1] * l[2],
+              tg[te.v[0]][2] * l[0] + tg[te.v[1]][2] * l[1] + tg[te.v[2]][2] * l[2]};
+      t = normalized(
+          t - n * dot(n, t),
+          normalized(cross(std::abs(n.x) < 0.9 ? V3{1, 0, 0} : V3{0, 1, 0}, n), {1, 0, 0}));
+      double w = tg[te.v[0]][3] < 0 ? -1.0 : 1.0;
+      V3 b = cross(n, t) * w;
+      double x = (tex[0] * 2.0 - 1.0) * m.normal_scale, y = (tex[1] * 2.0 - 1.0) * m.normal_scale;
+      double z = tex[2] * 2.0 - 1.0;
+      if (images_[m.normal_texture.image].channels < 3)
+        z = std::sqrt(std::max(0.0, 1.0 - x * x - y * y));
+      world = normalized(t * x + b * y + n * z, n);
+    }
+    // The atlas frame: tangent along +x of the atlas, bitangent up the atlas image (glTF).
+    V3 ta = normalized(
+        te.dpdx - n * dot(n, te.dpdx),
+        normalized(cross(std::abs(n.x) < 0.9 ? V3{1, 0, 0} : V3{0, 1, 0}, n), {1, 0, 0}));
+    double wa = dot(cross(n, ta), te.dpdy) > 0 ? -1.0 : 1.0;
+    V3 ba = cross(n, ta) * wa;
+    s.normal[0] = float(dot(world, ta));
+    s.normal[1] = float(dot(world, ba));
+    s.normal[2] = float(dot(world, n));
+  }
+}
+
+Expected<TransferResult> Transfer::run() {
+  auto start = std::chrono::steady_clock::now();
+  const uint32_t W = opt_.width, H = opt_.height;
+  if (W == 0 || H == 0) return Error(ErrorCode::kInvalidArgument, "transfer: empty atlas");
+  if (opt_.supersample != 1 && opt_.supersample != 4 && opt_.supersample != 16) {
+    return Error(ErrorCode::kInvalidArgument, "transfer: supersample must be 1, 4 or 16");
+  }
+  if (uint64_t(W) * H > opt_.max_texels) {
+    return Error(ErrorCode::kResourceLimit, "transfer: atlas of " + std::to_string(W) + "x" +
+                                                std::to_string(H) + " texels exceeds the limit");
+  }
+  sub_scale_ = 1.0 / std::sqrt(double(opt_.supersample));
+  VT_RETURN_IF_ERROR(setup_images());
+  VT_RETURN_IF_ERROR(setup_prims());
+
+  TransferResult result;
+  result.width = W, result.height = H;
+  const size_t N = size_t(W) * H;
+  // Accumulators: albedo 4, normal 3, orm 3, emissive 3 channels.
+  static constexpr uint32_t kChannels[4] = {4, 3, 3, 3};
+  std::vector<float> acc[4];
+  for (int l = 0; l < 4; ++l)
+    if (want_[l]) acc[l].assign(N * kChannels[l], 0.0f);
+  auto coverage = std::make_shared<std::vector<uint8_t>>(N, 0);
+  const auto pattern = supersample_pattern(opt_.supersample);
+  const uint32_t bands = (H + kBandRows - 1) / kBandRows;
+  auto bins = bin_triangles(tris_, H, bands);
+  std::atomic<uint64_t> sampled{0}, edge_only{0}, contested{0}, samples{0};
+
+  auto store = [&](size_t texel, const Sample& s, float weight, bool add) {
+    const float* src[4] = {s.albedo, s.normal, s.orm, s.emissive};
+    for (int l = 0; l < 4; ++l) {
+      if (!want_[l]) continue;
+      float* d = &acc[l][texel * kChannels[l]];
+      for (uint32_t c = 0; c < kChannels[l]; ++c)
+        d[c] = add ? d[c] + src[l][c] * weight : src[l][c];
+    }
+  };
+
+  for_each_band(bands, opt_.threads, opt_.progress, [&](uint32_t b) {
+    OIIO::TextureSystem::Perthread* pt = ts_->get_perthread_info();
+    BandRaster band;
+    uint32_t y0 = b * kBandRows, y1 = std::min(H, y0 + kBandRows);
+    band.reset(W, y0, y1);
+    TriEval te;
+    Sample s{};
+    uint64_t n_samples = 0;
+    const float weight = 1.0f / float(pattern.size());
+    for (uint32_t t : bins[b]) {
+      make_eval(t, te);
+      raster_triangle(tris_[t], int32_t(t), band, pattern, H, [&](size_t i, const double* l) {
+        evaluate(pt, te, l, s);
+        store(size_t(y0) * W + i, s, weight, true);
+        ++n_samples;
+      });
+    }
+    uint64_t n_sampled = 0, n_edge = 0, n_contested = 0;
+    for (size_t i = 0; i < band.best_tri.size(); ++i) {
+      if (band.best_tri[i] < 0) continue;
+      size_t texel = size_t(y0) * W + i;
+      (*coverage)[texel] = 1;
+      n_contested += band.contested[i];
+      if (band.inside[i] > 0) {
+        ++n_sampled;
+        // Partially covered texels average only the samples that fell inside.
+        float scale = float(pattern.size()) / float(band.inside[i]);
+        if (scale != 1.0f) {
+          for (int l = 0; l < 4; ++l) {
+            if (!want_[l]) continue;
+            for (uint32_t c = 0; c < kChannels[l]; ++c) acc[l][texel * kChannels[l] + c] *= scale;
+          }
+        }
+        continue;
+      }
+      // Touched but no sample inside: the closest point of the closest triangle.
+      ++n_edge;
+      uint32_t t = uint32_t(band.best_tri[i]);
+      make_eval(t, te);
+      double l[3];
+      closest_barycentrics(tris_[t], (i % W) + 0.5, (y0 + i / W) + 0.5, l);
+      evaluate(pt, te, l, s);
+      store(texel, s, 1.0f, false);
+      ++n_samples;
+    }
+    sampled += n_sampled, edge_only += n_edge, contested += n_contested, samples += n_samples;
+  });
+  if (lookup_failed_) return Error(ErrorCode::kIo, lookup_error_);
+
+  // Layers: only those called for; alpha only if some covered texel is not opaque.
+  for (int l = 0; l < 4; ++l) {
+    if (!want_[l]) continue;
+    TransferLayer layer;
+    layer.semantic = LayerSemantic(l);
+    layer.channels = kChannels[l];
+    if (l == int(LayerSemantic::kAlbedo)) {
+      bool alpha = false;
+      for (size_t i = 0; i < N && !alpha; ++i)
+        alpha = (*coverage)[i] && acc[l][4 * i + 3] < kOpaque;
+      if (!alpha) {
+        std::vector<float> rgb(N * 3);
+        for (size_t i = 0; i < N; ++i)
+          for (int c = 0; c < 3; ++c) rgb[3 * i + c] = acc[l][4 * i + c];
+        acc[l] = std::move(rgb);
+        layer.channels = 3;
+      }
+    }
+    if (l == int(LayerSemantic::kNormal)) {
+      for (size_t i = 0; i < N; ++i) {
+        float* n = &acc[l][3 * i];
+        if (!(*coverage)[i]) continue;
+        V3 v = normalized({n[0], n[1], n[2]}, {0, 0, 1});
+        n[0] = float(v.x), n[1] = float(v.y), n[2] = float(v.z);
+      }
+    } else {
+      for (float v : acc[l]) layer.hdr |= v > 1.0f;
+    }
+    layer.texels = std::move(acc[l]);
+    result.layers.push_back(std::move(layer));
+  }
+  result.coverage = coverage;
+  result.stats.triangles = tris_.size();
+  result.stats.sampled_texels = sampled;
+  result.stats.edge_only_texels = edge_only;
+  result.stats.covered_texels = sampled + edge_only;
+  result.stats.contested_texels = contested;
+  result.stats.samples = samples;
+  result.stats.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace
+
+std::vector<std::array<double, 2>> supersample_pattern(int supersample) {
+  int k = supersample >= 16 ? 4 : supersample >= 4 ? 2 : 1;
+  std::vector<std::array<double, 2>> p;
+  for (int j = 0; j < k; ++j)
+    for (int i = 0; i < k; ++i) p.push_back({(i + 0.5) / k, (j + 0.5) / k});
+  return p;
+}
+
+std::vector<LayerSemantic> layers_used(const scene::Scene& scene) {
+  bool normal = false, orm = false, emissive = false;
+  scene::Material fallback;
+  for (const auto& mesh : scene.meshes) {
+    for (const auto& p : mesh.primitives) {
+      const scene::Material& m = p.material >= 0 && size_t(p.material) < scene.materials.size()
+                                     ? scene.materials[p.material]
+                                     : fallback;
+      normal |= m.normal_texture.valid();
+      orm |= material_has_orm(m);
+      emissive |= material_has_emissive(m);
+    }
+  }
+  std::vector<LayerSemantic> out = {LayerSemantic::kAlbedo};
+  if (normal) out.push_back(LayerSemantic::kNormal);
+  if (orm) out.push_back(LayerSemantic::kOrm);
+  if (emissive) out.push_back(LayerSemantic::kEmissive);
+  return out;
+}
+
+Expected<TransferResult> transfer_materials(const scene::Scene& scene,
+                                            const TransferOptions& options) {
+  Transfer t(scene, options);
+  return t.run();
+}
+
+AtlasRaster rasterize_atlas(const std::vector<std::array<double, 6>>& triangles,
+                            const std::vector<int32_t>& chart, uint32_t width, uint32_t height,
+                            int supersample) {
+  AtlasRaster out;
+  out.owner.assign(size_t(width) * height, -1);
+  out.inside.assign(size_t(width) * height, 0);
+  std::vector<RasterTri> tris;
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    tris.push_back(make_raster_tri(triangles[t], t < chart.size() ? chart[t] : 0));
+  }
+  const auto pattern = supersample_pattern(supersample);
+  const uint32_t bands = (height + kBandRows - 1) / kBandRows;
+  auto bins = bin_triangles(tris, height, bands);
+  BandRaster band;
+  for (uint32_t b = 0; b < bands; ++b) {
+    uint32_t y0 = b * kBandRows, y1 = std::min(height, y0 + kBandRows);
+    band.reset(width, y0, y1);
+    for (uint32_t t : bins[b]) {
+      out.double_sampled +=
+          raster_triangle(tris[t], int32_t(t), band, pattern, height, [](size_t, const double*) {});
+    }
+    for (size_t i = 0; i < band.best_tri.size(); ++i) {
+      out.owner[size_t(y0) * width + i] = band.best_tri[i];
+      out.inside[size_t(y0) * width + i] = band.inside[i];
+      out.contested_texels += band.contested[i];
+    }
+  }
+  return out;
+}
+
+}  // namespace vt

@@ -1,0 +1,89 @@
+// Material transfer: fills the level-0 texels of every layer the scene's materials use from the
+// source materials, through the atlas UVs the unwrapper added. Rasterisation in atlas space is
+// exact (texel-centre samples, top-left fill rule, shared edges evaluated bit-identically so no
+// sample lands in two triangles) and conservative (a texel any part of a triangle touches is
+// covered; with no sample inside it takes the closest point of the closest triangle). Textures
+// are read through OpenImageIO's TextureSystem, filtered at the footprint of the atlas texel
+// (or sub-sample). Normal maps are decoded in the source tangent frame and re-encoded in the
+// atlas UVs' tangent frame. The output is linear (colour) or data texels in memory plus a
+// coverage mask, ready for build_page_file.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bake/scene/scene.h"
+#include "common/status.h"
+#include "format/page_file.h"
+
+namespace vt {
+
+struct TransferOptions {
+  uint32_t width = 0, height = 0;  // atlas size in texels
+  int atlas_uv_set = -1;           // UV set holding atlas UVs; -1 = each primitive's last set
+  int supersample = 1;             // samples per texel: 1, 4 (2x2) or 16 (4x4)
+  int threads = 0;                 // 0 = all cores; the output does not depend on it
+  // Folder for copies of embedded images (OpenImageIO's texture cache reads files). "" = the
+  // system temporary folder. Copies are removed before transfer_materials returns.
+  std::string scratch_dir;
+  uint64_t max_texels = uint64_t(16384) * 16384;  // larger atlases are a resource error
+  std::function<void(double fraction)> progress;  // from the calling thread, 0..1
+};
+
+struct TransferLayer {
+  LayerSemantic semantic = LayerSemantic::kAlbedo;
+  uint32_t channels = 0;  // albedo 3 or 4 (alpha only if a texel is not opaque), normal 3, ...
+  bool hdr = false;       // some value is above 1 (emissive or linear EXR sources)
+  // width * height * channels floats. Albedo/emissive: linear RGB(A), not premultiplied.
+  // ORM: occlusion, roughness, metallic. Normal: unit xyz in the atlas tangent frame.
+  // Uncovered texels are 0 (the build dilates them away).
+  std::vector<float> texels;
+};
+
+struct TransferStats {
+  uint64_t triangles = 0;
+  uint64_t covered_texels = 0;
+  uint64_t sampled_texels = 0;    // covered texels with at least one sample inside
+  uint64_t edge_only_texels = 0;  // covered conservatively only (closest-point value)
+  uint64_t contested_texels = 0;  // touched by two charts (0 when the atlas has a gutter)
+  uint64_t samples = 0;           // material evaluations
+  double seconds = 0;
+};
+
+struct TransferResult {
+  uint32_t width = 0, height = 0;
+  std::shared_ptr<const std::vector<uint8_t>> coverage;  // width * height, 1 = covered
+  std::vector<TransferLayer> layers;  // in LayerSemantic order, only those the scene uses
+  TransferStats stats;
+};
+
+// Which layers the materials of `scene` call for: albedo always; normal if some material has a
+// normal map; ORM if some material has a metallic-roughness or occlusion texture or factors
+// other than glTF's defaults; emissive if some material emits. (Alpha is decided by texels.)
+std::vector<LayerSemantic> layers_used(const scene::Scene& scene);
+
+// Transfers the materials of an unwrapped scene (meshes carrying atlas UVs in [0,1], glTF
+// orientation: v down, texel row y = v * height). Errors name the image or mesh at fault.
+Expected<TransferResult> transfer_materials(const scene::Scene& scene,
+                                            const TransferOptions& options);
+
+// Rasterisation alone, for tests and the atlas checks: triangles given as atlas texel
+// coordinates (x0, y0, x1, y1, x2, y2) and a chart id each. owner[t] = the triangle whose
+// value texel t takes (-1 = not covered), inside[t] = samples of t that lie inside a triangle.
+struct AtlasRaster {
+  std::vector<int32_t> owner;
+  std::vector<uint8_t> inside;
+  uint64_t contested_texels = 0;
+  uint64_t double_sampled = 0;  // sub-sample positions claimed by two triangles (must be 0)
+};
+AtlasRaster rasterize_atlas(const std::vector<std::array<double, 6>>& triangles,
+                            const std::vector<int32_t>& chart, uint32_t width, uint32_t height,
+                            int supersample = 1);
+
+// Sub-sample offsets inside a texel (in [0,1)^2) for 1, 4 or 16 samples per texel.
+std::vector<std::array<double, 2>> supersample_pattern(int supersample);
+
+}  // namespace vt

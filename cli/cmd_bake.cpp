@@ -1,0 +1,194 @@
+// `vtbake bake SCENE -o OUT.vtpf`: the main job. Unwraps the scene, transfers its materials into
+// the atlas, builds the page file and writes the unwrapped scene beside it. Flags map onto
+// vt::SceneBakeOptions; the work is bake_scene() (bake/scene_bake.h).
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "bake/scene_bake.h"
+#include "cli/command.h"
+
+namespace {
+
+using vt::cli::kExitBadInput;
+using vt::cli::kExitFailure;
+using vt::cli::kExitOk;
+
+struct BakeFlags {
+  std::string scene;
+  std::string output;
+  std::string unwrapped;
+  double texels_per_unit = 0;
+  int size_pages = 0;
+  int padding = 4;
+  std::string method = "lscm";
+  int supersample = 1;
+  std::string codec = "dct";
+  bool share_instances = false;
+  std::string memory_limit_gib = "8";
+};
+
+int bad(const std::string& msg) {
+  std::fprintf(stderr, "vtbake bake: %s\n", msg.c_str());
+  return kExitBadInput;
+}
+
+int exit_code_for(const vt::Status& s) {
+  switch (s.code()) {
+    case vt::ErrorCode::kInvalidArgument:
+    case vt::ErrorCode::kNotFound:
+    case vt::ErrorCode::kCorrupt:
+    case vt::ErrorCode::kUnsupported:
+      return kExitBadInput;
+    default:
+      return kExitFailure;
+  }
+}
+
+// dct, dct:Q (1..100), bc, bc:high, raw.
+bool parse_codec(const std::string& s, vt::PageEncoderOptions* o) {
+  std::string kind = s.substr(0, s.find(':'));
+  std::string arg = s.find(':') == std::string::npos ? "" : s.substr(s.find(':') + 1);
+  if (kind == "dct") {
+    o->codec = vt::CodecKind::kDct;
+    if (!arg.empty()) {
+      char* end = nullptr;
+      long q = std::strtol(arg.c_str(), &end, 10);
+      if (*end || q < 1 || q > 100) return false;
+      o->dct_quality = int(q);
+    }
+    return true;
+  }
+  if (kind == "bc") {
+    o->codec = vt::CodecKind::kBc;
+    if (arg == "high")
+      o->bc_quality = vt::BcQuality::kHigh;
+    else if (arg == "fast")
+      o->bc_quality = vt::BcQuality::kRealtime;
+    else if (!arg.empty())
+      return false;
+    return true;
+  }
+  if (kind == "raw" && arg.empty()) {
+    o->codec = vt::CodecKind::kRaw;
+    return true;
+  }
+  return false;
+}
+
+// One redrawn line on stderr: stage, its fraction, elapsed time.
+class Progress {
+ public:
+  explicit Progress(bool enabled) : enabled_(enabled), start_(Clock::now()) {}
+  void update(const vt::SceneBakeProgress& p) {
+    if (!enabled_) return;
+    auto now = Clock::now();
+    bool change = stage_ != p.stage;
+    if (!change && p.fraction < 1.0 && now - last_ < std::chrono::milliseconds(200)) return;
+    last_ = now;
+    stage_ = p.stage;
+    std::fprintf(stderr, "\r%-12s %5.1f%%  %6.1f s   ", p.stage, 100.0 * p.fraction,
+                 std::chrono::duration<double>(now - start_).count());
+    std::fflush(stderr);
+  }
+  void done() {
+    if (enabled_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  bool enabled_;
+  Clock::time_point start_, last_{};
+  std::string stage_;
+};
+
+void print_summary(const vt::SceneBakeSummary& s) {
+  const auto& g = s.build.geometry;
+  std::printf("baked %s -> %s (unwrapped scene: %s)\n", s.triangles ? "scene" : "",
+              s.output.c_str(), s.unwrapped.empty() ? "not written" : s.unwrapped.c_str());
+  std::printf("  atlas      %u x %u texels, %lld charts, %.3g texels/unit, utilisation %.3f\n",
+              g.width, g.height, (long long)s.unwrap.charts, s.unwrap.texels_per_unit,
+              s.unwrap.utilisation);
+  std::printf("  transfer   %llu triangles, %llu covered texels (%llu edge-only, %llu contested)\n",
+              (unsigned long long)s.triangles, (unsigned long long)s.transfer.covered_texels,
+              (unsigned long long)s.transfer.edge_only_texels,
+              (unsigned long long)s.transfer.contested_texels);
+  std::printf("  layers    ");
+  for (const auto& l : s.build.layers) {
+    std::printf(" %s(%u ch, %s", l.name.c_str(), unsigned(l.spec.channels),
+                vt::to_string(l.spec.codec));
+    if (std::isfinite(l.psnr_db)) std::printf(", %.1f dB", l.psnr_db);
+    std::printf(")");
+  }
+  std::printf("\n");
+  std::printf("  pages      %llu in %u levels: %llu stored, %llu constant, %llu absent\n",
+              (unsigned long long)s.build.pages, g.level_count(),
+              (unsigned long long)s.build.stored, (unsigned long long)s.build.constant,
+              (unsigned long long)s.build.absent);
+  std::printf("  bytes      %llu in the file, %llu raw texels, ratio %.1f:1\n",
+              (unsigned long long)s.build.file_bytes, (unsigned long long)s.raw_bytes, s.ratio);
+  std::printf("  time      ");
+  for (const auto& st : s.stages) std::printf(" %s %.2f s,", st.name.c_str(), st.seconds);
+  std::printf(" total %.2f s\n", s.seconds);
+}
+
+vt::cli::CommandRunner make_bake(CLI::App& app) {
+  auto f = std::make_shared<BakeFlags>();
+  app.add_option("scene", f->scene, "Scene to bake (.gltf, .glb, .obj, .ply, .drc)")->required();
+  app.add_option("-o,--output", f->output, "Page file to write (.vtpf)")->required();
+  app.add_option("--unwrapped", f->unwrapped,
+                 "Where to write the unwrapped scene (.glb; default OUT.glb; '-' = not written)");
+  auto* tpu = app.add_option("--texels-per-unit", f->texels_per_unit, "World texel density")
+                  ->check(CLI::PositiveNumber);
+  auto* size = app.add_option("--size", f->size_pages, "Atlas side in pages (default 16)")
+                   ->check(CLI::Range(1, 1024));
+  tpu->excludes(size);
+  app.add_option("--padding", f->padding, "Empty texels between charts")->check(CLI::Range(0, 64));
+  app.add_option("--method", f->method, "Parameterisation: lscm or arap")
+      ->check(CLI::IsMember({"lscm", "arap"}));
+  app.add_option("--supersample", f->supersample, "Transfer samples per texel: 1, 4 or 16")
+      ->check(CLI::IsMember({1, 4, 16}));
+  app.add_option("--codec", f->codec, "Page codec: dct[:QUALITY], bc[:high|fast] or raw");
+  app.add_flag("--share-instances", f->share_instances,
+               "Instances of one mesh share texels (default: each gets its own)");
+  app.add_option("--memory-limit", f->memory_limit_gib, "Memory budget in GiB");
+  return [f](const vt::cli::GlobalOptions& global) -> int {
+    vt::SceneBakeOptions o;
+    o.output = f->output;
+    o.unwrapped = f->unwrapped;
+    o.unwrap.texels_per_unit = f->texels_per_unit;
+    if (f->size_pages > 0) o.unwrap.size_pages = f->size_pages;
+    o.unwrap.padding = f->padding;
+    o.unwrap.method = f->method == "arap" ? vt::unwrap::Method::kArap : vt::unwrap::Method::kLscm;
+    o.unwrap.share_instances = f->share_instances;
+    o.supersample = f->supersample;
+    if (!parse_codec(f->codec, &o.codec))
+      return bad("--codec: expected dct[:1-100], bc[:high|fast] or raw, got '" + f->codec + "'");
+    char* end = nullptr;
+    double gib = std::strtod(f->memory_limit_gib.c_str(), &end);
+    if (*end || !(gib > 0)) return bad("--memory-limit: expected a positive number of GiB");
+    o.memory_limit = uint64_t(gib * double(uint64_t(1) << 30));
+    o.threads = global.threads;
+    Progress progress(!global.quiet);
+    o.progress = [&](const vt::SceneBakeProgress& p) { progress.update(p); };
+    auto summary = vt::bake_scene(f->scene, o);
+    progress.done();
+    if (!summary.ok()) {
+      std::fprintf(stderr, "vtbake bake: %s\n", summary.status().message().c_str());
+      return exit_code_for(summary.status());
+    }
+    if (global.json) {
+      std::printf("%s\n", vt::summary_json(*summary).c_str());
+    } else {
+      print_summary(*summary);
+    }
+    return kExitOk;
+  };
+}
+
+const vt::cli::CommandRegistration kBake{
+    "bake", "Bake a scene's materials into a page file (unwrap, transfer, pyramid, pages)",
+    make_bake};
+
+}  // namespace

@@ -1,0 +1,424 @@
+// End-to-end bakes of small procedural scenes: the level-0 payload of the page file, resampled
+// back through the atlas UVs of the unwrapped scene, against the source textures.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "bake/sample_scene.h"
+#include "bake/scene_bake.h"
+#include "bake/transfer.h"
+#include "format/page_file.h"
+#include "transfer_test_util.h"
+
+namespace vt {
+namespace {
+
+using test::kPi;
+
+// Smooth colour (8-bit sRGB-encoded values) that bilinear resampling reproduces well.
+void smooth_colour(double u, double v, float* t) {
+  t[0] = float(std::round((0.5 + 0.35 * std::sin(2 * kPi * (2 * u + v))) * 255) / 255);
+  t[1] = float(std::round((0.5 + 0.35 * std::cos(2 * kPi * (u - 3 * v))) * 255) / 255);
+  t[2] = float(
+      std::round((0.5 + 0.3 * std::sin(2 * kPi * 4 * u) * std::cos(2 * kPi * 2 * v)) * 255) / 255);
+}
+
+struct RoundTrip {
+  double psnr = 0;
+  uint64_t samples = 0;
+  std::unique_ptr<PageFileReader> reader;
+};
+
+// Bakes `s` (raw codec, `tpu` texels per unit) and compares the albedo layer with smooth_colour
+// at every source texel centre (texture w x h) of every triangle.
+RoundTrip bake_and_compare(const scene::Scene& s, const test::ScratchDir& dir, double tpu,
+                           uint32_t w, uint32_t h) {
+  RoundTrip out;
+  SceneBakeOptions o;
+  o.output = dir.file("out.vtpf");
+  o.unwrap.texels_per_unit = tpu;
+  o.codec.codec = CodecKind::kRaw;
+  auto summary = bake_scene(s, o);
+  EXPECT_TRUE(summary.ok()) << summary.status().message();
+  if (!summary.ok()) return out;
+  EXPECT_EQ(summary->transfer.contested_texels, 0u);
+  auto reader = PageFileReader::open(o.output);
+  EXPECT_TRUE(reader.ok()) << reader.status().message();
+  auto unwrapped = scene::load_scene(dir.file("out.glb"));
+  EXPECT_TRUE(unwrapped.ok()) << unwrapped.status().message();
+  if (!reader.ok() || !unwrapped.ok()) return out;
+  int albedo = test::find_layer(**reader, LayerSemantic::kAlbedo);
+  EXPECT_GE(albedo, 0);
+  test::Level0 level = test::read_level0(**reader, uint32_t(albedo));
+  double se = 0;
+  for (const auto& mesh : unwrapped->meshes) {
+    for (const auto& p : mesh.primitives) {
+      const auto& atlas = p.uvs.back();
+      test::for_each_source_texel(
+          p, w, h, [&](const uint32_t v[3], const double l[3], double u, double vv) {
+            double ax = 0, ay = 0;
+            for (int k = 0; k < 3; ++k) ax += l[k] * atlas[v[k]][0], ay += l[k] * atlas[v[k]][1];
+            float want[3];
+            smooth_colour(u, vv, want);
+            for (int c = 0; c < 3; ++c) {
+              double d = level.at(ax * level.width, ay * level.height, c) - want[c];
+              se += d * d;
+            }
+            out.samples += 3;
+          });
+    }
+  }
+  out.psnr = test::psnr(se, out.samples);
+  out.reader = std::move(reader).value();
+  return out;
+}
+
+TEST(SceneBake, TexturedQuadRoundTripsAbove40dB) {
+  test::ScratchDir dir;
+  ASSERT_TRUE(write_texture(dir.file("quad.png"), 256, 256, 3, smooth_colour).ok());
+  scene::Material m;
+  m.name = "quad";
+  scene::Scene s = test::single_mesh_scene(make_grid(1.0f, 1, 1), m);
+  s.materials[0].base_color_texture.image = test::add_image(s, dir.file("quad.png"));
+  RoundTrip r = bake_and_compare(s, dir, 256, 256, 256);
+  ASSERT_TRUE(r.reader);
+  EXPECT_GT(r.samples, 3u * 250 * 250);
+  EXPECT_GE(r.psnr, 40.0) << "measured " << r.psnr;
+  RecordProperty("psnr_db", std::to_string(r.psnr));
+  // Only what the scene calls for: one albedo layer, opaque (no alpha), no normal layer.
+  ASSERT_EQ(r.reader->layers().size(), 1u);
+  EXPECT_EQ(r.reader->layers()[0].semantic, LayerSemantic::kAlbedo);
+  EXPECT_EQ(r.reader->layers()[0].channels, 3);
+  EXPECT_EQ(r.reader->layers()[0].color_space, ColorSpace::kSrgb);
+}
+
+TEST(SceneBake, TexturedCubeRoundTripsAbove40dB) {
+  test::ScratchDir dir;
+  ASSERT_TRUE(write_texture(dir.file("cube.png"), 128, 128, 3, smooth_colour).ok());
+  scene::Material m;
+  m.name = "cube";
+  m.metallic_factor = 0.0f;  // non-default factors: the scene calls for an ORM layer
+  m.roughness_factor = 0.25f;
+  scene::Scene s = test::single_mesh_scene(make_box(1, 1, 1), m);
+  s.materials[0].base_color_texture.image = test::add_image(s, dir.file("cube.png"));
+  RoundTrip r = bake_and_compare(s, dir, 128, 128, 128);
+  ASSERT_TRUE(r.reader);
+  EXPECT_GT(r.samples, 3u * 6 * 120 * 120);
+  EXPECT_GE(r.psnr, 40.0) << "measured " << r.psnr;
+  RecordProperty("psnr_db", std::to_string(r.psnr));
+  ASSERT_EQ(r.reader->layers().size(), 2u);
+  EXPECT_EQ(r.reader->layers()[0].channels, 3);
+  int orm = test::find_layer(*r.reader, LayerSemantic::kOrm);
+  ASSERT_GE(orm, 0);
+  EXPECT_EQ(test::find_layer(*r.reader, LayerSemantic::kNormal), -1);
+  EXPECT_EQ(test::find_layer(*r.reader, LayerSemantic::kEmissive), -1);
+  // The ORM layer holds the factors exactly (occlusion 1, roughness 0.25, metallic 0).
+  test::Level0 level = test::read_level0(*r.reader, uint32_t(orm));
+  uint64_t checked = 0;
+  for (size_t i = 0; i < size_t(level.width) * level.height; ++i) {
+    if (!level.present[i]) continue;
+    EXPECT_NEAR(level.texels[3 * i + 0], 1.0f, 0.5f / 255);
+    EXPECT_NEAR(level.texels[3 * i + 1], 0.25f, 0.5f / 255 + 1e-6);
+    EXPECT_NEAR(level.texels[3 * i + 2], 0.0f, 0.5f / 255);
+    ++checked;
+  }
+  EXPECT_GT(checked, 0u);
+}
+
+TEST(SceneBake, AlphaOnlyWhereSomeTexelIsNotOpaque) {
+  test::ScratchDir dir;
+  auto rgba = [](double u, double v, float* t) {
+    smooth_colour(u, v, t);
+    t[3] = (u - 0.5) * (u - 0.5) + (v - 0.5) * (v - 0.5) < 0.1 ? 1.0f : 0.0f;
+  };
+  ASSERT_TRUE(write_texture(dir.file("card.png"), 64, 64, 4, rgba).ok());
+  for (auto mode : {scene::AlphaMode::kMask, scene::AlphaMode::kOpaque}) {
+    scene::Material m;
+    m.alpha_mode = mode;
+    scene::Scene s = test::single_mesh_scene(make_grid(1.0f, 1, 1), m);
+    s.materials[0].base_color_texture.image = test::add_image(s, dir.file("card.png"));
+    auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 64});
+    ASSERT_TRUE(un.ok()) << un.status().message();
+    TransferOptions to;
+    to.width = uint32_t(un->stats.atlas_width), to.height = uint32_t(un->stats.atlas_height);
+    auto t = transfer_materials(un->scene, to);
+    ASSERT_TRUE(t.ok()) << t.status().message();
+    ASSERT_EQ(t->layers.size(), 1u);
+    // MASK keeps the alpha the texture has; OPAQUE ignores it, so no alpha channel is made.
+    EXPECT_EQ(t->layers[0].channels, mode == scene::AlphaMode::kMask ? 4u : 3u);
+  }
+}
+
+TEST(SceneBake, LayersFollowTheMaterials) {
+  scene::Material plain;
+  scene::Scene s = test::single_mesh_scene(make_grid(1, 1, 1), plain);
+  EXPECT_EQ(layers_used(s), std::vector<LayerSemantic>({LayerSemantic::kAlbedo}));
+  s.materials[0].emissive_factor = {0.5f, 0, 0};
+  EXPECT_EQ(layers_used(s),
+            std::vector<LayerSemantic>({LayerSemantic::kAlbedo, LayerSemantic::kEmissive}));
+  s.materials[0].normal_texture.image = 0;
+  s.materials[0].roughness_factor = 0.5f;
+  EXPECT_EQ(layers_used(s),
+            std::vector<LayerSemantic>({LayerSemantic::kAlbedo, LayerSemantic::kNormal,
+                                        LayerSemantic::kOrm, LayerSemantic::kEmissive}));
+}
+
+// Tangent-space normal map of ridges; the expected object-space normal is computed from the
+// analytic sphere frame, independently of the transfer's tangent generation.
+void ridge_normal(double u, double v, float* t) {
+  double x = 0.35 * std::sin(2 * kPi * 6 * u), y = 0.35 * std::cos(2 * kPi * 3 * v), z = 1;
+  double l = std::sqrt(x * x + y * y + z * z);
+  t[0] = float(x / l * 0.5 + 0.5), t[1] = float(y / l * 0.5 + 0.5), t[2] = float(z / l * 0.5 + 0.5);
+}
+
+struct V {
+  double x, y, z;
+};
+V operator+(V a, V b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+V operator-(V a, V b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+V operator*(V a, double s) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+double dot(V a, V b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+V cross(V a, V b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+V unit(V a) {
+  return a * (1.0 / std::sqrt(dot(a, a)));
+}
+
+TEST(SceneBake, NormalMappedSphereKeepsItsNormals) {
+  test::ScratchDir dir;
+  ASSERT_TRUE(write_texture(dir.file("n.png"), 256, 128, 3, ridge_normal).ok());
+  scene::Primitive sphere = make_uv_sphere(1.0f, 32);
+  // glTF tangents: +u direction; w so that cross(N, T) * w points up the image (-v).
+  for (size_t i = 0; i < sphere.positions.size(); ++i) {
+    double phi = 2 * kPi * sphere.uvs[0][i][0];
+    V t = {-std::sin(phi), 0, -std::cos(phi)};
+    sphere.tangents.push_back({float(t.x), float(t.y), float(t.z), 1.0f});
+  }
+  scene::Material m;
+  m.name = "bumpy";
+  scene::Scene s = test::single_mesh_scene(sphere, m);
+  s.materials[0].normal_texture.image = test::add_image(s, dir.file("n.png"));
+  SceneBakeOptions o;
+  o.output = dir.file("out.vtpf");
+  o.unwrap.texels_per_unit = 48;
+  o.codec.codec = CodecKind::kRaw;
+  auto summary = bake_scene(s, o);
+  ASSERT_TRUE(summary.ok()) << summary.status().message();
+  auto reader = PageFileReader::open(o.output);
+  ASSERT_TRUE(reader.ok());
+  int nl = test::find_layer(**reader, LayerSemantic::kNormal);
+  ASSERT_GE(nl, 0);
+  test::Level0 level = test::read_level0(**reader, uint32_t(nl));
+  ASSERT_EQ(level.channels, 2u);
+  auto un = scene::load_scene(dir.file("out.glb"));
+  ASSERT_TRUE(un.ok());
+  const scene::Primitive& p = un->meshes[0].primitives[0];
+  const auto& atlas = p.uvs.back();
+  std::vector<double> angles;
+  auto pos = [&](uint32_t i) { return V{p.positions[i][0], p.positions[i][1], p.positions[i][2]}; };
+  test::for_each_source_texel(
+      p, 128, 64, [&](const uint32_t v[3], const double l[3], double u, double vv) {
+        V n =
+            unit(V{0, 0, 0} + V{p.normals[v[0]][0], p.normals[v[0]][1], p.normals[v[0]][2]} * l[0] +
+                 V{p.normals[v[1]][0], p.normals[v[1]][1], p.normals[v[1]][2]} * l[1] +
+                 V{p.normals[v[2]][0], p.normals[v[2]][1], p.normals[v[2]][2]} * l[2]);
+        // Expected: the source map in the analytic frame.
+        double phi = 2 * kPi * u, theta = kPi * vv;
+        V t = unit(V{-std::sin(phi), 0, -std::cos(phi)} -
+                   n * dot(n, V{-std::sin(phi), 0, -std::cos(phi)}));
+        V down = {std::cos(theta) * std::cos(phi), -std::sin(theta),
+                  -std::cos(theta) * std::sin(phi)};
+        V b = cross(n, t) * (dot(cross(n, t), down) > 0 ? -1.0 : 1.0);
+        float src[3];
+        ridge_normal(u, vv, src);
+        V want = unit(t * (src[0] * 2.0 - 1) + b * (src[1] * 2.0 - 1) + n * (src[2] * 2.0 - 1));
+        // Baked: the atlas frame of this triangle (x right, y down the atlas image).
+        double ax[3], ay[3];
+        for (int k = 0; k < 3; ++k)
+          ax[k] = atlas[v[k]][0] * level.width, ay[k] = atlas[v[k]][1] * level.height;
+        double det = (ax[1] - ax[0]) * (ay[2] - ay[0]) - (ax[2] - ax[0]) * (ay[1] - ay[0]);
+        V e1 = pos(v[1]) - pos(v[0]), e2 = pos(v[2]) - pos(v[0]);
+        V dpdx = (e1 * (ay[2] - ay[0]) - e2 * (ay[1] - ay[0])) * (1.0 / det);
+        V dpdy = (e2 * (ax[1] - ax[0]) - e1 * (ax[2] - ax[0])) * (1.0 / det);
+        V ta = unit(dpdx - n * dot(n, dpdx));
+        V ba = cross(n, ta) * (dot(cross(n, ta), dpdy) > 0 ? -1.0 : 1.0);
+        double px = 0, py = 0;
+        for (int k = 0; k < 3; ++k) px += l[k] * ax[k], py += l[k] * ay[k];
+        double x = level.at(px, py, 0) * 2.0 - 1, y = level.at(px, py, 1) * 2.0 - 1;
+        double z = std::sqrt(std::max(0.0, 1 - x * x - y * y));
+        V got = unit(ta * x + ba * y + n * z);
+        angles.push_back(std::acos(std::clamp(dot(got, want), -1.0, 1.0)) * 180 / kPi);
+      });
+  ASSERT_GT(angles.size(), 4000u);
+  std::sort(angles.begin(), angles.end());
+  double mean = 0;
+  for (double a : angles) mean += a;
+  mean /= angles.size();
+  double p95 = angles[angles.size() * 95 / 100];
+  RecordProperty("mean_deg", std::to_string(mean));
+  RecordProperty("p95_deg", std::to_string(p95));
+  EXPECT_LT(mean, 0.6) << "p95 " << p95 << " max " << angles.back();
+  EXPECT_LT(p95, 2.0) << "mean " << mean << " max " << angles.back();
+}
+
+// A linear EXR of fine stripes, baked at 1/16 of its density: more samples per texel must
+// approach the footprint average (reference: 32 x 32 exact samples per texel) monotonically.
+TEST(SceneBake, SupersamplingImprovesAccuracyMonotonically) {
+  test::ScratchDir dir;
+  auto stripes = [](double u, double v, float* t) {
+    double s = 0.5 + 0.45 * std::sin(2 * kPi * (37 * u + 11 * v));
+    t[0] = t[1] = t[2] = float(s);
+  };
+  ASSERT_TRUE(write_texture(dir.file("stripes.exr"), 512, 512, 3, stripes).ok());
+  scene::Material m;
+  scene::Scene s = test::single_mesh_scene(make_grid(1.0f, 1, 1), m);
+  s.materials[0].base_color_texture.image = test::add_image(s, dir.file("stripes.exr"));
+  auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 32});
+  ASSERT_TRUE(un.ok());
+  const scene::Primitive& p = un->scene.meshes[0].primitives[0];
+  double rmse[3];
+  int k = 0;
+  for (int ss : {1, 4, 16}) {
+    TransferOptions to;
+    to.width = uint32_t(un->stats.atlas_width), to.height = uint32_t(un->stats.atlas_height);
+    to.supersample = ss;
+    auto t = transfer_materials(un->scene, to);
+    ASSERT_TRUE(t.ok()) << t.status().message();
+    const auto& texels = t->layers[0].texels;
+    // Reference over texels whose square lies inside the quad's atlas footprint.
+    double se = 0;
+    uint64_t n = 0;
+    const auto& atlas = p.uvs.back();
+    for (uint32_t y = 0; y < to.height; ++y) {
+      for (uint32_t x = 0; x < to.width; ++x) {
+        double sum = 0;
+        bool all_in = true;
+        for (int j = 0; j < 32 && all_in; ++j) {
+          for (int i = 0; i < 32 && all_in; ++i) {
+            double px = (x + (i + 0.5) / 32) / to.width, py = (y + (j + 0.5) / 32) / to.height;
+            all_in = false;
+            for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
+              const auto &a = atlas[p.indices[f]], &b = atlas[p.indices[f + 1]],
+                         &c = atlas[p.indices[f + 2]];
+              double d = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+              double l1 = ((px - a[0]) * (c[1] - a[1]) - (py - a[1]) * (c[0] - a[0])) / d;
+              double l2 = ((b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0])) / d;
+              if (l1 < 0 || l2 < 0 || l1 + l2 > 1) continue;
+              const auto &ua = p.uvs[0][p.indices[f]], &ub = p.uvs[0][p.indices[f + 1]],
+                         &uc = p.uvs[0][p.indices[f + 2]];
+              double u = ua[0] + l1 * (ub[0] - ua[0]) + l2 * (uc[0] - ua[0]);
+              double v = ua[1] + l1 * (ub[1] - ua[1]) + l2 * (uc[1] - ua[1]);
+              float val[3];
+              stripes(u, v, val);
+              sum += val[0];
+              all_in = true;
+              break;
+            }
+          }
+        }
+        if (!all_in) continue;
+        double d = texels[(size_t(y) * to.width + x) * 3] - sum / 1024;
+        se += d * d, ++n;
+      }
+    }
+    ASSERT_GT(n, 500u);
+    rmse[k++] = std::sqrt(se / n);
+  }
+  RecordProperty("rmse_1_4_16", std::to_string(rmse[0]) + " " + std::to_string(rmse[1]) + " " +
+                                    std::to_string(rmse[2]));
+  EXPECT_LT(rmse[1], rmse[0]) << rmse[0] << " " << rmse[1] << " " << rmse[2];
+  EXPECT_LT(rmse[2], rmse[1]) << rmse[0] << " " << rmse[1] << " " << rmse[2];
+}
+
+TEST(SceneBake, SameTexelsWhateverTheThreadCount) {
+  test::ScratchDir dir;
+  ASSERT_TRUE(write_texture(dir.file("c.png"), 64, 64, 3, smooth_colour).ok());
+  scene::Material m;
+  scene::Scene s = test::single_mesh_scene(make_uv_sphere(1.0f, 24), m);
+  s.materials[0].base_color_texture.image = test::add_image(s, dir.file("c.png"));
+  auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 40});
+  ASSERT_TRUE(un.ok());
+  std::vector<float> first;
+  for (int threads : {1, 2, 3}) {
+    TransferOptions to;
+    to.width = uint32_t(un->stats.atlas_width), to.height = uint32_t(un->stats.atlas_height);
+    to.threads = threads;
+    to.supersample = 4;
+    auto t = transfer_materials(un->scene, to);
+    ASSERT_TRUE(t.ok());
+    EXPECT_EQ(t->stats.contested_texels, 0u);
+    EXPECT_GT(t->stats.edge_only_texels, 0u);
+    if (first.empty())
+      first = t->layers[0].texels;
+    else
+      EXPECT_TRUE(first == t->layers[0].texels) << threads << " threads";
+  }
+}
+
+TEST(SceneBake, MissingImageIsAnErrorNamingTheFile) {
+  scene::Material m;
+  scene::Scene s = test::single_mesh_scene(make_grid(1, 1, 1), m);
+  s.materials[0].base_color_texture.image = test::add_image(s, "/nonexistent/dir/albedo.png");
+  auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 16});
+  ASSERT_TRUE(un.ok());
+  TransferOptions to;
+  to.width = uint32_t(un->stats.atlas_width), to.height = uint32_t(un->stats.atlas_height);
+  auto t = transfer_materials(un->scene, to);
+  ASSERT_FALSE(t.ok());
+  EXPECT_NE(t.status().message().find("/nonexistent/dir/albedo.png"), std::string::npos)
+      << t.status().message();
+}
+
+TEST(SceneBake, SceneWithoutAtlasUvsIsAnError) {
+  scene::Material m;
+  scene::Primitive p = make_grid(1, 1, 1);
+  p.uvs.clear();
+  scene::Scene s = test::single_mesh_scene(p, m);
+  TransferOptions to;
+  to.width = to.height = 16;
+  auto t = transfer_materials(s, to);
+  ASSERT_FALSE(t.ok());
+  EXPECT_NE(t.status().message().find("atlas UVs"), std::string::npos) << t.status().message();
+}
+
+TEST(SceneBake, SampleSceneBakesWithEveryLayer) {
+  test::ScratchDir dir;
+  SampleSceneOptions so;
+  so.texture_size = 64;
+  so.sphere_segments = 16;
+  so.ground_cells = 4;
+  ASSERT_TRUE(write_sample_scene(dir.file("sample"), so).ok());
+  SceneBakeOptions o;
+  o.output = dir.file("sample.vtpf");
+  o.unwrap.size_pages = 4;
+  auto summary = bake_scene(dir.file("sample/scene.gltf"), o);
+  ASSERT_TRUE(summary.ok()) << summary.status().message();
+  EXPECT_EQ(summary->transfer.contested_texels, 0u);
+  auto reader = PageFileReader::open(o.output);
+  ASSERT_TRUE(reader.ok());
+  EXPECT_TRUE((*reader)->verify().ok());
+  // Albedo with alpha (the masked leaf), normal, ORM, emissive.
+  ASSERT_EQ((*reader)->layers().size(), 4u);
+  EXPECT_EQ((*reader)->layers()[0].channels, 4);
+  EXPECT_GE(test::find_layer(**reader, LayerSemantic::kNormal), 0);
+  EXPECT_GE(test::find_layer(**reader, LayerSemantic::kOrm), 0);
+  EXPECT_GE(test::find_layer(**reader, LayerSemantic::kEmissive), 0);
+  EXPECT_GT(summary->build.stored, 0u);
+  EXPECT_GT(summary->ratio, 1.0);
+  auto un = scene::load_scene(dir.file("sample.glb"));
+  ASSERT_TRUE(un.ok()) << un.status().message();
+  EXPECT_EQ(un->instances().size(), 7u);
+}
+
+}  // namespace
+}  // namespace vt
