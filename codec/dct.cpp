@@ -1,10 +1,11 @@
 // The page DCT codec (see dct.h). Bitstream of a page: one range-coded stream, no header. For
 // every plane in order (Y, Co, Cg, alpha or channel 0..3), blocks in raster order; each block
-// codes its AC nonzero count (6-bit tree, context: neighbours' counts), its DC as a residual
-// from a median predictor (context: neighbours' DC difference), then the AC coefficients in
-// zigzag order: a zero flag per position while nonzeros remain (context: position, nonzeros
+// codes its AC nonzero count (Exp-Golomb-like bins, context: neighbours' counts), its DC as a
+// residual from a median predictor (context: neighbours' DC difference), then the AC coefficients
+// in zigzag order: a zero flag per position while nonzeros remain (context: position, nonzeros
 // left, neighbours' magnitude at that position), an Exp-Golomb-like magnitude with adaptive
-// exponent bins, and a raw sign. Context probabilities start from the per-layer tables.
+// exponent bins, then its low bits and sign raw. Context probabilities start from the per-layer
+// tables.
 #include "codec/dct.h"
 
 #include <algorithm>
@@ -46,14 +47,24 @@ constexpr int16_t kIdctBasis[8][8] = {
     {1448, -2009, 1892, -1703, 1448, -1138, 784, -400},
 };
 
+struct TransposedBasis {
+  int32_t b[8][8];  // b[u][x] = kIdctBasis[x][u], rows the second pass combines
+  constexpr TransposedBasis() : b() {
+    for (int u = 0; u < 8; u++)
+      for (int x = 0; x < 8; x++) b[u][x] = kIdctBasis[x][u];
+  }
+};
+constexpr TransposedBasis kIdctBasisT;
+
 // Context layout of one plane's models (offsets into a flat BitModel array).
-constexpr int kNzCtx = 11;   // predicted AC count buckets + "no neighbour"
-constexpr int kDcCtx = 8;    // bit length of the neighbours' DC difference
-constexpr int kRemCtx = 7;   // nonzeros left
-constexpr int kNbCtx = 6;    // neighbours' magnitude at the same position
-constexpr int kBandCtx = 6;  // zigzag position bands
-constexpr int kNzOff = 0;
-constexpr int kDcZeroOff = kNzOff + kNzCtx * 64;
+constexpr int kNzCtx = 11;                          // predicted AC count buckets + "no neighbour"
+constexpr int kDcCtx = 8;                           // bit length of the neighbours' DC difference
+constexpr int kRemCtx = 7;                          // nonzeros left
+constexpr int kNbCtx = 6;                           // neighbours' magnitude at the same position
+constexpr int kBandCtx = 6;                         // zigzag position bands
+constexpr int kNzExpOff = 0;                        // [ctx][bit length 0..6]
+constexpr int kNzMantOff = kNzExpOff + kNzCtx * 7;  // [ctx][bit length][bit]
+constexpr int kDcZeroOff = kNzMantOff + kNzCtx * 7 * 5;
 constexpr int kDcSignOff = kDcZeroOff + kDcCtx;
 constexpr int kDcExpOff = kDcSignOff + kDcCtx;
 constexpr int kDcMantOff = kDcExpOff + kDcCtx * kMaxExp;
@@ -64,6 +75,9 @@ constexpr int kConstOff = kAcMantOff + kBandCtx * kMaxExp;  // plane 0 only: con
 constexpr int kModelsPerPlane = kConstOff + 1;
 
 constexpr uint8_t kMagic[4] = {'V', 'T', 'D', 'C'};
+// Raw bits closing every page: a cut or damaged stream decodes them wrong (odds 1 in 65536 of
+// missing it), where the arithmetic decoder alone would just read zeros and carry on.
+constexpr int kEndMarker = 0xA55A;
 constexpr uint8_t kTablesVersion = 1;
 
 struct BucketTables {
@@ -218,10 +232,24 @@ void code_plane(Coder& c, BitModel* m, int bw, int bh, int16_t* coefs, BlockInfo
         nz_ctx = kBuckets.nz[(a + b + 1) >> 1];
       }
       {
-        BitModel* tree = m + kNzOff + nz_ctx * 64;
-        int node = 1;
-        for (int i = 5; i >= 0; i--) node = node * 2 + c.bit(tree[node], (nz >> i) & 1);
-        nz = node - 64;
+        // Bit length of the count in unary, then the bits below its top bit.
+        BitModel* exp = m + kNzExpOff + nz_ctx * 7;
+        int e = 0;
+        if constexpr (Coder::kDecoding) {
+          while (e < 6 && c.bit(exp[e])) e++;
+        } else {
+          e = bit_length(unsigned(nz));
+          for (int i = 0; i < e; i++) c.bit(exp[i], 1);
+          if (e < 6) c.bit(exp[e], 0);
+        }
+        if (e > 1) {
+          BitModel* mant = m + kNzMantOff + (nz_ctx * 7 + e) * 5;
+          int v = 1;
+          for (int i = e - 2; i >= 0; i--) v = v * 2 + c.bit(mant[i], (nz >> i) & 1);
+          nz = v;
+        } else {
+          nz = e;
+        }
       }
 
       // DC: residual from a median (LOCO-I) predictor.
@@ -282,7 +310,6 @@ void code_plane(Coder& c, BitModel* m, int bw, int bh, int16_t* coefs, BlockInfo
         }
         rem--;
         last = k;
-        const int neg = c.direct(v < 0, 1);
         int mag = std::abs(v);
         const int band = kBuckets.band[k];
         BitModel* exp = m + kAcExpOff + (band * kNbCtx + nb) * kMaxExp;
@@ -294,12 +321,16 @@ void code_plane(Coder& c, BitModel* m, int bw, int bh, int16_t* coefs, BlockInfo
           for (int i = 0; i < e; i++) c.bit(exp[i], 1);
           if (e < kMaxExp - 1) c.bit(exp[e], 0);
         }
+        int neg;
         if (e > 0) {
           const int hi = c.bit(m[kAcMantOff + band * kMaxExp + e], (mag >> (e - 1)) & 1);
-          const int lo = c.direct(mag & ((1 << (e - 1)) - 1), e - 1);
-          mag = (((2 | hi) << (e - 1)) | lo);
+          // The bits below and the sign are equiprobable: one raw field.
+          const int lo_sign = c.direct(((mag & ((1 << (e - 1)) - 1)) << 1) | (v < 0), e);
+          mag = (((2 | hi) << (e - 1)) | (lo_sign >> 1));
+          neg = lo_sign & 1;
         } else {
           mag = 1;
+          neg = c.direct(v < 0, 1);
         }
         if constexpr (Coder::kDecoding) z[k] = int16_t(neg ? -mag : mag);
       }
@@ -400,31 +431,56 @@ void quantize_plane(const FloatPlane& fp, const uint8_t* quant, int16_t* coefs) 
 // < nv and columns < nu. Output in 1/8 texel units, clamped to +-4095.
 // Rounding is part of the format: pass 1 keeps 3 fractional bits ((x + 2^8) >> 9), pass 2
 // rounds to 1/8 ((x + 2^11) >> 12). |F| <= 2^11 and |B| <= 2^11 keep every sum inside int32.
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-void idct_block(const int32_t* f, int nv, int nu, int16_t* out, int stride) {
+// NV and NU are compile-time bounds (2, 4 or 8) so the loops vectorise cleanly; the rows and
+// columns beyond the last nonzero contribute zeros and are skipped exactly.
+template <int NV, int NU>
+inline void idct_block_n(const int32_t* f, int16_t* out, int stride) {
   int32_t tmp[8][8];
   for (int y = 0; y < 8; y++) {
     int32_t acc[8] = {};
-    for (int v = 0; v < nv; v++) {
+    for (int v = 0; v < NV; v++) {
       const int32_t b = kIdctBasis[y][v];
       for (int u = 0; u < 8; u++) acc[u] += b * f[v * 8 + u];
     }
     for (int u = 0; u < 8; u++) tmp[y][u] = (acc[u] + 256) >> 9;
   }
-  int32_t bt[8][8];  // bt[u][x] = B[x][u]
-  for (int u = 0; u < 8; u++)
-    for (int x = 0; x < 8; x++) bt[u][x] = kIdctBasis[x][u];
   for (int y = 0; y < 8; y++) {
     int32_t acc[8] = {};
-    for (int u = 0; u < nu; u++) {
+    for (int u = 0; u < NU; u++) {
       const int32_t t = tmp[y][u];
-      for (int x = 0; x < 8; x++) acc[x] += t * bt[u][x];
+      for (int x = 0; x < 8; x++) acc[x] += t * kIdctBasisT.b[u][x];
     }
     for (int x = 0; x < 8; x++) {
       out[y * stride + x] = int16_t(std::clamp((acc[x] + 2048) >> 12, -4095, 4095));
     }
+  }
+}
+
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
+__attribute__((target_clones("avx2", "default"), flatten))
+#endif
+void idct_block(const int32_t* f, int nv, int nu, int16_t* out, int stride) {
+  const int rv = nv <= 2 ? 0 : nv <= 4 ? 1 : 2;
+  const int ru = nu <= 2 ? 0 : nu <= 4 ? 1 : 2;
+  switch (rv * 3 + ru) {
+    case 0:
+      return idct_block_n<2, 2>(f, out, stride);
+    case 1:
+      return idct_block_n<2, 4>(f, out, stride);
+    case 2:
+      return idct_block_n<2, 8>(f, out, stride);
+    case 3:
+      return idct_block_n<4, 2>(f, out, stride);
+    case 4:
+      return idct_block_n<4, 4>(f, out, stride);
+    case 5:
+      return idct_block_n<4, 8>(f, out, stride);
+    case 6:
+      return idct_block_n<8, 2>(f, out, stride);
+    case 7:
+      return idct_block_n<8, 4>(f, out, stride);
+    default:
+      return idct_block_n<8, 8>(f, out, stride);
   }
 }
 
@@ -507,6 +563,20 @@ void ycocg420_to_rgb(const int16_t* yp, int ystride, const int16_t* co, const in
                 (cg3 + vcg[r]) >> 4);
     }
   }
+}
+
+// A valid page ends with the marker, overreads at most 5 bytes (the zeros the encoder trimmed
+// plus one) and leaves no byte unread.
+Status check_end(RangeDecoder& dec, size_t size) {
+  const int marker = dec.direct(0, 16);
+  if (marker != kEndMarker || dec.overread() > 8) {
+    return Error(ErrorCode::kCorrupt,
+                 "dct page: data cut short or damaged (" + std::to_string(size) + " bytes)");
+  }
+  if (!dec.consumed_all()) {
+    return Error(ErrorCode::kCorrupt, "dct page: trailing bytes after the page data");
+  }
+  return Status::Ok();
 }
 
 }  // namespace
@@ -662,6 +732,7 @@ Status dct_encode_page(const DctTables& tables, const uint8_t* texels, int width
   }
   if (enc.bit(models[kConstOff], constant)) {
     for (int c = 0; c < ch; c++) enc.direct(texels[c], 8);
+    enc.direct(kEndMarker, 16);
     enc.finish();
     return Status::Ok();
   }
@@ -675,6 +746,7 @@ Status dct_encode_page(const DctTables& tables, const uint8_t* texels, int width
     models = tables.models[p];
     code_plane(enc, models.data(), d.bw, d.bh, coefs.data(), info.data());
   }
+  enc.direct(kEndMarker, 16);
   enc.finish();
   return Status::Ok();
 }
@@ -692,7 +764,7 @@ Status dct_decode_page(const DctTables& tables, std::span<const uint8_t> data, i
   if (dec.bit(const_model)) {
     uint8_t texel[4];
     for (int c = 0; c < ch; c++) texel[c] = uint8_t(dec.direct(0, 8));
-    if (dec.overread() > 8) return Error(ErrorCode::kCorrupt, "dct page: data ends early");
+    VT_RETURN_IF_ERROR(check_end(dec, data.size()));
     const size_t count = size_t(width) * height;
     for (size_t i = 0; i < count; i++) std::memcpy(texels + i * ch, texel, size_t(ch));
     return Status::Ok();
@@ -714,6 +786,7 @@ Status dct_decode_page(const DctTables& tables, std::span<const uint8_t> data, i
     reconstruct_plane(d, tables.quant[p], scratch.coefs.data(), scratch.info.data(),
                       scratch.samples[p].data());
   }
+  VT_RETURN_IF_ERROR(check_end(dec, data.size()));
 
   if (s.layout == DctPlaneLayout::kPlanes) {
     for (int p = 0; p < n; p++) {

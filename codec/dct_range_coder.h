@@ -170,6 +170,7 @@ class RangeDecoder {
   }
 
   size_t overread() const { return overread_; }
+  bool consumed_all() const { return p_ == end_; }
 
  private:
   uint32_t next() {
