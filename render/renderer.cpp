@@ -337,7 +337,7 @@ Status Renderer::Impl::init(const RenderOptions& o) {
   pl.pSetLayouts = &vt_set_layout;
   VT_VK(vkCreatePipelineLayout(dev, &pl, nullptr, &vt_layout));
 
-  const VkFormat ref_formats[] = {kColorFormat};
+  const VkFormat ref_formats[] = {kColorFormat, kUintFormat};
   const VkFormat fb_formats[] = {kUintFormat};
   const VkFormat vt_formats[] = {kColorFormat, kUintFormat};
   VT_ASSIGN_OR_RETURN(ref_pipe, make_pipeline(ref_layout, spirv_reference_frag(), ref_formats));
@@ -698,7 +698,7 @@ Status Renderer::upload_page_table(const PageTableLevels& table) {
   });
 }
 
-Expected<Rgba8Image> Renderer::render_reference(const Camera& camera) {
+Expected<ReferenceFrame> Renderer::render_reference(const Camera& camera) {
   Impl& s = *impl_;
   for (const auto& m : s.meshes) {
     if (m.texture >= s.textures.size()) {
@@ -708,9 +708,9 @@ Expected<Rgba8Image> Renderer::render_reference(const Camera& camera) {
     }
   }
   const uint32_t w = options_.width, h = options_.height;
-  const Image* targets[] = {&s.color};
-  const Buffer* readbacks[] = {&s.color_rb};
-  const VkClearColorValue clears[] = {{{0.0f, 0.0f, 0.0f, 0.0f}}};
+  const Image* targets[] = {&s.color, &s.status};
+  const Buffer* readbacks[] = {&s.color_rb, &s.status_rb};
+  const VkClearColorValue clears[] = {{{0.0f, 0.0f, 0.0f, 0.0f}}, {}};
   VT_RETURN_IF_ERROR(s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
     s.begin_pass(cmd, targets, s.depth, w, h, clears);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.ref_pipe);
@@ -737,10 +737,12 @@ Expected<Rgba8Image> Renderer::render_reference(const Camera& camera) {
     }
     s.end_pass(cmd, targets, readbacks, w, h);
   }));
-  Rgba8Image out;
-  out.width = w;
-  out.height = h;
-  out.texels.assign(s.color_rb.mapped(), s.color_rb.mapped() + size_t(w) * h * 4);
+  ReferenceFrame out;
+  out.color.width = w;
+  out.color.height = h;
+  out.color.texels.assign(s.color_rb.mapped(), s.color_rb.mapped() + size_t(w) * h * 4);
+  out.covered.resize(size_t(w) * h);
+  std::memcpy(out.covered.data(), s.status_rb.mapped(), out.covered.size() * 4);
   return out;
 }
 

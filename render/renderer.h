@@ -85,6 +85,11 @@ struct Rgba8Image {
   std::vector<uint8_t> texels;  // RGBA8 row-major
 };
 
+struct ReferenceFrame {
+  Rgba8Image color;
+  std::vector<uint32_t> covered;  // per pixel: 1 where the surface was drawn (after alpha test)
+};
+
 struct FeedbackImage {
   uint32_t width = 0;
   uint32_t height = 0;
@@ -117,7 +122,7 @@ class Renderer {
   Status upload_slots(std::span<const SlotUpload> pages);
   Status upload_page_table(const PageTableLevels& table);
 
-  Expected<Rgba8Image> render_reference(const Camera& camera);
+  Expected<ReferenceFrame> render_reference(const Camera& camera);
   // `frame` rotates which tap each pixel reports and jitters the sub-pixel position.
   Expected<FeedbackImage> render_feedback(const Camera& camera, uint32_t frame);
   Expected<VirtualFrame> render_virtual(const Camera& camera);

@@ -104,6 +104,7 @@ Status write_report_json(const std::string& path, const ValidationReport& r) {
                      {"pixels_compared", m.pixels},
                      {"coarser_share", m.coarser_share},
                      {"unresident_pixels", m.unresident_pixels},
+                     {"coverage_mismatch_share", m.coverage_mismatch_share},
                      {"converged", v.converge.converged},
                      {"frames_to_converge", v.converge.frames_to_converge},
                      {"frames_rendered", v.converge.frames_rendered},
@@ -125,7 +126,8 @@ Status write_report_json(const std::string& path, const ValidationReport& r) {
               {"thresholds",
                {{"min_psnr", r.thresholds.min_psnr},
                 {"min_tile_psnr", r.thresholds.min_tile_psnr},
-                {"max_coarser_share", r.thresholds.max_coarser_share}}},
+                {"max_coarser_share", r.thresholds.max_coarser_share},
+                {"max_coverage_mismatch", r.thresholds.max_coverage_mismatch}}},
               {"passed", r.passed()},
               {"views", views}};
   std::ofstream f(path, std::ios::binary | std::ios::trunc);

@@ -105,58 +105,57 @@ Expected<ConvergeResult> converge_view(Renderer& renderer, Streamer& streamer, c
   return result;
 }
 
-Expected<ViewMetrics> compare_view(const Rgba8Image& reference, const VirtualFrame& frame) {
+Expected<ViewMetrics> compare_view(const ReferenceFrame& reference_frame,
+                                   const VirtualFrame& frame) {
+  const Rgba8Image& reference = reference_frame.color;
   const Rgba8Image& test = frame.color;
+  const size_t n = size_t(test.width) * test.height;
   if (reference.width != test.width || reference.height != test.height ||
-      reference.texels.size() != test.texels.size() ||
-      frame.status.size() != size_t(test.width) * test.height) {
+      reference.texels.size() != n * 4 || test.texels.size() != n * 4 || frame.status.size() != n ||
+      reference_frame.covered.size() != n) {
     return Error(ErrorCode::kInvalidArgument, "render: compared images differ in size");
   }
   ViewMetrics m;
-  const size_t n = size_t(test.width) * test.height;
-  // PSNR over the pixels either render covers, so an empty background does not inflate it.
+  // Colour is compared where both renders drew the surface; pixels only one of them drew
+  // (alpha-test decisions that flip on a rounding difference, or a broken alpha channel) are
+  // counted apart, so a background colour never enters the PSNR.
   std::vector<uint8_t> ref_px, test_px;
-  uint64_t covered = 0, coarser = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const uint32_t st = frame.status[i];
-    const bool cov = (st & 0x80000000u) != 0;
-    const uint8_t* r = &reference.texels[i * 4];
-    const uint8_t* t = &test.texels[i * 4];
-    if (cov) {
-      ++covered;
-      uint32_t wanted = st & 0xFF, sampled = (st >> 8) & 0xFF;
-      if (sampled == 31) ++m.unresident_pixels;
-      if (sampled > wanted) ++coarser;
-    }
-    if (cov || r[0] != t[0] || r[1] != t[1] || r[2] != t[2] || r[3] != t[3]) {
+  uint64_t covered = 0, coarser = 0, either = 0, mismatch = 0;
+  constexpr uint32_t kTile = 16;
+  const uint32_t tiles_x = (test.width + kTile - 1) / kTile;
+  const uint32_t tiles_y = (test.height + kTile - 1) / kTile;
+  std::vector<double> sse(size_t(tiles_x) * tiles_y, 0.0);
+  std::vector<uint32_t> count(size_t(tiles_x) * tiles_y, 0);
+  for (uint32_t y = 0; y < test.height; ++y) {
+    for (uint32_t x = 0; x < test.width; ++x) {
+      const size_t i = size_t(y) * test.width + x;
+      const uint32_t st = frame.status[i];
+      const bool vcov = (st & 0x80000000u) != 0;
+      const bool rcov = reference_frame.covered[i] != 0;
+      if (vcov) {
+        ++covered;
+        uint32_t wanted = st & 0xFF, sampled = (st >> 8) & 0xFF;
+        if (sampled == 31) ++m.unresident_pixels;
+        if (sampled > wanted) ++coarser;
+      }
+      if (vcov || rcov) ++either;
+      if (vcov != rcov) ++mismatch;
+      if (!(vcov && rcov)) continue;
+      const uint8_t* r = &reference.texels[i * 4];
+      const uint8_t* t = &test.texels[i * 4];
       ref_px.insert(ref_px.end(), r, r + 4);
       test_px.insert(test_px.end(), t, t + 4);
+      const size_t k = size_t(y / kTile) * tiles_x + x / kTile;
+      for (int c = 0; c < 3; ++c) sse[k] += double(int(r[c]) - t[c]) * double(int(r[c]) - t[c]);
+      count[k]++;
     }
   }
   m.pixels = ref_px.size() / 4;
-  {
-    constexpr uint32_t kTile = 16;
-    const uint32_t tx = (test.width + kTile - 1) / kTile, ty = (test.height + kTile - 1) / kTile;
-    std::vector<double> sse(size_t(tx) * ty, 0.0);
-    std::vector<uint32_t> count(size_t(tx) * ty, 0);
-    for (uint32_t y = 0; y < test.height; ++y) {
-      for (uint32_t x = 0; x < test.width; ++x) {
-        size_t i = size_t(y) * test.width + x;
-        const uint8_t* r = &reference.texels[i * 4];
-        const uint8_t* t = &test.texels[i * 4];
-        bool cov = (frame.status[i] & 0x80000000u) != 0;
-        if (!cov && r[0] == t[0] && r[1] == t[1] && r[2] == t[2] && r[3] == t[3]) continue;
-        size_t k = size_t(y / kTile) * tx + x / kTile;
-        for (int c = 0; c < 3; ++c)
-          sse[k] += double(int(r[c]) - int(t[c])) * (int(r[c]) - int(t[c]));
-        count[k]++;
-      }
-    }
-    m.worst_tile_psnr = kPsnrIdentical;
-    for (size_t k = 0; k < sse.size(); ++k) {
-      if (count[k] < 32) continue;
-      m.worst_tile_psnr = std::min(m.worst_tile_psnr, psnr_from_mse(sse[k] / (3.0 * count[k])));
-    }
+  m.coverage_mismatch_share = either ? double(mismatch) / double(either) : 0.0;
+  m.worst_tile_psnr = kPsnrIdentical;
+  for (size_t k = 0; k < sse.size(); ++k) {
+    if (count[k] < 32) continue;
+    m.worst_tile_psnr = std::min(m.worst_tile_psnr, psnr_from_mse(sse[k] / (3.0 * count[k])));
   }
   m.coarser_share = covered ? double(coarser) / double(covered) : 0.0;
   if (m.pixels > 0) {
@@ -211,6 +210,11 @@ std::vector<std::string> check_view(const ViewMetrics& m, const Thresholds& t) {
                   t.min_tile_psnr);
     why.push_back(line);
   }
+  if (m.coverage_mismatch_share > t.max_coverage_mismatch) {
+    std::snprintf(line, sizeof(line), "%.2f%% of pixels drawn by one render only (alpha test)",
+                  100.0 * m.coverage_mismatch_share);
+    why.push_back(line);
+  }
   if (m.coarser_share > t.max_coarser_share) {
     std::snprintf(line, sizeof(line), "%.1f%% of pixels sampled a coarser level than wanted",
                   100.0 * m.coarser_share);
@@ -249,7 +253,7 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
     VT_ASSIGN_OR_RETURN(VirtualFrame frame, renderer.render_virtual(cameras[v]));
     view.virtual_ms = ms_since(t0);
     t0 = std::chrono::steady_clock::now();
-    VT_ASSIGN_OR_RETURN(Rgba8Image reference, renderer.render_reference(cameras[v]));
+    VT_ASSIGN_OR_RETURN(ReferenceFrame reference, renderer.render_reference(cameras[v]));
     view.reference_ms = ms_since(t0);
     VT_ASSIGN_OR_RETURN(view.metrics, compare_view(reference, frame));
     view.failures = check_view(view.metrics, report.thresholds);
@@ -263,9 +267,9 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
     if (!options.out_dir.empty()) {
       const std::string base = options.out_dir + "/view_" + std::to_string(v) + "_";
       const std::pair<const char*, Rgba8Image> images[] = {
-          {"reference.png", reference},
+          {"reference.png", reference.color},
           {"virtual.png", frame.color},
-          {"diff.png", difference_map(reference, frame.color)},
+          {"diff.png", difference_map(reference.color, frame.color)},
           {"residency.png", residency_heat_map(frame)}};
       for (const auto& [name, image] : images) {
         VT_RETURN_IF_ERROR(write_png(base + name, image));

@@ -7,6 +7,7 @@ layout(set = 0, binding = 0) uniform sampler2D u_texture;
 
 layout(location = 0) in vec2 v_uv;
 layout(location = 0) out vec4 out_color;
+layout(location = 1) out uint out_covered;  // 1 where a fragment survived the alpha test
 
 void main() {
   Footprint f = footprint(v_uv, 1.0);
@@ -15,4 +16,5 @@ void main() {
   c /= float(kTaps);
   if (pc.tex.w >= 0.0 && c.a < pc.tex.w) discard;
   out_color = c;
+  out_covered = 1u;
 }
