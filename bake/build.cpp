@@ -336,9 +336,13 @@ void store_page(const LayerPlan& plan, float* texels, size_t count, uint8_t* out
       for (int c = 0; c < 3; ++c) t[c] = a > 0 ? std::min(t[c] / a, kFloatMax) : 0.0f;
     }
   }
-  if (plan.to_storage) plan.to_storage->apply(texels, count, int(wc));
   if (plan.spec.texel_type == TexelType::kF32) {
+    if (plan.to_storage) plan.to_storage->apply(texels, count, int(wc));
     std::memcpy(out, texels, count * wc * sizeof(float));
+    return;
+  }
+  if (plan.to_storage) {
+    plan.to_storage->apply_to_u8(texels, count, int(wc), out);
     return;
   }
   auto q = [](float v) -> uint8_t {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstring>
 #include <mutex>
 #include <sstream>
 #include <vector>
@@ -56,27 +57,95 @@ const OCIO::ConstConfigRcPtr& config() {
   return c;
 }
 
+inline uint8_t round_u8(float v) {
+  if (!(v > 0)) return 0;
+  if (v >= 1) return 255;
+  return uint8_t(v * 255.0f + 0.5f);
+}
+
+// Ordered integer key of a float (monotonic for all non-NaN floats).
+inline int32_t float_key(float f) {
+  int32_t i;
+  std::memcpy(&i, &f, 4);
+  return i >= 0 ? i : int32_t(0x80000000u - uint32_t(i));
+}
+inline float key_float(int32_t k) {
+  int32_t i = k >= 0 ? k : int32_t(0x80000000u - uint32_t(k));
+  float f;
+  std::memcpy(&f, &i, 4);
+  return f;
+}
+
 class OcioConverter final : public ColorConverter {
  public:
-  explicit OcioConverter(OCIO::ConstCPUProcessorRcPtr cpu) : cpu_(std::move(cpu)) {}
+  explicit OcioConverter(OCIO::ConstCPUProcessorRcPtr cpu) : cpu_(std::move(cpu)) {
+    if (is_identity()) return;
+    for (int k = 0; k < 256; ++k) lut_[k] = convert_one(float(k) / 255.0f);
+    // Boundary k (1..255): the smallest float whose converted, rounded code is >= k. The curves
+    // vtbake converts with are increasing, so bisection over ordered floats finds it exactly.
+    for (int k = 1; k < 256; ++k) {
+      int64_t lo = float_key(-1.0f), hi = float_key(3.4e38f);
+      while (hi - lo > 1) {
+        int64_t mid = lo + (hi - lo) / 2;
+        if (round_u8(convert_one(key_float(int32_t(mid)))) >= k) {
+          hi = mid;
+        } else {
+          lo = mid;
+        }
+      }
+      bounds_[k - 1] = key_float(int32_t(hi));
+    }
+  }
   bool is_identity() const override { return !cpu_ || cpu_->isNoOp(); }
+
   void apply(float* texels, size_t count, int channels) const override {
     if (is_identity() || count == 0) return;
-    if (channels >= 3) {
-      OCIO::PackedImageDesc desc(texels, long(count), 1, channels);
-      cpu_->apply(desc);
-      return;
-    }
-    // Grey (+alpha): convert the grey value as R=G=B.
+    const int colour = channels >= 3 ? 3 : 1;
     for (size_t i = 0; i < count; ++i) {
-      float rgb[3] = {texels[i * channels], texels[i * channels], texels[i * channels]};
-      cpu_->applyRGB(rgb);
-      texels[i * channels] = rgb[0];
+      float* t = texels + i * channels;
+      bool coded = true;
+      int code[3];
+      for (int c = 0; c < colour; ++c) {
+        float v = t[c];
+        int k = (v >= 0.0f && v <= 1.0f) ? int(v * 255.0f + 0.5f) : -1;
+        code[c] = k;
+        coded &= k >= 0 && float(k) / 255.0f == v;
+      }
+      if (coded) {
+        for (int c = 0; c < colour; ++c) t[c] = lut_[code[c]];
+      } else if (colour == 3) {
+        cpu_->applyRGB(t);
+      } else {
+        t[0] = convert_one(t[0]);
+      }
+    }
+  }
+
+  void apply_to_u8(const float* texels, size_t count, int channels, uint8_t* out) const override {
+    const int colour = channels >= 3 ? 3 : 1;
+    for (size_t i = 0; i < count * size_t(channels); ++i) {
+      int c = int(i % size_t(channels));
+      float v = texels[i];
+      if (c >= colour || is_identity()) {
+        out[i] = round_u8(v);
+      } else if (!(v >= bounds_[0])) {
+        out[i] = 0;  // NaN too
+      } else {
+        out[i] = uint8_t(std::upper_bound(bounds_, bounds_ + 255, v) - bounds_);
+      }
     }
   }
 
  private:
+  float convert_one(float v) const {
+    float rgb[3] = {v, v, v};
+    cpu_->applyRGB(rgb);
+    return rgb[0];
+  }
+
   OCIO::ConstCPUProcessorRcPtr cpu_;
+  float lut_[256] = {};
+  float bounds_[255] = {};
 };
 
 }  // namespace

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -23,8 +24,14 @@ class ColorConverter {
                                                           const std::string& to);
   virtual ~ColorConverter() = default;
   virtual bool is_identity() const = 0;
-  // Converts `count` texels of `channels` (1..4) interleaved floats in place.
+  // Converts `count` texels of `channels` (1..4) interleaved floats in place. Values that are
+  // exact 8-bit codes (k / 255) go through a 256-entry table OpenColorIO filled: same result.
   virtual void apply(float* texels, size_t count, int channels) const = 0;
+  // apply() followed by rounding to 8 bits (clamped to [0, 1]), without a per-texel power:
+  // the colour channels are compared against the 255 code boundaries, found exactly (by
+  // bisection over floats) through OpenColorIO when the converter was made. Alpha (channel 3,
+  // or 1 for grey+alpha) is rounded as it is.
+  virtual void apply_to_u8(const float* texels, size_t count, int channels, uint8_t* out) const = 0;
 };
 
 // The generated config as OCIO YAML, for provenance and for users who want to reproduce it.
