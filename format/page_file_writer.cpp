@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <cerrno>
+#include <condition_variable>
 #include <cstring>
 #include <mutex>
 
@@ -174,6 +175,7 @@ class PageFileWriterImpl final : public PageFileWriter {
     e.spill_offset = offset;
     e.checksum = XXH3_64bits(data.data(), data.size());
     std::lock_guard lock(mutex_);
+    release();
     if (!s.ok()) {
       failed_ = s;
       return s;
@@ -196,15 +198,18 @@ class PageFileWriterImpl final : public PageFileWriter {
     std::memcpy(e.constant, texel.data(), texel.size());
     e.checksum = XXH3_64bits(texel.data(), texel.size());
     std::lock_guard lock(mutex_);
+    release();
     entries_[slot] = e;
     return Status::Ok();
   }
 
   Status finish() override {
     {
-      std::lock_guard lock(mutex_);
+      std::unique_lock lock(mutex_);
       if (finished_) return Error(ErrorCode::kInvalidArgument, path_ + ": finish() called twice");
       finished_ = true;
+      // Pages accepted before finish() but still being written are waited for, not lost.
+      idle_.wait(lock, [&] { return in_flight_ == 0; });
       if (!failed_.ok()) return failed_;
     }
     Status s = write_file();
@@ -239,7 +244,13 @@ class PageFileWriterImpl final : public PageFileWriter {
     if (finished_) return bad(id, layer, "page added after finish()");
     if (claimed_[slot]) return bad(id, layer, "page added twice");
     claimed_[slot] = 1;
+    ++in_flight_;
     return Status::Ok();
+  }
+
+  // Called under mutex_ when a claimed page's entry is recorded.
+  void release() {
+    if (--in_flight_ == 0) idle_.notify_all();
   }
 
   Status write_file();
@@ -251,6 +262,8 @@ class PageFileWriterImpl final : public PageFileWriter {
   std::vector<SpillEntry> entries_;
   std::vector<uint8_t> claimed_;
   std::mutex mutex_;
+  std::condition_variable idle_;
+  uint64_t in_flight_ = 0;
   std::atomic<uint64_t> spill_end_{0};
   Status failed_;
   bool finished_ = false;
