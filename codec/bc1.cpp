@@ -271,10 +271,211 @@ void refine_search(const Pixels& px, Candidate& best, int max_passes) {
   }
 }
 
+// ---- Real-time level: 16 blocks at a time ----
+//
+// The real-time encoder runs the same arithmetic on 16 blocks side by side (structure of arrays,
+// innermost loops over the blocks), which compilers turn into SIMD. It is built twice, for
+// AVX-512, AVX2 and the baseline, and picked at run time; both do the same IEEE operations in the
+// same order per block (no FMA, no reassociation), so the bytes do not depend on the machine.
+constexpr int kLanes = 16;
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_ADDRESS__)
+#define VT_BC1_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define VT_BC1_CLONES
+#endif
+
+VT_BC1_CLONES
+void encode_realtime_lanes(const uint8_t* rgba, uint16_t c0_out[kLanes], uint16_t c1_out[kLanes],
+                           uint32_t bits_out[kLanes], bool constant_out[kLanes]) {
+  float r[16][kLanes], g[16][kLanes], b[16][kLanes];
+  for (int i = 0; i < 16; ++i) {
+    for (int l = 0; l < kLanes; ++l) {
+      r[i][l] = float(rgba[l * 64 + 4 * i]);
+      g[i][l] = float(rgba[l * 64 + 4 * i + 1]);
+      b[i][l] = float(rgba[l * 64 + 4 * i + 2]);
+    }
+  }
+  float mr[kLanes], mg[kLanes], mb[kLanes];
+  for (int l = 0; l < kLanes; ++l) mr[l] = mg[l] = mb[l] = 0;
+  for (int i = 0; i < 16; ++i) {
+    for (int l = 0; l < kLanes; ++l) mr[l] += r[i][l], mg[l] += g[i][l], mb[l] += b[i][l];
+  }
+  for (int l = 0; l < kLanes; ++l) mr[l] *= 0.0625f, mg[l] *= 0.0625f, mb[l] *= 0.0625f;
+  float crr[kLanes], crg[kLanes], crb[kLanes], cgg[kLanes], cgb[kLanes], cbb[kLanes];
+  for (int l = 0; l < kLanes; ++l) crr[l] = crg[l] = crb[l] = cgg[l] = cgb[l] = cbb[l] = 0;
+  for (int i = 0; i < 16; ++i) {
+    for (int l = 0; l < kLanes; ++l) {
+      const float dr = r[i][l] - mr[l], dg = g[i][l] - mg[l], db = b[i][l] - mb[l];
+      crr[l] += dr * dr, crg[l] += dr * dg, crb[l] += dr * db;
+      cgg[l] += dg * dg, cgb[l] += dg * db, cbb[l] += db * db;
+    }
+  }
+  // Integer texels, a mean of 16 and their deviations are exact in float: zero spread is
+  // exactly a one-colour block.
+  for (int l = 0; l < kLanes; ++l) constant_out[l] = crr[l] + cgg[l] + cbb[l] == 0.0f;
+  // Power iteration from the covariance row of the widest channel.
+  float vr[kLanes], vg[kLanes], vb[kLanes];
+  for (int l = 0; l < kLanes; ++l) {
+    const bool rw = crr[l] >= cgg[l] && crr[l] >= cbb[l];
+    const bool gw = !rw && cgg[l] >= cbb[l];
+    vr[l] = rw ? crr[l] : gw ? crg[l] : crb[l];
+    vg[l] = rw ? crg[l] : gw ? cgg[l] : cgb[l];
+    vb[l] = rw ? crb[l] : gw ? cgb[l] : cbb[l];
+  }
+  for (int it = 0; it < 3; ++it) {
+    for (int l = 0; l < kLanes; ++l) {
+      const float x = crr[l] * vr[l] + crg[l] * vg[l] + crb[l] * vb[l];
+      const float y = crg[l] * vr[l] + cgg[l] * vg[l] + cgb[l] * vb[l];
+      const float z = crb[l] * vr[l] + cgb[l] * vg[l] + cbb[l] * vb[l];
+      const float m = std::max(std::fabs(x), std::max(std::fabs(y), std::fabs(z)));
+      const float inv = m > 1e-12f ? 1.0f / m : 0.0f;
+      vr[l] = m > 1e-12f ? x * inv : vr[l];
+      vg[l] = m > 1e-12f ? y * inv : vg[l];
+      vb[l] = m > 1e-12f ? z * inv : vb[l];
+    }
+  }
+  for (int l = 0; l < kLanes; ++l) {
+    float len2 = vr[l] * vr[l] + vg[l] * vg[l] + vb[l] * vb[l];
+    const bool degenerate = !(len2 > 1e-12f);
+    vr[l] = degenerate ? 1.0f : vr[l];
+    vg[l] = degenerate ? 1.0f : vg[l];
+    vb[l] = degenerate ? 1.0f : vb[l];
+    len2 = degenerate ? 3.0f : len2;
+    const float inv = 1.0f / std::sqrt(len2);
+    vr[l] *= inv, vg[l] *= inv, vb[l] *= inv;
+  }
+  float tmin[kLanes], tmax[kLanes];
+  for (int l = 0; l < kLanes; ++l) tmin[l] = 1e30f, tmax[l] = -1e30f;
+  for (int i = 0; i < 16; ++i) {
+    for (int l = 0; l < kLanes; ++l) {
+      const float t =
+          (r[i][l] - mr[l]) * vr[l] + (g[i][l] - mg[l]) * vg[l] + (b[i][l] - mb[l]) * vb[l];
+      tmin[l] = std::min(tmin[l], t);
+      tmax[l] = std::max(tmax[l], t);
+    }
+  }
+  // Endpoints as 565 levels (floats holding integers), decoded palette, indices, error. Every
+  // value truncated below is non-negative, so int conversion is floor (and vectorises).
+  float q0[3][kLanes], q1[3][kLanes];
+  auto quantise_lanes = [](float x, float levels) {
+    const float q = float(int(std::min(std::max(x, 0.0f), 255.0f) * (levels / 255.0f) + 0.5f));
+    return q;
+  };
+  for (int l = 0; l < kLanes; ++l) {
+    const float inset = (tmax[l] - tmin[l]) * (1.0f / 16.0f);
+    const float hi = tmax[l] - inset, lo = tmin[l] + inset;
+    q0[0][l] = quantise_lanes(mr[l] + hi * vr[l], 31.0f);
+    q0[1][l] = quantise_lanes(mg[l] + hi * vg[l], 63.0f);
+    q0[2][l] = quantise_lanes(mb[l] + hi * vb[l], 31.0f);
+    q1[0][l] = quantise_lanes(mr[l] + lo * vr[l], 31.0f);
+    q1[1][l] = quantise_lanes(mg[l] + lo * vg[l], 63.0f);
+    q1[2][l] = quantise_lanes(mb[l] + lo * vb[l], 31.0f);
+  }
+
+  int idx[16][kLanes];
+  float err[kLanes];
+  // Palette of 565 levels q0, q1 as the decoder builds it; nearest entry per texel.
+  auto select = [&](const float(&a)[3][kLanes], const float(&c)[3][kLanes], int(&out)[16][kLanes],
+                    float(&e)[kLanes]) {
+    float p[4][3][kLanes];
+    for (int ch = 0; ch < 3; ++ch) {
+      const float mul = ch == 1 ? 4.0f : 8.0f, shift = ch == 1 ? 1.0f / 16.0f : 1.0f / 4.0f;
+      for (int l = 0; l < kLanes; ++l) {
+        // Bit replication: (q << 3) | (q >> 2) for 5 bits, (q << 2) | (q >> 4) for 6.
+        const float x0 = a[ch][l] * mul + float(int(a[ch][l] * shift));
+        const float x1 = c[ch][l] * mul + float(int(c[ch][l] * shift));
+        p[0][ch][l] = x0;
+        p[1][ch][l] = x1;
+        p[2][ch][l] = float(int((2.0f * x0 + x1) / 3.0f));
+        p[3][ch][l] = float(int((x0 + 2.0f * x1) / 3.0f));
+      }
+    }
+    for (int l = 0; l < kLanes; ++l) e[l] = 0;
+    for (int i = 0; i < 16; ++i) {
+      float best[kLanes];
+      int bi[kLanes];
+      for (int l = 0; l < kLanes; ++l) {
+        const float dr = r[i][l] - p[0][0][l], dg = g[i][l] - p[0][1][l], db = b[i][l] - p[0][2][l];
+        best[l] = dr * dr + dg * dg + db * db;
+        bi[l] = 0;
+      }
+      for (int k = 1; k < 4; ++k) {
+        for (int l = 0; l < kLanes; ++l) {
+          const float dr = r[i][l] - p[k][0][l], dg = g[i][l] - p[k][1][l],
+                      db = b[i][l] - p[k][2][l];
+          const float d = dr * dr + dg * dg + db * db;
+          const bool better = d < best[l];
+          best[l] = better ? d : best[l];
+          bi[l] = better ? k : bi[l];
+        }
+      }
+      for (int l = 0; l < kLanes; ++l) out[i][l] = bi[l], e[l] += best[l];
+    }
+  };
+  select(q0, q1, idx, err);
+
+  // One least-squares refinement on the chosen indices; kept where it lowers the error.
+  float aa[kLanes], bb[kLanes], ab[kLanes], ax[3][kLanes], bx[3][kLanes];
+  for (int l = 0; l < kLanes; ++l) {
+    aa[l] = bb[l] = ab[l] = 0;
+    for (int ch = 0; ch < 3; ++ch) ax[ch][l] = bx[ch][l] = 0;
+  }
+  for (int i = 0; i < 16; ++i) {
+    for (int l = 0; l < kLanes; ++l) {
+      const int k = idx[i][l];
+      const float wa = k == 0 ? 1.0f : k == 1 ? 0.0f : k == 2 ? 2.0f / 3.0f : 1.0f / 3.0f;
+      const float wb = 1.0f - wa;
+      aa[l] += wa * wa, bb[l] += wb * wb, ab[l] += wa * wb;
+      ax[0][l] += wa * r[i][l], ax[1][l] += wa * g[i][l], ax[2][l] += wa * b[i][l];
+      bx[0][l] += wb * r[i][l], bx[1][l] += wb * g[i][l], bx[2][l] += wb * b[i][l];
+    }
+  }
+  float n0[3][kLanes], n1[3][kLanes];
+  bool solvable[kLanes];
+  for (int l = 0; l < kLanes; ++l) {
+    const float det = aa[l] * bb[l] - ab[l] * ab[l];
+    solvable[l] = std::fabs(det) > 1e-3f;
+    const float inv = solvable[l] ? 1.0f / det : 0.0f;
+    for (int ch = 0; ch < 3; ++ch) {
+      const float levels = ch == 1 ? 63.0f : 31.0f;
+      n0[ch][l] = quantise_lanes((ax[ch][l] * bb[l] - bx[ch][l] * ab[l]) * inv, levels);
+      n1[ch][l] = quantise_lanes((bx[ch][l] * aa[l] - ax[ch][l] * ab[l]) * inv, levels);
+    }
+  }
+  int idx2[16][kLanes];
+  float err2[kLanes];
+  select(n0, n1, idx2, err2);
+
+  for (int l = 0; l < kLanes; ++l) {
+    const bool take = solvable[l] && err2[l] < err[l];
+    const float(&e0)[3][kLanes] = take ? n0 : q0;
+    const float(&e1)[3][kLanes] = take ? n1 : q1;
+    uint16_t c0 = pack565(int(e0[0][l]), int(e0[1][l]), int(e0[2][l]));
+    uint16_t c1 = pack565(int(e1[0][l]), int(e1[1][l]), int(e1[2][l]));
+    uint32_t bits = 0;
+    for (int i = 0; i < 16; ++i) bits |= uint32_t(take ? idx2[i][l] : idx[i][l]) << (2 * i);
+    if (c0 < c1) {
+      std::swap(c0, c1);
+      bits ^= 0x55555555u;  // 0<->1, 2<->3
+    } else if (c0 == c1) {
+      bits = 0;
+    }
+    c0_out[l] = c0;
+    c1_out[l] = c1;
+    bits_out[l] = bits;
+  }
+}
+
 }  // namespace
 
 void bc1_encode_block(const uint8_t rgba[64], BcQuality quality, uint8_t out[8],
                       bool four_colour_only) {
+  if (quality == BcQuality::kRealtime) {
+    bc1_encode_blocks_realtime(rgba, 1, out, 8);
+    return;
+  }
   Pixels px;
   int mn[3] = {255, 255, 255}, mx[3] = {0, 0, 0};
   for (int i = 0; i < 16; ++i) {
@@ -350,6 +551,33 @@ void bc1_encode_block(const uint8_t rgba[64], BcQuality quality, uint8_t out[8],
     }
   }
   emit(best, out);
+}
+
+void bc1_encode_blocks_realtime(const uint8_t* rgba, size_t count, uint8_t* out,
+                                size_t out_stride) {
+  uint8_t lanes[kLanes * 64];
+  for (size_t first = 0; first < count; first += kLanes) {
+    const size_t n = std::min<size_t>(kLanes, count - first);
+    std::memcpy(lanes, rgba + first * 64, n * 64);
+    // Idle lanes repeat the last block; their results are dropped.
+    for (size_t l = n; l < size_t(kLanes); ++l)
+      std::memcpy(lanes + l * 64, rgba + (first + n - 1) * 64, 64);
+    uint16_t c0[kLanes], c1[kLanes];
+    uint32_t bits[kLanes];
+    bool constant[kLanes];
+    encode_realtime_lanes(lanes, c0, c1, bits, constant);
+    for (size_t l = 0; l < n; ++l) {
+      const uint8_t* px = lanes + l * 64;
+      uint8_t* dst = out + (first + l) * out_stride;
+      if (constant[l]) {
+        encode_single_colour(px[0], px[1], px[2], dst);
+        continue;
+      }
+      dst[0] = uint8_t(c0[l]), dst[1] = uint8_t(c0[l] >> 8);
+      dst[2] = uint8_t(c1[l]), dst[3] = uint8_t(c1[l] >> 8);
+      for (int i = 0; i < 4; ++i) dst[4 + i] = uint8_t(bits[l] >> (8 * i));
+    }
+  }
 }
 
 void bc1_decode_block(const uint8_t block[8], uint8_t rgba[64], bool force_four_colour) {

@@ -9,6 +9,7 @@
 // the RGB format: decoded alpha is always 255.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 #include "codec/bc.h"
@@ -20,6 +21,12 @@ namespace vt {
 // 4-colour); otherwise kHigh may choose the 3-colour mode where it is closer.
 void bc1_encode_block(const uint8_t rgba[64], BcQuality quality, uint8_t out[8],
                       bool four_colour_only = false);
+
+// The real-time level for many blocks at once (what bc_encode_image uses): `count` blocks of 16
+// RGBA texels each, back to back in `rgba`; block i is written at out + i * out_stride (8 for
+// BC1, 16 with offset 8 for BC3 colour halves). Always 4-colour; the same bytes as
+// bc1_encode_block(..., kRealtime, ...) block by block, on every machine.
+void bc1_encode_blocks_realtime(const uint8_t* rgba, size_t count, uint8_t* out, size_t out_stride);
 
 // Decodes one block into 16 RGBA texels. `force_four_colour` decodes as the colour half of a
 // BC3 block does (always 4-colour, whatever the endpoint order).

@@ -1,6 +1,7 @@
 // Whole-image BC encode/decode: gathers 4x4 blocks and calls the per-format block codecs.
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "codec/bc.h"
 #include "codec/bc1.h"
@@ -53,24 +54,47 @@ Status bc_encode_image(BcFormat format, BcQuality quality, const uint8_t* texels
   VT_RETURN_IF_ERROR(check_image(format, texels, out, width, height, channels));
   const size_t block_bytes = bc_block_bytes(format);
   const size_t row_stride = size_t(width) * size_t(channels);
-  uint8_t rgba[64];
+  const int blocks_x = width / 4;
+  std::vector<uint8_t> row(size_t(blocks_x) * 64);
   for (int by = 0; by < height / 4; ++by) {
-    for (int bx = 0; bx < width / 4; ++bx) {
+    // Gather one row of blocks as RGBA.
+    for (int bx = 0; bx < blocks_x; ++bx) {
       for (int y = 0; y < 4; ++y) {
         const uint8_t* src =
             texels + (size_t(by) * 4 + size_t(y)) * row_stride + size_t(bx) * 4 * size_t(channels);
-        uint8_t* dst = rgba + 16 * y;
+        uint8_t* dst = row.data() + size_t(bx) * 64 + 16 * y;
         if (channels == 4) {
           std::memcpy(dst, src, 16);
-          continue;
-        }
-        for (int x = 0; x < 4; ++x) {
-          for (int c = 0; c < 4; ++c) {
-            dst[4 * x + c] = c < channels ? src[x * channels + c] : (c == 3 ? 255 : 0);
+        } else if (channels == 3) {
+          for (int x = 0; x < 4; ++x) {
+            dst[4 * x] = src[3 * x], dst[4 * x + 1] = src[3 * x + 1];
+            dst[4 * x + 2] = src[3 * x + 2], dst[4 * x + 3] = 255;
+          }
+        } else {
+          for (int x = 0; x < 4; ++x) {
+            for (int c = 0; c < 4; ++c) {
+              dst[4 * x + c] = c < channels ? src[x * channels + c] : (c == 3 ? 255 : 0);
+            }
           }
         }
       }
-      uint8_t* block = out + (size_t(by) * size_t(width / 4) + size_t(bx)) * block_bytes;
+    }
+    uint8_t* out_row = out + size_t(by) * size_t(blocks_x) * block_bytes;
+    const bool realtime = quality == BcQuality::kRealtime;
+    if (realtime && format == BcFormat::kBc1) {
+      bc1_encode_blocks_realtime(row.data(), size_t(blocks_x), out_row, 8);
+      continue;
+    }
+    if (realtime && format == BcFormat::kBc3) {
+      bc1_encode_blocks_realtime(row.data(), size_t(blocks_x), out_row + 8, 16);
+      for (int bx = 0; bx < blocks_x; ++bx) {
+        bc4_encode_block(row.data() + size_t(bx) * 64 + 3, 4, quality, out_row + size_t(bx) * 16);
+      }
+      continue;
+    }
+    for (int bx = 0; bx < blocks_x; ++bx) {
+      const uint8_t* rgba = row.data() + size_t(bx) * 64;
+      uint8_t* block = out_row + size_t(bx) * block_bytes;
       switch (format) {
         case BcFormat::kBc1:
           bc1_encode_block(rgba, quality, block);
