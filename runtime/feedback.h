@@ -53,7 +53,9 @@ struct ResolveStats {
 // Not thread-safe (one resolver per caller thread).
 class FeedbackResolver {
  public:
-  // `source` gives the geometry and the presence map; it must outlive the resolver.
+  // `source` gives the geometry (at most 4096 x 4096 pages at level 0 and 32 levels, the
+  // format's limits; Streamer::create checks) and the presence map; it must outlive the
+  // resolver.
   explicit FeedbackResolver(const PageSource& source);
   ~FeedbackResolver();
   FeedbackResolver(FeedbackResolver&&) noexcept;

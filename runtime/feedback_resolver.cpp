@@ -3,6 +3,7 @@
 // by the value. Only the few thousand distinct values then go through validation, the LOD
 // bias, the presence map and the ancestor chain, into a second flat table keyed by page index.
 #include <algorithm>
+#include <array>
 #include <utility>
 
 #include "runtime/feedback.h"
@@ -20,9 +21,9 @@ inline uint32_t hash32(uint32_t x) {
   return x;
 }
 
-// Flat open-addressing map uint32 -> count: one 8-byte slot per probe (key + 1, 0 = empty,
-// and the count), plus dense lists of the entries' keys and slots so that iterating and
-// clearing cost O(entries), not O(slots).
+// Flat open-addressing map uint32 -> count. A slot holds key + 1 (0 = empty) and the index of
+// the entry in dense arrays (keys, counts, slots), so iterating and clearing cost O(entries)
+// and counting into a known entry touches only the small dense count array.
 class CountTable {
  public:
   CountTable() { slots_.resize(1024); }
@@ -30,13 +31,14 @@ class CountTable {
     // By recorded slot: emptying slots while looking keys up would cut probe chains.
     for (uint32_t i : entry_slot_) slots_[i] = {};
     keys_.clear();
+    counts_.clear();
     entry_slot_.clear();
   }
   // Adds `count` to `key`; returns the entry's dense index and whether it is new.
   std::pair<uint32_t, bool> add(uint32_t key, uint32_t count) {
     uint32_t i = find(key);
     if (slots_[i].key != 0) {
-      slots_[i].count += count;
+      counts_[slots_[i].index] += count;
       return {slots_[i].index, false};
     }
     if ((keys_.size() + 1) * 2 > slots_.size()) {
@@ -44,21 +46,20 @@ class CountTable {
       i = find(key);
     }
     const uint32_t index = uint32_t(keys_.size());
-    slots_[i] = {key + 1, count, index};
+    slots_[i] = {key + 1, index};
     keys_.push_back(key);
+    counts_.push_back(count);
     entry_slot_.push_back(i);
     return {index, true};
   }
-  // Hot path for runs: only the count.
-  void add_count(uint32_t key, uint32_t count) { add(key, count); }
+  void add_at(uint32_t index, uint32_t count) { counts_[index] += count; }
   size_t size() const { return keys_.size(); }
   uint32_t key(uint32_t index) const { return keys_[index]; }
-  uint32_t count(uint32_t index) const { return slots_[entry_slot_[index]].count; }
+  uint32_t count(uint32_t index) const { return counts_[index]; }
 
  private:
   struct Slot {
     uint32_t key = 0;
-    uint32_t count = 0;
     uint32_t index = 0;
   };
   uint32_t find(uint32_t key) const {
@@ -68,18 +69,16 @@ class CountTable {
     return i;
   }
   void grow() {
-    std::vector<Slot> old;
-    old.swap(slots_);
-    slots_.assign(old.size() * 2, {});
+    slots_.assign(slots_.size() * 2, {});
     for (uint32_t e = 0; e < keys_.size(); ++e) {
-      const Slot& o = old[entry_slot_[e]];
       const uint32_t i = find(keys_[e]);
-      slots_[i] = o;
+      slots_[i] = {keys_[e] + 1, e};
       entry_slot_[e] = i;
     }
   }
   std::vector<Slot> slots_;
   std::vector<uint32_t> keys_;
+  std::vector<uint32_t> counts_;
   std::vector<uint32_t> entry_slot_;
 };
 
@@ -92,6 +91,11 @@ struct FeedbackResolver::Impl {
   std::vector<uint32_t> level_base;
   CountTable values;
   CountTable pages;
+  struct Recent {
+    uint32_t key = 0;  // value + 1; 0 = empty
+    uint32_t index = 0;
+  };
+  std::array<Recent, 256> recent;
   std::vector<std::vector<std::pair<PageId, uint32_t>>> buckets;  // per level: page, entry
 
   explicit Impl(const PageSource& s) : source(s), geometry(s.geometry()) {
@@ -131,6 +135,7 @@ ResolveStats FeedbackResolver::resolve(std::span<const uint32_t> feedback, uint3
   out.clear();
   m.values.clear();
   m.pages.clear();
+  m.recent.fill({});
   if (m.levels == 0) return stats;
 
   const size_t n = feedback.size();
@@ -139,7 +144,17 @@ ResolveStats FeedbackResolver::resolve(std::span<const uint32_t> feedback, uint3
     const uint32_t v = feedback[i];
     size_t j = i + 1;
     while (j < n && feedback[j] == v) ++j;
-    if (v != kFeedbackNone) m.values.add(v, uint32_t(std::min<size_t>(j - i, UINT32_MAX)));
+    if (v != kFeedbackNone) {
+      const uint32_t run = uint32_t(std::min<size_t>(j - i, UINT32_MAX));
+      // Feedback is row-coherent: the values of one row mostly recur in the next rows, so a
+      // tiny direct-mapped cache in L1 answers most runs without probing the big table.
+      auto& r = m.recent[(v * 0x9E3779B1u) >> 24];
+      if (r.key == v + 1) {
+        m.values.add_at(r.index, run);
+      } else {
+        r = {v + 1, m.values.add(v, run).first};
+      }
+    }
     i = j;
   }
   stats.unique_values = uint32_t(m.values.size());
