@@ -46,6 +46,8 @@ struct Streamer::Impl {
   std::map<uint64_t, PageRequest> explicit_requests;     // request() calls not yet mapped
   std::vector<LoadedPage> ready;                         // collected, waiting for a slot/parent
   std::unordered_set<uint64_t> ready_keys;
+  // Pages whose load failed (corrupt or unreadable): not retried, their parent stands in.
+  std::unordered_set<uint64_t> failed;
   std::vector<PageUpload> uploads;
   std::vector<CacheEvent> events;
 
@@ -116,7 +118,10 @@ struct Streamer::Impl {
           stats.load_errors += !page.status.ok();
           stats.dropped += !page.status.ok();
           // A failed prefetch is not retried forever; feedback may ask again.
-          if (!page.status.ok()) explicit_requests.erase(page_key(page.id));
+          if (!page.status.ok()) {
+            explicit_requests.erase(page_key(page.id));
+            failed.insert(page_key(page.id));
+          }
           erase_ready(i);
           continue;
         }
@@ -158,7 +163,7 @@ struct Streamer::Impl {
         loader->reprioritise(r.id, prio);
         continue;
       }
-      if (has_ready(r.id)) continue;
+      if (has_ready(r.id) || failed.count(k)) continue;
       if (staging_pages() >= options.max_in_flight) break;
       if (loader->request(r.id, prio)) {
         requested.emplace(k, prio);

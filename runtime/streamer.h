@@ -58,10 +58,11 @@ struct FrameStats {
   uint32_t cancelled = 0;
   uint32_t mapped = 0;  // pages mapped (== uploads) this frame
   uint32_t evicted = 0;
-  uint32_t dropped = 0;  // finished loads that found no slot (thrashing) or failed
-  uint32_t load_errors = 0;
-  uint32_t lod_bias = 0;   // bias in force for the next frame
-  bool thrashing = false;  // the working set did not fit the cache this frame
+  uint32_t dropped = 0;      // finished loads that found no slot (thrashing) or failed
+  uint32_t load_errors = 0;  // pages the source could not deliver (never retried: the
+                             // parent stands in for them)
+  uint32_t lod_bias = 0;     // bias in force for the next frame
+  bool thrashing = false;    // the working set did not fit the cache this frame
   uint64_t invalid_pixels = 0;
   uint64_t resident_bytes = 0;
 };

@@ -39,6 +39,7 @@ class FakeSource final : public PageSource {
     loads_.fetch_add(1, std::memory_order_relaxed);
     if (!present(id)) return Error(ErrorCode::kNotFound, "fake: absent page");
     if (delay_us_ > 0) std::this_thread::sleep_for(std::chrono::microseconds(delay_us_));
+    if (fail_ && fail_(id)) return Error(ErrorCode::kCorrupt, "fake: page checksum mismatch");
     fill(id, layer, out);
     return Status::Ok();
   }
@@ -52,6 +53,8 @@ class FakeSource final : public PageSource {
   }
   uint64_t loads() const { return loads_.load(); }
   void set_delay_us(int us) { delay_us_ = us; }
+  // Pages for which load() reports corrupt data (present, but unreadable).
+  void set_failing(std::function<bool(const PageId&)> fail) { fail_ = std::move(fail); }
 
  private:
   PageGeometry geometry_;
@@ -59,6 +62,7 @@ class FakeSource final : public PageSource {
   std::function<bool(const PageId&)> absent_;
   mutable std::atomic<uint64_t> loads_{0};
   int delay_us_ = 0;
+  std::function<bool(const PageId&)> fail_;
 };
 
 // A small geometry: 8 x 6 pages of 8 + 2 * 4 texels (levels: 8x6, 4x3, 2x2, 1x1).

@@ -249,6 +249,42 @@ TEST(Streamer, RejectsBadOptionsAndBudgets) {
             ErrorCode::kUnsupported);
 }
 
+TEST(Streamer, UnreadablePagesFallBackToTheirParent) {
+  auto src = std::make_shared<FakeSource>(small_geometry(8, 8), 1);
+  src->set_failing([](const PageId& id) { return id.level == 0 && id.x == 2; });
+  auto s = make_streamer(src, 12, 12, 2);
+  std::vector<uint32_t> fb;
+  for (uint32_t y = 0; y < 8; ++y)
+    for (uint32_t x = 0; x < 8; ++x) fb.push_back(feedback_pack(0, x, y));
+  uint32_t errors = 0;
+  for (int f = 0; f < 20; ++f) {
+    const FrameStats st = s->update(fb);
+    errors += st.load_errors;
+    s->take_uploads();
+    s->wait_idle();
+    ASSERT_TRUE(s->check_invariants().ok()) << s->check_invariants().message();
+  }
+  EXPECT_EQ(errors, 8u);  // each failing page reported once, never retried
+  const PageTable t = s->page_table();
+  for (uint32_t y = 0; y < 8; ++y) {
+    EXPECT_EQ(t.entry({0, 2, y}).level, 1) << y;  // the parent stands in
+    EXPECT_EQ(t.entry({0, 3, y}).level, 0) << y;
+  }
+}
+
+TEST(Streamer, UpdateReturnsWhileLoadsAreStillRunning) {
+  auto src = std::make_shared<FakeSource>(small_geometry(8, 8), 1);
+  src->set_delay_us(20000);  // 20 ms per page: nothing can finish inside update()
+  auto s = make_streamer(src, 12, 12, 1);
+  const FrameStats st = s->update(std::vector<uint32_t>{feedback_pack(0, 5, 5)});
+  EXPECT_GT(st.queued, 0u);
+  EXPECT_EQ(st.mapped, 0u);
+  EXPECT_FALSE(s->idle());
+  s->wait_idle();
+  const FrameStats st2 = s->update(std::vector<uint32_t>{feedback_pack(0, 5, 5)});
+  EXPECT_GT(st2.mapped, 0u);
+}
+
 // 8 threads hammer one streamer with random frames, prefetches, evictions and upload takes
 // while the loader's workers run: 1M operations in all. Run under TSan (see docs/bench).
 TEST(Streamer, EightThreadTorture) {
