@@ -249,6 +249,23 @@ TEST(Streamer, RejectsBadOptionsAndBudgets) {
             ErrorCode::kUnsupported);
 }
 
+TEST(Streamer, EmptyFileStillGivesAValidTable) {
+  // Nothing stored at all (an atlas with no covered texel): the root slot is mapped with
+  // zeros so that every table entry is valid and sampling reads defined data.
+  auto src =
+      std::make_shared<FakeSource>(small_geometry(8, 6), 1, [](const PageId&) { return true; });
+  auto s = make_streamer(src, 4, 4, 1);
+  const auto ups = s->take_uploads();
+  ASSERT_EQ(ups.size(), 1u);
+  EXPECT_TRUE(std::all_of(ups[0].layers[0].begin(), ups[0].layers[0].end(),
+                          [](uint8_t b) { return b == 0; }));
+  const FrameStats st = s->update(std::vector<uint32_t>{feedback_pack(0, 7, 5)});
+  EXPECT_EQ(st.needed, 1u);
+  EXPECT_EQ(st.queued, 0u);
+  EXPECT_EQ(s->page_table().entry({0, 7, 5}).level, 3);
+  EXPECT_TRUE(s->check_invariants().ok());
+}
+
 TEST(Streamer, UnreadablePagesFallBackToTheirParent) {
   auto src = std::make_shared<FakeSource>(small_geometry(8, 8), 1);
   src->set_failing([](const PageId& id) { return id.level == 0 && id.x == 2; });
