@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstring>
 #include <mutex>
 #include <sstream>
@@ -95,6 +96,15 @@ class OcioConverter final : public ColorConverter {
       }
       bounds_[k - 1] = key_float(int32_t(hi));
     }
+    // Code of the first float of every bucket of 2^15 floats in [0, 1]; a bucket spans at most
+    // a few codes, so encode_u8 steps up from there.
+    bucket_code_.resize((0x3F800000u >> kBucketShift) + 1);
+    for (size_t b = 0; b < bucket_code_.size(); ++b) {
+      uint32_t bits = uint32_t(b) << kBucketShift;
+      float v;
+      std::memcpy(&v, &bits, 4);
+      bucket_code_[b] = uint8_t(std::upper_bound(bounds_, bounds_ + 255, v) - bounds_);
+    }
   }
   bool is_identity() const override { return !cpu_ || cpu_->isNoOp(); }
 
@@ -109,7 +119,7 @@ class OcioConverter final : public ColorConverter {
         float v = t[c];
         int k = (v >= 0.0f && v <= 1.0f) ? int(v * 255.0f + 0.5f) : -1;
         code[c] = k;
-        coded &= k >= 0 && float(k) / 255.0f == v;
+        coded &= k >= 0 && std::abs(v * 255.0f - float(k)) <= 1e-4f;  // any k/255 rounding
       }
       if (coded) {
         for (int c = 0; c < colour; ++c) t[c] = lut_[code[c]];
@@ -122,21 +132,28 @@ class OcioConverter final : public ColorConverter {
   }
 
   void apply_to_u8(const float* texels, size_t count, int channels, uint8_t* out) const override {
-    const int colour = channels >= 3 ? 3 : 1;
-    for (size_t i = 0; i < count * size_t(channels); ++i) {
-      int c = int(i % size_t(channels));
-      float v = texels[i];
-      if (c >= colour || is_identity()) {
-        out[i] = round_u8(v);
-      } else if (!(v >= bounds_[0])) {
-        out[i] = 0;  // NaN too
-      } else {
-        out[i] = uint8_t(std::upper_bound(bounds_, bounds_ + 255, v) - bounds_);
-      }
+    const int colour = is_identity() ? 0 : channels >= 3 ? 3 : 1;
+    for (size_t i = 0; i < count; ++i) {
+      const float* t = texels + i * channels;
+      uint8_t* o = out + i * channels;
+      for (int c = 0; c < colour; ++c) o[c] = encode_u8(t[c]);
+      for (int c = colour; c < channels; ++c) o[c] = round_u8(t[c]);
     }
   }
 
  private:
+  static constexpr int kBucketShift = 15;
+
+  uint8_t encode_u8(float v) const {
+    if (!(v > 0)) return 0;  // NaN too
+    if (v >= 1.0f) return round_u8(convert_one(v));
+    uint32_t bits;
+    std::memcpy(&bits, &v, 4);
+    int code = bucket_code_[bits >> kBucketShift];
+    while (code < 255 && v >= bounds_[code]) ++code;
+    return uint8_t(code);
+  }
+
   float convert_one(float v) const {
     float rgb[3] = {v, v, v};
     cpu_->applyRGB(rgb);
@@ -146,6 +163,7 @@ class OcioConverter final : public ColorConverter {
   OCIO::ConstCPUProcessorRcPtr cpu_;
   float lut_[256] = {};
   float bounds_[255] = {};
+  std::vector<uint8_t> bucket_code_;
 };
 
 }  // namespace

@@ -25,7 +25,7 @@ class ColorConverter {
   virtual ~ColorConverter() = default;
   virtual bool is_identity() const = 0;
   // Converts `count` texels of `channels` (1..4) interleaved floats in place. Values that are
-  // exact 8-bit codes (k / 255) go through a 256-entry table OpenColorIO filled: same result.
+  // 8-bit codes (k / 255, however rounded) go through a 256-entry table OpenColorIO filled.
   virtual void apply(float* texels, size_t count, int channels) const = 0;
   // apply() followed by rounding to 8 bits (clamped to [0, 1]), without a per-texel power:
   // the colour channels are compared against the 255 code boundaries, found exactly (by
