@@ -140,6 +140,12 @@ struct Renderer::Impl {
     float alpha_cutoff = -1.0f;
   };
   std::vector<GpuMesh> meshes;
+  std::vector<GpuMesh> ref_meshes;
+  bool separate_reference = false;
+  const std::vector<GpuMesh>& reference_meshes() const {
+    return separate_reference ? ref_meshes : meshes;
+  }
+  Status upload_meshes(std::span<const MeshData> meshes, std::vector<GpuMesh>& out);
 
   struct GpuTexture {
     Image image;
@@ -444,7 +450,16 @@ uint32_t Renderer::feedback_height() const {
 }
 
 Status Renderer::set_meshes(std::span<const MeshData> meshes) {
-  std::vector<Impl::GpuMesh> gpu;
+  return impl_->upload_meshes(meshes, impl_->meshes);
+}
+
+Status Renderer::set_reference_meshes(std::span<const MeshData> meshes) {
+  impl_->separate_reference = true;
+  return impl_->upload_meshes(meshes, impl_->ref_meshes);
+}
+
+Status Renderer::Impl::upload_meshes(std::span<const MeshData> meshes, std::vector<GpuMesh>& out) {
+  std::vector<GpuMesh> gpu;
   for (size_t i = 0; i < meshes.size(); ++i) {
     const MeshData& m = meshes[i];
     if (m.indices.size() % 3 != 0) {
@@ -458,21 +473,20 @@ Status Renderer::set_meshes(std::span<const MeshData> meshes) {
       }
     }
     if (m.indices.empty()) continue;
-    Impl::GpuMesh g;
+    GpuMesh g;
     std::span<const uint8_t> vb(reinterpret_cast<const uint8_t*>(m.vertices.data()),
                                 m.vertices.size() * sizeof(Vertex));
     std::span<const uint8_t> ib(reinterpret_cast<const uint8_t*>(m.indices.data()),
                                 m.indices.size() * sizeof(uint32_t));
-    VT_ASSIGN_OR_RETURN(g.vertices,
-                        impl_->ctx.create_buffer_with(vb, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT));
-    VT_ASSIGN_OR_RETURN(g.indices,
-                        impl_->ctx.create_buffer_with(ib, VK_BUFFER_USAGE_INDEX_BUFFER_BIT));
+    VT_ASSIGN_OR_RETURN(g.vertices, ctx.create_buffer_with(vb, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT));
+    VT_ASSIGN_OR_RETURN(g.indices, ctx.create_buffer_with(ib, VK_BUFFER_USAGE_INDEX_BUFFER_BIT));
     g.index_count = uint32_t(m.indices.size());
     g.texture = m.reference_texture;
     g.alpha_cutoff = m.alpha_cutoff;
     gpu.push_back(std::move(g));
   }
-  impl_->meshes = std::move(gpu);
+  vkDeviceWaitIdle(dev);
+  out = std::move(gpu);
   return Status::Ok();
 }
 
@@ -700,7 +714,7 @@ Status Renderer::upload_page_table(const PageTableLevels& table) {
 
 Expected<ReferenceFrame> Renderer::render_reference(const Camera& camera) {
   Impl& s = *impl_;
-  for (const auto& m : s.meshes) {
+  for (const auto& m : s.reference_meshes()) {
     if (m.texture >= s.textures.size()) {
       return Error(ErrorCode::kInvalidArgument, "render: a mesh names reference texture " +
                                                     std::to_string(m.texture) + " but only " +
@@ -714,7 +728,7 @@ Expected<ReferenceFrame> Renderer::render_reference(const Camera& camera) {
   VT_RETURN_IF_ERROR(s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
     s.begin_pass(cmd, targets, s.depth, w, h, clears);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.ref_pipe);
-    for (const auto& m : s.meshes) {
+    for (const auto& m : s.reference_meshes()) {
       const auto& t = s.textures[m.texture];
       vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.ref_layout, 0, 1, &t.set, 0,
                               nullptr);

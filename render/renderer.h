@@ -115,7 +115,11 @@ class Renderer {
   uint32_t feedback_width() const;
   uint32_t feedback_height() const;
 
+  // The meshes every pass draws (virtual-texture UVs; reference_texture for the reference pass).
   Status set_meshes(std::span<const MeshData> meshes);
+  // Other meshes for the reference pass only (the original scene with its own UVs and
+  // textures, where the virtual pass draws the unwrapped scene).
+  Status set_reference_meshes(std::span<const MeshData> meshes);
   Status set_reference_textures(std::span<const ReferenceTexture> textures);
   // Creates the physical cache and page-table textures (contents undefined until uploaded).
   Status set_virtual_texture(const VirtualTextureSetup& setup);

@@ -1,0 +1,199 @@
+#include "render/scene_draws.h"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace vt::render {
+namespace {
+
+float srgb_to_linear(float c) {
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+uint8_t linear_to_srgb8(float c) {
+  c = std::clamp(c, 0.0f, 1.0f);
+  float s = c <= 0.0031308f ? c * 12.92f : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+  return uint8_t(std::lround(s * 255.0f));
+}
+
+struct Bounds {
+  Vec3 lo{std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
+          std::numeric_limits<float>::max()};
+  Vec3 hi{-std::numeric_limits<float>::max(), -std::numeric_limits<float>::max(),
+          -std::numeric_limits<float>::max()};
+  void add(float x, float y, float z) {
+    lo = {std::min(lo.x, x), std::min(lo.y, y), std::min(lo.z, z)};
+    hi = {std::max(hi.x, x), std::max(hi.y, y), std::max(hi.z, z)};
+  }
+};
+
+std::string where(const scene::Scene& s, int mesh, size_t prim) {
+  return s.source_path + ": mesh '" + s.meshes[mesh].name + "' primitive " + std::to_string(prim);
+}
+
+float cutoff_of(const scene::Scene& s, const scene::Primitive& p) {
+  if (p.material < 0 || size_t(p.material) >= s.materials.size()) return -1.0f;
+  const scene::Material& m = s.materials[p.material];
+  return m.alpha_mode == scene::AlphaMode::kMask ? m.alpha_cutoff : -1.0f;
+}
+
+// Flattens instances; `uv_of(prim)` gives the UV array to use (or an error).
+template <typename UvOf>
+Expected<SceneDraws> draws(const scene::Scene& s, UvOf uv_of, bool reference) {
+  SceneDraws out;
+  Bounds b;
+  for (const scene::Instance& inst : s.instances()) {
+    if (inst.mesh < 0 || size_t(inst.mesh) >= s.meshes.size()) continue;
+    const scene::Mesh& mesh = s.meshes[inst.mesh];
+    for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
+      const scene::Primitive& p = mesh.primitives[pi];
+      if (p.indices.empty()) continue;
+      VT_ASSIGN_OR_RETURN(const std::vector<scene::Vec2>* uvs, uv_of(inst.mesh, pi, p));
+      MeshData m;
+      m.vertices.resize(p.positions.size());
+      for (size_t v = 0; v < p.positions.size(); ++v) {
+        auto w = scene::transform_point(inst.world, p.positions[v]);
+        Vertex& o = m.vertices[v];
+        o.x = float(w[0]), o.y = float(w[1]), o.z = float(w[2]);
+        if (!std::isfinite(o.x) || !std::isfinite(o.y) || !std::isfinite(o.z)) {
+          return Error(ErrorCode::kCorrupt, where(s, inst.mesh, pi) + ": vertex " +
+                                                std::to_string(v) + " has a non-finite position");
+        }
+        o.u = uvs ? (*uvs)[v][0] : 0.0f;
+        o.v = uvs ? (*uvs)[v][1] : 0.0f;
+        b.add(o.x, o.y, o.z);
+      }
+      m.indices = p.indices;
+      m.alpha_cutoff = cutoff_of(s, p);
+      // Reference texture index = material index; the default material is the last texture.
+      m.reference_texture =
+          reference ? uint32_t(p.material >= 0 ? p.material : int(s.materials.size())) : 0;
+      out.meshes.push_back(std::move(m));
+    }
+  }
+  out.bounds_min = b.lo;
+  out.bounds_max = b.hi;
+  return out;
+}
+
+// RGBA8 sRGB texels of an image, float images encoded from linear.
+Expected<std::vector<uint8_t>> load_rgba8(const scene::Image& image, uint32_t* width,
+                                          uint32_t* height) {
+  std::unique_ptr<OIIO::ImageInput> in;
+  OIIO::Filesystem::IOMemReader mem(image.bytes.data(), image.bytes.size());
+  const std::string name = image.embedded()
+                               ? (image.mime_type == "image/jpeg" ? "embedded.jpg" : "embedded.png")
+                               : image.path;
+  if (image.embedded()) {
+    in = OIIO::ImageInput::open(name, nullptr, &mem);
+  } else {
+    in = OIIO::ImageInput::open(name);
+  }
+  if (!in) {
+    return Error(ErrorCode::kNotFound,
+                 "render: cannot open image '" + name + "': " + OIIO::geterror());
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  const int ch = spec.nchannels;
+  if (spec.width <= 0 || spec.height <= 0 || ch <= 0 || spec.width > 65536 || spec.height > 65536) {
+    return Error(ErrorCode::kCorrupt, "render: image '" + name + "' has a bad size");
+  }
+  std::vector<float> px(size_t(spec.width) * spec.height * ch);
+  if (!in->read_image(0, 0, 0, ch, OIIO::TypeDesc::FLOAT, px.data())) {
+    return Error(ErrorCode::kCorrupt,
+                 "render: cannot read image '" + name + "': " + in->geterror());
+  }
+  const bool linear = spec.format.is_floating_point();
+  *width = uint32_t(spec.width);
+  *height = uint32_t(spec.height);
+  std::vector<uint8_t> out(size_t(spec.width) * spec.height * 4);
+  for (size_t i = 0, n = size_t(spec.width) * spec.height; i < n; ++i) {
+    const float* s = &px[i * ch];
+    float rgb[3] = {s[0], ch >= 3 ? s[1] : s[0], ch >= 3 ? s[2] : s[0]};
+    float a = ch == 2 ? s[1] : ch >= 4 ? s[3] : 1.0f;
+    for (int c = 0; c < 3; ++c) {
+      out[i * 4 + c] = linear ? linear_to_srgb8(rgb[c])
+                              : uint8_t(std::lround(std::clamp(rgb[c], 0.0f, 1.0f) * 255.0f));
+    }
+    out[i * 4 + 3] = uint8_t(std::lround(std::clamp(a, 0.0f, 1.0f) * 255.0f));
+  }
+  return out;
+}
+
+}  // namespace
+
+Expected<SceneDraws> virtual_scene_draws(const scene::Scene& s, int uv_set) {
+  return draws(
+      s,
+      [&](int mesh, size_t pi,
+          const scene::Primitive& p) -> Expected<const std::vector<scene::Vec2>*> {
+        int set = uv_set < 0 ? int(p.uvs.size()) - 1 : uv_set;
+        if (set < 0 || size_t(set) >= p.uvs.size() || p.uvs[set].size() != p.positions.size()) {
+          return Error(ErrorCode::kInvalidArgument, where(s, mesh, pi) + ": no atlas UV set " +
+                                                        std::to_string(set) +
+                                                        " (is this the unwrapped scene?)");
+        }
+        return &p.uvs[set];
+      },
+      false);
+}
+
+Expected<SceneDraws> reference_scene_draws(const scene::Scene& s, uint32_t max_side) {
+  VT_ASSIGN_OR_RETURN(
+      SceneDraws out,
+      draws(
+          s,
+          [&](int mesh, size_t pi,
+              const scene::Primitive& p) -> Expected<const std::vector<scene::Vec2>*> {
+            if (p.material < 0 || size_t(p.material) >= s.materials.size()) return nullptr;
+            const scene::TextureRef& t = s.materials[p.material].base_color_texture;
+            if (!t.valid()) return nullptr;
+            if (size_t(t.texcoord) >= p.uvs.size() ||
+                p.uvs[t.texcoord].size() != p.positions.size()) {
+              return Error(ErrorCode::kCorrupt, where(s, mesh, pi) + ": base colour reads UV set " +
+                                                    std::to_string(t.texcoord) +
+                                                    " which it does not have");
+            }
+            return &p.uvs[t.texcoord];
+          },
+          true));
+  // One texture per material plus the default material's.
+  for (size_t mi = 0; mi <= s.materials.size(); ++mi) {
+    ReferenceTexture tex;
+    scene::Vec4 factor = {1, 1, 1, 1};
+    std::vector<uint8_t> texels = {255, 255, 255, 255};
+    tex.width = tex.height = 1;
+    if (mi < s.materials.size()) {
+      const scene::Material& m = s.materials[mi];
+      factor = m.base_color_factor;
+      const scene::TextureRef& t = m.base_color_texture;
+      if (t.valid() && size_t(t.image) < s.images.size()) {
+        VT_ASSIGN_OR_RETURN(texels, load_rgba8(s.images[t.image], &tex.width, &tex.height));
+        tex.address_mode =
+            t.wrap_s == scene::WrapMode::kClampToEdge ? AddressMode::kClamp : AddressMode::kWrap;
+      }
+    }
+    for (size_t i = 0; i + 3 < texels.size(); i += 4) {
+      for (int c = 0; c < 3; ++c) {
+        texels[i + c] = linear_to_srgb8(srgb_to_linear(texels[i + c] / 255.0f) * factor[c]);
+      }
+      texels[i + 3] = uint8_t(std::lround(std::clamp(texels[i + 3] * factor[3], 0.0f, 255.0f)));
+    }
+    tex.levels = box_mip_chain(texels.data(), tex.width, tex.height);
+    // Too large for the device or memory: drop the finest levels.
+    uint32_t drop = 0;
+    while (std::max(tex.width >> drop, tex.height >> drop) > max_side) ++drop;
+    if (drop > 0) {
+      tex.levels.erase(tex.levels.begin(), tex.levels.begin() + drop);
+      tex.width = std::max(1u, tex.width >> drop);
+      tex.height = std::max(1u, tex.height >> drop);
+    }
+    out.textures.push_back(std::move(tex));
+  }
+  return out;
+}
+
+}  // namespace vt::render

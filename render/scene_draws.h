@@ -1,0 +1,35 @@
+// From the scene model (bake/scene) to what the renderer draws: world-space meshes (instances
+// flattened) with the UVs of the virtual texture, and the reference meshes with their own UVs
+// and textures (base colour x factor, as the bake's albedo layer holds it).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "bake/scene/scene.h"
+#include "common/status.h"
+#include "render/camera.h"
+#include "render/renderer.h"
+
+namespace vt::render {
+
+struct SceneDraws {
+  std::vector<MeshData> meshes;
+  std::vector<ReferenceTexture> textures;  // reference draws only
+  Vec3 bounds_min, bounds_max;             // world space; min > max when there is no geometry
+};
+
+// The unwrapped scene for the virtual-texture pass: every primitive with its UV set `uv_set`
+// (-1: its last set, where the unwrapper puts the atlas UVs). Alpha-mask materials keep their
+// cutoff. Errors name the mesh and primitive lacking the set.
+Expected<SceneDraws> virtual_scene_draws(const scene::Scene& scene, int uv_set = -1);
+
+// The original scene for the reference pass: one reference texture per material, its base
+// colour image (OpenImageIO; float images are taken as linear, others as sRGB) multiplied by
+// base_color_factor in linear light and stored as sRGB 8-bit, with a full mip chain; a material
+// without an image gets a 1 x 1 texture of its factor. Images larger than `max_texture_side`
+// are box-reduced to fit. Vertex colours are not applied.
+Expected<SceneDraws> reference_scene_draws(const scene::Scene& scene,
+                                           uint32_t max_texture_side = 4096);
+
+}  // namespace vt::render
