@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/build.h"
+#include "bake/procedural.h"
 #include "cli/command.h"
 
 namespace {
@@ -255,9 +256,19 @@ int run_build(const BuildFlags& f, const vt::cli::GlobalOptions& global) {
   }
   if (inputs.empty()) return bad("no input image (give IMAGE or --layer NAME=PATH)");
   for (auto& [name, path] : inputs) {
-    auto src = vt::open_image_file(path);
-    if (!src.ok()) return bad(src.status().message());
     vt::LayerInput in;
+    // procedural:WIDTHxHEIGHT is the generated sample pattern (benchmarks of any size, no file).
+    uint32_t pw = 0, ph = 0;
+    if (std::sscanf(path.c_str(), "procedural:%ux%u", &pw, &ph) == 2) {
+      if (pw == 0 || ph == 0) return bad("bad size in '" + path + "'");
+      auto pattern =
+          name == "normal" ? vt::ProceduralPattern::kNormal : vt::ProceduralPattern::kAlbedo;
+      in.source = std::make_shared<vt::ProceduralImageSource>(pattern, pw, ph, 3, 1);
+    } else {
+      auto src = vt::open_image_file(path);
+      if (!src.ok()) return bad(src.status().message());
+      in.source = std::shared_ptr<vt::ImageSource>(std::move(src).value());
+    }
     vt::LayerSemantic sem;
     if (parse_semantic(name, &sem)) {
       in.semantic = sem;
@@ -265,8 +276,6 @@ int run_build(const BuildFlags& f, const vt::cli::GlobalOptions& global) {
       in.semantic = vt::LayerSemantic::kCustom;
       in.name = name;
     }
-    // A positional albedo that is not colour (one or two channels of data) stays custom.
-    in.source = std::shared_ptr<vt::ImageSource>(std::move(src).value());
     in.color_space = f.colorspace;
     o.layers.push_back(std::move(in));
   }
@@ -297,7 +306,9 @@ int run_build(const BuildFlags& f, const vt::cli::GlobalOptions& global) {
 
 vt::cli::CommandRunner make_build(CLI::App& sub) {
   auto f = std::make_shared<BuildFlags>();
-  sub.add_option("images", f->images, "Input images (the first becomes the albedo layer)");
+  sub.add_option("images", f->images,
+                 "Input images (the first becomes the albedo layer); procedural:WxH for the "
+                 "generated pattern");
   sub.add_option("-o,--output", f->output, "Output page file (.vtpf)")->required();
   sub.add_option("--layer", f->layers,
                  "A layer NAME=PATH; NAME albedo, normal, orm, emissive or any custom name");

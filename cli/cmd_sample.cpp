@@ -1,5 +1,6 @@
 // `vtbake sample -o DIR`: writes the bundled sample's images, made procedurally (no downloads):
-// DIR/albedo.png (sRGB colour with fine detail) and DIR/normal.png (tangent-space normals).
+// DIR/albedo.png (sRGB colour with fine detail) and DIR/normal.png (tangent-space normals);
+// --ext tif|exr for other formats (benchmark inputs).
 #include <cstdio>
 #include <filesystem>
 
@@ -12,6 +13,8 @@ struct SampleFlags {
   std::string dir;
   uint32_t width = 4096;
   uint32_t height = 3072;
+  std::string ext = "png";
+  bool albedo_only = false;
 };
 
 int run_sample(const SampleFlags& f, const vt::cli::GlobalOptions& global) {
@@ -25,10 +28,12 @@ int run_sample(const SampleFlags& f, const vt::cli::GlobalOptions& global) {
     const char* file;
     vt::ProceduralPattern pattern;
   };
-  for (const Item& item : {Item{"albedo.png", vt::ProceduralPattern::kAlbedo},
-                           Item{"normal.png", vt::ProceduralPattern::kNormal}}) {
+  for (const Item& item : {Item{"albedo", vt::ProceduralPattern::kAlbedo},
+                           Item{"normal", vt::ProceduralPattern::kNormal}}) {
+    if (f.albedo_only && item.pattern != vt::ProceduralPattern::kAlbedo) continue;
     vt::ProceduralImageSource src(item.pattern, f.width, f.height, 3, 1);
-    std::string path = (std::filesystem::path(f.dir) / item.file).string();
+    std::string path =
+        (std::filesystem::path(f.dir) / (std::string(item.file) + "." + f.ext)).string();
     vt::Status s = vt::write_image_file(src, path);
     if (!s.ok()) {
       std::fprintf(stderr, "vtbake sample: %s\n", s.message().c_str());
@@ -49,6 +54,10 @@ vt::cli::CommandRunner make_sample(CLI::App& sub) {
       ->capture_default_str();
   sub.add_option("--height", f->height, "Image height")
       ->check(CLI::Range(1u, 1u << 16))
+      ->capture_default_str();
+  sub.add_flag("--albedo-only", f->albedo_only, "Write only the albedo image");
+  sub.add_option("--ext", f->ext, "Image format by extension: png, tif, exr")
+      ->check(CLI::IsMember({"png", "tif", "exr"}))
       ->capture_default_str();
   return [f](const vt::cli::GlobalOptions& global) { return run_sample(*f, global); };
 }
