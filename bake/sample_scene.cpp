@@ -480,7 +480,7 @@ Status write_sample_scene(const std::string& dir, const SampleSceneOptions& o) {
   int ground_mesh = mesh("ground", make_grid(12, o.ground_cells, 3), 0);
   int box_mesh = mesh("box", make_box(1.2f, 1.2f, 1.2f), 1);
   int sphere_mesh = mesh("sphere", make_uv_sphere(1.0f, o.sphere_segments), 2);
-  int torus_mesh = mesh("torus", make_torus(0.9f, 0.3f, std::max(12u, o.sphere_segments)), 3);
+  int torus_mesh = mesh("torus", make_torus(0.9f, 0.3f, std::max(12u, o.sphere_segments / 2)), 3);
   scene::Primitive card = make_grid(1.5f, 1, 1);
   for (auto& n : card.normals) n = normalize3({0, 0, 1});
   for (auto& pos : card.positions) pos = {pos[0], -pos[2] + 0.75f, 0.0f};  // stand it up, facing +z

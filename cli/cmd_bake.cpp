@@ -105,8 +105,8 @@ class Progress {
 
 void print_summary(const vt::SceneBakeSummary& s) {
   const auto& g = s.build.geometry;
-  std::printf("baked %s -> %s (unwrapped scene: %s)\n", s.triangles ? "scene" : "",
-              s.output.c_str(), s.unwrapped.empty() ? "not written" : s.unwrapped.c_str());
+  std::printf("baked %s (unwrapped scene: %s)\n", s.output.c_str(),
+              s.unwrapped.empty() ? "not written" : s.unwrapped.c_str());
   std::printf("  atlas      %u x %u texels, %lld charts, %.3g texels/unit, utilisation %.3f\n",
               g.width, g.height, (long long)s.unwrap.charts, s.unwrap.texels_per_unit,
               s.unwrap.utilisation);
