@@ -193,6 +193,13 @@ Thresholds default_thresholds(RuntimeFormat cache_format) {
   return t;
 }
 
+Thresholds scene_thresholds() {
+  Thresholds t;
+  t.min_psnr = 30.0;
+  t.min_tile_psnr = 20.0;
+  return t;
+}
+
 std::vector<std::string> check_view(const ViewMetrics& m, const Thresholds& t) {
   std::vector<std::string> why;
   char line[160];
