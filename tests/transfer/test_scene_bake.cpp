@@ -422,3 +422,48 @@ TEST(SceneBake, SampleSceneBakesWithEveryLayer) {
 
 }  // namespace
 }  // namespace vt
+
+namespace vt {
+namespace {
+
+TEST(SceneBake, FactorsTimesVertexColoursAreExact) {
+  scene::Material m;
+  m.base_color_factor = {0.5f, 1.0f, 1.0f, 1.0f};
+  m.emissive_factor = {0.25f, 0.5f, 0.0f};
+  scene::Primitive p = make_grid(1.0f, 2, 1);
+  // Colour varies with x only: red follows u linearly, so interpolation is checkable.
+  for (const auto& uv : p.uvs[0]) p.colors.push_back({uv[0], 0.4f, 0.8f, 1.0f});
+  scene::Scene s = test::single_mesh_scene(p, m);
+  auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 40});
+  ASSERT_TRUE(un.ok());
+  TransferOptions to;
+  to.width = uint32_t(un->stats.atlas_width), to.height = uint32_t(un->stats.atlas_height);
+  auto t = transfer_materials(un->scene, to);
+  ASSERT_TRUE(t.ok()) << t.status().message();
+  ASSERT_EQ(t->layers.size(), 2u);  // albedo (opaque) and emissive
+  ASSERT_EQ(t->layers[0].semantic, LayerSemantic::kAlbedo);
+  ASSERT_EQ(t->layers[0].channels, 3u);
+  ASSERT_EQ(t->layers[1].semantic, LayerSemantic::kEmissive);
+  float rmin = 1, rmax = 0;
+  uint64_t n = 0;
+  for (size_t i = 0; i < size_t(to.width) * to.height; ++i) {
+    if (!(*t->coverage)[i]) continue;
+    const float* a = &t->layers[0].texels[3 * i];
+    EXPECT_GE(a[0], -1e-6f);
+    EXPECT_LE(a[0], 0.5f + 1e-6f);
+    EXPECT_NEAR(a[1], 0.4f, 1e-6f);
+    EXPECT_NEAR(a[2], 0.8f, 1e-6f);
+    rmin = std::min(rmin, a[0]), rmax = std::max(rmax, a[0]);
+    const float* e = &t->layers[1].texels[3 * i];
+    EXPECT_FLOAT_EQ(e[0], 0.25f);
+    EXPECT_FLOAT_EQ(e[1], 0.5f);
+    EXPECT_FLOAT_EQ(e[2], 0.0f);
+    ++n;
+  }
+  EXPECT_GT(n, 1500u);
+  EXPECT_LT(rmin, 0.02f);  // the red ramp spans the quad
+  EXPECT_GT(rmax, 0.48f);
+}
+
+}  // namespace
+}  // namespace vt
