@@ -327,13 +327,15 @@ class RowWindow {
 };
 
 // Linear working texels of a page to the layer's stored bytes.
-void store_page(const LayerPlan& plan, float* texels, size_t count, uint8_t* out) {
+void store_page(const LayerPlan& plan, float alpha_scale, float* texels, size_t count,
+                uint8_t* out) {
   const uint32_t wc = plan.work_channels;
   if (plan.alpha >= 0) {
     for (size_t i = 0; i < count; ++i) {
       float* t = texels + i * wc;
       float a = t[plan.alpha];
       for (int c = 0; c < 3; ++c) t[c] = a > 0 ? std::min(t[c] / a, kFloatMax) : 0.0f;
+      if (alpha_scale != 1.0f) t[plan.alpha] = std::min(1.0f, a * alpha_scale);
     }
   }
   if (plan.spec.texel_type == TexelType::kF32) {
@@ -519,6 +521,14 @@ Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDe
     }
 
     Accum acc;
+    // Coverage-preserving alpha: level 0's fraction of texels at or above the reference, and a
+    // histogram of the next level's alpha gathered as its rows are made.
+    const float alpha_ref = options.alpha_coverage_reference;
+    const bool keep_coverage = alpha_ref > 0 && plan.alpha >= 0;
+    constexpr int kAlphaBins = 4096;
+    std::vector<uint64_t> alpha_hist(kAlphaBins);
+    uint64_t covered0 = 0;
+    float alpha_scale = 1.0f;
     for (uint32_t l = 0; l < levels; ++l) {
       const uint32_t lw = g.level_width(l), lh = g.level_height(l);
       const uint32_t px = g.pages_x(l), py = g.pages_y(l);
@@ -566,6 +576,13 @@ Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDe
         int64_t band_begin = int64_t(r) * P - margin;
         VT_ASSIGN_OR_RETURN(RowBand band, window.fetch(band_begin, P + 2 * margin));
         t_read += seconds_since(t0);
+        if (keep_coverage && l == 0) {
+          for (uint32_t y = r * P; y < std::min(lh, r * P + P); ++y) {
+            const float* row = band.row(y);
+            for (uint32_t x = 0; x < lw; ++x)
+              covered0 += row[size_t(x) * wc + plan.alpha] >= alpha_ref;
+          }
+        }
 
         // Pages of this row, encoded in parallel.
         t0 = Clock::now();
@@ -579,7 +596,7 @@ Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDe
           page.resize(page_texels * wc);
           bytes.resize(encoder.page_bytes());
           cut_page(g, id, options.address, band, page.data());
-          store_page(plan, page.data(), page_texels, bytes.data());
+          store_page(plan, alpha_scale, page.data(), page_texels, bytes.data());
           errors[x] = encoder.encode(bytes.data(), encoded[x]);
         });
         for (uint32_t x = 0; x < px; ++x) {
@@ -626,6 +643,11 @@ Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDe
                               next_rows.data() + size_t(a - y0) * next->row_floats());
             });
             VT_RETURN_IF_ERROR(next->write_rows(y0, y1 - y0, next_rows.data()));
+            if (keep_coverage) {
+              for (size_t i = size_t(plan.alpha); i < next_rows.size(); i += wc) {
+                ++alpha_hist[std::clamp(int(next_rows[i] * kAlphaBins), 0, kAlphaBins - 1)];
+              }
+            }
           }
           t_pyramid += seconds_since(t0);
         }
@@ -641,6 +663,22 @@ Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDe
           coverage = downsample_coverage(coverage.data(), lw, lh);
           pull_push(next->data(), coverage.data(), next->width(), next->height(), wc);
           t_pyramid += seconds_since(t0);
+        }
+        if (keep_coverage) {
+          // The alpha threshold that as large a fraction of the next level passes as level 0,
+          // and the scale that moves it onto the reference (bounded: 1/4 to 4).
+          uint64_t n = uint64_t(next->width()) * next->height();
+          double target = double(covered0) / (double(g.width) * g.height) * double(n);
+          uint64_t above = 0;
+          int bin = kAlphaBins - 1;
+          for (; bin > 0; --bin) {
+            above += alpha_hist[bin];
+            if (double(above) >= target) break;
+          }
+          double threshold = double(bin) / kAlphaBins;
+          alpha_scale = threshold > 0 ? float(std::clamp(alpha_ref / threshold, 0.25, 4.0)) : 4.0f;
+          if (covered0 == 0) alpha_scale = 1.0f;  // nothing to preserve
+          std::fill(alpha_hist.begin(), alpha_hist.end(), 0);
         }
         current = std::move(next);
       }

@@ -61,6 +61,9 @@ struct BuildOptions {
   uint64_t memory_limit = uint64_t(2) << 30;
   int threads = 0;  // 0 = all cores
   NonFinitePolicy non_finite = NonFinitePolicy::kBlack;
+  // Coverage-preserving alpha (alpha-tested foliage, fences): when > 0, each level's alpha is
+  // scaled so that the fraction of texels with alpha >= this reference matches level 0's.
+  float alpha_coverage_reference = 0;
   std::string scratch_dir;  // "" = the output's directory
   std::string metadata_json = "{}";
   std::function<void(const BuildProgress&)> progress;

@@ -31,6 +31,7 @@ struct BuildFlags {
   std::string colorspace;
   std::string fix_nonfinite = "black";
   std::string scratch_dir;
+  float alpha_coverage = 0;
 };
 
 bool parse_size(const std::string& s, uint64_t* out) {
@@ -203,6 +204,7 @@ int run_build(const BuildFlags& f, const vt::cli::GlobalOptions& global) {
   o.border = f.border;
   o.threads = global.threads;
   o.scratch_dir = f.scratch_dir;
+  o.alpha_coverage_reference = f.alpha_coverage;
   // --codec dct[:QUALITY] | bc | raw
   std::string codec = f.codec, quality;
   if (auto colon = codec.find(':'); colon != std::string::npos) {
@@ -326,6 +328,9 @@ vt::cli::CommandRunner make_build(CLI::App& sub) {
   sub.add_option("--fix-nonfinite", f->fix_nonfinite,
                  "NaN/Inf/negative colour values: black, clamp or error")
       ->capture_default_str();
+  sub.add_option("--alpha-coverage", f->alpha_coverage,
+                 "Keep the fraction of texels with alpha >= this value (e.g. 0.5) at every level")
+      ->check(CLI::Range(0.0f, 1.0f));
   sub.add_option("--scratch-dir", f->scratch_dir,
                  "Where levels larger than memory go (default: beside the output)");
   return [f](const vt::cli::GlobalOptions& global) { return run_build(*f, global); };

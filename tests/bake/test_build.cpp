@@ -331,3 +331,51 @@ TEST(Build, MissingFileIsAClearError) {
 
 }  // namespace
 }  // namespace vt
+
+namespace vt {
+namespace {
+
+// Alpha-tested foliage: thin opaque blades on a transparent background fade away in plain
+// mips; with coverage-preserving alpha each level keeps level 0's fraction above the reference.
+TEST(Build, CoveragePreservingAlpha) {
+  const uint32_t w = 128, h = 128;
+  std::vector<float> t(w * h * 4, 0.0f);
+  for (uint32_t y = 0; y < h; ++y) {
+    for (uint32_t x = 0; x < w; ++x) {
+      float* p = &t[(y * w + x) * 4];
+      p[0] = 0.2f, p[1] = 0.6f, p[2] = 0.1f;
+      p[3] = (x % 6 == 0 || (x + y / 3) % 11 == 0) ? 1.0f : 0.0f;
+    }
+  }
+  auto fractions = [&](float reference) {
+    BuildOptions o;
+    o.layers.push_back({LayerSemantic::kAlbedo, "", memory_image(w, h, 4, t, false)});
+    o.codec.codec = CodecKind::kRaw;
+    o.payload = 24;
+    o.alpha_coverage_reference = reference;
+    auto b = test::build_in_memory(o);
+    EXPECT_TRUE(b);
+    std::vector<double> f;
+    if (!b) return f;
+    auto enc = test::encoder_for(*b, 0, o);
+    for (uint32_t l = 0; l < 4; ++l) {
+      auto lvl = test::reassemble_level(*b, 0, l, enc);
+      size_t above = 0;
+      for (size_t i = 3; i < lvl.size(); i += 4) above += lvl[i] >= 128;
+      f.push_back(double(above) / double(lvl.size() / 4));
+    }
+    return f;
+  };
+  auto plain = fractions(0);
+  auto kept = fractions(0.5f);
+  ASSERT_EQ(kept.size(), 4u);
+  EXPECT_DOUBLE_EQ(plain[0], kept[0]);
+  EXPECT_GT(kept[0], 0.2);
+  for (uint32_t l = 1; l < 4; ++l) {
+    EXPECT_NEAR(kept[l], kept[0], 0.06) << "level " << l;
+  }
+  EXPECT_GT(std::abs(plain[3] - plain[0]), std::abs(kept[3] - kept[0]));
+}
+
+}  // namespace
+}  // namespace vt
