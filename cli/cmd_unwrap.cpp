@@ -52,7 +52,7 @@ vt::cli::CommandRunner make_unwrap(CLI::App& sub) {
                  "Stretch split-and-redo rounds (default 4; 0 = none)")
       ->check(CLI::Range(0, 64));
   sub.add_option("--chart-angle", args->options.max_chart_angle_deg,
-                 "Largest normal deviation inside a chart, degrees (default 50)")
+                 "Largest normal deviation inside a chart, degrees (default 60)")
       ->check(CLI::Range(1.0, 179.0));
   sub.add_option("--report", args->report, "Report JSON path (default OUT.report.json)");
   sub.add_option("--picture", args->picture, "Atlas PNG path (default OUT.atlas.png)");

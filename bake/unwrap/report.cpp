@@ -48,8 +48,8 @@ std::array<uint8_t, 3> chart_colour(int32_t chart) {
 }
 
 std::array<uint8_t, 3> stretch_colour(float l2) {
-  // 1 -> blue, 2 or more -> red, through green.
-  double t = std::clamp((static_cast<double>(l2) - 1.0), 0.0, 1.0);
+  // 1 -> blue, 1.5 or more -> red, through green: stretch worth seeing is a few percent.
+  double t = std::clamp((static_cast<double>(l2) - 1.0) * 2.0, 0.0, 1.0);
   if (!std::isfinite(l2)) t = 1;
   double r = std::clamp(2 * t, 0.0, 1.0), g = 1 - std::abs(2 * t - 1),
          b = std::clamp(1 - 2 * t, 0.0, 1.0);

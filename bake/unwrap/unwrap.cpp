@@ -580,6 +580,60 @@ void fit_box(detail::PackChart* pc) {
   pc->height = gy;
 }
 
+// Twice the signed area in atlas texels (x right, y down); front faces are negative.
+double atlas_cross(const std::vector<scene::Vec2>& uv, const uint32_t* t, double W, double H) {
+  double ax = uv[t[0]][0] * W, ay = uv[t[0]][1] * H;
+  double bx = uv[t[1]][0] * W, by = uv[t[1]][1] * H;
+  double cx = uv[t[2]][0] * W, cy = uv[t[2]][1] * H;
+  return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
+}
+
+void repair_rounding(const Surface& s, const std::vector<uint32_t>& index, double W, double H,
+                     std::vector<scene::Vec2>* uv) {
+  size_t faces = index.size() / 3;
+  std::vector<uint32_t> bad;
+  for (size_t f = 0; f < faces; ++f)
+    if (!s.degenerate[f] && !(atlas_cross(*uv, &index[3 * f], W, H) < 0))
+      bad.push_back(static_cast<uint32_t>(f));
+  if (bad.empty()) return;
+  // Faces around each vertex (CSR).
+  std::vector<uint32_t> start(uv->size() + 1, 0), list(index.size());
+  for (uint32_t v : index) ++start[v + 1];
+  for (size_t v = 0; v < uv->size(); ++v) start[v + 1] += start[v];
+  std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+  for (size_t c = 0; c < index.size(); ++c) list[fill[index[c]]++] = static_cast<uint32_t>(c / 3);
+  for (uint32_t f : bad) {
+    for (int step = 0; step < 64 && !(atlas_cross(*uv, &index[3 * f], W, H) < 0); ++step) {
+      int k = step % 3;
+      const uint32_t* t = &index[3 * f];
+      uint32_t v = t[k];
+      const auto& a = (*uv)[t[(k + 1) % 3]];
+      const auto& b = (*uv)[t[(k + 2) % 3]];
+      // Moving v lowers the cross product along -(gradient); in (x, y) texel space the
+      // gradient for the corner opposite edge a->b is (-(b.y - a.y), b.x - a.x) up to scale.
+      double gx = -(b[1] - a[1]) * H, gy = (b[0] - a[0]) * W;
+      scene::Vec2 old = (*uv)[v];
+      std::vector<uint32_t> good;  // triangles at v that are fine now must stay fine
+      for (uint32_t m = start[v]; m < start[v + 1]; ++m)
+        if (list[m] != f && !s.degenerate[list[m]] &&
+            atlas_cross(*uv, &index[3 * list[m]], W, H) < 0)
+          good.push_back(list[m]);
+      scene::Vec2 moved = old;
+      for (int n = 0; n <= step / 3; ++n) {
+        if (gx != 0) moved[0] = std::nextafter(moved[0], gx > 0 ? -1.0f : 2.0f);
+        if (gy != 0) moved[1] = std::nextafter(moved[1], gy > 0 ? -1.0f : 2.0f);
+      }
+      moved[0] = std::clamp(moved[0], 0.0f, 1.0f);
+      moved[1] = std::clamp(moved[1], 0.0f, 1.0f);
+      (*uv)[v] = moved;
+      bool others_fine = true;
+      for (uint32_t g : good)
+        if (!(atlas_cross(*uv, &index[3 * g], W, H) < 0)) others_fine = false;
+      if (!others_fine) (*uv)[v] = old;
+    }
+  }
+}
+
 }  // namespace
 
 Expected<UnwrapResult> unwrap_scene(const scene::Scene& in, const UnwrapOptions& opt) {
@@ -763,11 +817,23 @@ Expected<UnwrapResult> unwrap_scene(const scene::Scene& in, const UnwrapOptions&
     double lo = 0, hi = 0;
     tpu = std::sqrt(0.7 * static_cast<double>(width) * width / std::max(area3d, 1e-300));
     if (!(area3d > 0)) tpu = 1;
+    // No chart may be longer than the atlas: bound the start by the longest chart (its
+    // bounding-box diagonal at one texel per unit bounds every rotation's extent).
+    double longest = 0;
+    for (const auto& c : charts) {
+      if (c.degenerate || !(c.area3d > 0) || !(c.area_uv > 0)) continue;
+      double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+      for (const P2& p : c.uv)
+        for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+      longest = std::max(
+          longest, std::hypot(hi[0] - lo[0], hi[1] - lo[1]) * std::sqrt(c.area3d / c.area_uv));
+    }
+    if (longest > 0) tpu = std::min(tpu, (width - 2.0) / longest);
     bool have_fit = false;
     std::vector<detail::PackChart> best_pcs;
     detail::PackResult best_pack;
     double best_tpu = 0;
-    for (int iter = 0; iter < 10; ++iter) {
+    for (int iter = 0; iter < 16; ++iter) {
       auto trial = make_pack_charts(tpu);
       int w = choose_width(trial);
       bool fits = false;
@@ -850,6 +916,11 @@ Expected<UnwrapResult> unwrap_scene(const scene::Scene& in, const UnwrapOptions&
         }
       }
     }
+    // Float rounding of atlas UVs can flip or flatten a triangle that is a sliver in UV. Such
+    // a triangle is repaired by moving its corners a few float ulps (far below the 1/16 texel
+    // chart margin) in the direction that restores its orientation, keeping every triangle
+    // around the moved corner correctly oriented.
+    repair_rounding(s, new_index, W, H, &atlas_uv);
     // Rebuild the primitive's vertex arrays from source_of.
     auto gather = [&](const auto& from, auto& to) {
       if (from.empty()) return;

@@ -24,7 +24,7 @@ struct UnwrapOptions {
   int padding = 4;         // empty texels kept between any two charts (the gutter)
   Method method = Method::kLscm;
   bool share_instances = false;       // false: every instance gets its own texels (megatexture)
-  double max_chart_angle_deg = 50.0;  // a face joins a chart only within this cone of normals
+  double max_chart_angle_deg = 60.0;  // a face joins a chart only within this cone of normals
   double max_chart_stretch = 1.05;    // chart L2 stretch above this is split and redone
   int max_split_rounds = 4;           // stretch-driven split rounds (disk/flip splits always run)
   int threads = 0;                    // 0 = hardware concurrency
@@ -88,7 +88,7 @@ AtlasCheck check_atlas(const std::vector<AtlasTriangle>& triangles, int width, i
 // The unwrap report as JSON text.
 std::string report_json(const UnwrapStats& stats);
 // A PNG of the atlas: left half charts in distinct colours, right half L2 stretch (blue = 1,
-// red >= 2), background dark. At most max_side pixels per half-side (the atlas is scaled down).
+// red >= 1.5), background dark. At most max_side pixels per half-side (the atlas is scaled down).
 Status write_atlas_picture(const UnwrapResult& result, const std::string& path,
                            int max_side = 2048);
 

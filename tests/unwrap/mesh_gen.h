@@ -114,6 +114,16 @@ inline void expect_valid(const Scene& in, const unwrap::UnwrapResult& r,
     }
   EXPECT_EQ(faces, s.faces);
   EXPECT_EQ(static_cast<int64_t>(r.triangles.size()), s.faces);
+  // Every triangle of nonzero 3D area is strictly front-facing in the float atlas UVs
+  // (counter-clockwise as an image, y down: negative cross product).
+  int64_t not_front = 0;
+  for (const auto& t : r.triangles) {
+    double cross =
+        (static_cast<double>(t.uv[2]) - t.uv[0]) * (static_cast<double>(t.uv[5]) - t.uv[1]) -
+        (static_cast<double>(t.uv[3]) - t.uv[1]) * (static_cast<double>(t.uv[4]) - t.uv[0]);
+    not_front += !(cross < 0);
+  }
+  EXPECT_LE(not_front, s.degenerate_faces);
   if (padding_to_check > 0) {
     // Texels any triangle touches (a point-in-texel or edge-crossing test), per chart; then
     // every touched texel must have no other chart within `padding` texels (Chebyshev).

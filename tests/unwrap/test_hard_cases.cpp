@@ -59,6 +59,19 @@ TEST(HardCases, Slivers1e6) {
   expect_unwraps(scene_of(p));
 }
 
+TEST(HardCases, SliverThinnerThanFloatUvPrecision) {
+  // Aspect ratio ~1e8: the isometric UV height is far below a float ulp of the atlas UVs, so
+  // rounding alone would flatten it; the output must still be strictly front-facing.
+  Primitive p;
+  p.positions = {{0, 0, 0}, {1000, 0, 0}, {500, 1e-5f, 0}, {0, 0, 5}, {1, 0, 5}, {0, 1, 5}};
+  p.indices = {0, 1, 2, 3, 4, 5};
+  Scene s = scene_of(p);
+  auto r = unwrap::unwrap_scene(s, options());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  expect_valid(s, *r, 4);
+  EXPECT_EQ(r->stats.degenerate_faces, 0);
+}
+
 TEST(HardCases, DuplicateVerticesWeld) {
   // The same sphere as an unindexed triangle soup: welding gives the same chart count.
   Primitive indexed = sphere(24, 12);
