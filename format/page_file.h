@@ -121,6 +121,8 @@ struct ReaderOptions {
 // Reads a page file. Never trusts a size or offset from the file: every malformed file gives a
 // kCorrupt/kUnsupported Status naming the file and the problem, never a crash, a hang or an
 // allocation beyond what the file's own size justifies. Thread-safe for concurrent reads.
+// The file is memory-mapped: it must not be truncated or rewritten in place while open (writers
+// replace files by rename, which is safe).
 class PageFileReader {
  public:
   static Expected<std::unique_ptr<PageFileReader>> open(const std::string& path,
