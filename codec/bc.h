@@ -2,7 +2,14 @@
 // load-time transcode, a high-quality level for offline bakes) and decoders. Images are
 // row-major 8-bit texels; width and height must be multiples of 4. Output blocks are in
 // row-major block order (8 bytes per block for BC1/BC4, 16 for BC3/BC5/BC7).
-// Deterministic: same input and level, same bytes, on every machine.
+// Deterministic: same input and level, same bytes, on every machine (the SIMD paths do the same
+// IEEE operations per block as the scalar ones).
+//
+// Decoders round as Mesa's lavapipe samples, so CPU decodes match its renders bit for bit:
+// BC1 4-colour blocks truncate the in-between colours ((2*c0 + c1) / 3), 3-colour blocks round
+// the midpoint up ((c0 + c1 + 1) / 2) and index 3 is black; BC3's colour half is always
+// 4-colour; BC4/BC5 truncate their interpolated values; BC7 is exact by the format. Encoders pick
+// indices against these palettes. Details per format: codec/bc1.h, bc3.h, bc4.h, bc7.h.
 #pragma once
 
 #include <cstddef>
