@@ -63,6 +63,9 @@ int run(const ValidateFlags& f, const vt::cli::GlobalOptions& global) {
       f.out.empty() ? std::filesystem::path(f.page_file).replace_extension(".validate").string()
                     : f.out;
 
+  auto reader = PageFileReader::open(f.page_file);
+  if (!reader.ok()) return fail(reader.status().message(), code_for(reader.status()));
+  std::shared_ptr<const PageFileReader> shared_reader(std::move(*reader));
   auto original = scene::load_scene(f.scene);
   if (!original.ok()) return fail(original.status().message(), code_for(original.status()));
   auto baked = scene::load_scene(unwrapped);
@@ -75,9 +78,6 @@ int run(const ValidateFlags& f, const vt::cli::GlobalOptions& global) {
     return fail(f.scene + ": nothing to draw", kExitBadInput);
   }
 
-  auto reader = PageFileReader::open(f.page_file);
-  if (!reader.ok()) return fail(reader.status().message(), code_for(reader.status()));
-  std::shared_ptr<const PageFileReader> shared_reader(std::move(*reader));
   // Only the albedo layer has a reference (the original base colour).
   int layer = -1;
   for (size_t i = 0; i < shared_reader->layers().size(); ++i) {
