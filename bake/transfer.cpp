@@ -425,8 +425,10 @@ Status Transfer::setup_images() {
         ext = ".exr";
       else if (img.mime_type == "image/webp")
         ext = ".webp";
-      path = (scratch /
-              ("vtbake-transfer-" + std::to_string(getpid()) + "-" + std::to_string(i) + ext))
+      // Unique per process and per call, so concurrent transfers never share a copy.
+      static std::atomic<uint64_t> calls{0};
+      path = (scratch / ("vtbake-transfer-" + std::to_string(getpid()) + "-" +
+                         std::to_string(calls.fetch_add(1)) + "-" + std::to_string(i) + ext))
                  .string();
       std::ofstream f(path, std::ios::binary);
       f.write(reinterpret_cast<const char*>(img.bytes.data()), std::streamsize(img.bytes.size()));

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 
 #include "bake/sample_scene.h"
 #include "bake/scene_bake.h"
@@ -463,6 +465,40 @@ TEST(SceneBake, FactorsTimesVertexColoursAreExact) {
   EXPECT_GT(n, 1500u);
   EXPECT_LT(rmin, 0.02f);  // the red ramp spans the quad
   EXPECT_GT(rmax, 0.48f);
+}
+
+}  // namespace
+}  // namespace vt
+
+namespace vt {
+namespace {
+
+TEST(SceneBake, EmbeddedImagesGiveTheSameTexelsAsFiles) {
+  test::ScratchDir dir;
+  ASSERT_TRUE(write_texture(dir.file("e.png"), 64, 64, 3, smooth_colour).ok());
+  scene::Material m;
+  scene::Scene s = test::single_mesh_scene(make_grid(1.0f, 1, 1), m);
+  s.materials[0].base_color_texture.image = test::add_image(s, dir.file("e.png"));
+  auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 32});
+  ASSERT_TRUE(un.ok());
+  TransferOptions to;
+  to.width = uint32_t(un->stats.atlas_width), to.height = uint32_t(un->stats.atlas_height);
+  to.scratch_dir = dir.file("");
+  auto from_file = transfer_materials(un->scene, to);
+  ASSERT_TRUE(from_file.ok()) << from_file.status().message();
+  // The same bytes embedded, as a .glb or data: URI would hold them.
+  std::ifstream f(dir.file("e.png"), std::ios::binary);
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  scene::Image& im = un->scene.images[0];
+  im.bytes = bytes, im.path.clear(), im.uri.clear(), im.mime_type = "image/png";
+  auto embedded = transfer_materials(un->scene, to);
+  ASSERT_TRUE(embedded.ok()) << embedded.status().message();
+  EXPECT_TRUE(from_file->layers[0].texels == embedded->layers[0].texels);
+  // The private copy is gone afterwards.
+  size_t left = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir.file("")))
+    left += e.path().filename().string().rfind("vtbake-transfer-", 0) == 0;
+  EXPECT_EQ(left, 0u);
 }
 
 }  // namespace
