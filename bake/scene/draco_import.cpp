@@ -102,7 +102,12 @@ Expected<Scene> load_ply(const std::string& path) {
   draco::Mesh mesh;
   draco::PlyDecoder decoder;
   draco::Status st = decoder.DecodeFromFile(path, &mesh);
-  if (!st.ok()) return Error(ErrorCode::kCorrupt, path + ": PLY: " + st.error_msg_string());
+  if (!st.ok()) {
+    // Draco reads no `tristrips` element: fall back to the small reader for such files.
+    auto own = load_ply_own(path);
+    if (own.ok() && own->triangle_count() > 0) return own;
+    return Error(ErrorCode::kCorrupt, path + ": PLY: " + st.error_msg_string());
+  }
   auto prim = convert(mesh, {});
   if (!prim.ok()) return prim.status().with_context(path);
   std::vector<Primitive> prims;

@@ -21,6 +21,7 @@ std::string percent_decode(const std::string& uri);
 Expected<Scene> load_gltf(const std::string& path);
 Expected<Scene> load_obj(const std::string& path);
 Expected<Scene> load_ply(const std::string& path);
+Expected<Scene> load_ply_own(const std::string& path);  // fallback: tristrips
 Expected<Scene> load_drc(const std::string& path);
 // Decodes a Draco-compressed mesh into a primitive. attribute_ids maps glTF attribute names
 // (POSITION, NORMAL, TEXCOORD_n, COLOR_0, TANGENT) to Draco unique ids; when empty the Draco

@@ -111,6 +111,35 @@ TEST(SceneIo, PlyAsciiAndBinary) {
   EXPECT_NE(c.status().message().find("c.ply"), std::string::npos);
 }
 
+TEST(SceneIo, PlyTristripsWithRestart) {
+  // Draco's reader has no tristrips element; the fallback reader turns strips into triangles
+  // with alternating winding, restarting at -1.
+  write_text(temp("s.ply"),
+             "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float "
+             "y\nproperty float z\n"
+             "element tristrips 1\nproperty list int int vertex_indices\nend_header\n"
+             "0 0 0\n1 0 0\n0 1 0\n1 1 0\n5 0 0\n6 0 0\n8 0 1 2 3 -1 4 5 2\n");
+  auto s = scene::load_scene(temp("s.ply"));
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  const auto& p = s->meshes[0].primitives[0];
+  EXPECT_EQ(p.indices, (std::vector<uint32_t>{0, 1, 2, 2, 1, 3, 4, 5, 2}));
+  // All three triangles face +z (counter-clockwise seen from above).
+  for (size_t t = 0; t < 3; ++t) {
+    const auto& a = p.positions[p.indices[3 * t]];
+    const auto& b = p.positions[p.indices[3 * t + 1]];
+    const auto& c = p.positions[p.indices[3 * t + 2]];
+    EXPECT_GT((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]), 0) << t;
+  }
+  // A truncated strip list is an error naming the file.
+  write_text(temp("s2.ply"),
+             "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty "
+             "float y\nproperty float z\n"
+             "element tristrips 1\nproperty list int int vertex_indices\nend_header\n\x01\x02");
+  auto bad = scene::load_scene(temp("s2.ply"));
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("s2.ply"), std::string::npos);
+}
+
 // A glTF with an external .bin: two nodes (TRS parent, child with a matrix) instancing one
 // mesh, a textured material with a sampler, uint16 indices and a normalised uint8 colour.
 TEST(SceneIo, GltfWithExternalBufferNodesAndMaterials) {
