@@ -201,5 +201,37 @@ TEST(CliExtract, RoundTripsEveryLevelExactly) {
   EXPECT_EQ(run("extract " + t.path + " -o " + png).exit_code, 2);  // --level is required
 }
 
+TEST(CliExtract, HalfFloatLayerToExrIsExact) {
+  PageFileDesc desc;
+  desc.geometry = {20, 12, 8, 2};
+  desc.layers = {layer("emissive", 3, TexelType::kF16, PageCodec::kRawZstd)};
+  const PageGeometry& g = desc.geometry;
+  auto levels = random_levels(g, 6, 9);
+  for (auto& level : levels)
+    for (size_t i = 1; i < level.size(); i += 2) level[i] &= 0xBB;  // finite halves only
+  const std::string path = temp_path("half.vtpf");
+  {
+    auto w = PageFileWriter::create(path, desc);
+    ASSERT_TRUE(w.ok());
+    for (uint32_t y = 0; y < g.pages_y(0); ++y)
+      for (uint32_t x = 0; x < g.pages_x(0); ++x) {
+        auto p = cut_page(levels[0], g.level_width(0), g.level_height(0), 6, g, {0, x, y});
+        std::vector<uint8_t> z(ZSTD_compressBound(p.size()));
+        z.resize(ZSTD_compress(z.data(), z.size(), p.data(), p.size(), 1));
+        ASSERT_TRUE((*w)->add_page({0, x, y}, 0, z).ok());
+      }
+    ASSERT_TRUE((*w)->finish().ok());
+  }
+  const std::string exr = temp_path("half.exr");
+  ASSERT_EQ(run("-q extract " + path + " --level 0 -o " + exr).exit_code, 0);
+  auto in = OIIO::ImageInput::open(exr);
+  ASSERT_TRUE(in);
+  ASSERT_EQ(in->spec().format, OIIO::TypeDesc::HALF);
+  ASSERT_EQ(in->spec().nchannels, 3);
+  std::vector<uint8_t> halves(levels[0].size());
+  ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::HALF, halves.data()));
+  EXPECT_EQ(halves, levels[0]);
+}
+
 }  // namespace
 }  // namespace vt
