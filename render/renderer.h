@@ -105,6 +105,7 @@ struct VirtualFrame {
 
 class Renderer {
  public:
+  // `ctx` must outlive the renderer.
   static Expected<std::unique_ptr<Renderer>> create(VulkanContext& ctx,
                                                     const RenderOptions& options);
   ~Renderer();

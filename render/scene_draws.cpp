@@ -64,6 +64,10 @@ Expected<SceneDraws> draws(const scene::Scene& s, UvOf uv_of, bool reference) {
         }
         o.u = uvs ? (*uvs)[v][0] : 0.0f;
         o.v = uvs ? (*uvs)[v][1] : 0.0f;
+        if (!std::isfinite(o.u) || !std::isfinite(o.v)) {
+          return Error(ErrorCode::kCorrupt, where(s, inst.mesh, pi) + ": vertex " +
+                                                std::to_string(v) + " has a non-finite UV");
+        }
         b.add(o.x, o.y, o.z);
       }
       m.indices = p.indices;

@@ -18,9 +18,11 @@
 #include <string>
 #include <vector>
 
+#include "bake/scene/scene.h"
 #include "format/page_file.h"
 #include "render/renderer.h"
 #include "render/report.h"
+#include "render/scene_draws.h"
 #include "render/validate.h"
 #include "render/vulkan_context.h"
 #include "runtime/page_source.h"
@@ -667,6 +669,61 @@ TEST(Report, HeatMapAndDifferenceMap) {
   EXPECT_EQ(d.texels[0], 0);
   EXPECT_EQ(d.texels[4], 24);
   EXPECT_EQ(d.texels[8], 255);
+}
+
+scene::Scene one_triangle_scene() {
+  scene::Scene sc;
+  sc.source_path = "memory.gltf";
+  scene::Primitive p;
+  p.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  p.uvs = {{{0, 0}, {1, 0}, {0, 1}}};
+  p.indices = {0, 1, 2};
+  p.material = 0;
+  scene::Mesh mesh;
+  mesh.name = "tri";
+  mesh.primitives.push_back(p);
+  sc.meshes.push_back(mesh);
+  scene::Material m;
+  m.base_color_factor = {0.5f, 1.0f, 1.0f, 1.0f};
+  m.alpha_mode = scene::AlphaMode::kMask;
+  m.alpha_cutoff = 0.25f;
+  sc.materials.push_back(m);
+  scene::Node node;
+  node.mesh = 0;
+  node.local = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 10, 20, 30, 1};  // translation (10, 20, 30)
+  sc.nodes.push_back(node);
+  sc.roots = {0};
+  return sc;
+}
+
+TEST(SceneDraws, FlattensInstancesAndAppliesTheFactor) {
+  scene::Scene sc = one_triangle_scene();
+  auto virt = virtual_scene_draws(sc);
+  ASSERT_TRUE(virt.ok()) << virt.status().message();
+  ASSERT_EQ(virt->meshes.size(), 1u);
+  EXPECT_EQ(virt->meshes[0].vertices[1].x, 11.0f);
+  EXPECT_EQ(virt->meshes[0].vertices[2].y, 21.0f);
+  EXPECT_EQ(virt->meshes[0].vertices[1].u, 1.0f);
+  EXPECT_EQ(virt->meshes[0].alpha_cutoff, 0.25f);
+  EXPECT_EQ(virt->bounds_min.z, 30.0f);
+  EXPECT_EQ(virt->bounds_max.x, 11.0f);
+  // No atlas UV set 1: the error names the primitive.
+  auto missing = virtual_scene_draws(sc, 1);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.status().message().find("mesh 'tri' primitive 0"), std::string::npos);
+
+  auto ref = reference_scene_draws(sc);
+  ASSERT_TRUE(ref.ok()) << ref.status().message();
+  ASSERT_EQ(ref->textures.size(), 2u);  // the material's and the default material's
+  const std::vector<uint8_t>& t = ref->textures[0].levels[0];
+  ASSERT_EQ(t.size(), 4u);
+  EXPECT_EQ(t[0], 188);  // linear 0.5 stored as sRGB
+  EXPECT_EQ(t[1], 255);
+  EXPECT_EQ(t[3], 255);
+  EXPECT_EQ(ref->meshes[0].reference_texture, 0u);
+
+  sc.meshes[0].primitives[0].uvs[0][1][0] = std::nanf("");
+  EXPECT_EQ(virtual_scene_draws(sc).status().code(), ErrorCode::kCorrupt);
 }
 
 double median_of(std::vector<double> v) {
