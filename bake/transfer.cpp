@@ -2,6 +2,8 @@
 // the triangles that overlap it in index order, so the result does not depend on threads.
 #include "bake/transfer.h"
 
+#include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
 #include <OpenImageIO/texture.h>
 
 #include <unistd.h>
@@ -442,7 +444,6 @@ Status Transfer::setup_images() {
       std::string err = ts_->geterror();
       return Error(ErrorCode::kNotFound, slot.name + ": cannot read image (" + err + ")");
     }
-    slot.handle = ts_->get_texture_handle(name);
     slot.channels = std::min(spec->nchannels, 4);
     std::string cs = spec->get_string_attribute("oiio:ColorSpace");
     std::transform(cs.begin(), cs.end(), cs.begin(),
@@ -451,6 +452,29 @@ Status Transfer::setup_images() {
                     spec->format.basetype == OIIO::TypeDesc::HALF ||
                     spec->format.basetype == OIIO::TypeDesc::DOUBLE;
     slot.linear = is_float || cs == "linear" || cs == "scene_linear" || cs == "lin_srgb";
+    // Optionally, untiled sources get MIP levels made with another filter (as maketx does);
+    // should that fail, OpenImageIO's automatic levels still give a result.
+    bool untiled = false;
+    if (auto in = OIIO::ImageInput::open(path)) untiled = in->spec().tile_width == 0;
+    (void)OIIO::geterror();
+    if (!opt_.mip_filter.empty() && untiled) {
+      static std::atomic<uint64_t> made{0};
+      std::string tx = (scratch / ("vtbake-transfer-" + std::to_string(getpid()) + "-mip" +
+                                   std::to_string(made.fetch_add(1)) + ".tx"))
+                           .string();
+      OIIO::ImageSpec config;
+      config.attribute("maketx:filtername", opt_.mip_filter);
+      config.tile_width = config.tile_height = 64;
+      if (OIIO::ImageBufAlgo::make_texture(OIIO::ImageBufAlgo::MakeTxTexture, path, tx, config)) {
+        temp_files_.push_back(tx);
+        name = OIIO::ustring(tx);
+      } else {
+        (void)OIIO::geterror();
+        std::error_code ec;
+        std::filesystem::remove(tx, ec);
+      }
+    }
+    slot.handle = ts_->get_texture_handle(name);
   }
   return Status::Ok();
 }

@@ -503,3 +503,39 @@ TEST(SceneBake, EmbeddedImagesGiveTheSameTexelsAsFiles) {
 
 }  // namespace
 }  // namespace vt
+
+namespace vt {
+namespace {
+
+TEST(SceneBake, FilteredMipLevelsOptionIsUsedAndAgreesOnSmoothTextures) {
+  test::ScratchDir dir;
+  ASSERT_TRUE(write_texture(dir.file("m.png"), 64, 64, 3, smooth_colour).ok());
+  scene::Material m;
+  scene::Scene s = test::single_mesh_scene(make_grid(1.0f, 1, 1), m);
+  s.materials[0].base_color_texture.image = test::add_image(s, dir.file("m.png"));
+  auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 16});  // reads MIP level 2
+  ASSERT_TRUE(un.ok());
+  TransferOptions to;
+  to.width = uint32_t(un->stats.atlas_width), to.height = uint32_t(un->stats.atlas_height);
+  to.scratch_dir = dir.file("");
+  auto box = transfer_materials(un->scene, to);
+  to.mip_filter = "lanczos3";
+  auto lanczos = transfer_materials(un->scene, to);
+  ASSERT_TRUE(box.ok() && lanczos.ok());
+  // Box and Lanczos levels of a smooth texture differ only slightly.
+  double se = 0;
+  uint64_t n = 0;
+  for (size_t i = 0; i < box->layers[0].texels.size(); ++i) {
+    double d = box->layers[0].texels[i] - lanczos->layers[0].texels[i];
+    se += d * d, ++n;
+  }
+  EXPECT_GT(test::psnr(se, n), 35.0);
+  EXPECT_FALSE(box->layers[0].texels == lanczos->layers[0].texels);  // the .tx was used
+  size_t left = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir.file("")))
+    left += e.path().filename().string().rfind("vtbake-transfer-", 0) == 0;
+  EXPECT_EQ(left, 0u);
+}
+
+}  // namespace
+}  // namespace vt
