@@ -9,6 +9,12 @@
 #include <cmath>
 #include <cstring>
 
+// Keep a * b + c as two roundings in every build: the AVX-512 clone below would otherwise fuse
+// them (FMA) and give different bytes from the baseline build.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC optimize("fp-contract=off")
+#endif
+
 namespace vt {
 namespace {
 
