@@ -1,11 +1,13 @@
 // `vtbake validate SCENE BAKED.vtpf`: renders the baked scene through the virtual-texture path
 // (feedback -> runtime streamer -> physical cache -> page table -> final pass) on Vulkan
-// (lavapipe when no GPU) and the original scene from its own textures, from automatic views,
-// and fails when they differ. The work is render::validate_views (render/validate.h).
+// (lavapipe when no GPU) and the original scene from its own textures, from automatic views or
+// a camera file (render/camera.h), and fails when they differ. The work is render::validate_views
+// (render/validate.h).
 #include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "bake/scene/scene.h"
 #include "cli/command.h"
@@ -30,6 +32,7 @@ struct ValidateFlags {
   std::string out;
   std::string size = "1280x720";
   std::string layer;
+  std::string cameras;  // camera file; excludes --views
   int views = 6;
   double min_psnr = -1;
   double min_tile_psnr = -1;
@@ -55,6 +58,13 @@ int run(const ValidateFlags& f, const vt::cli::GlobalOptions& global) {
   if (std::sscanf(f.size.c_str(), "%ux%u", &width, &height) != 2 || width == 0 || height == 0 ||
       width > 8192 || height > 8192) {
     return fail("--size must be WxH (at most 8192x8192), got '" + f.size + "'", kExitBadInput);
+  }
+  // Before any scene or Vulkan work: a bad camera file is a quick, clear error.
+  std::vector<render::Camera> file_cameras;
+  if (!f.cameras.empty()) {
+    auto cams = render::load_cameras_json(f.cameras, float(width) / float(height));
+    if (!cams.ok()) return fail(cams.status().message(), kExitBadInput);
+    file_cameras = std::move(*cams);
   }
   const std::string unwrapped =
       f.unwrapped.empty() ? std::filesystem::path(f.page_file).replace_extension(".glb").string()
@@ -117,8 +127,10 @@ int run(const ValidateFlags& f, const vt::cli::GlobalOptions& global) {
   if (s.ok()) s = (*renderer)->set_reference_textures(reference->textures);
   if (!s.ok()) return fail(s.message(), code_for(s));
 
-  std::vector<render::Camera> cameras = render::orbit_views(
-      reference->bounds_min, reference->bounds_max, f.views, float(width) / float(height));
+  std::vector<render::Camera> cameras =
+      !file_cameras.empty() ? file_cameras
+                            : render::orbit_views(reference->bounds_min, reference->bounds_max,
+                                                  f.views, float(width) / float(height));
   render::ValidateOptions vopt;
   vopt.layer = uint32_t(layer);
   vopt.address_mode = shared_reader->layers()[layer].address_mode;
@@ -173,8 +185,11 @@ vt::cli::CommandRunner make_validate(CLI::App& app) {
   app.add_option("page_file", f->page_file, "The baked page file (.vtpf)")->required();
   app.add_option("--unwrapped", f->unwrapped,
                  "The unwrapped scene `vtbake bake` wrote (default: PAGE_FILE with .glb)");
-  app.add_option("--views", f->views, "Automatic camera views around the scene")
-      ->check(CLI::Range(1, 64));
+  auto* views = app.add_option("--views", f->views, "Automatic camera views around the scene")
+                    ->check(CLI::Range(1, 64));
+  auto* cameras = app.add_option("--cameras", f->cameras,
+                                 "Camera file (JSON, format below) instead of automatic views");
+  views->excludes(cameras);
   app.add_option("--size", f->size, "Render size WxH");
   app.add_option("--layer", f->layer, "Layer to validate (default: the albedo layer)");
   app.add_option("--min-psnr", f->min_psnr,
@@ -191,6 +206,14 @@ vt::cli::CommandRunner make_validate(CLI::App& app) {
   app.add_flag("--hardware", f->hardware, "Prefer a hardware Vulkan device over lavapipe");
   app.add_option("--out", f->out,
                  "Folder for the PNGs and report.json (default PAGE_FILE.validate)");
+  app.footer(
+      "Camera file (--cameras), in the scene's world units:\n"
+      "  {\"cameras\": [{\"eye\": [0, 6, 8], \"target\": [0, 0, 0], \"up\": [0, 1, 0],\n"
+      "                \"fov_y_deg\": 50, \"near\": 0.1, \"far\": 100}, ...]}\n"
+      "eye and target are required; up defaults to [0, 1, 0], fov_y_deg (vertical, in (0, 180))\n"
+      "to 50, near and far to 1/100 and 100 times the eye-target distance. 1-256 cameras;\n"
+      "unknown keys, non-finite numbers, eye == target and up parallel to the view are errors.\n"
+      "Exit status: 0 every view passes, 1 a view fails its bounds, 2 bad input or no Vulkan.");
   return [f](const vt::cli::GlobalOptions& global) { return run(*f, global); };
 }
 

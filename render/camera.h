@@ -3,7 +3,11 @@
 #pragma once
 
 #include <array>
+#include <string>
+#include <string_view>
 #include <vector>
+
+#include "common/status.h"
 
 namespace vt::render {
 
@@ -32,5 +36,30 @@ struct Camera {
 // Views around an axis-aligned box: a frontal view, close-ups (fine levels), grazing views
 // (anisotropic footprints) and a distant view (coarse levels). Deterministic.
 std::vector<Camera> orbit_views(Vec3 bounds_min, Vec3 bounds_max, int count, float aspect);
+
+// Camera file (`vtbake validate --cameras FILE.json`), in the scene's world units:
+//
+//   {"cameras": [{"eye": [0, 6, 8], "target": [0, 0, 0], "up": [0, 1, 0],
+//                 "fov_y_deg": 50, "near": 0.1, "far": 100}]}
+//
+// "eye" and "target" are required; "up" defaults to [0, 1, 0], "fov_y_deg" (vertical field of
+// view, degrees, in (0, 180)) to 50, "near" to 1/100 and "far" to 100 times the eye-target
+// distance. 1 to 256 cameras. Unknown keys are errors, so a misspelt key is not silently
+// replaced by its default. The aspect ratio comes from the render size.
+struct CameraSpec {
+  Vec3 eye, target, up{0, 1, 0};
+  float fov_y_deg = 50.0f;
+  float z_near = 0, z_far = 0;  // 0 = derived from the eye-target distance
+};
+inline constexpr size_t kMaxFileCameras = 256;
+
+// The camera of a spec, or kInvalidArgument naming the problem (eye == target, up parallel to
+// the view direction, fov outside (0, 180), near <= 0, far <= near, non-finite matrix).
+Expected<Camera> camera_from_spec(const CameraSpec& spec, float aspect);
+// Parses a camera file's text; errors start with `name` (the file name) and the camera index.
+Expected<std::vector<Camera>> parse_cameras_json(std::string_view text, const std::string& name,
+                                                 float aspect);
+// Reads and parses a camera file (at most 1 MiB).
+Expected<std::vector<Camera>> load_cameras_json(const std::string& path, float aspect);
 
 }  // namespace vt::render

@@ -203,6 +203,8 @@ Thresholds scene_thresholds() {
 std::vector<std::string> check_view(const ViewMetrics& m, const Thresholds& t) {
   std::vector<std::string> why;
   char line[160];
+  // Nothing to compare (a camera that looks away from the scene) must not pass as identical.
+  if (m.pixels == 0) why.push_back("no pixel drawn by both renders (the view shows no surface)");
   if (m.unresident_pixels > 0) {
     std::snprintf(line, sizeof(line), "%llu pixels found no resident page",
                   (unsigned long long)m.unresident_pixels);

@@ -86,7 +86,8 @@ Thresholds default_thresholds(RuntimeFormat cache_format);
 // cache, 4 views at 640x360): 34.1-36.3 dB whole view, 24.9-26.6 dB worst tile. Provisional:
 // min_psnr 30 dB, min_tile_psnr 20 dB, until broken real bakes have been measured.
 Thresholds scene_thresholds();
-// Why the view fails (one line per broken bound); empty when it passes.
+// Why the view fails (one line per broken bound, or no compared pixel at all); empty when it
+// passes.
 std::vector<std::string> check_view(const ViewMetrics& metrics, const Thresholds& thresholds);
 
 struct ViewReport {

@@ -1,0 +1,237 @@
+// End-to-end: `vtbake sample-scene` -> `vtbake bake` -> `vtbake validate` through the binary.
+// A correct bake must pass from automatic views and from a camera file; the same bake with its
+// pages shuffled (a wrong page in the index, checksums valid) must fail. Skips without Vulkan.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "format/page_file.h"
+
+namespace vt {
+namespace {
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out;  // stdout and stderr together
+};
+
+RunResult run(const std::string& args) {
+  RunResult r;
+  const std::string command = std::string(VTBAKE_BINARY) + " " + args + " 2>&1";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) return r;
+  char buf[4096];
+  for (size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;) r.out.append(buf, n);
+  const int status = ::pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+bool contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+
+nlohmann::json read_json(const std::string& path) {
+  std::ifstream f(path);
+  return nlohmann::json::parse(f, nullptr, /*allow_exceptions=*/false);
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+// Copies a page file, giving each stored page of `layer` the stored bytes of the next stored
+// page of its level (Morton-free row order, wrapping): every page decodes cleanly and passes
+// its checksum, but shows the wrong part of the texture. rotate = false copies faithfully.
+Status rewrite_page_file(const std::string& in, const std::string& out, uint32_t layer,
+                         bool rotate) {
+  VT_ASSIGN_OR_RETURN(auto reader, PageFileReader::open(in));
+  PageFileDesc desc;
+  desc.geometry = reader->geometry();
+  desc.layers = reader->layers();
+  desc.metadata_json = reader->metadata_json();
+  VT_ASSIGN_OR_RETURN(auto writer, PageFileWriter::create(out, desc));
+  const PageGeometry& g = desc.geometry;
+  for (uint32_t l = 0; l < g.level_count(); ++l) {
+    for (uint32_t li = 0; li < desc.layers.size(); ++li) {
+      std::vector<PageId> stored;
+      for (uint32_t y = 0; y < g.pages_y(l); ++y) {
+        for (uint32_t x = 0; x < g.pages_x(l); ++x) {
+          const PageId id{l, x, y};
+          VT_ASSIGN_OR_RETURN(PageEntry e, reader->entry(id, li));
+          if (e.state == PageState::kConstant) {
+            VT_RETURN_IF_ERROR(writer->add_constant_page(
+                id, li, std::span<const uint8_t>(e.constant, desc.layers[li].texel_bytes())));
+          } else if (e.state == PageState::kStored) {
+            stored.push_back(id);
+          }
+        }
+      }
+      for (size_t i = 0; i < stored.size(); ++i) {
+        const PageId from = rotate && li == layer ? stored[(i + 1) % stored.size()] : stored[i];
+        VT_ASSIGN_OR_RETURN(auto bytes, reader->read_stored(from, li));
+        VT_RETURN_IF_ERROR(writer->add_page(stored[i], li, bytes));
+      }
+    }
+  }
+  return writer->finish();
+}
+
+class ValidateCli : public ::testing::Test {
+ protected:
+  // One scene and one bake for the whole suite: baking is the slow part.
+  static void SetUpTestSuite() {
+    dir_ =
+        (std::filesystem::temp_directory_path() / ("vt_validate_cli_" + std::to_string(::getpid())))
+            .string();
+    std::filesystem::remove_all(dir_);
+    RunResult s = run("sample-scene " + dir_ +
+                      " --ground-cells 4 --sphere-segments 12 --texture-size 64 --quiet");
+    setup_error_ = s.exit_code == 0 ? "" : "sample-scene failed: " + s.out;
+    if (!setup_error_.empty()) return;
+    RunResult b = run("bake " + dir_ + "/scene.gltf -o " + dir_ +
+                      "/bake.vtpf --size 4 --supersample 1 --quiet");
+    if (b.exit_code != 0) setup_error_ = "bake failed: " + b.out;
+  }
+  static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
+
+  void SetUp() override { ASSERT_TRUE(setup_error_.empty()) << setup_error_; }
+
+  // Runs validate; true when the test must skip (no Vulkan device on this machine).
+  static bool no_vulkan(const RunResult& r) {
+    return r.exit_code == 2 && (contains(r.out, "Vulkan") || contains(r.out, "vulkan"));
+  }
+
+  static std::string dir_;
+  static std::string setup_error_;
+};
+std::string ValidateCli::dir_;
+std::string ValidateCli::setup_error_;
+
+// Looks down at the ground (12 x 12 at y = 0) from above the front edge: level 0 and 1 pages.
+const char* kGroundCamera =
+    R"({"cameras":[{"eye":[0,5,7],"target":[0,0,0],"fov_y_deg":50,"near":0.5,"far":40}]})";
+
+TEST_F(ValidateCli, BakedSampleScenePassesFromAutomaticViews) {
+  const std::string out = dir_ + "/auto";
+  RunResult r = run("validate " + dir_ + "/scene.gltf " + dir_ +
+                    "/bake.vtpf --views 2 --size 320x180 --out " + out);
+  if (no_vulkan(r)) GTEST_SKIP() << "no Vulkan device: " << r.out;
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_TRUE(contains(r.out, "PASS")) << r.out;
+  nlohmann::json report = read_json(out + "/report.json");
+  ASSERT_TRUE(report.is_object());
+  EXPECT_EQ(report["passed"], true);
+  EXPECT_EQ(report["width"], 320);
+  EXPECT_EQ(report["height"], 180);
+  ASSERT_EQ(report["views"].size(), 2u);
+  for (const auto& v : report["views"]) {
+    EXPECT_EQ(v["passed"], true) << v.dump();
+    EXPECT_EQ(v["converged"], true);
+    EXPECT_GT(v["pixels_compared"].get<uint64_t>(), 320u * 180u / 10) << v.dump();
+    EXPECT_GE(v["psnr_rgb"].get<double>(), report["thresholds"]["min_psnr"].get<double>());
+    EXPECT_GT(v["pages_uploaded"].get<uint64_t>(), 0u);
+    for (const auto& image : v["images"]) {
+      EXPECT_TRUE(std::filesystem::exists(image.get<std::string>())) << image;
+    }
+  }
+}
+
+TEST_F(ValidateCli, CameraFileViewPassesAndAShuffledBakeFails) {
+  const std::string cams = dir_ + "/ground_camera.json";
+  write_text(cams, kGroundCamera);
+  const std::string scene = dir_ + "/scene.gltf", glb = dir_ + "/bake.glb";
+  const std::string args = " --cameras " + cams + " --size 320x180 --unwrapped " + glb;
+
+  RunResult good =
+      run("validate " + scene + " " + dir_ + "/bake.vtpf" + args + " --out " + dir_ + "/cam_good");
+  if (no_vulkan(good)) GTEST_SKIP() << "no Vulkan device: " << good.out;
+  ASSERT_EQ(good.exit_code, 0) << good.out;
+  nlohmann::json report = read_json(dir_ + "/cam_good/report.json");
+  ASSERT_EQ(report["views"].size(), 1u);  // the file's one camera, not the 6 automatic views
+  EXPECT_GT(report["views"][0]["pixels_compared"].get<uint64_t>(), 320u * 180u / 2);
+
+  // Which layer the renderer validates: the albedo one.
+  auto reader = PageFileReader::open(dir_ + "/bake.vtpf");
+  ASSERT_TRUE(reader.ok()) << reader.status().message();
+  uint32_t albedo = 0;
+  while (albedo < (*reader)->layers().size() &&
+         (*reader)->layers()[albedo].semantic != LayerSemantic::kAlbedo) {
+    ++albedo;
+  }
+  ASSERT_LT(albedo, (*reader)->layers().size());
+
+  // Control: a faithful rewrite passes too, so the failure below comes from the shuffle.
+  const std::string copy = dir_ + "/copy.vtpf", shuffled = dir_ + "/shuffled.vtpf";
+  Status s = rewrite_page_file(dir_ + "/bake.vtpf", copy, albedo, /*rotate=*/false);
+  ASSERT_TRUE(s.ok()) << s.message();
+  RunResult same = run("validate " + scene + " " + copy + args + " --out " + dir_ + "/cam_copy");
+  EXPECT_EQ(same.exit_code, 0) << same.out;
+
+  s = rewrite_page_file(dir_ + "/bake.vtpf", shuffled, albedo, /*rotate=*/true);
+  ASSERT_TRUE(s.ok()) << s.message();
+  ASSERT_EQ(run("verify " + shuffled + " --quiet").exit_code, 0);  // checksums still valid
+  RunResult bad =
+      run("validate " + scene + " " + shuffled + args + " --out " + dir_ + "/cam_shuffled");
+  EXPECT_EQ(bad.exit_code, 1) << bad.out;
+  EXPECT_TRUE(contains(bad.out, "FAIL")) << bad.out;
+  report = read_json(dir_ + "/cam_shuffled/report.json");
+  ASSERT_EQ(report["views"].size(), 1u);
+  EXPECT_EQ(report["passed"], false);
+  EXPECT_EQ(report["views"][0]["passed"], false);
+  EXPECT_LT(report["views"][0]["worst_tile_psnr"].get<double>(),
+            report["thresholds"]["min_tile_psnr"].get<double>());
+}
+
+TEST_F(ValidateCli, CameraLookingAwayFromTheSceneFails) {
+  const std::string cams = dir_ + "/away.json";
+  write_text(cams, R"({"cameras":[{"eye":[0,5,7],"target":[0,10,14]}]})");
+  RunResult r = run("validate " + dir_ + "/scene.gltf " + dir_ + "/bake.vtpf --cameras " + cams +
+                    " --size 64x36 --out " + dir_ + "/away");
+  if (no_vulkan(r)) GTEST_SKIP() << "no Vulkan device: " << r.out;
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_TRUE(contains(r.out, "no pixel drawn by both renders")) << r.out;
+}
+
+// These fail before any scene, page file or Vulkan work, so they run everywhere.
+TEST(ValidateCliArgs, BadCameraFilesAreBadInputNamingTheFile) {
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / ("vt_validate_args_" + std::to_string(::getpid())))
+          .string();
+  std::filesystem::create_directories(dir);
+  const std::string cams = dir + "/cams.json";
+  write_text(cams, R"({"cameras":[{"eye":[1,2,3],"target":[1,2,3]}]})");
+  RunResult r = run("validate none.gltf none.vtpf --cameras " + cams);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(contains(r.out, cams + ": camera 0: eye and target coincide")) << r.out;
+
+  write_text(cams, R"({"cameras":[{"eye":[1,2,3]}]})");
+  r = run("validate none.gltf none.vtpf --cameras " + cams);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(contains(r.out, cams + ": camera 0: missing \"target\"")) << r.out;
+
+  r = run("validate none.gltf none.vtpf --cameras " + dir + "/nope.json");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(contains(r.out, dir + "/nope.json: cannot open camera file")) << r.out;
+
+  // --views and --cameras exclude each other.
+  write_text(cams, kGroundCamera);
+  r = run("validate none.gltf none.vtpf --views 2 --cameras " + cams);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(contains(r.out, "excludes")) << r.out;
+
+  r = run("validate --help");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_TRUE(contains(r.out, "\"fov_y_deg\"")) << r.out;
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace vt
