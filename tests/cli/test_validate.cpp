@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -100,7 +101,10 @@ class ValidateCli : public ::testing::Test {
                       "/bake.vtpf --size 4 --supersample 1 --quiet");
     if (b.exit_code != 0) setup_error_ = "bake failed: " + b.out;
   }
-  static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
+  // VTBAKE_KEEP_TEST_OUTPUT=1 keeps the scene, bakes, images and reports for inspection.
+  static void TearDownTestSuite() {
+    if (!std::getenv("VTBAKE_KEEP_TEST_OUTPUT")) std::filesystem::remove_all(dir_);
+  }
 
   void SetUp() override { ASSERT_TRUE(setup_error_.empty()) << setup_error_; }
 

@@ -157,6 +157,39 @@ TEST(CameraFile, RejectsEveryMalformedCameraWithTheFileTheCameraAndTheProblem) {
   }
 }
 
+// Hostile input: byte mutations of a valid file give either cameras with finite matrices or an
+// error naming the file, never a crash or a NaN.
+TEST(CameraFile, MutatedFilesGiveFiniteCamerasOrErrors) {
+  const std::string base =
+      R"({"cameras":[{"eye":[0,6,8],"target":[0,0,0],"up":[0,1,0],"fov_y_deg":50,)"
+      R"("near":0.1,"far":100},{"eye":[-2.5e3,1,0.5],"target":[1,2,3]}]})";
+  const char kBytes[] = "0123456789.-+eE[]{},:\"x ";
+  uint64_t state = 0x9E3779B97F4A7C15ull;
+  auto next = [&] {
+    state ^= state << 13, state ^= state >> 7, state ^= state << 17;
+    return state;
+  };
+  int parsed = 0;
+  for (int i = 0; i < 3000; ++i) {
+    std::string text = base;
+    for (int k = 0, n = 1 + int(next() % 3); k < n; ++k) {
+      text[next() % text.size()] = kBytes[next() % (sizeof(kBytes) - 1)];
+    }
+    auto r = parse_cameras_json(text, "m.json", kAspect);
+    if (!r.ok()) {
+      EXPECT_EQ(r.status().message().rfind("m.json: ", 0), 0u) << r.status().message();
+      continue;
+    }
+    ++parsed;
+    for (const Camera& c : *r) {
+      for (float v : c.view_proj.m) ASSERT_TRUE(std::isfinite(v)) << text;
+    }
+  }
+  // Mutations that only change a digit still parse: the loop exercises both outcomes.
+  EXPECT_GT(parsed, 100);
+  EXPECT_LT(parsed, 3000);
+}
+
 TEST(CameraFile, LimitsTheNumberOfCameras) {
   std::string body;
   for (size_t i = 0; i < kMaxFileCameras; ++i) {
