@@ -9,6 +9,7 @@
 #include <string>
 
 #include "render/camera.h"
+#include "render/validate.h"
 
 namespace vt::render {
 namespace {
@@ -236,6 +237,19 @@ TEST(CameraFile, LoadsFromDiskAndNamesTheFileInErrors) {
   auto directory = load_cameras_json(dir.string(), kAspect);
   EXPECT_FALSE(directory.ok());
   std::filesystem::remove_all(dir);
+}
+
+// A camera file can point a view at nothing: such a view must fail, not pass as identical.
+TEST(CameraFile, ViewWithNoComparedPixelFails) {
+  ViewMetrics m;
+  m.pixels = 0;
+  m.psnr_rgb = m.worst_tile_psnr = 100;  // what compare_view reports for an empty comparison
+  m.ssim = 1;
+  const auto why = check_view(m, scene_thresholds());
+  ASSERT_EQ(why.size(), 1u);
+  EXPECT_TRUE(contains(why[0], "no pixel drawn by both renders")) << why[0];
+  m.pixels = 1;
+  EXPECT_TRUE(check_view(m, scene_thresholds()).empty());
 }
 
 }  // namespace
