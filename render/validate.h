@@ -66,7 +66,7 @@ struct ViewMetrics {
 
 Expected<ViewMetrics> compare_view(const ReferenceFrame& reference, const VirtualFrame& frame);
 
-// Pass/fail bounds of one view. Measured on the synthetic bake (docs/bench/render.md): correct
+// Pass/fail bounds of one view. Measured on the synthetic bake (docs/BENCHMARKS.md): correct
 // bakes score >= 55 dB whole view and per tile with an uncompressed cache, >= 35.6 / 34.1 dB
 // with BC1; zeroed borders, a wrong page, an off-by-one table level or swapped channels sink
 // the worst tile to <= 28.3 dB.

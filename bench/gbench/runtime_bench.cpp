@@ -1,4 +1,4 @@
-// Runtime benchmarks (docs/bench/runtime.md): pages per second from page file to BC-ready
+// Runtime benchmarks (docs/BENCHMARKS.md): pages per second from page file to BC-ready
 // upload buffer (1 and 2 loader threads, per stored codec), feedback resolve time for a
 // 1920x1080 buffer, and page-table update time per mapped page.
 //

@@ -731,7 +731,7 @@ double median_of(std::vector<double> v) {
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
-// Figures for docs/bench/render.md, not a test (no assertion on time): run with
+// Figures for docs/BENCHMARKS.md, not a test (no assertion on time): run with
 //   vt_render_tests --gtest_also_run_disabled_tests --gtest_filter='*Bench*'
 // 1280x720, feedback at 320x180, the synthetic bake, per view: medians of 9 passes after warm-up.
 TEST(DISABLED_RenderBench, FrameTimes1280x720) {

@@ -303,7 +303,7 @@ TEST(Streamer, UpdateReturnsWhileLoadsAreStillRunning) {
 }
 
 // 8 threads hammer one streamer with random frames, prefetches, evictions and upload takes
-// while the loader's workers run: 1M operations in all. Run under TSan (see docs/bench).
+// while the loader's workers run: 1M operations in all. Run under TSan (see docs/BENCHMARKS.md).
 TEST(Streamer, EightThreadTorture) {
   auto src = std::make_shared<FakeSource>(PageGeometry{64, 64, 4, 2}, 1);  // 16x16 pages of 8²
   auto s = make_streamer(src, 6, 6, 3, 0, 12);
