@@ -7,6 +7,7 @@
 #include <string>
 
 #include "bake/scene_bake.h"
+#include "cli/cli_util.h"
 #include "cli/command.h"
 
 namespace {
@@ -26,55 +27,12 @@ struct BakeFlags {
   int supersample = 1;
   std::string codec = "dct";
   bool share_instances = false;
-  std::string memory_limit_gib = "8";
+  std::string memory_limit = "8G";
 };
 
 int bad(const std::string& msg) {
   std::fprintf(stderr, "vtbake bake: %s\n", msg.c_str());
   return kExitBadInput;
-}
-
-int exit_code_for(const vt::Status& s) {
-  switch (s.code()) {
-    case vt::ErrorCode::kInvalidArgument:
-    case vt::ErrorCode::kNotFound:
-    case vt::ErrorCode::kCorrupt:
-    case vt::ErrorCode::kUnsupported:
-      return kExitBadInput;
-    default:
-      return kExitFailure;
-  }
-}
-
-// dct, dct:Q (1..100), bc, bc:high, raw.
-bool parse_codec(const std::string& s, vt::PageEncoderOptions* o) {
-  std::string kind = s.substr(0, s.find(':'));
-  std::string arg = s.find(':') == std::string::npos ? "" : s.substr(s.find(':') + 1);
-  if (kind == "dct") {
-    o->codec = vt::CodecKind::kDct;
-    if (!arg.empty()) {
-      char* end = nullptr;
-      long q = std::strtol(arg.c_str(), &end, 10);
-      if (*end || q < 1 || q > 100) return false;
-      o->dct_quality = int(q);
-    }
-    return true;
-  }
-  if (kind == "bc") {
-    o->codec = vt::CodecKind::kBc;
-    if (arg == "high")
-      o->bc_quality = vt::BcQuality::kHigh;
-    else if (arg == "fast")
-      o->bc_quality = vt::BcQuality::kRealtime;
-    else if (!arg.empty())
-      return false;
-    return true;
-  }
-  if (kind == "raw" && arg.empty()) {
-    o->codec = vt::CodecKind::kRaw;
-    return true;
-  }
-  return false;
 }
 
 // One redrawn line on stderr: stage, its fraction, elapsed time.
@@ -152,7 +110,7 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
   app.add_option("--codec", f->codec, "Page codec: dct[:QUALITY], bc[:high|fast] or raw");
   app.add_flag("--share-instances", f->share_instances,
                "Instances of one mesh share texels (default: each gets its own)");
-  app.add_option("--memory-limit", f->memory_limit_gib, "Memory budget in GiB");
+  app.add_option("--memory-limit", f->memory_limit, "Memory budget, e.g. 512M, 8G (default 8G)");
   return [f](const vt::cli::GlobalOptions& global) -> int {
     vt::SceneBakeOptions o;
     o.output = f->output;
@@ -163,21 +121,16 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
     o.unwrap.method = f->method == "arap" ? vt::unwrap::Method::kArap : vt::unwrap::Method::kLscm;
     o.unwrap.share_instances = f->share_instances;
     o.supersample = f->supersample;
-    if (!parse_codec(f->codec, &o.codec))
-      return bad("--codec: expected dct[:1-100], bc[:high|fast] or raw, got '" + f->codec + "'");
-    char* end = nullptr;
-    double gib = std::strtod(f->memory_limit_gib.c_str(), &end);
-    if (*end || !(gib > 0)) return bad("--memory-limit: expected a positive number of GiB");
-    o.memory_limit = uint64_t(gib * double(uint64_t(1) << 30));
+    if (vt::Status st = vt::cli::parse_codec(f->codec, &o.codec); !st.ok())
+      return bad(st.message());
+    if (vt::Status st = vt::cli::parse_byte_size(f->memory_limit, &o.memory_limit); !st.ok())
+      return bad("--memory-limit: " + st.message());
     o.threads = global.threads;
     Progress progress(!global.quiet);
     o.progress = [&](const vt::SceneBakeProgress& p) { progress.update(p); };
     auto summary = vt::bake_scene(f->scene, o);
     progress.done();
-    if (!summary.ok()) {
-      std::fprintf(stderr, "vtbake bake: %s\n", summary.status().message().c_str());
-      return exit_code_for(summary.status());
-    }
+    if (!summary.ok()) return vt::cli::report_error("bake", summary.status());
     if (global.json) {
       std::printf("%s\n", vt::summary_json(*summary).c_str());
     } else {

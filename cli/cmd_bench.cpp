@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bench/registry.h"
+#include "cli/cli_util.h"
 #include "cli/command.h"
 
 namespace {
@@ -29,7 +30,7 @@ vt::cli::CommandRunner make_bench(CLI::App& app) {
     }
     sub->add_option("inputs", a.inputs, kind.inputs_help);
   }
-  return [&app, args](const vt::cli::GlobalOptions& global) {
+  return [&app, args](const vt::cli::GlobalOptions& global) -> int {
     for (CLI::App* sub : app.get_subcommands()) {
       for (const vt::bench::BenchKind& kind : vt::bench::bench_kinds()) {
         if (kind.name != sub->get_name()) continue;
@@ -44,13 +45,7 @@ vt::cli::CommandRunner make_bench(CLI::App& app) {
         }
         auto report = kind.run(request);
         if (!report.ok()) {
-          std::fprintf(stderr, "vtbake bench %s: %s\n", kind.name.c_str(),
-                       report.status().message().c_str());
-          const vt::ErrorCode code = report.status().code();
-          const bool bad_input = code == vt::ErrorCode::kInvalidArgument ||
-                                 code == vt::ErrorCode::kIo || code == vt::ErrorCode::kNotFound ||
-                                 code == vt::ErrorCode::kCorrupt;
-          return bad_input ? vt::cli::kExitBadInput : vt::cli::kExitFailure;
+          return vt::cli::report_error(("bench " + kind.name).c_str(), report.status());
         }
         std::fputs(global.json ? report->json.c_str() : report->text.c_str(), stdout);
         return vt::cli::kExitOk;

@@ -10,6 +10,7 @@
 
 #include "bake/build.h"
 #include "bake/procedural.h"
+#include "cli/cli_util.h"
 #include "cli/command.h"
 
 namespace {
@@ -34,24 +35,6 @@ struct BuildFlags {
   float alpha_coverage = 0;
 };
 
-bool parse_size(const std::string& s, uint64_t* out) {
-  char* end = nullptr;
-  double v = std::strtod(s.c_str(), &end);
-  if (end == s.c_str() || !(v > 0)) return false;
-  std::string unit(end);
-  double mul = 1;
-  if (unit == "K" || unit == "k" || unit == "KiB")
-    mul = 1024.0;
-  else if (unit == "M" || unit == "m" || unit == "MiB")
-    mul = 1024.0 * 1024;
-  else if (unit == "G" || unit == "g" || unit == "GiB")
-    mul = 1024.0 * 1024 * 1024;
-  else if (!unit.empty())
-    return false;
-  *out = uint64_t(v * mul);
-  return true;
-}
-
 bool parse_semantic(const std::string& s, vt::LayerSemantic* sem) {
   static const std::pair<const char*, vt::LayerSemantic> kNames[] = {
       {"albedo", vt::LayerSemantic::kAlbedo},
@@ -71,18 +54,6 @@ bool parse_semantic(const std::string& s, vt::LayerSemantic* sem) {
 int bad(const std::string& msg) {
   std::fprintf(stderr, "vtbake build: %s\n", msg.c_str());
   return kExitBadInput;
-}
-
-int exit_code_for(const vt::Status& s) {
-  switch (s.code()) {
-    case vt::ErrorCode::kInvalidArgument:
-    case vt::ErrorCode::kNotFound:
-    case vt::ErrorCode::kCorrupt:
-    case vt::ErrorCode::kUnsupported:
-      return kExitBadInput;
-    default:
-      return kExitFailure;
-  }
 }
 
 // One line on a terminal, redrawn at most 5 times a second: stage, pages, rate and ETA.
@@ -205,27 +176,7 @@ int run_build(const BuildFlags& f, const vt::cli::GlobalOptions& global) {
   o.threads = global.threads;
   o.scratch_dir = f.scratch_dir;
   o.alpha_coverage_reference = f.alpha_coverage;
-  // --codec dct[:QUALITY] | bc | raw
-  std::string codec = f.codec, quality;
-  if (auto colon = codec.find(':'); colon != std::string::npos) {
-    quality = codec.substr(colon + 1);
-    codec = codec.substr(0, colon);
-  }
-  if (codec == "dct") {
-    o.codec.codec = vt::CodecKind::kDct;
-    if (!quality.empty()) {
-      char* end = nullptr;
-      long q = std::strtol(quality.c_str(), &end, 10);
-      if (*end != '\0' || q < 1 || q > 100) return bad("--codec dct:QUALITY needs 1..100");
-      o.codec.dct_quality = int(q);
-    }
-  } else if (codec == "bc" && quality.empty()) {
-    o.codec.codec = vt::CodecKind::kBc;
-  } else if (codec == "raw" && quality.empty()) {
-    o.codec.codec = vt::CodecKind::kRaw;
-  } else {
-    return bad("unknown --codec '" + f.codec + "' (expected dct[:QUALITY], bc or raw)");
-  }
+  if (vt::Status st = vt::cli::parse_codec(f.codec, &o.codec); !st.ok()) return bad(st.message());
   auto filter = vt::parse_mip_filter(f.filter.c_str());
   if (!filter.ok()) return bad(filter.status().message());
   o.filter = *filter;
@@ -236,8 +187,8 @@ int run_build(const BuildFlags& f, const vt::cli::GlobalOptions& global) {
   } else {
     return bad("unknown --address '" + f.address + "' (expected clamp or wrap)");
   }
-  if (!parse_size(f.memory_limit, &o.memory_limit)) {
-    return bad("bad --memory-limit '" + f.memory_limit + "' (e.g. 512M, 2G)");
+  if (vt::Status st = vt::cli::parse_byte_size(f.memory_limit, &o.memory_limit); !st.ok()) {
+    return bad("--memory-limit: " + st.message());
   }
   auto policy = vt::parse_non_finite_policy(f.fix_nonfinite);
   if (!policy.ok()) return bad(policy.status().message());
@@ -294,10 +245,7 @@ int run_build(const BuildFlags& f, const vt::cli::GlobalOptions& global) {
   auto summary = vt::build_page_file(o);
   line.done();
   double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!summary.ok()) {
-    std::fprintf(stderr, "vtbake build: %s\n", summary.status().message().c_str());
-    return exit_code_for(summary.status());
-  }
+  if (!summary.ok()) return vt::cli::report_error("build", summary.status());
   if (global.json) {
     std::printf("%s\n", summary_json(o, *summary, wall).dump(2).c_str());
   } else if (!global.quiet) {
@@ -314,7 +262,8 @@ vt::cli::CommandRunner make_build(CLI::App& sub) {
   sub.add_option("-o,--output", f->output, "Output page file (.vtpf)")->required();
   sub.add_option("--layer", f->layers,
                  "A layer NAME=PATH; NAME albedo, normal, orm, emissive or any custom name");
-  sub.add_option("--codec", f->codec, "dct[:QUALITY] (default, quality 75), bc or raw (lossless)");
+  sub.add_option("--codec", f->codec,
+                 "dct[:QUALITY] (default, quality 75), bc[:high|fast] or raw (lossless)");
   sub.add_option("--payload", f->payload, "Payload texels per page side")->capture_default_str();
   sub.add_option("--border", f->border, "Border texels per page side")->capture_default_str();
   sub.add_option("--filter", f->filter, "Mip filter: kaiser, box or lanczos3")

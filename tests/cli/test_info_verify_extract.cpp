@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "format/page_file.h"
+#include "tests/cli/cli_test_util.h"
 #include "tests/format/page_file_test_util.h"
 
 namespace vt {
@@ -15,21 +16,9 @@ namespace {
 
 using namespace vt::testing;
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out;
-};
-
+using vt::testing::RunResult;
 RunResult run(const std::string& args) {
-  RunResult r;
-  const std::string command = std::string(VTBAKE_BINARY) + " " + args + " 2>/dev/null";
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return r;
-  char buf[4096];
-  for (size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;) r.out.append(buf, n);
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return vt::testing::run_vtbake(args, false);
 }
 
 // A two-layer file with every page of every level cut from known level images; level 1 of

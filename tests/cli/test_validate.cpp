@@ -14,25 +14,14 @@
 #include <vector>
 
 #include "format/page_file.h"
+#include "tests/cli/cli_test_util.h"
 
 namespace vt {
 namespace {
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out;  // stdout and stderr together
-};
-
+using vt::testing::RunResult;
 RunResult run(const std::string& args) {
-  RunResult r;
-  const std::string command = std::string(VTBAKE_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return r;
-  char buf[4096];
-  for (size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;) r.out.append(buf, n);
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return vt::testing::run_vtbake(args, true);
 }
 
 bool contains(const std::string& s, const std::string& part) {

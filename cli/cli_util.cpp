@@ -1,0 +1,81 @@
+#include "cli/cli_util.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "cli/command.h"
+
+namespace vt::cli {
+
+int exit_code_for(const Status& status) {
+  switch (status.code()) {
+    case ErrorCode::kInvalidArgument:
+    case ErrorCode::kNotFound:
+    case ErrorCode::kCorrupt:
+    case ErrorCode::kUnsupported:
+      return kExitBadInput;
+    default:
+      return kExitFailure;
+  }
+}
+
+int report_error(const char* command, const Status& status) {
+  std::fprintf(stderr, "vtbake %s: %s\n", command, status.message().c_str());
+  return exit_code_for(status);
+}
+
+Status parse_codec(const std::string& text, PageEncoderOptions* options) {
+  const size_t colon = text.find(':');
+  const std::string kind = text.substr(0, colon);
+  const std::string arg = colon == std::string::npos ? "" : text.substr(colon + 1);
+  const Status bad =
+      Error(ErrorCode::kInvalidArgument,
+            "--codec: expected dct[:1-100], bc[:high|fast] or raw, got '" + text + "'");
+  if (kind == "dct") {
+    options->codec = CodecKind::kDct;
+    if (colon != std::string::npos) {
+      char* end = nullptr;
+      long quality = std::strtol(arg.c_str(), &end, 10);
+      if (arg.empty() || *end || quality < 1 || quality > 100) return bad;
+      options->dct_quality = int(quality);
+    }
+    return Status::Ok();
+  }
+  if (kind == "bc") {
+    options->codec = CodecKind::kBc;
+    if (arg == "high") {
+      options->bc_quality = BcQuality::kHigh;
+    } else if (arg == "fast") {
+      options->bc_quality = BcQuality::kRealtime;
+    } else if (colon != std::string::npos) {
+      return bad;
+    }
+    return Status::Ok();
+  }
+  if (kind == "raw" && colon == std::string::npos) {
+    options->codec = CodecKind::kRaw;
+    return Status::Ok();
+  }
+  return bad;
+}
+
+Status parse_byte_size(const std::string& text, uint64_t* bytes) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  const std::string unit(end);
+  double scale = 0;
+  if (unit.empty()) scale = 1;
+  if (unit == "K" || unit == "k" || unit == "KiB") scale = 1024.0;
+  if (unit == "M" || unit == "m" || unit == "MiB") scale = 1024.0 * 1024;
+  if (unit == "G" || unit == "g" || unit == "GiB") scale = 1024.0 * 1024 * 1024;
+  // 2^62 bytes bounds the conversion so that huge inputs give an error, not an overflow.
+  if (end == text.c_str() || !(value > 0) || scale == 0 || !(value * scale < 0x1p62)) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "expected a size such as 512M or 2G, got '" + text + "'");
+  }
+  *bytes = uint64_t(value * scale);
+  return Status::Ok();
+}
+
+}  // namespace vt::cli
