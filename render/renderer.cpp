@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "render/shaders.h"
+#include "runtime/page_source.h"
 
 namespace vt::render {
 namespace {
@@ -89,24 +90,8 @@ VkFormat cache_vk_format(RuntimeFormat f) {
 }
 
 size_t cache_page_bytes(RuntimeFormat f, uint32_t page_size) {
-  size_t texels = size_t(page_size) * page_size;
-  switch (f) {
-    case RuntimeFormat::kRgba8:
-      return texels * 4;
-    case RuntimeFormat::kR8:
-      return texels;
-    case RuntimeFormat::kRg8:
-      return texels * 2;
-    case RuntimeFormat::kBc1:
-    case RuntimeFormat::kBc4:
-      return texels / 2;
-    case RuntimeFormat::kBc3:
-    case RuntimeFormat::kBc5:
-    case RuntimeFormat::kBc7:
-      return texels;
-    default:
-      return 0;
-  }
+  if (cache_vk_format(f) == VK_FORMAT_UNDEFINED) return 0;
+  return runtime_format_page_bytes(f, page_size);
 }
 
 struct Renderer::Impl {
@@ -712,6 +697,22 @@ Status Renderer::upload_page_table(const PageTableLevels& table) {
   });
 }
 
+namespace {
+
+// Pushes the constants of one mesh and draws it.
+template <typename Mesh>
+void draw_mesh(VkCommandBuffer cmd, VkPipelineLayout layout, const Push& p, const Mesh& m) {
+  vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                     sizeof(p), &p);
+  VkDeviceSize offset = 0;
+  VkBuffer vb = m.vertices.handle();
+  vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
+  vkCmdBindIndexBuffer(cmd, m.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
+  vkCmdDrawIndexed(cmd, m.index_count, 1, 0, 0, 0);
+}
+
+}  // namespace
+
 Expected<ReferenceFrame> Renderer::render_reference(const Camera& camera) {
   Impl& s = *impl_;
   for (const auto& m : s.reference_meshes()) {
@@ -740,14 +741,7 @@ Expected<ReferenceFrame> Renderer::render_reference(const Camera& camera) {
       p.tex[3] = m.alpha_cutoff;
       p.misc[1] = t.mode == AddressMode::kWrap ? 1 : 0;
       p.misc[2] = int32_t(t.max_level);
-      vkCmdPushConstants(cmd, s.ref_layout,
-                         VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(p),
-                         &p);
-      VkDeviceSize offset = 0;
-      VkBuffer vb = m.vertices.handle();
-      vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
-      vkCmdBindIndexBuffer(cmd, m.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
-      vkCmdDrawIndexed(cmd, m.index_count, 1, 0, 0, 0);
+      draw_mesh(cmd, s.ref_layout, p, m);
     }
     s.end_pass(cmd, targets, readbacks, w, h);
   }));
@@ -801,14 +795,7 @@ Expected<FeedbackImage> Renderer::render_feedback(const Camera& camera, uint32_t
       p.tex[2] = float(w) / float(options_.width);
       p.tex[3] = -1.0f;
       p.misc[0] = int32_t(frame & 3);
-      vkCmdPushConstants(cmd, s.fb_layout,
-                         VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(p),
-                         &p);
-      VkDeviceSize offset = 0;
-      VkBuffer vb = m.vertices.handle();
-      vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
-      vkCmdBindIndexBuffer(cmd, m.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
-      vkCmdDrawIndexed(cmd, m.index_count, 1, 0, 0, 0);
+      draw_mesh(cmd, s.fb_layout, p, m);
     }
     s.end_pass(cmd, targets, readbacks, w, h);
   }));
@@ -838,14 +825,7 @@ Expected<VirtualFrame> Renderer::render_virtual(const Camera& camera) {
       fill_vt_push(p, s.vt);
       p.tex[2] = 1.0f;
       p.tex[3] = m.alpha_cutoff;
-      vkCmdPushConstants(cmd, s.vt_layout,
-                         VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(p),
-                         &p);
-      VkDeviceSize offset = 0;
-      VkBuffer vb = m.vertices.handle();
-      vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
-      vkCmdBindIndexBuffer(cmd, m.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
-      vkCmdDrawIndexed(cmd, m.index_count, 1, 0, 0, 0);
+      draw_mesh(cmd, s.vt_layout, p, m);
     }
     s.end_pass(cmd, targets, readbacks, w, h);
   }));
