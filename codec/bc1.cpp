@@ -293,14 +293,17 @@ constexpr int kLanes = 16;
 #endif
 
 VT_BC1_CLONES
-void encode_realtime_lanes(const uint8_t* rgba, uint16_t c0_out[kLanes], uint16_t c1_out[kLanes],
-                           uint32_t bits_out[kLanes], bool constant_out[kLanes]) {
-  float r[16][kLanes], g[16][kLanes], b[16][kLanes];
+void encode_realtime_lanes(const uint32_t (&texels)[16][kLanes], uint16_t c0_out[kLanes],
+                           uint16_t c1_out[kLanes], uint32_t bits_out[kLanes],
+                           bool constant_out[kLanes]) {
+  float r[16][kLanes], g[16][kLanes], b[16][kLanes], xx[16][kLanes];
   for (int i = 0; i < 16; ++i) {
     for (int l = 0; l < kLanes; ++l) {
-      r[i][l] = float(rgba[l * 64 + 4 * i]);
-      g[i][l] = float(rgba[l * 64 + 4 * i + 1]);
-      b[i][l] = float(rgba[l * 64 + 4 * i + 2]);
+      const uint32_t w = texels[i][l];
+      r[i][l] = float(int(w & 255u));
+      g[i][l] = float(int((w >> 8) & 255u));
+      b[i][l] = float(int((w >> 16) & 255u));
+      xx[i][l] = r[i][l] * r[i][l] + g[i][l] * g[i][l] + b[i][l] * b[i][l];
     }
   }
   float mr[kLanes], mg[kLanes], mb[kLanes];
@@ -380,10 +383,11 @@ void encode_realtime_lanes(const uint8_t* rgba, uint16_t c0_out[kLanes], uint16_
     q1[2][l] = quantise_lanes(mb[l] + lo * vb[l], 31.0f);
   }
 
-  int idx[16][kLanes];
+  uint32_t idx[kLanes];
   float err[kLanes];
-  // Palette of 565 levels q0, q1 as the decoder builds it; nearest entry per texel.
-  auto select = [&](const float(&a)[3][kLanes], const float(&c)[3][kLanes], int(&out)[16][kLanes],
+  // Palette of 565 levels q0, q1 as the decoder builds it; nearest entry per texel, returned as
+  // the block's packed 2-bit indices (texel i at bits 2i).
+  auto select = [&](const float(&a)[3][kLanes], const float(&c)[3][kLanes], uint32_t(&out)[kLanes],
                     float(&e)[kLanes]) {
     float p[4][3][kLanes];
     for (int ch = 0; ch < 3; ++ch) {
@@ -398,26 +402,33 @@ void encode_realtime_lanes(const uint8_t* rgba, uint16_t c0_out[kLanes], uint16_
         p[3][ch][l] = float(int((x0 + 2.0f * x1) / 3.0f));
       }
     }
-    for (int l = 0; l < kLanes; ++l) e[l] = 0;
+    // |x - p|^2 = |x|^2 + (|p|^2 - 2 x.p): the palette half is shared by all texels, and every
+    // term is an integer below 2^24, so the comparisons and the error are exactly as before.
+    float pp[4][kLanes], m2[4][3][kLanes];
+    for (int k = 0; k < 4; ++k) {
+      for (int l = 0; l < kLanes; ++l) {
+        pp[k][l] = p[k][0][l] * p[k][0][l] + p[k][1][l] * p[k][1][l] + p[k][2][l] * p[k][2][l];
+        for (int ch = 0; ch < 3; ++ch) m2[k][ch][l] = -2.0f * p[k][ch][l];
+      }
+    }
+    for (int l = 0; l < kLanes; ++l) e[l] = 0, out[l] = 0;
     for (int i = 0; i < 16; ++i) {
       float best[kLanes];
-      int bi[kLanes];
+      uint32_t bi[kLanes];
       for (int l = 0; l < kLanes; ++l) {
-        const float dr = r[i][l] - p[0][0][l], dg = g[i][l] - p[0][1][l], db = b[i][l] - p[0][2][l];
-        best[l] = dr * dr + dg * dg + db * db;
+        best[l] = pp[0][l] + r[i][l] * m2[0][0][l] + g[i][l] * m2[0][1][l] + b[i][l] * m2[0][2][l];
         bi[l] = 0;
       }
       for (int k = 1; k < 4; ++k) {
         for (int l = 0; l < kLanes; ++l) {
-          const float dr = r[i][l] - p[k][0][l], dg = g[i][l] - p[k][1][l],
-                      db = b[i][l] - p[k][2][l];
-          const float d = dr * dr + dg * dg + db * db;
+          const float d =
+              pp[k][l] + r[i][l] * m2[k][0][l] + g[i][l] * m2[k][1][l] + b[i][l] * m2[k][2][l];
           const bool better = d < best[l];
           best[l] = better ? d : best[l];
-          bi[l] = better ? k : bi[l];
+          bi[l] = better ? uint32_t(k) : bi[l];
         }
       }
-      for (int l = 0; l < kLanes; ++l) out[i][l] = bi[l], e[l] += best[l];
+      for (int l = 0; l < kLanes; ++l) out[l] |= bi[l] << (2 * i), e[l] += best[l] + xx[i][l];
     }
   };
   select(q0, q1, idx, err);
@@ -430,7 +441,7 @@ void encode_realtime_lanes(const uint8_t* rgba, uint16_t c0_out[kLanes], uint16_
   }
   for (int i = 0; i < 16; ++i) {
     for (int l = 0; l < kLanes; ++l) {
-      const int k = idx[i][l];
+      const uint32_t k = (idx[l] >> (2 * i)) & 3u;
       const float wa = k == 0 ? 1.0f : k == 1 ? 0.0f : k == 2 ? 2.0f / 3.0f : 1.0f / 3.0f;
       const float wb = 1.0f - wa;
       aa[l] += wa * wa, bb[l] += wb * wb, ab[l] += wa * wb;
@@ -450,27 +461,21 @@ void encode_realtime_lanes(const uint8_t* rgba, uint16_t c0_out[kLanes], uint16_
       n1[ch][l] = quantise_lanes((bx[ch][l] * aa[l] - ax[ch][l] * ab[l]) * inv, levels);
     }
   }
-  int idx2[16][kLanes];
+  uint32_t idx2[kLanes];
   float err2[kLanes];
   select(n0, n1, idx2, err2);
 
   for (int l = 0; l < kLanes; ++l) {
     const bool take = solvable[l] && err2[l] < err[l];
-    const float(&e0)[3][kLanes] = take ? n0 : q0;
-    const float(&e1)[3][kLanes] = take ? n1 : q1;
-    uint16_t c0 = pack565(int(e0[0][l]), int(e0[1][l]), int(e0[2][l]));
-    uint16_t c1 = pack565(int(e1[0][l]), int(e1[1][l]), int(e1[2][l]));
-    uint32_t bits = 0;
-    for (int i = 0; i < 16; ++i) bits |= uint32_t(take ? idx2[i][l] : idx[i][l]) << (2 * i);
-    if (c0 < c1) {
-      std::swap(c0, c1);
-      bits ^= 0x55555555u;  // 0<->1, 2<->3
-    } else if (c0 == c1) {
-      bits = 0;
-    }
-    c0_out[l] = c0;
-    c1_out[l] = c1;
-    bits_out[l] = bits;
+    const int a = (int(take ? n0[0][l] : q0[0][l]) << 11) | (int(take ? n0[1][l] : q0[1][l]) << 5) |
+                  int(take ? n0[2][l] : q0[2][l]);
+    const int c = (int(take ? n1[0][l] : q1[0][l]) << 11) | (int(take ? n1[1][l] : q1[1][l]) << 5) |
+                  int(take ? n1[2][l] : q1[2][l]);
+    const uint32_t bits = take ? idx2[l] : idx[l];
+    // 4-colour mode needs c0 > c1: swapping the endpoints maps index 0<->1 and 2<->3.
+    c0_out[l] = uint16_t(a < c ? c : a);
+    c1_out[l] = uint16_t(a < c ? a : c);
+    bits_out[l] = a < c ? bits ^ 0x55555555u : a == c ? 0u : bits;
   }
 }
 
@@ -561,19 +566,21 @@ void bc1_encode_block(const uint8_t rgba[64], BcQuality quality, uint8_t out[8],
 
 void bc1_encode_blocks_realtime(const uint8_t* rgba, size_t count, uint8_t* out,
                                 size_t out_stride) {
-  uint8_t lanes[kLanes * 64];
+  uint32_t texels[16][kLanes];
   for (size_t first = 0; first < count; first += kLanes) {
     const size_t n = std::min<size_t>(kLanes, count - first);
-    std::memcpy(lanes, rgba + first * 64, n * 64);
+    // Texel-major transpose, one 32-bit move per texel, so the kernel's loads are contiguous.
     // Idle lanes repeat the last block; their results are dropped.
-    for (size_t l = n; l < size_t(kLanes); ++l)
-      std::memcpy(lanes + l * 64, rgba + (first + n - 1) * 64, 64);
+    for (size_t l = 0; l < size_t(kLanes); ++l) {
+      const uint8_t* src = rgba + (first + std::min(l, n - 1)) * 64;
+      for (int i = 0; i < 16; ++i) std::memcpy(&texels[i][l], src + 4 * i, 4);
+    }
     uint16_t c0[kLanes], c1[kLanes];
     uint32_t bits[kLanes];
     bool constant[kLanes];
-    encode_realtime_lanes(lanes, c0, c1, bits, constant);
+    encode_realtime_lanes(texels, c0, c1, bits, constant);
     for (size_t l = 0; l < n; ++l) {
-      const uint8_t* px = lanes + l * 64;
+      const uint8_t* px = rgba + (first + l) * 64;
       uint8_t* dst = out + (first + l) * out_stride;
       if (constant[l]) {
         encode_single_colour(px[0], px[1], px[2], dst);
