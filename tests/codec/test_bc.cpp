@@ -2,6 +2,7 @@
 // procedural content, decoder rounding rules (lavapipe's), determinism and argument errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstring>
 #include <vector>
@@ -175,6 +176,71 @@ TEST(Bc1, AnyConstantColourIsWithinOneOfExact) {
     bc1_decode_block(block, out);
     for (int i = 0; i < 64; ++i) ASSERT_LE(std::abs(out[i] - rgba[i]), 1) << v;
     for (int i = 4; i < 64; ++i) ASSERT_EQ(out[i], out[i % 4]);  // one colour out
+  }
+}
+
+// The batch encoder runs 16 blocks side by side: every block must come out as if encoded alone
+// (lane independence, the partial last batch, the output stride), and every non-constant
+// block's indices must name a nearest entry of the palette the decoder builds.
+TEST(Bc1, RealtimeBatchMatchesSingleBlocksAndPicksNearestEntries) {
+  Rng rng(77);
+  constexpr int kBlocks = 41;  // two full batches and a partial one
+  std::vector<uint8_t> rgba(kBlocks * 64);
+  for (int blk = 0; blk < kBlocks; ++blk) {
+    uint8_t* px = &rgba[size_t(blk) * 64];
+    const int kind = blk % 4;
+    const int base[3] = {rng.below(256), rng.below(256), rng.below(256)};
+    for (int i = 0; i < 16; ++i) {
+      for (int c = 0; c < 3; ++c) {
+        int v = base[c];
+        if (kind == 1) v = rng.below(256);                                   // noise
+        if (kind == 2) v = (base[c] * (15 - i) + (255 - base[c]) * i) / 15;  // gradient
+        if (kind == 3) v = (i & 5) ? base[c] : 255 - base[c];                // two colours
+        px[4 * i + c] = uint8_t(v);
+      }
+      px[4 * i + 3] = 255;
+    }
+  }
+  std::vector<uint8_t> batch8(kBlocks * 8), batch16(kBlocks * 16, 0xAB);
+  for (size_t count : {size_t(1), size_t(15), size_t(16), size_t(17), size_t(kBlocks)}) {
+    bc1_encode_blocks_realtime(rgba.data(), count, batch8.data(), 8);
+    bc1_encode_blocks_realtime(rgba.data(), count, batch16.data() + 8, 16);
+    for (size_t blk = 0; blk < count; ++blk) {
+      uint8_t single[8];
+      bc1_encode_block(&rgba[blk * 64], BcQuality::kRealtime, single);
+      ASSERT_EQ(std::memcmp(single, &batch8[blk * 8], 8), 0) << count << " " << blk;
+      ASSERT_EQ(std::memcmp(single, &batch16[blk * 16 + 8], 8), 0) << count << " " << blk;
+      for (int i = 0; i < 8; ++i) ASSERT_EQ(batch16[blk * 16 + size_t(i)], 0xAB);
+    }
+  }
+  for (int blk = 0; blk < kBlocks; ++blk) {
+    if (blk % 4 == 0) continue;  // constant blocks go through the single-colour tables
+    const uint8_t* px = &rgba[size_t(blk) * 64];
+    const uint8_t* b = &batch8[size_t(blk) * 8];
+    uint8_t out[64], pal_block[8], pal[64];
+    bc1_decode_block(b, out);
+    // The four palette entries: the same endpoints with indices 0, 1, 2, 3.
+    std::memcpy(pal_block, b, 4);
+    pal_block[4] = 0xE4, pal_block[5] = pal_block[6] = pal_block[7] = 0;
+    bc1_decode_block(pal_block, pal);
+    for (int i = 0; i < 16; ++i) {
+      int best = 1 << 30, got = 0;
+      // c0 <= c1 only when the endpoints collapsed: 3-colour decode, black is not a choice.
+      const int entries = (b[0] | (b[1] << 8)) > (b[2] | (b[3] << 8)) ? 4 : 3;
+      for (int k = 0; k < entries; ++k) {
+        int d = 0;
+        for (int c = 0; c < 3; ++c) {
+          const int e = pal[4 * k + c] - px[4 * i + c];
+          d += e * e;
+        }
+        best = std::min(best, d);
+      }
+      for (int c = 0; c < 3; ++c) {
+        const int e = out[4 * i + c] - px[4 * i + c];
+        got += e * e;
+      }
+      ASSERT_EQ(got, best) << "block " << blk << " texel " << i;
+    }
   }
 }
 
