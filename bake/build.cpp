@@ -694,6 +694,7 @@ Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDe
                      ? std::numeric_limits<double>::infinity()
                      : 10.0 * std::log10(255.0 * 255.0 * double(acc.samples) / acc.sse);
     ls.non_finite = level0.report();
+    ls.alpha_dropped = options.layers[li].alpha_dropped;
     sum.layers.push_back(std::move(ls));
   }
   for (const LevelSummary& ls : sum.levels) {
@@ -705,8 +706,23 @@ Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDe
   return sum;
 }
 
-Expected<BuildSummary> build_page_file(const BuildOptions& options) {
-  if (options.output.empty()) return Status(ErrorCode::kInvalidArgument, "no output path");
+Status drop_opaque_alpha(BuildOptions& options) {
+  for (LayerInput& in : options.layers) {
+    if (in.semantic != LayerSemantic::kAlbedo || in.alpha_dropped || !in.source) continue;
+    const uint32_t ch = in.source->info().channels;
+    if (ch != 2 && ch != 4) continue;
+    VT_ASSIGN_OR_RETURN(bool opaque, channel_is_opaque(*in.source, ch - 1));
+    if (!opaque) continue;
+    in.source = std::make_shared<DropChannelSource>(in.source, ch - 1);
+    in.alpha_dropped = true;
+  }
+  return Status();
+}
+
+Expected<BuildSummary> build_page_file(const BuildOptions& opts) {
+  if (opts.output.empty()) return Status(ErrorCode::kInvalidArgument, "no output path");
+  BuildOptions options = opts;
+  VT_RETURN_IF_ERROR(drop_opaque_alpha(options));
   VT_ASSIGN_OR_RETURN(PageFileDesc desc, plan_build(options));
   VT_ASSIGN_OR_RETURN(auto writer, PageFileWriter::create(options.output, desc));
   WriterSink sink(*writer);

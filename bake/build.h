@@ -39,6 +39,7 @@ struct LayerInput {
   // are absent; the levels must then fit in the memory limit.
   std::shared_ptr<const std::vector<uint8_t>> coverage;
   // Normal maps: the input holds xyz (or xy) in [0, 1] as n * 0.5 + 0.5 unless float.
+  bool alpha_dropped = false;  // set by drop_opaque_alpha: the source's alpha was all 1
 };
 
 // Progress of the running build, reported from the calling thread after every page row.
@@ -91,6 +92,7 @@ struct LayerSummary {
   double psnr_db = 0;  // stored pages vs unencoded texels; infinite when lossless
   uint32_t max_error = 0;
   NonFiniteReport non_finite;
+  bool alpha_dropped = false;  // the input's alpha was opaque everywhere and is not stored
 };
 
 struct StageTime {
@@ -127,8 +129,14 @@ Expected<PageFileDesc> plan_build(const BuildOptions& options);
 Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDesc& desc,
                                    PageSink& sink);
 
-// plan_build + a PageFileWriter at options.output + build_pages + finish. Nothing is left under
-// options.output on failure.
+// Alpha is kept only where some texel is not opaque: for every albedo layer whose source has
+// alpha (2 or 4 channels), reads the source once in bounded bands and, when every alpha is
+// >= 1, replaces the source by one without the alpha channel (so the layer is RGB, BC1 rather
+// than BC3) and sets LayerInput::alpha_dropped. Must run before plan_build.
+Status drop_opaque_alpha(BuildOptions& options);
+
+// drop_opaque_alpha + plan_build + a PageFileWriter at options.output + build_pages + finish.
+// Nothing is left under options.output on failure.
 Expected<BuildSummary> build_page_file(const BuildOptions& options);
 
 }  // namespace vt

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cstring>
+#include <filesystem>
+#include <map>
 
 namespace vt {
 namespace {
@@ -127,6 +129,172 @@ Status write_image_file(ImageSource& source, const std::string& path, uint32_t t
   }
   if (!out->close()) return Error(ErrorCode::kIo, path + ": " + out->geterror());
   return Status::Ok();
+}
+
+namespace {
+// Rows per band so that a band stays around 16 MiB of floats.
+uint32_t band_rows(const ImageInfo& info) {
+  size_t row = size_t(info.width) * info.channels;
+  return uint32_t(std::clamp<size_t>((size_t(4) << 20) / std::max<size_t>(row, 1), 1,
+                                     std::max<uint32_t>(info.height, 1)));
+}
+}  // namespace
+
+Expected<bool> channel_is_opaque(ImageSource& source, uint32_t channel) {
+  const ImageInfo& info = source.info();
+  if (channel >= info.channels) return Status(ErrorCode::kInvalidArgument, "no such channel");
+  const uint32_t band = band_rows(info), ch = info.channels;
+  std::vector<float> rows(size_t(band) * info.width * ch);
+  for (uint32_t y = 0; y < info.height; y += band) {
+    uint32_t y1 = std::min(info.height, y + band);
+    VT_RETURN_IF_ERROR(source.read_rows(y, y1, rows.data()));
+    const size_t n = size_t(y1 - y) * info.width * ch;
+    for (size_t i = channel; i < n; i += ch) {
+      if (!(rows[i] >= 1.0f)) return false;
+    }
+  }
+  return true;
+}
+
+DropChannelSource::DropChannelSource(std::shared_ptr<ImageSource> source, uint32_t channel)
+    : source_(std::move(source)), channel_(channel), info_(source_->info()) {
+  info_.channels -= 1;
+  if (info_.alpha_channel == int(channel)) {
+    info_.alpha_channel = -1;
+  } else if (info_.alpha_channel > int(channel)) {
+    info_.alpha_channel -= 1;
+  }
+}
+
+Status DropChannelSource::read_rows(uint32_t y0, uint32_t y1, float* out) {
+  const uint32_t sc = info_.channels + 1;
+  const size_t texels = size_t(y1 - y0) * info_.width;
+  rows_.resize(texels * sc);
+  VT_RETURN_IF_ERROR(source_->read_rows(y0, y1, rows_.data()));
+  for (size_t t = 0; t < texels; ++t) {
+    const float* s = &rows_[t * sc];
+    for (uint32_t c = 0; c < sc; ++c) {
+      if (c != channel_) *out++ = s[c];
+    }
+  }
+  return Status();
+}
+
+namespace {
+
+class UdimImageSource final : public ImageSource {
+ public:
+  UdimImageSource(ImageInfo info, uint32_t tiles_u, uint32_t tiles_v, uint32_t tile_w,
+                  uint32_t tile_h, std::vector<std::unique_ptr<ImageSource>> tiles)
+      : info_(std::move(info)),
+        tiles_u_(tiles_u),
+        tiles_v_(tiles_v),
+        tile_w_(tile_w),
+        tile_h_(tile_h),
+        tiles_(std::move(tiles)) {}
+  const ImageInfo& info() const override { return info_; }
+
+  Status read_rows(uint32_t y0, uint32_t y1, float* out) override {
+    if (y0 > y1 || y1 > info_.height) {
+      return Status(ErrorCode::kInvalidArgument, "UDIM image: rows out of range");
+    }
+    const uint32_t ch = info_.channels;
+    const size_t row = size_t(info_.width) * ch, tile_row = size_t(tile_w_) * ch;
+    for (uint32_t y = y0; y < y1;) {
+      const uint32_t v = y / tile_h_, ly0 = y - v * tile_h_;
+      const uint32_t ly1 = std::min(tile_h_, ly0 + (y1 - y));
+      const uint32_t n = ly1 - ly0;
+      float* dst = out + size_t(y - y0) * row;
+      for (uint32_t u = 0; u < tiles_u_; ++u) {
+        ImageSource* tile = tiles_[size_t(v) * tiles_u_ + u].get();
+        if (!tile) {
+          for (uint32_t r = 0; r < n; ++r)
+            std::fill_n(dst + r * row + u * tile_row, tile_row, 0.0f);
+          continue;
+        }
+        band_.resize(n * tile_row);
+        VT_RETURN_IF_ERROR(tile->read_rows(ly0, ly1, band_.data()));
+        for (uint32_t r = 0; r < n; ++r)
+          std::memcpy(dst + r * row + u * tile_row, &band_[r * tile_row], tile_row * sizeof(float));
+      }
+      y += n;
+    }
+    return Status();
+  }
+
+ private:
+  ImageInfo info_;
+  uint32_t tiles_u_, tiles_v_, tile_w_, tile_h_;
+  std::vector<std::unique_ptr<ImageSource>> tiles_;  // row-major, null where missing
+  std::vector<float> band_;
+};
+
+}  // namespace
+
+Expected<std::unique_ptr<ImageSource>> open_udim_image(const std::string& pattern) {
+  const size_t at = pattern.find("<UDIM>");
+  if (at == std::string::npos) {
+    return Status(ErrorCode::kInvalidArgument, pattern + ": no <UDIM> in the path");
+  }
+  namespace fs = std::filesystem;
+  const fs::path pat(pattern);
+  const std::string name = pat.filename().string();
+  const size_t nat = name.find("<UDIM>");
+  if (nat == std::string::npos) {
+    return Status(ErrorCode::kInvalidArgument, pattern + ": <UDIM> must be in the file name");
+  }
+  const std::string prefix = name.substr(0, nat), suffix = name.substr(nat + 6);
+  const fs::path dir = pat.has_parent_path() ? pat.parent_path() : fs::path(".");
+  std::map<uint32_t, std::string> found;  // (v * 10 + u) -> path
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string f = it->path().filename().string();
+    if (f.size() != prefix.size() + 4 + suffix.size() || f.compare(0, prefix.size(), prefix) ||
+        f.compare(f.size() - suffix.size(), suffix.size(), suffix)) {
+      continue;
+    }
+    const std::string digits = f.substr(prefix.size(), 4);
+    if (!std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      continue;
+    const uint32_t n = uint32_t(std::stoul(digits));
+    if (n < 1001) continue;
+    found[n - 1001] = it->path().string();
+  }
+  if (ec) return Status(ErrorCode::kNotFound, pattern + ": cannot list " + dir.string());
+  if (found.empty()) {
+    return Status(ErrorCode::kNotFound,
+                  pattern + ": no tile files (" + prefix + "1001" + suffix + " ...)");
+  }
+  uint32_t max_u = 0, max_v = 0;
+  for (auto& [i, p] : found) max_u = std::max(max_u, i % 10), max_v = std::max(max_v, i / 10);
+  const uint32_t tu = max_u + 1, tv = max_v + 1;
+  std::vector<std::unique_ptr<ImageSource>> tiles(size_t(tu) * tv);
+  ImageInfo first;
+  std::string first_path;
+  for (auto& [i, p] : found) {
+    VT_ASSIGN_OR_RETURN(auto tile, open_image_file(p));
+    const ImageInfo& ti = tile->info();
+    if (first_path.empty()) {
+      first = ti, first_path = p;
+    } else if (ti.width != first.width || ti.height != first.height ||
+               ti.channels != first.channels || ti.is_float != first.is_float) {
+      return Status(ErrorCode::kInvalidArgument,
+                    p + ": UDIM tile is " + std::to_string(ti.width) + "x" +
+                        std::to_string(ti.height) + " with " + std::to_string(ti.channels) +
+                        " channels, but " + first_path + " is " + std::to_string(first.width) +
+                        "x" + std::to_string(first.height) + " with " +
+                        std::to_string(first.channels) + " (all tiles must match)");
+    }
+    tiles[size_t(i / 10) * tu + i % 10] = std::move(tile);
+  }
+  const uint64_t w = uint64_t(first.width) * tu, h = uint64_t(first.height) * tv;
+  if (w > 0xffffffffu || h > 0xffffffffu) {
+    return Status(ErrorCode::kUnsupported, pattern + ": UDIM grid too large");
+  }
+  ImageInfo info = first;
+  info.width = uint32_t(w), info.height = uint32_t(h);
+  return std::unique_ptr<ImageSource>(
+      new UdimImageSource(info, tu, tv, first.width, first.height, std::move(tiles)));
 }
 
 }  // namespace vt

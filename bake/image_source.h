@@ -49,6 +49,35 @@ class MemoryImageSource final : public ImageSource {
   std::vector<float> texels_;
 };
 
+// A UDIM grid of tiles as one image: `pattern` holds "<UDIM>" where the files have a number
+// 1001 + u + 10 * v (u in 0..9), e.g. "tex.<UDIM>.png" finds tex.1001.png, tex.1002.png ...
+// The image is (max_u + 1) x (max_v + 1) tiles; tile (u, v) lies at texel (u * W, v * H), v = 0
+// at the top (image rows grow with v, as UV v does in Vulkan/glTF). Missing tiles are black
+// (0 in every channel, alpha 0 included). All tiles must share size, channels and data type;
+// errors name the offending file. Rows are read band by band from the tiles, never whole.
+Expected<std::unique_ptr<ImageSource>> open_udim_image(const std::string& pattern);
+inline bool is_udim_pattern(const std::string& path) {
+  return path.find("<UDIM>") != std::string::npos;
+}
+
+// True when every texel's channel `channel` is >= 1 (NaN is not opaque). Reads the source in
+// bands of a few MiB, top to bottom.
+Expected<bool> channel_is_opaque(ImageSource& source, uint32_t channel);
+
+// The source without one of its channels (e.g. an opaque alpha); rows are read through.
+class DropChannelSource final : public ImageSource {
+ public:
+  DropChannelSource(std::shared_ptr<ImageSource> source, uint32_t channel);
+  const ImageInfo& info() const override { return info_; }
+  Status read_rows(uint32_t y0, uint32_t y1, float* out) override;
+
+ private:
+  std::shared_ptr<ImageSource> source_;
+  uint32_t channel_;
+  ImageInfo info_;
+  std::vector<float> rows_;
+};
+
 // Writes a source to an image file (format from the extension), row band by row band, so a
 // procedural source larger than memory can be written. `tile` > 0 writes a tiled file where the
 // format supports it. 8-bit formats get values rounded from [0, 1].

@@ -125,6 +125,7 @@ nlohmann::json summary_json(const vt::BuildOptions& o, const vt::BuildSummary& s
                          {"max_error", l.max_error},
                          {"non_finite", l.non_finite.non_finite},
                          {"negative", l.non_finite.negative}};
+    if (l.alpha_dropped) lj["alpha_dropped"] = "opaque";
     // JSON has no infinity: a lossless layer's PSNR is null.
     lj["psnr_db"] = std::isfinite(l.psnr_db) ? nlohmann::json(l.psnr_db) : nlohmann::json();
     if (l.non_finite.any()) {
@@ -155,6 +156,7 @@ void print_text(const vt::BuildOptions& o, const vt::BuildSummary& s, double wal
     } else {
       std::printf("lossless\n");
     }
+    if (l.alpha_dropped) std::printf("  alpha dropped: opaque\n");
     if (l.non_finite.any()) {
       std::printf(
           "  warning: %llu non-finite and %llu negative values, first at texel (%u, %u) "
@@ -218,7 +220,7 @@ int run_build(const BuildFlags& f, const vt::cli::GlobalOptions& global) {
           name == "normal" ? vt::ProceduralPattern::kNormal : vt::ProceduralPattern::kAlbedo;
       in.source = std::make_shared<vt::ProceduralImageSource>(pattern, pw, ph, 3, 1);
     } else {
-      auto src = vt::open_image_file(path);
+      auto src = vt::is_udim_pattern(path) ? vt::open_udim_image(path) : vt::open_image_file(path);
       if (!src.ok()) return bad(src.status().message());
       in.source = std::shared_ptr<vt::ImageSource>(std::move(src).value());
     }
@@ -258,7 +260,7 @@ vt::cli::CommandRunner make_build(CLI::App& sub) {
   auto f = std::make_shared<BuildFlags>();
   sub.add_option("images", f->images,
                  "Input images (the first becomes the albedo layer); procedural:WxH for the "
-                 "generated pattern");
+                 "generated pattern; tex.<UDIM>.png for a UDIM grid of tiles (missing ones black)");
   sub.add_option("-o,--output", f->output, "Output page file (.vtpf)")->required();
   sub.add_option("--layer", f->layers,
                  "A layer NAME=PATH; NAME albedo, normal, orm, emissive or any custom name");

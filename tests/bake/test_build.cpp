@@ -323,6 +323,68 @@ TEST(Build, FileWrittenAndReadBack) {
   fs::remove_all(dir);
 }
 
+// Alpha is stored only where some texel is not opaque: an all-255 alpha PNG builds an RGB
+// (BC1) layer whose texels equal the colour channels; one texel at 254 keeps RGBA (BC3).
+TEST(Build, OpaqueAlphaDropped) {
+  fs::path dir = temp_dir();
+  const uint32_t w = 40, h = 30;
+  std::vector<float> texels(size_t(w) * h * 4);
+  for (size_t i = 0; i < size_t(w) * h; ++i) {
+    for (int c = 0; c < 3; ++c) texels[i * 4 + c] = float((i * 7 + size_t(c) * 61) % 256) / 255;
+    texels[i * 4 + 3] = 1.0f;
+  }
+  ImageInfo info;
+  info.width = w, info.height = h, info.channels = 4, info.alpha_channel = 3;
+  info.color_space = "sRGB";
+  for (bool translucent : {false, true}) {
+    std::vector<float> t = texels;
+    if (translucent) t[(size_t(17) * w + 23) * 4 + 3] = 254.0f / 255;
+    MemoryImageSource mem(info, t);
+    std::string png = (dir / (translucent ? "t.png" : "o.png")).string();
+    ASSERT_TRUE(write_image_file(mem, png).ok());
+    for (CodecKind codec : {CodecKind::kRaw, CodecKind::kBc}) {
+      auto src = open_image_file(png);
+      ASSERT_TRUE(src.ok()) << src.status().message();
+      BuildOptions o;
+      o.layers.push_back(
+          {LayerSemantic::kAlbedo, "", std::shared_ptr<ImageSource>(std::move(src).value())});
+      o.payload = 24;
+      o.codec.codec = codec;
+      o.output = png + ".vtpf";
+      auto sum = build_page_file(o);
+      ASSERT_TRUE(sum.ok()) << sum.status().message();
+      EXPECT_EQ(sum->layers[0].alpha_dropped, !translucent);
+      auto reader = PageFileReader::open(o.output);
+      ASSERT_TRUE(reader.ok()) << reader.status().message();
+      const LayerSpec& spec = (*reader)->layers()[0];
+      EXPECT_EQ(spec.channels, translucent ? 4 : 3);
+      EXPECT_EQ(spec.runtime_format, translucent ? RuntimeFormat::kBc3 : RuntimeFormat::kBc1);
+      if (codec != CodecKind::kRaw || translucent) continue;
+      // Raw: the stored level-0 payload equals the PNG's RGB exactly.
+      const PageGeometry& g = (*reader)->geometry();
+      std::vector<uint8_t> page((*reader)->decoded_page_bytes(0));
+      const uint32_t S = g.page_size();
+      for (uint32_t py = 0; py < g.pages_y(0); ++py) {
+        for (uint32_t px = 0; px < g.pages_x(0); ++px) {
+          ASSERT_TRUE((*reader)->read_texels(PageId{0, px, py}, 0, page).ok());
+          for (uint32_t y = 0; y < g.payload; ++y) {
+            for (uint32_t x = 0; x < g.payload; ++x) {
+              uint32_t gx = px * g.payload + x, gy = py * g.payload + y;
+              if (gx >= w || gy >= h) continue;
+              for (int c = 0; c < 3; ++c) {
+                ASSERT_EQ(page[(size_t(y + g.border) * S + x + g.border) * 3 + c],
+                          uint8_t(std::lround(t[(size_t(gy) * w + gx) * 4 + c] * 255)))
+                    << gx << "," << gy;
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  fs::remove_all(dir);
+}
+
 TEST(Build, MissingFileIsAClearError) {
   auto src = open_image_file("/nonexistent/dir/missing.exr");
   ASSERT_FALSE(src.ok());

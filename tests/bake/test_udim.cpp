@@ -1,0 +1,123 @@
+// UDIM grids: tiles found by number, placed in the grid, missing tiles black, mismatched tiles a
+// clear error naming the file.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "bake/build.h"
+#include "bake/image_source.h"
+#include "format/page_file.h"
+
+namespace vt {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path temp_dir() {
+  fs::path d =
+      fs::temp_directory_path() / ("vt_udim_tests_" + std::to_string(getpid()) + "_" +
+                                   testing::UnitTest::GetInstance()->current_test_info()->name());
+  fs::create_directories(d);
+  return d;
+}
+
+// An 8-bit tile whose texels depend on the tile number, so misplaced tiles are caught.
+std::vector<float> tile_texels(uint32_t w, uint32_t h, uint32_t ch, uint32_t udim) {
+  std::vector<float> t(size_t(w) * h * ch);
+  for (uint32_t y = 0; y < h; ++y)
+    for (uint32_t x = 0; x < w; ++x)
+      for (uint32_t c = 0; c < ch; ++c)
+        t[(size_t(y) * w + x) * ch + c] = float((x * 11 + y * 5 + c * 70 + udim * 37) % 256) / 255;
+  return t;
+}
+
+Status write_tile(const fs::path& path, uint32_t w, uint32_t h, uint32_t ch, uint32_t udim) {
+  ImageInfo info;
+  info.width = w, info.height = h, info.channels = ch, info.color_space = "sRGB";
+  MemoryImageSource src(info, tile_texels(w, h, ch, udim));
+  return write_image_file(src, path.string());
+}
+
+TEST(Udim, GridAssembledExactlyWithMissingTilesBlack) {
+  fs::path dir = temp_dir();
+  const uint32_t tw = 20, th = 14;
+  // u 0..2 on row v = 0, u 0 on row v = 1; (1, 1) and (2, 1) are missing. A decoy file with
+  // another prefix must be ignored.
+  for (uint32_t n : {1001u, 1002u, 1003u, 1011u})
+    ASSERT_TRUE(write_tile(dir / ("tex." + std::to_string(n) + ".png"), tw, th, 3, n).ok());
+  ASSERT_TRUE(write_tile(dir / "other.1004.png", tw, th, 3, 1004).ok());
+
+  auto src = open_udim_image((dir / "tex.<UDIM>.png").string());
+  ASSERT_TRUE(src.ok()) << src.status().message();
+  ASSERT_EQ((*src)->info().width, 3 * tw);
+  ASSERT_EQ((*src)->info().height, 2 * th);
+  ASSERT_EQ((*src)->info().channels, 3u);
+  const uint32_t w = 3 * tw, h = 2 * th;
+  auto expected = [&](uint32_t x, uint32_t y, uint32_t c) -> uint8_t {
+    uint32_t u = x / tw, v = y / th, n = 1001 + u + 10 * v;
+    if (v == 1 && u > 0) return 0;
+    float f = tile_texels(tw, th, 3, n)[(size_t(y % th) * tw + x % tw) * 3 + c];
+    return uint8_t(std::lround(f * 255));
+  };
+
+  BuildOptions o;
+  o.layers.push_back({LayerSemantic::kAlbedo, "", std::shared_ptr<ImageSource>(std::move(*src))});
+  o.payload = 24;  // pages straddle tile edges
+  o.codec.codec = CodecKind::kRaw;
+  o.output = (dir / "grid.vtpf").string();
+  auto sum = build_page_file(o);
+  ASSERT_TRUE(sum.ok()) << sum.status().message();
+
+  auto reader = PageFileReader::open(o.output);
+  ASSERT_TRUE(reader.ok()) << reader.status().message();
+  const PageGeometry& g = (*reader)->geometry();
+  ASSERT_EQ(g.width, w);
+  ASSERT_EQ(g.height, h);
+  std::vector<uint8_t> page((*reader)->decoded_page_bytes(0));
+  const uint32_t S = g.page_size();
+  size_t checked = 0;
+  for (uint32_t py = 0; py < g.pages_y(0); ++py) {
+    for (uint32_t px = 0; px < g.pages_x(0); ++px) {
+      ASSERT_TRUE((*reader)->read_texels(PageId{0, px, py}, 0, page).ok());
+      for (uint32_t y = 0; y < g.payload; ++y) {
+        for (uint32_t x = 0; x < g.payload; ++x) {
+          uint32_t gx = px * g.payload + x, gy = py * g.payload + y;
+          if (gx >= w || gy >= h) continue;
+          for (uint32_t c = 0; c < 3; ++c) {
+            ASSERT_EQ(page[(size_t(y + g.border) * S + x + g.border) * 3 + c], expected(gx, gy, c))
+                << gx << "," << gy << " c" << c;
+          }
+          ++checked;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(checked, size_t(w) * h);
+  fs::remove_all(dir);
+}
+
+TEST(Udim, MismatchedOrMissingTilesAreClearErrors) {
+  fs::path dir = temp_dir();
+  ASSERT_TRUE(write_tile(dir / "t.1001.png", 16, 16, 3, 1001).ok());
+  ASSERT_TRUE(write_tile(dir / "t.1002.png", 16, 8, 3, 1002).ok());
+  auto src = open_udim_image((dir / "t.<UDIM>.png").string());
+  ASSERT_FALSE(src.ok());
+  EXPECT_NE(src.status().message().find("t.1002.png"), std::string::npos) << src.status().message();
+
+  ASSERT_TRUE(write_tile(dir / "c.1001.png", 16, 16, 3, 1001).ok());
+  ASSERT_TRUE(write_tile(dir / "c.1002.png", 16, 16, 4, 1002).ok());
+  src = open_udim_image((dir / "c.<UDIM>.png").string());
+  ASSERT_FALSE(src.ok());
+  EXPECT_NE(src.status().message().find("c.1002.png"), std::string::npos);
+
+  src = open_udim_image((dir / "none.<UDIM>.png").string());
+  ASSERT_FALSE(src.ok());
+  EXPECT_NE(src.status().message().find("none.<UDIM>.png"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace vt
