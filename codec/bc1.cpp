@@ -402,33 +402,38 @@ void encode_realtime_lanes(const uint32_t (&texels)[16][kLanes], uint16_t c0_out
         p[3][ch][l] = float(int((x0 + 2.0f * x1) / 3.0f));
       }
     }
-    // |x - p|^2 = |x|^2 + (|p|^2 - 2 x.p): the palette half is shared by all texels, and every
-    // term is an integer below 2^24, so the comparisons and the error are exactly as before.
-    float pp[4][kLanes], m2[4][3][kLanes];
+    // |x - p|^2 = |x|^2 + (|p|^2 - 2 x.p): the palette half is shared by all texels. Scores
+    // 4 * (|p|^2 - 2 x.p + kBias) + k are non-negative integers below 2^24, exact in float, so
+    // one min per entry finds the nearest entry and its index (ties to the lower index, as a
+    // strict compare would) and the error stays exact.
+    constexpr float kBias = 3.0f * 255.0f * 255.0f;
+    float pk[4][kLanes], m8[4][3][kLanes];
     for (int k = 0; k < 4; ++k) {
       for (int l = 0; l < kLanes; ++l) {
-        pp[k][l] = p[k][0][l] * p[k][0][l] + p[k][1][l] * p[k][1][l] + p[k][2][l] * p[k][2][l];
-        for (int ch = 0; ch < 3; ++ch) m2[k][ch][l] = -2.0f * p[k][ch][l];
+        const float pp =
+            p[k][0][l] * p[k][0][l] + p[k][1][l] * p[k][1][l] + p[k][2][l] * p[k][2][l];
+        pk[k][l] = (pp + kBias) * 4.0f + float(k);
+        for (int ch = 0; ch < 3; ++ch) m8[k][ch][l] = -8.0f * p[k][ch][l];
       }
     }
     for (int l = 0; l < kLanes; ++l) e[l] = 0, out[l] = 0;
     for (int i = 0; i < 16; ++i) {
       float best[kLanes];
-      uint32_t bi[kLanes];
       for (int l = 0; l < kLanes; ++l) {
-        best[l] = pp[0][l] + r[i][l] * m2[0][0][l] + g[i][l] * m2[0][1][l] + b[i][l] * m2[0][2][l];
-        bi[l] = 0;
+        best[l] = pk[0][l] + r[i][l] * m8[0][0][l] + g[i][l] * m8[0][1][l] + b[i][l] * m8[0][2][l];
       }
       for (int k = 1; k < 4; ++k) {
         for (int l = 0; l < kLanes; ++l) {
           const float d =
-              pp[k][l] + r[i][l] * m2[k][0][l] + g[i][l] * m2[k][1][l] + b[i][l] * m2[k][2][l];
-          const bool better = d < best[l];
-          best[l] = better ? d : best[l];
-          bi[l] = better ? uint32_t(k) : bi[l];
+              pk[k][l] + r[i][l] * m8[k][0][l] + g[i][l] * m8[k][1][l] + b[i][l] * m8[k][2][l];
+          best[l] = d < best[l] ? d : best[l];
         }
       }
-      for (int l = 0; l < kLanes; ++l) out[l] |= bi[l] << (2 * i), e[l] += best[l] + xx[i][l];
+      for (int l = 0; l < kLanes; ++l) {
+        const int s = int(best[l]);
+        out[l] |= uint32_t(s & 3) << (2 * i);
+        e[l] += float(s >> 2) + (xx[i][l] - kBias);
+      }
     }
   };
   select(q0, q1, idx, err);
