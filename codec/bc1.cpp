@@ -6,6 +6,7 @@
 #include "codec/bc1.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 
@@ -578,7 +579,15 @@ void bc1_encode_blocks_realtime(const uint8_t* rgba, size_t count, uint8_t* out,
     // Idle lanes repeat the last block; their results are dropped.
     for (size_t l = 0; l < size_t(kLanes); ++l) {
       const uint8_t* src = rgba + (first + std::min(l, n - 1)) * 64;
-      for (int i = 0; i < 16; ++i) std::memcpy(&texels[i][l], src + 4 * i, 4);
+      for (int i = 0; i < 16; ++i) {
+        // R in the low byte on any host (the kernel unpacks by shifts).
+        if constexpr (std::endian::native == std::endian::little) {
+          std::memcpy(&texels[i][l], src + 4 * i, 4);
+        } else {
+          texels[i][l] = uint32_t(src[4 * i]) | (uint32_t(src[4 * i + 1]) << 8) |
+                         (uint32_t(src[4 * i + 2]) << 16);
+        }
+      }
     }
     uint16_t c0[kLanes], c1[kLanes];
     uint32_t bits[kLanes];
