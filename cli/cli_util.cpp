@@ -1,6 +1,9 @@
 #include "cli/cli_util.h"
 
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
 
@@ -23,6 +26,39 @@ int exit_code_for(const Status& status) {
 int report_error(const char* command, const Status& status) {
   std::fprintf(stderr, "vtbake %s: %s\n", command, status.message().c_str());
   return exit_code_for(status);
+}
+
+int bad_usage(const char* command, const std::string& message) {
+  std::fprintf(stderr, "vtbake %s: %s\n", command, message.c_str());
+  return kExitBadInput;
+}
+
+ProgressLine::ProgressLine(bool quiet)
+    : enabled_(!quiet && isatty(STDERR_FILENO)), start_(Clock::now()) {}
+
+bool ProgressLine::due(bool force) {
+  if (!enabled_) return false;
+  const Clock::time_point now = Clock::now();
+  if (!force && now - last_ < std::chrono::milliseconds(200)) return false;
+  last_ = now;
+  return true;
+}
+
+double ProgressLine::elapsed_seconds() const {
+  return std::chrono::duration<double>(Clock::now() - start_).count();
+}
+
+void ProgressLine::print(const char* format, ...) {
+  std::fputc('\r', stderr);
+  va_list args;
+  va_start(args, format);
+  std::vfprintf(stderr, format, args);
+  va_end(args);
+  std::fflush(stderr);
+}
+
+void ProgressLine::done() {
+  if (enabled_) std::fputc('\n', stderr);
 }
 
 Status parse_codec(const std::string& text, PageEncoderOptions* options) {

@@ -2,6 +2,7 @@
 // codec, a memory size and an error's exit status the same way.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <string>
 
@@ -16,6 +17,27 @@ int exit_code_for(const Status& status);
 
 // Prints "vtbake COMMAND: MESSAGE" on stderr and returns exit_code_for(status).
 int report_error(const char* command, const Status& status);
+
+// Prints "vtbake COMMAND: MESSAGE" on stderr and returns kExitBadInput (a wrong flag or input).
+int bad_usage(const char* command, const std::string& message);
+
+// One status line on stderr, redrawn in place at most 5 times a second. Silent with --quiet
+// and when stderr is not a terminal, so that logs do not fill with carriage returns.
+class ProgressLine {
+ public:
+  explicit ProgressLine(bool quiet);
+  // Whether a redraw is due now; always when `force` (a stage change, the last update).
+  bool due(bool force);
+  double elapsed_seconds() const;
+  void print(const char* format, ...) __attribute__((format(printf, 2, 3)));
+  // Ends the line so that what follows starts on its own line.
+  void done();
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  bool enabled_;
+  Clock::time_point start_, last_{};
+};
 
 // --codec: dct, dct:QUALITY (1..100), bc, bc:high, bc:fast, raw.
 Status parse_codec(const std::string& text, PageEncoderOptions* options);

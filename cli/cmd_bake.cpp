@@ -1,7 +1,6 @@
 // `vtbake bake SCENE -o OUT.vtpf`: the main job. Unwraps the scene, transfers its materials into
 // the atlas, builds the page file and writes the unwrapped scene beside it. Flags map onto
 // vt::SceneBakeOptions; the work is bake_scene() (bake/scene_bake.h).
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -31,35 +30,8 @@ struct BakeFlags {
 };
 
 int bad(const std::string& msg) {
-  std::fprintf(stderr, "vtbake bake: %s\n", msg.c_str());
-  return kExitBadInput;
+  return vt::cli::bad_usage("bake", msg);
 }
-
-// One redrawn line on stderr: stage, its fraction, elapsed time.
-class Progress {
- public:
-  explicit Progress(bool enabled) : enabled_(enabled), start_(Clock::now()) {}
-  void update(const vt::SceneBakeProgress& p) {
-    if (!enabled_) return;
-    auto now = Clock::now();
-    bool change = stage_ != p.stage;
-    if (!change && p.fraction < 1.0 && now - last_ < std::chrono::milliseconds(200)) return;
-    last_ = now;
-    stage_ = p.stage;
-    std::fprintf(stderr, "\r%-12s %5.1f%%  %6.1f s   ", p.stage, 100.0 * p.fraction,
-                 std::chrono::duration<double>(now - start_).count());
-    std::fflush(stderr);
-  }
-  void done() {
-    if (enabled_) std::fprintf(stderr, "\n");
-  }
-
- private:
-  using Clock = std::chrono::steady_clock;
-  bool enabled_;
-  Clock::time_point start_, last_{};
-  std::string stage_;
-};
 
 void print_summary(const vt::SceneBakeSummary& s) {
   const auto& g = s.build.geometry;
@@ -126,8 +98,15 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
     if (vt::Status st = vt::cli::parse_byte_size(f->memory_limit, &o.memory_limit); !st.ok())
       return bad("--memory-limit: " + st.message());
     o.threads = global.threads;
-    Progress progress(!global.quiet);
-    o.progress = [&](const vt::SceneBakeProgress& p) { progress.update(p); };
+    // Stage, its fraction, elapsed time; redrawn at once when the stage changes.
+    vt::cli::ProgressLine progress(global.quiet);
+    std::string stage;
+    o.progress = [&](const vt::SceneBakeProgress& p) {
+      if (!progress.due(stage != p.stage || p.fraction >= 1.0)) return;
+      stage = p.stage;
+      progress.print("%-12s %5.1f%%  %6.1f s   ", p.stage, 100.0 * p.fraction,
+                     progress.elapsed_seconds());
+    };
     auto summary = vt::bake_scene(f->scene, o);
     progress.done();
     if (!summary.ok()) return vt::cli::report_error("bake", summary.status());

@@ -1,7 +1,5 @@
 // `vtbake build IMAGE... -o FILE.vtpf`: images (any size, any format OpenImageIO reads) into a
 // page file: mip pyramid, bordered pages, per-layer codec. Flags map onto vt::BuildOptions.
-#include <unistd.h>
-
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -52,37 +50,19 @@ bool parse_semantic(const std::string& s, vt::LayerSemantic* sem) {
 }
 
 int bad(const std::string& msg) {
-  std::fprintf(stderr, "vtbake build: %s\n", msg.c_str());
-  return kExitBadInput;
+  return vt::cli::bad_usage("build", msg);
 }
 
-// One line on a terminal, redrawn at most 5 times a second: stage, pages, rate and ETA.
-class ProgressLine {
- public:
-  explicit ProgressLine(bool enabled) : enabled_(enabled), start_(Clock::now()) {}
-  void update(const vt::BuildProgress& p) {
-    if (!enabled_) return;
-    auto now = Clock::now();
-    bool final = p.pages_done >= p.pages_total;
-    if (!final && now - last_ < std::chrono::milliseconds(200)) return;
-    last_ = now;
-    double t = std::chrono::duration<double>(now - start_).count();
-    double rate = t > 0 ? double(p.pages_done) / t : 0;
-    double eta = rate > 0 ? double(p.pages_total - p.pages_done) / rate : 0;
-    std::fprintf(stderr, "\r%-15s layer %u level %2u  %llu/%llu pages  %.0f pages/s  ETA %.0f s  ",
-                 p.stage, p.layer, p.level, (unsigned long long)p.pages_done,
-                 (unsigned long long)p.pages_total, rate, eta);
-    std::fflush(stderr);
-  }
-  void done() {
-    if (enabled_) std::fprintf(stderr, "\n");
-  }
-
- private:
-  using Clock = std::chrono::steady_clock;
-  bool enabled_;
-  Clock::time_point start_, last_{};
-};
+// Stage, pages, rate and ETA.
+void show_progress(vt::cli::ProgressLine& line, const vt::BuildProgress& p) {
+  if (!line.due(p.pages_done >= p.pages_total)) return;
+  const double t = line.elapsed_seconds();
+  const double rate = t > 0 ? double(p.pages_done) / t : 0;
+  const double eta = rate > 0 ? double(p.pages_total - p.pages_done) / rate : 0;
+  line.print("%-15s layer %u level %2u  %llu/%llu pages  %.0f pages/s  ETA %.0f s  ", p.stage,
+             p.layer, p.level, (unsigned long long)p.pages_done, (unsigned long long)p.pages_total,
+             rate, eta);
+}
 
 nlohmann::json summary_json(const vt::BuildOptions& o, const vt::BuildSummary& s, double wall) {
   nlohmann::json j;
@@ -241,8 +221,8 @@ int run_build(const BuildFlags& f, const vt::cli::GlobalOptions& global) {
   for (auto& [name, path] : inputs) meta["sources"].push_back({{"layer", name}, {"path", path}});
   o.metadata_json = meta.dump();
 
-  ProgressLine line(!global.quiet && isatty(STDERR_FILENO));
-  o.progress = [&line](const vt::BuildProgress& p) { line.update(p); };
+  vt::cli::ProgressLine line(global.quiet);
+  o.progress = [&line](const vt::BuildProgress& p) { show_progress(line, p); };
   auto start = std::chrono::steady_clock::now();
   auto summary = vt::build_page_file(o);
   line.done();

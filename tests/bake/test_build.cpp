@@ -38,15 +38,6 @@ fs::path temp_dir() {
   return d;
 }
 
-// An 8-bit level-0 texel of page (0,0,0) at level texel (x, y) (payload 8, border 4).
-uint8_t texel0(const test::BuiltPages& b, const BuildOptions& o, uint32_t x, uint32_t y,
-               uint32_t c) {
-  PageEncoder enc = test::encoder_for(b, 0, o);
-  auto level = test::reassemble_level(b, 0, 0, enc);
-  uint32_t tb = b.desc.layers[0].texel_bytes();
-  return level[(size_t(y) * b.desc.geometry.width + x) * tb + c];
-}
-
 class NonFinite : public testing::Test {
  protected:
   BuildOptions options(NonFinitePolicy policy) {
