@@ -32,13 +32,13 @@ Expected<NonFinitePolicy> parse_non_finite_policy(const std::string& name);
 struct LayerInput {
   LayerSemantic semantic = LayerSemantic::kAlbedo;
   std::string name;  // "" = the semantic's name
+  // Normal maps: the source holds xyz (or xy) in [0, 1] as n * 0.5 + 0.5 unless float.
   std::shared_ptr<ImageSource> source;
   std::string color_space;  // "" = the source's metadata (ImageInfo::color_space)
   // Optional level-0 coverage (width * height bytes, non-zero = covered); empty = all covered.
   // With a mask, every level is dilated by pull-push and pages with no covered payload texel
   // are absent; the levels must then fit in the memory limit.
   std::shared_ptr<const std::vector<uint8_t>> coverage;
-  // Normal maps: the input holds xyz (or xy) in [0, 1] as n * 0.5 + 0.5 unless float.
   bool alpha_dropped = false;  // set by drop_opaque_alpha: the source's alpha was all 1
 };
 
