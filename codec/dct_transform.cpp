@@ -66,11 +66,16 @@ void ycocg420_row_scalar(const int16_t* yr, const int* vco, const int* vcg, int 
 
 // ---- scalar reference ----
 
-void idct_block_scalar(const int16_t* f, int nv, int nu, int16_t* out, int stride) {
+namespace {
+
+// NV, NU (2, 4 or 8) bound the nonzero rows and columns at compile time so that the loops
+// vectorise; the rows and columns skipped are zeros and contribute nothing.
+template <int NV, int NU>
+void idct_block_n(const int16_t* f, int16_t* out, int stride) {
   int32_t tmp[8][8];
   for (int y = 0; y < 8; y++) {
     int32_t acc[8] = {};
-    for (int v = 0; v < nv; v++) {
+    for (int v = 0; v < NV; v++) {
       const int32_t b = kIdctBasis[y][v];
       for (int u = 0; u < 8; u++) acc[u] += b * f[v * 8 + u];
     }
@@ -78,13 +83,40 @@ void idct_block_scalar(const int16_t* f, int nv, int nu, int16_t* out, int strid
   }
   for (int y = 0; y < 8; y++) {
     int32_t acc[8] = {};
-    for (int u = 0; u < nu; u++) {
+    for (int u = 0; u < NU; u++) {
       const int32_t t = tmp[y][u];
       for (int x = 0; x < 8; x++) acc[x] += t * kIdctBasis[x][u];
     }
     for (int x = 0; x < 8; x++) {
       out[y * stride + x] = int16_t(std::clamp((acc[x] + 2048) >> 12, -4095, 4095));
     }
+  }
+}
+
+}  // namespace
+
+void idct_block_scalar(const int16_t* f, int nv, int nu, int16_t* out, int stride) {
+  const int rv = nv <= 2 ? 0 : nv <= 4 ? 1 : 2;
+  const int ru = nu <= 2 ? 0 : nu <= 4 ? 1 : 2;
+  switch (rv * 3 + ru) {
+    case 0:
+      return idct_block_n<2, 2>(f, out, stride);
+    case 1:
+      return idct_block_n<2, 4>(f, out, stride);
+    case 2:
+      return idct_block_n<2, 8>(f, out, stride);
+    case 3:
+      return idct_block_n<4, 2>(f, out, stride);
+    case 4:
+      return idct_block_n<4, 4>(f, out, stride);
+    case 5:
+      return idct_block_n<4, 8>(f, out, stride);
+    case 6:
+      return idct_block_n<8, 2>(f, out, stride);
+    case 7:
+      return idct_block_n<8, 4>(f, out, stride);
+    default:
+      return idct_block_n<8, 8>(f, out, stride);
   }
 }
 
@@ -287,9 +319,183 @@ void idct_dc_block_sse2(int dc, int16_t* out, int stride) {
   idct_dc_x86(dc, out, stride);
 }
 
+// SSE2 colour conversion: 16 texels per step. Without pshufb, RGB is packed from RGB0 dwords
+// with shifts.
+
+VT_INLINE __m128i loadu128(const int16_t* p) {
+  return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p));
+}
+
+// 4 RGB0 texels (dwords) to 12 RGB bytes in bytes 0-11 (bytes 12-15 zero).
+VT_INLINE __m128i pack_rgb0(__m128i x) {
+  const __m128i lo32 = _mm_set_epi32(0, -1, 0, -1);
+  const __m128i q = _mm_or_si128(_mm_and_si128(x, lo32), _mm_slli_epi64(_mm_srli_epi64(x, 32), 24));
+  return _mm_or_si128(_mm_move_epi64(q), _mm_slli_si128(_mm_srli_si128(q, 8), 6));
+}
+
+// 16 texels from luma row `yr` and full-resolution chroma: *0 = texels 0-7, *1 = texels 8-15.
+template <int CH>
+VT_INLINE void put16_sse2(const int16_t* yr, __m128i co0, __m128i co1, __m128i cg0, __m128i cg1,
+                          uint8_t* o) {
+  const __m128i k = _mm_set1_epi16(1028);  // +1024 centre, +4 rounding
+  const __m128i y0 = _mm_add_epi16(loadu128(yr), k), y1 = _mm_add_epi16(loadu128(yr + 8), k);
+  const __m128i t0 = _mm_sub_epi16(y0, cg0), t1 = _mm_sub_epi16(y1, cg1);
+  const __m128i r = _mm_packus_epi16(_mm_srai_epi16(_mm_add_epi16(t0, co0), 3),
+                                     _mm_srai_epi16(_mm_add_epi16(t1, co1), 3));
+  const __m128i g = _mm_packus_epi16(_mm_srai_epi16(_mm_add_epi16(y0, cg0), 3),
+                                     _mm_srai_epi16(_mm_add_epi16(y1, cg1), 3));
+  const __m128i b = _mm_packus_epi16(_mm_srai_epi16(_mm_sub_epi16(t0, co0), 3),
+                                     _mm_srai_epi16(_mm_sub_epi16(t1, co1), 3));
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i rg0 = _mm_unpacklo_epi8(r, g), rg1 = _mm_unpackhi_epi8(r, g);
+  const __m128i b0 = _mm_unpacklo_epi8(b, zero), b1 = _mm_unpackhi_epi8(b, zero);
+  const __m128i x[4] = {_mm_unpacklo_epi16(rg0, b0), _mm_unpackhi_epi16(rg0, b0),
+                        _mm_unpacklo_epi16(rg1, b1), _mm_unpackhi_epi16(rg1, b1)};
+  __m128i* d = reinterpret_cast<__m128i*>(o);
+  if constexpr (CH == 3) {
+    const __m128i p0 = pack_rgb0(x[0]), p1 = pack_rgb0(x[1]);
+    const __m128i p2 = pack_rgb0(x[2]), p3 = pack_rgb0(x[3]);
+    _mm_storeu_si128(d, _mm_or_si128(p0, _mm_slli_si128(p1, 12)));
+    _mm_storeu_si128(d + 1, _mm_or_si128(_mm_srli_si128(p1, 4), _mm_slli_si128(p2, 8)));
+    _mm_storeu_si128(d + 2, _mm_or_si128(_mm_srli_si128(p2, 8), _mm_slli_si128(p3, 4)));
+  } else {
+    const __m128i keep = _mm_set1_epi32(int32_t(0xFF000000u));  // channel 3 stays
+    for (int i = 0; i < 4; i++) {
+      const __m128i old = _mm_and_si128(_mm_loadu_si128(d + i), keep);
+      _mm_storeu_si128(d + i, _mm_or_si128(old, x[i]));
+    }
+  }
+}
+
+VT_INLINE __m128i clamp_chroma_sse2(__m128i v) {
+  return _mm_min_epi16(_mm_max_epi16(v, _mm_set1_epi16(-2047)), _mm_set1_epi16(2047));
+}
+
+// v[i] = 3 * clamp(a[i]) + clamp(b[i]) for i < n (n >= 8).
+VT_INLINE void blend_rows_sse2(const int16_t* a, const int16_t* b, int n, int16_t* v) {
+  for (int i = 0;; i += 8) {
+    if (i > n - 8) i = n - 8;  // the last step may overlap the one before
+    const __m128i x = clamp_chroma_sse2(loadu128(a + i));
+    const __m128i y = clamp_chroma_sse2(loadu128(b + i));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(v + i),
+                     _mm_add_epi16(_mm_add_epi16(x, _mm_add_epi16(x, x)), y));
+    if (i == n - 8) break;
+  }
+}
+
+// Horizontal 3:1 step of the 4:2:0 filter for 8 chroma samples at v (v[-1], v[8] valid).
+VT_INLINE void upsample8_sse2(const int16_t* v, __m128i* lo, __m128i* hi) {
+  const __m128i c = loadu128(v), l = loadu128(v - 1), r = loadu128(v + 1);
+  const __m128i c3 = _mm_add_epi16(_mm_add_epi16(c, _mm_add_epi16(c, c)), _mm_set1_epi16(8));
+  const __m128i even = _mm_srai_epi16(_mm_add_epi16(c3, l), 4);
+  const __m128i odd = _mm_srai_epi16(_mm_add_epi16(c3, r), 4);
+  *lo = _mm_unpacklo_epi16(even, odd);  // texels 0-7
+  *hi = _mm_unpackhi_epi16(even, odd);  // texels 8-15
+}
+
+template <int CH>
+void ycocg420_sse2(const int16_t* yp, int ystride, const int16_t* co, const int16_t* cg,
+                   int cstride, int width, int height, uint8_t* texels) {
+  const int cw = width / 2, chh = height / 2;
+  alignas(16) int16_t vco[kMaxWidth / 2 + 2], vcg[kMaxWidth / 2 + 2];
+  for (int y = 0; y < height; y++) {
+    const int cy = y >> 1;
+    const int ny = std::clamp((y & 1) ? cy + 1 : cy - 1, 0, chh - 1);
+    blend_rows_sse2(co + size_t(cy) * cstride, co + size_t(ny) * cstride, cw, vco + 1);
+    blend_rows_sse2(cg + size_t(cy) * cstride, cg + size_t(ny) * cstride, cw, vcg + 1);
+    vco[0] = vco[1], vco[cw + 1] = vco[cw];
+    vcg[0] = vcg[1], vcg[cw + 1] = vcg[cw];
+    const int16_t* yr = yp + size_t(y) * ystride;
+    uint8_t* o = texels + size_t(y) * width * CH;
+    for (int cx = 0;; cx += 8) {
+      if (cx > cw - 8) cx = cw - 8;
+      __m128i co0, co1, cg0, cg1;
+      upsample8_sse2(vco + 1 + cx, &co0, &co1);
+      upsample8_sse2(vcg + 1 + cx, &cg0, &cg1);
+      put16_sse2<CH>(yr + 2 * cx, co0, co1, cg0, cg1, o + size_t(2 * cx) * CH);
+      if (cx == cw - 8) break;
+    }
+  }
+}
+
+template <int CH>
+void ycocg_sse2(const int16_t* yp, int ystride, const int16_t* co, const int16_t* cg, int cstride,
+                int width, int height, uint8_t* texels) {
+  for (int y = 0; y < height; y++) {
+    const int16_t* yr = yp + size_t(y) * ystride;
+    const int16_t* cor = co + size_t(y) * cstride;
+    const int16_t* cgr = cg + size_t(y) * cstride;
+    uint8_t* o = texels + size_t(y) * width * CH;
+    for (int x = 0;; x += 16) {
+      if (x > width - 16) x = width - 16;
+      put16_sse2<CH>(yr + x, loadu128(cor + x), loadu128(cor + x + 8), loadu128(cgr + x),
+                     loadu128(cgr + x + 8), o + size_t(x) * CH);
+      if (x == width - 16) break;
+    }
+  }
+}
+
+void ycocg420_to_rgb_sse2(const int16_t* yp, int ystride, const int16_t* co, const int16_t* cg,
+                          int cstride, int width, int height, int ch, uint8_t* texels) {
+  if (width < 16) {
+    return ycocg420_to_rgb_scalar(yp, ystride, co, cg, cstride, width, height, ch, texels);
+  }
+  if (ch == 3) return ycocg420_sse2<3>(yp, ystride, co, cg, cstride, width, height, texels);
+  ycocg420_sse2<4>(yp, ystride, co, cg, cstride, width, height, texels);
+}
+
+void ycocg_to_rgb_sse2(const int16_t* yp, int ystride, const int16_t* co, const int16_t* cg,
+                       int cstride, int width, int height, int ch, uint8_t* texels) {
+  if (width < 16) {
+    return ycocg_to_rgb_scalar(yp, ystride, co, cg, cstride, width, height, ch, texels);
+  }
+  if (ch == 3) return ycocg_sse2<3>(yp, ystride, co, cg, cstride, width, height, texels);
+  ycocg_sse2<4>(yp, ystride, co, cg, cstride, width, height, texels);
+}
+
+// clamp((v + 1028) >> 3, 0, 255) in 16-bit lanes, exact for any int16 (see the AVX2 version).
+VT_INLINE __m128i to_u8_lanes_sse2(__m128i v) {
+  const __m128i s = _mm_srai_epi16(_mm_adds_epi16(v, _mm_set1_epi16(1028)), 3);
+  return _mm_min_epi16(_mm_max_epi16(s, _mm_setzero_si128()), _mm_set1_epi16(255));
+}
+
+void plane_to_channel_sse2(const int16_t* src, int stride, int width, int height, int ch, int c,
+                           uint8_t* texels) {
+  const int step = ch == 1 ? 16 : ch == 2 ? 8 : 4;
+  if (ch == 3 || width < step) {
+    return plane_to_channel_scalar(src, stride, width, height, ch, c, texels);
+  }
+  const __m128i keep = ch == 2 ? _mm_set1_epi16(int16_t(~(0xFF << (8 * c))))
+                               : _mm_set1_epi32(int32_t(~(0xFFu << (8 * c))));
+  const __m128i shift = _mm_cvtsi32_si128(8 * c);
+  for (int y = 0; y < height; y++) {
+    const int16_t* r = src + size_t(y) * stride;
+    uint8_t* o = texels + size_t(y) * width * ch;
+    for (int x = 0;; x += step) {
+      if (x > width - step) x = width - step;  // the last step may overlap (same bytes again)
+      __m128i* d = reinterpret_cast<__m128i*>(o + size_t(x) * ch);
+      if (ch == 1) {
+        _mm_storeu_si128(d, _mm_packus_epi16(to_u8_lanes_sse2(loadu128(r + x)),
+                                             to_u8_lanes_sse2(loadu128(r + x + 8))));
+      } else {
+        __m128i v;
+        if (ch == 2) {
+          v = _mm_sll_epi16(to_u8_lanes_sse2(loadu128(r + x)), shift);
+        } else {
+          const __m128i w =
+              to_u8_lanes_sse2(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(r + x)));
+          v = _mm_sll_epi32(_mm_unpacklo_epi16(w, _mm_setzero_si128()), shift);
+        }
+        _mm_storeu_si128(d, _mm_or_si128(_mm_and_si128(_mm_loadu_si128(d), keep), v));
+      }
+      if (x == width - step) break;
+    }
+  }
+}
+
 // ---- AVX2 ----
 // The IDCT is the SSE2 code above compiled with VEX encoding; the colour conversion runs on
-// 32 texels per step.
+// 32 texels per step (pshufb packs RGB).
 
 #define VT_AVX2 __attribute__((target("avx2")))
 
@@ -532,12 +738,11 @@ constexpr TransformImpl kScalar = {"scalar",
                                    plane_to_channel_scalar};
 
 #if VT_TRANSFORM_X86
-// The SSE2 entry keeps the scalar colour conversion (AVX2 hosts use the AVX2 one).
 constexpr TransformImpl kImpls[] = {
     {"avx2", idct_block_avx2, idct_dc_block_avx2, ycocg420_to_rgb_avx2, ycocg_to_rgb_avx2,
      plane_to_channel_avx2},
-    {"sse2", idct_block_sse2, idct_dc_block_sse2, ycocg420_to_rgb_scalar, ycocg_to_rgb_scalar,
-     plane_to_channel_scalar},
+    {"sse2", idct_block_sse2, idct_dc_block_sse2, ycocg420_to_rgb_sse2, ycocg_to_rgb_sse2,
+     plane_to_channel_sse2},
     kScalar,
 };
 #else
