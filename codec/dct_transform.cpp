@@ -6,6 +6,8 @@
 // since B[7-y][v] = (-1)^v B[y][v]: out[y] = E[y] + O[y], out[7-y] = E[y] - O[y], where E and O
 // are pmaddwd sums over pairs of inputs. Every product and sum is an exact int32, so regrouping
 // the sums changes nothing. Rows (pass 1) and columns (pass 2) past nv/nu are zero and skipped.
+// SSE2 runs each pass as two 4-lane halves; AVX2 runs all 8 lanes in one ymm and transposes
+// in-lane. Colour: 16 (SSE2) or 32 (AVX2) texels per step in int16 lanes, packus to bytes.
 #include "codec/dct_transform.h"
 
 #include <algorithm>
@@ -494,13 +496,130 @@ void plane_to_channel_sse2(const int16_t* src, int stride, int width, int height
 }
 
 // ---- AVX2 ----
-// The IDCT is the SSE2 code above compiled with VEX encoding; the colour conversion runs on
-// 32 texels per step (pshufb packs RGB).
+// The colour conversion runs on 32 texels per step (pshufb packs RGB).
 
 #define VT_AVX2 __attribute__((target("avx2")))
 
+// AVX2 IDCT: one ymm holds all 8 lanes of a pass as int32 (columns 0-3 | 4-7 in pass 1, rows
+// 0-3 | 4-7 in pass 2), so each pmaddwd does the work of two SSE2 ones. The odd pairs are
+// (1,3), (5,7) in pass 1 and (1,5), (3,7) in pass 2 (what the in-lane transpose leaves side by
+// side); any pairing gives the same exact sums.
+
+VT_AVX2 VT_INLINE __m256i pair256(int a, int b) {
+  return _mm256_set1_epi32(int32_t(uint32_t(uint16_t(a)) | (uint32_t(uint16_t(b)) << 16)));
+}
+
+// (a[i], b[i]) for i = 0..7 as int16 pairs, from rows broadcast to both lanes.
+VT_AVX2 VT_INLINE __m256i zip_rows(__m256i a, __m256i b) {
+  return _mm256_blend_epi32(_mm256_unpacklo_epi16(a, b), _mm256_unpackhi_epi16(a, b), 0xF0);
+}
+
+// res[y] = (bias + sum_i B[y][i] * x[i]) >> kShift, given x as pairs p04 = (x0, x4),
+// p26 = (x2, x6), pa = (x[A0], x[A1]), pb = (x[B0], x[B1]); inputs from index N on are zero.
+template <int N, int kShift, int A0, int A1, int B0, int B1>
+VT_AVX2 VT_INLINE void idct_1d_avx2(__m256i p04, __m256i p26, __m256i pa, __m256i pb, int bias,
+                                    __m256i* res) {
+  const __m256i b = _mm256_set1_epi32(bias);
+  __m256i e[4], o[4];
+  const __m256i ee0 = _mm256_add_epi32(_mm256_madd_epi16(p04, pair256(1448, 1448)), b);
+  const __m256i ee1 =
+      N > 4 ? _mm256_add_epi32(_mm256_madd_epi16(p04, pair256(1448, -1448)), b) : ee0;
+  if constexpr (N > 2) {
+    const __m256i eo0 = _mm256_madd_epi16(p26, pair256(1892, 784));
+    const __m256i eo1 = _mm256_madd_epi16(p26, pair256(784, -1892));
+    e[0] = _mm256_add_epi32(ee0, eo0);
+    e[1] = _mm256_add_epi32(ee1, eo1);
+    e[2] = _mm256_sub_epi32(ee1, eo1);
+    e[3] = _mm256_sub_epi32(ee0, eo0);
+  } else {
+    e[0] = e[1] = e[2] = e[3] = ee0;
+  }
+  for (int y = 0; y < 4; y++) {
+    o[y] = _mm256_madd_epi16(pa, pair256(kIdctBasis[y][A0], kIdctBasis[y][A1]));
+    if constexpr (B0 < N) {
+      o[y] = _mm256_add_epi32(o[y],
+                              _mm256_madd_epi16(pb, pair256(kIdctBasis[y][B0], kIdctBasis[y][B1])));
+    }
+  }
+  for (int y = 0; y < 4; y++) {
+    res[y] = _mm256_srai_epi32(_mm256_add_epi32(e[y], o[y]), kShift);
+    res[7 - y] = _mm256_srai_epi32(_mm256_sub_epi32(e[y], o[y]), kShift);
+  }
+}
+
+// In-lane transpose of q[k] = (rows k, k + 4 of an 8x8 int16 matrix, columns 0-3 | 4-7), as
+// packssdw leaves them, into w[k] = (column k | column k + 4).
+VT_AVX2 VT_INLINE void transpose_avx2(const __m256i* q, __m256i* w) {
+  const __m256i u0 = _mm256_unpacklo_epi16(q[0], q[1]), u1 = _mm256_unpackhi_epi16(q[0], q[1]);
+  const __m256i u2 = _mm256_unpacklo_epi16(q[2], q[3]), u3 = _mm256_unpackhi_epi16(q[2], q[3]);
+  const __m256i v0 = _mm256_unpacklo_epi32(u0, u2), v1 = _mm256_unpackhi_epi32(u0, u2);
+  const __m256i v2 = _mm256_unpacklo_epi32(u1, u3), v3 = _mm256_unpackhi_epi32(u1, u3);
+  w[0] = _mm256_unpacklo_epi64(v0, v2);
+  w[1] = _mm256_unpackhi_epi64(v0, v2);
+  w[2] = _mm256_unpacklo_epi64(v1, v3);
+  w[3] = _mm256_unpackhi_epi64(v1, v3);
+}
+
+// (column k | column k + 4) -> pairs (T[y][k], T[y][k + 4]) for rows 0-3 | 4-7.
+VT_AVX2 VT_INLINE __m256i column_pairs(__m256i w) {
+  const __m256i m = _mm256_setr_epi8(0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15, 0, 1, 8,
+                                     9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15);
+  return _mm256_shuffle_epi8(_mm256_permute4x64_epi64(w, 0xD8), m);
+}
+
+template <int NV, int NU>
+VT_AVX2 VT_INLINE void idct_block_avx2_n(const int16_t* f, int16_t* out, int stride) {
+  const __m256i zero = _mm256_setzero_si256();
+  __m256i r[8];
+  for (int v = 0; v < 8; v++) {
+    r[v] = v < NV ? _mm256_broadcastsi128_si256(
+                        _mm_loadu_si128(reinterpret_cast<const __m128i*>(f + 8 * v)))
+                  : zero;
+  }
+  __m256i acc[8], q[4], w[4];
+  // Pass 1: acc[y] = row y of tmp, columns 0-3 | 4-7.
+  idct_1d_avx2<NV, 9, 1, 3, 5, 7>(zip_rows(r[0], r[4]), zip_rows(r[2], r[6]), zip_rows(r[1], r[3]),
+                                  zip_rows(r[5], r[7]), 256, acc);
+  for (int k = 0; k < 4; k++) q[k] = _mm256_packs_epi32(acc[k], acc[k + 4]);  // int16 saturation
+  transpose_avx2(q, w);
+  // Pass 2: acc[x] = output column x, rows 0-3 | 4-7.
+  idct_1d_avx2<NU, 12, 1, 5, 3, 7>(column_pairs(w[0]), column_pairs(w[2]), column_pairs(w[1]),
+                                   column_pairs(w[3]), 2048, acc);
+  const __m256i lo = _mm256_set1_epi16(-4095), hi = _mm256_set1_epi16(4095);
+  for (int k = 0; k < 4; k++) {
+    q[k] = _mm256_min_epi16(_mm256_max_epi16(_mm256_packs_epi32(acc[k], acc[k + 4]), lo), hi);
+  }
+  transpose_avx2(q, w);  // w[k] = (output row k | row k + 4)
+  for (int k = 0; k < 4; k++) {
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + k * stride), _mm256_castsi256_si128(w[k]));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + (k + 4) * stride),
+                     _mm256_extracti128_si256(w[k], 1));
+  }
+}
+
 VT_AVX2 void idct_block_avx2(const int16_t* f, int nv, int nu, int16_t* out, int stride) {
-  idct_block_dispatch(f, nv, nu, out, stride);
+  const int rv = nv <= 2 ? 0 : nv <= 4 ? 1 : 2;
+  const int ru = nu <= 2 ? 0 : nu <= 4 ? 1 : 2;
+  switch (rv * 3 + ru) {
+    case 0:
+      return idct_block_avx2_n<2, 2>(f, out, stride);
+    case 1:
+      return idct_block_avx2_n<2, 4>(f, out, stride);
+    case 2:
+      return idct_block_avx2_n<2, 8>(f, out, stride);
+    case 3:
+      return idct_block_avx2_n<4, 2>(f, out, stride);
+    case 4:
+      return idct_block_avx2_n<4, 4>(f, out, stride);
+    case 5:
+      return idct_block_avx2_n<4, 8>(f, out, stride);
+    case 6:
+      return idct_block_avx2_n<8, 2>(f, out, stride);
+    case 7:
+      return idct_block_avx2_n<8, 4>(f, out, stride);
+    default:
+      return idct_block_avx2_n<8, 8>(f, out, stride);
+  }
 }
 VT_AVX2 void idct_dc_block_avx2(int dc, int16_t* out, int stride) {
   idct_dc_x86(dc, out, stride);
