@@ -13,7 +13,9 @@
 #include <algorithm>
 #include <cstring>
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+// VT_TRANSFORM_NO_SIMD builds the scalar reference alone (as on non-x86 hosts).
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && \
+    !defined(VT_TRANSFORM_NO_SIMD)
 #define VT_TRANSFORM_X86 1
 #include <immintrin.h>
 #endif
