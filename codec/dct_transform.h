@@ -10,7 +10,8 @@
 //      pass 2 (horizontal) is unchanged:
 //        out[y][x] = clamp((sum_u B[x][u] * tmp[y][u] + 2048) >> 12, -4095, 4095)
 //      with B = kIdctBasis (12-bit orthonormal basis, dct_transform.cpp) and >> arithmetic.
-//      Pass 1 only saturates for |F| near 2047 in several rows at once, which no valid block has.
+//      Pass 1 can only saturate when a column holds several coefficients near +-2047 with
+//      matching signs; blocks of 8-bit content (|F| <= 1024 plus half a quantiser step) never do.
 //   2. 4:2:0 chroma samples (Co, Cg) are clamped to [-2047, 2047] before the 9-3-3-1 filter
 //      (valid content stays within about +-1020), so 9a + 3b + 3c + d + 8 fits int16.
 // Everything else is as before: 9-3-3-1 filter = vertical 3a + b, then (3v + v' + 8) >> 4 with
@@ -45,8 +46,8 @@ void ycocg420_to_rgb(const int16_t* y, int ystride, const int16_t* co, const int
 void ycocg_to_rgb(const int16_t* y, int ystride, const int16_t* co, const int16_t* cg, int cstride,
                   int width, int height, int ch, uint8_t* texels);
 
-// One plane (1/8 units, centred on 0) into channel c of interleaved texels with ch (1..4)
-// channels; the other channels are untouched.
+// One plane (1/8 units, centred on 0; any int16) into channel c of interleaved texels with ch
+// (1..4) channels as clamp((v + 1028) >> 3, 0, 255); the other channels are untouched.
 void plane_to_channel(const int16_t* src, int stride, int width, int height, int ch, int c,
                       uint8_t* texels);
 
