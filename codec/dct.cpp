@@ -1,31 +1,44 @@
-// The page DCT codec (see dct.h). Bitstream of a page: one range-coded stream, no header. For
-// every plane in order (Y, Co, Cg, alpha or channel 0..3), blocks in raster order; each block
-// codes its AC nonzero count (Exp-Golomb-like bins, context: neighbours' counts), its DC as a
-// residual from a median predictor (context: neighbours' DC difference), then the AC coefficients
-// in zigzag order: a zero flag per position while nonzeros remain (context: position, nonzeros
-// left, neighbours' magnitude at that position), an Exp-Golomb-like magnitude with adaptive
-// exponent bins, then its low bits and sign raw. Context probabilities start from the per-layer
-// tables.
+// The page DCT codec (see dct.h). Bitstream of a page: a kind byte (0 coded, 1 constant, 2
+// stored); a constant page then holds its texel raw, a stored page all its texels raw. A coded page
+// holds the byte length of its rANS part (LEB128), the rANS part (codec/dct_rans.h), then the raw
+// bits. For every plane in order (Y, Co, Cg, alpha or channel 0..3), blocks in raster order; each
+// block codes its AC nonzero count (context: neighbours' counts), its DC as a residual from a
+// median predictor (context: neighbours' DC difference), then for each zigzag position while
+// nonzeros remain one token (0 = zero, else a magnitude class; context: position band, nonzeros
+// left, neighbours' magnitude there) whose low bits and sign follow raw. Token frequencies are
+// static per layer.
 #include "codec/dct.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
+#include <map>
+#include <mutex>
 #include <string>
+#include <tuple>
 
-#include "codec/dct_range_coder.h"
+#include "codec/dct_rans.h"
+#include "codec/dct_transform.h"
 
 namespace vt {
 
-using dct_detail::BinCounter;
-using dct_detail::BitModel;
-using dct_detail::RangeDecoder;
-using dct_detail::RangeEncoder;
+using dct_detail::BitReader;
+using dct_detail::BitWriter;
+using dct_detail::idct_block;
+using dct_detail::idct_dc_block;
+using dct_detail::kFreqTotal;
+using dct_detail::kTokens;
+using dct_detail::plane_to_channel;
+using dct_detail::RansDecoder;
+using dct_detail::RansEncoder;
+using dct_detail::TokenModel;
+using dct_detail::ycocg420_to_rgb;
+using dct_detail::ycocg_to_rgb;
 
 namespace {
 
 constexpr int kMaxPageSize = 4096;
-constexpr int kMaxExp = 12;  // magnitudes below 2^12
 constexpr int kMaxQuantized = 4095;
 constexpr int kMaxDequantized = 2047;  // far beyond any 8-bit block's coefficients
 
@@ -34,64 +47,66 @@ constexpr uint8_t kZigzag[64] = {0,  1,  8,  16, 9,  2,  3,  10, 17, 24, 32, 25,
                                  35, 42, 49, 56, 57, 50, 43, 36, 29, 22, 15, 23, 30, 37, 44, 51,
                                  58, 59, 52, 45, 38, 31, 39, 46, 53, 60, 61, 54, 47, 55, 62, 63};
 
-// Orthonormal 8-point DCT basis B[x][u] in 1/4096, rounded once (hard-coded, not computed,
-// so that no libm difference can change a decoded texel).
-constexpr int16_t kIdctBasis[8][8] = {
-    {1448, 2009, 1892, 1703, 1448, 1138, 784, 400},
-    {1448, 1703, 784, -400, -1448, -2009, -1892, -1138},
-    {1448, 1138, -784, -2009, -1448, 400, 1892, 1703},
-    {1448, 400, -1892, -1138, 1448, 1703, -784, -2009},
-    {1448, -400, -1892, 1138, 1448, -1703, -784, 2009},
-    {1448, -1138, -784, 2009, -1448, -400, 1892, -1703},
-    {1448, -1703, 784, 400, -1448, 2009, -1892, 1138},
-    {1448, -2009, 1892, -1703, 1448, -1138, 784, -400},
-};
+// Magnitude classes: tokens 0-3 are the values themselves, 4-7 pairs and quads, 8-15 powers of
+// two from 16 to 2048; `extra` low bits follow raw.
+constexpr uint16_t kTokenBase[kTokens] = {0,  1,  2,  3,   4,   6,   8,    12,
+                                          16, 32, 64, 128, 256, 512, 1024, 2048};
+constexpr uint8_t kTokenExtra[kTokens] = {0, 0, 0, 0, 1, 1, 2, 2, 4, 5, 6, 7, 8, 9, 10, 11};
+// Raw bits after an AC token: the low bits and the sign; none for a zero.
+constexpr uint8_t kFieldBits[kTokens] = {0, 1, 1, 1, 2, 2, 3, 3, 5, 6, 7, 8, 9, 10, 11, 12};
+constexpr int16_t kZeroBlock[64] = {};
 
-struct TransposedBasis {
-  int32_t b[8][8];  // b[u][x] = kIdctBasis[x][u], rows the second pass combines
-  constexpr TransposedBasis() : b() {
-    for (int u = 0; u < 8; u++)
-      for (int x = 0; x < 8; x++) b[u][x] = kIdctBasis[x][u];
-  }
-};
-constexpr TransposedBasis kIdctBasisT;
+inline int bit_length(unsigned v) {
+  return v == 0 ? 0 : 32 - __builtin_clz(v);
+}
 
-// Context layout of one plane's models (offsets into a flat BitModel array).
-constexpr int kNzCtx = 11;                          // predicted AC count buckets + "no neighbour"
-constexpr int kDcCtx = 8;                           // bit length of the neighbours' DC difference
-constexpr int kRemCtx = 7;                          // nonzeros left
-constexpr int kNbCtx = 6;                           // neighbours' magnitude at the same position
-constexpr int kBandCtx = 6;                         // zigzag position bands
-constexpr int kNzExpOff = 0;                        // [ctx][bit length 0..6]
-constexpr int kNzMantOff = kNzExpOff + kNzCtx * 7;  // [ctx][bit length][bit]
-constexpr int kDcZeroOff = kNzMantOff + kNzCtx * 7 * 5;
-constexpr int kDcSignOff = kDcZeroOff + kDcCtx;
-constexpr int kDcExpOff = kDcSignOff + kDcCtx;
-constexpr int kDcMantOff = kDcExpOff + kDcCtx * kMaxExp;
-constexpr int kAcZeroOff = kDcMantOff + kMaxExp;
-constexpr int kAcExpOff = kAcZeroOff + 64 * kRemCtx * kNbCtx;
-constexpr int kAcMantOff = kAcExpOff + kBandCtx * kNbCtx * kMaxExp;
-constexpr int kConstOff = kAcMantOff + kBandCtx * kMaxExp;  // plane 0 only: constant page
-constexpr int kModelsPerPlane = kConstOff + 1;
+// v <= 4095.
+inline int token_of(unsigned v) {
+  return v < 4    ? int(v)
+         : v < 8  ? 4 + int((v - 4) >> 1)
+         : v < 16 ? 6 + int((v - 8) >> 2)
+                  : 3 + bit_length(v);
+}
+
+// Token models of one plane (offsets into its model array).
+constexpr int kNzCtx = 11;  // predicted AC count buckets + "no neighbour"
+constexpr int kDcCtx = 8;   // bit length of the neighbours' DC difference
+constexpr int kBands = 10;  // zigzag position bands
+constexpr int kRemCtx = 7;  // nonzeros left
+constexpr int kNbCtx = 6;   // neighbours' magnitude at the same position
+constexpr int kNzHist = 0;
+constexpr int kDcHist = kNzHist + kNzCtx;
+constexpr int kAcHist = kDcHist + kDcCtx;
+constexpr int kHistPerPlane = kAcHist + kBands * kRemCtx * kNbCtx;
 
 constexpr uint8_t kMagic[4] = {'V', 'T', 'D', 'C'};
-// Raw bits closing every page: a cut or damaged stream decodes them wrong (odds 1 in 65536 of
-// missing it), where the arithmetic decoder alone would just read zeros and carry on.
-constexpr int kEndMarker = 0xA55A;
-constexpr uint8_t kTablesVersion = 1;
+constexpr uint8_t kTablesVersion = 2;
+constexpr uint8_t kPageCoded = 0;
+constexpr uint8_t kPageConstant = 1;
+constexpr uint8_t kPageStored = 2;  // texels raw, when coding would not make the page smaller
 
 struct BucketTables {
   uint8_t nz[64];
-  uint8_t rem[64];
-  uint8_t band[64];
+  uint8_t rem[64];      // index: nonzeros left (>= 1); histogram offset of its bucket
+  uint16_t ac[64];      // first AC histogram of zigzag position k's band
   uint8_t nb[64];       // index: min(sum of neighbour magnitudes, 63)
   uint8_t max_row[64];  // largest row / column among zigzag positions 0..k
   uint8_t max_col[64];
-  constexpr BucketTables() : nz(), rem(), band(), nb(), max_row(), max_col() {
+  constexpr BucketTables() : nz(), rem(), ac(), nb(), max_row(), max_col() {
     for (int i = 0; i < 64; i++) {
       nz[i] = i <= 3 ? i : i <= 5 ? 4 : i <= 7 ? 5 : i <= 11 ? 6 : i <= 17 ? 7 : i <= 27 ? 8 : 9;
-      rem[i] = i <= 1 ? 0 : i <= 3 ? i - 1 : i <= 5 ? 3 : i <= 8 ? 4 : i <= 14 ? 5 : 6;
-      band[i] = i <= 2 ? 0 : i <= 5 ? 1 : i <= 9 ? 2 : i <= 14 ? 3 : i <= 27 ? 4 : 5;
+      rem[i] = kNbCtx * (i <= 1 ? 0 : i <= 3 ? i - 1 : i <= 5 ? 3 : i <= 8 ? 4 : i <= 14 ? 5 : 6);
+      const int band = i <= 1    ? 0
+                       : i <= 2  ? 1
+                       : i <= 4  ? 2
+                       : i <= 6  ? 3
+                       : i <= 9  ? 4
+                       : i <= 14 ? 5
+                       : i <= 20 ? 6
+                       : i <= 27 ? 7
+                       : i <= 38 ? 8
+                                 : 9;
+      ac[i] = uint16_t(kAcHist + band * kRemCtx * kNbCtx);
       nb[i] = i <= 2 ? i : i <= 4 ? 3 : i <= 8 ? 4 : 5;
       int r = 0, c = 0;
       for (int k = 0; k <= i; k++) {
@@ -104,10 +119,6 @@ struct BucketTables {
   }
 };
 constexpr BucketTables kBuckets;
-
-int bit_length(unsigned v) {
-  return v == 0 ? 0 : 32 - __builtin_clz(v);
-}
 
 int plane_count(const DctSettings& s) {
   return s.channels;
@@ -190,7 +201,11 @@ struct DctTables {
   int width = 0;
   int height = 0;
   uint8_t quant[4][64] = {};
-  std::vector<BitModel> models[4];  // initial context state per plane
+  // Token models per plane (kHistPerPlane each) and their observation counts. Trained models
+  // stay fixed (static, the fast path); untrained ones adapt while a page is coded.
+  bool adaptive = true;
+  std::vector<TokenModel> models[4];
+  std::vector<uint8_t> seen[4];
 };
 
 void DctTablesDeleter::operator()(DctTables* t) const {
@@ -206,19 +221,89 @@ struct BlockInfo {
   uint8_t last;  // zigzag index of the last nonzero coefficient, 0 when only DC
 };
 
-// Codes one plane's blocks. Encoding reads `coefs` (quantised, zigzag order, one block after
-// another); decoding writes them. One template so both sides select contexts identically.
+// One plane's token models while a page is coded; they adapt as tokens go by.
+struct PlaneModels {
+  TokenModel* m;
+  uint8_t* seen;
+};
+
+// The three ways of walking a plane's tokens: encoding records them, counting trains the
+// models, decoding reads them. Each has token(models, index, token) and raw(value, bits).
+
+template <bool kAdaptive>
+class TokenEncoder {
+ public:
+  static constexpr bool kDecoding = false;
+  int token(PlaneModels& pm, int i, int t) {
+    rans.put(pm.m[i], t);
+    if constexpr (kAdaptive) dct_detail::adapt(pm.m[i], pm.seen[i], t);
+    return t;
+  }
+  uint32_t raw(uint32_t v, int n) {
+    bits.put(v, n);
+    return v;
+  }
+  RansEncoder rans;
+  BitWriter bits;
+};
+
+class TokenCounter {
+ public:
+  static constexpr bool kDecoding = false;
+  explicit TokenCounter(std::array<uint32_t, kTokens>* counts) : counts_(counts) {}
+  int token(PlaneModels&, int i, int t) {
+    counts_[i][t]++;
+    return t;
+  }
+  uint32_t raw(uint32_t v, int) { return v; }
+
+ private:
+  std::array<uint32_t, kTokens>* counts_;
+};
+
+template <bool kAdaptive>
+class TokenDecoder {
+ public:
+  static constexpr bool kDecoding = true;
+  TokenDecoder(const uint8_t* rans, size_t rans_size, const uint8_t* raw, size_t raw_size)
+      : rans_(rans, rans_size), bits_(raw, raw_size) {}
+  int token(PlaneModels& pm, int i, int) {
+    const int t = rans_.get(pm.m[i]);
+    if constexpr (kAdaptive) dct_detail::adapt(pm.m[i], pm.seen[i], t);
+    return t;
+  }
+  uint32_t raw(uint32_t, int n) { return bits_.get(n); }
+  bool valid_end() const { return rans_.valid_end() && bits_.valid_end(); }
+  // A valid stream never invents input; a little slack keeps the check off the hot path.
+  bool ran_dry() const { return rans_.overread() > 64; }
+
+ private:
+  RansDecoder rans_;
+  BitReader bits_;
+};
+
+// An unsigned value as a token in histogram i plus its low bits raw.
 template <class Coder>
-void code_plane(Coder& c, BitModel* m, int bw, int bh, int16_t* coefs, BlockInfo* info) {
+int code_uint(Coder& c, PlaneModels& h, int i, int v) {
+  int t = 0;
+  if constexpr (!Coder::kDecoding) t = token_of(unsigned(v));
+  t = c.token(h, i, t);
+  const int extra = kTokenExtra[t];
+  return kTokenBase[t] + (extra ? int(c.raw(uint32_t(v - kTokenBase[t]), extra)) : 0);
+}
+
+// Codes one plane's blocks. Encoding reads `coefs` (quantised, zigzag order, one block after
+// another); decoding writes them. One template so every side selects contexts identically.
+template <class Coder>
+void code_plane(Coder& c, PlaneModels h, int bw, int bh, int16_t* coefs, BlockInfo* info) {
   for (int by = 0; by < bh; by++) {
     for (int bx = 0; bx < bw; bx++) {
       const int index = by * bw + bx;
       int16_t* z = coefs + size_t(index) * 64;
       const bool has_left = bx > 0, has_up = by > 0;
-      const int16_t* left = has_left ? z - 64 : nullptr;
-      const int16_t* up = has_up ? z - size_t(bw) * 64 : nullptr;
-      if (!left) left = up;
-      if (!up) up = left;
+      // A missing neighbour is the other one, or zeros for the first block.
+      const int16_t* left = has_left ? z - 64 : has_up ? z - size_t(bw) * 64 : kZeroBlock;
+      const int16_t* up = has_up ? z - size_t(bw) * 64 : left;
 
       // AC nonzero count.
       int nz = 0;
@@ -231,28 +316,9 @@ void code_plane(Coder& c, BitModel* m, int bw, int bh, int16_t* coefs, BlockInfo
         const int b = has_up ? info[index - bw].nz : a;
         nz_ctx = kBuckets.nz[(a + b + 1) >> 1];
       }
-      {
-        // Bit length of the count in unary, then the bits below its top bit.
-        BitModel* exp = m + kNzExpOff + nz_ctx * 7;
-        int e = 0;
-        if constexpr (Coder::kDecoding) {
-          while (e < 6 && c.bit(exp[e])) e++;
-        } else {
-          e = bit_length(unsigned(nz));
-          for (int i = 0; i < e; i++) c.bit(exp[i], 1);
-          if (e < 6) c.bit(exp[e], 0);
-        }
-        if (e > 1) {
-          BitModel* mant = m + kNzMantOff + (nz_ctx * 7 + e) * 5;
-          int v = 1;
-          for (int i = e - 2; i >= 0; i--) v = v * 2 + c.bit(mant[i], (nz >> i) & 1);
-          nz = v;
-        } else {
-          nz = e;
-        }
-      }
+      nz = std::min(code_uint(c, h, kNzHist + nz_ctx, nz), 63);
 
-      // DC: residual from a median (LOCO-I) predictor.
+      // DC: residual from a median (LOCO-I) predictor, magnitude token then sign.
       int pred = 0, dc_ctx = 0;
       if (has_left && has_up) {
         const int l = info[index - 1].dc, a = info[index - bw].dc;
@@ -267,72 +333,39 @@ void code_plane(Coder& c, BitModel* m, int bw, int bh, int16_t* coefs, BlockInfo
       {
         int res = 0;
         if constexpr (!Coder::kDecoding) res = z[0] - pred;
-        if (c.bit(m[kDcZeroOff + dc_ctx], res != 0)) {
-          const int neg = c.bit(m[kDcSignOff + dc_ctx], res < 0);
-          int mag = std::abs(res);
-          BitModel* exp = m + kDcExpOff + dc_ctx * kMaxExp;
-          int e = 0;
-          if constexpr (Coder::kDecoding) {
-            while (e < kMaxExp - 1 && c.bit(exp[e])) e++;
-          } else {
-            e = bit_length(unsigned(mag)) - 1;
-            for (int i = 0; i < e; i++) c.bit(exp[i], 1);
-            if (e < kMaxExp - 1) c.bit(exp[e], 0);
-          }
-          if (e > 0) {
-            const int hi = c.bit(m[kDcMantOff + e], (mag >> (e - 1)) & 1);
-            const int lo = c.direct(mag & ((1 << (e - 1)) - 1), e - 1);
-            mag = (((2 | hi) << (e - 1)) | lo);
-          } else {
-            mag = 1;
-          }
-          res = neg ? -mag : mag;
-        } else {
-          res = 0;
-        }
+        int mag = code_uint(c, h, kDcHist + dc_ctx, std::abs(res));
+        if (mag != 0 && c.raw(res < 0, 1)) mag = -mag;
         if constexpr (Coder::kDecoding) {
-          z[0] = int16_t(std::clamp(pred + res, -kMaxQuantized, kMaxQuantized));
+          z[0] = int16_t(std::clamp(pred + mag, -kMaxQuantized, kMaxQuantized));
         }
       }
 
-      // AC coefficients.
+      // AC coefficients. Decoding runs without a branch per position: a zero token reads no
+      // raw bits and writes 0.
       if constexpr (Coder::kDecoding) std::memset(z + 1, 0, 63 * sizeof(int16_t));
-      int rem = nz, last = 0;
+      // The context takes the nonzeros left as they were two positions back, so a token's
+      // context never waits on the two tokens decoded just before it.
+      int rem = nz, rem1 = nz, rem2 = nz, last = 0;
       for (int k = 1; k < 64 && rem > 0; k++) {
-        int nb_sum = 0;
-        if (left) nb_sum = std::abs(left[k]) + std::abs(up[k]);
-        const int nb = kBuckets.nb[std::min(nb_sum, 63)];
-        int v = 0;
-        if constexpr (!Coder::kDecoding) v = z[k];
-        if (64 - k != rem) {
-          BitModel& zm = m[kAcZeroOff + (k * kRemCtx + kBuckets.rem[rem]) * kNbCtx + nb];
-          if (!c.bit(zm, v != 0)) continue;
+        const int nb_sum = std::abs(left[k]) + std::abs(up[k]);
+        const int i = kBuckets.ac[k] + kBuckets.rem[rem2] + kBuckets.nb[std::min(nb_sum, 63)];
+        rem2 = rem1;
+        rem1 = rem;
+        int v = 0, t = 0;
+        if constexpr (!Coder::kDecoding) {
+          v = z[k];
+          t = token_of(unsigned(std::abs(v)));
         }
-        rem--;
-        last = k;
-        int mag = std::abs(v);
-        const int band = kBuckets.band[k];
-        BitModel* exp = m + kAcExpOff + (band * kNbCtx + nb) * kMaxExp;
-        int e = 0;
+        t = c.token(h, i, t);
+        // The low bits and the sign are near equiprobable: one raw field.
+        const uint32_t field =
+            c.raw((uint32_t(std::abs(v) - kTokenBase[t]) << 1) | (v < 0), kFieldBits[t]);
         if constexpr (Coder::kDecoding) {
-          while (e < kMaxExp - 1 && c.bit(exp[e])) e++;
-        } else {
-          e = bit_length(unsigned(mag)) - 1;
-          for (int i = 0; i < e; i++) c.bit(exp[i], 1);
-          if (e < kMaxExp - 1) c.bit(exp[e], 0);
+          const int mag = kTokenBase[t] + int(field >> 1), neg = -int(field & 1);
+          z[k] = int16_t((mag ^ neg) - neg);
         }
-        int neg;
-        if (e > 0) {
-          const int hi = c.bit(m[kAcMantOff + band * kMaxExp + e], (mag >> (e - 1)) & 1);
-          // The bits below and the sign are equiprobable: one raw field.
-          const int lo_sign = c.direct(((mag & ((1 << (e - 1)) - 1)) << 1) | (v < 0), e);
-          mag = (((2 | hi) << (e - 1)) | (lo_sign >> 1));
-          neg = lo_sign & 1;
-        } else {
-          mag = 1;
-          neg = c.direct(v < 0, 1);
-        }
-        if constexpr (Coder::kDecoding) z[k] = int16_t(neg ? -mag : mag);
+        rem -= t != 0;
+        last = t != 0 ? k : last;
       }
       info[index].dc = z[0];
       info[index].nz = uint8_t(nz);
@@ -425,73 +458,172 @@ void quantize_plane(const FloatPlane& fp, const uint8_t* quant, int16_t* coefs) 
   }
 }
 
+// ---- tables: static token frequencies ----
+
+// A model whose frequencies sum to kFreqTotal, each >= 1, from non-negative weights.
+TokenModel make_model(const double* w) {
+  double total = 0;
+  for (int t = 0; t < kTokens; t++) total += w[t];
+  int f[kTokens], sum = 0, largest = 0;
+  for (int t = 0; t < kTokens; t++) {
+    const double share = total > 0 ? w[t] / total : 1.0 / kTokens;
+    f[t] = std::max(1, int(std::lround(share * (kFreqTotal - kTokens))));
+    sum += f[t];
+    if (f[t] > f[largest]) largest = t;
+  }
+  f[largest] += int(kFreqTotal) - sum;  // rounding leaves at most a few units to move
+  TokenModel m;
+  uint32_t above = 0;
+  for (int t = 0; t < kTokens; t++) m.above()[t] = uint16_t(above += uint32_t(f[t]));
+  return m;
+}
+
+using TokenCounts = std::vector<std::array<uint32_t, kTokens>>;  // [plane * kHistPerPlane + i]
+
+// Deterministic stand-in for content when no training pages are given: value noise over
+// several octaves (roughly the 1/f spectrum of photographs and textures), mostly shared by the
+// channels, whose fine detail fades in and out across the page so that busy, smooth and flat
+// areas all occur, plus a hard edge. The last page is a flat field with a gentle gradient.
+std::vector<uint8_t> synthetic_page(int size, int channels, uint32_t seed, bool flat) {
+  auto hash = [](uint32_t x) {
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+  };
+  auto lattice = [&](int x, int y, uint32_t salt) {
+    return float(hash(uint32_t(x) * 73856093u ^ uint32_t(y) * 19349663u ^ salt) >> 8) /
+               float(1 << 24) -
+           0.5f;
+  };
+  auto noise = [&](int x, int y, int cell, uint32_t salt) {
+    const int gx = x / cell, gy = y / cell;
+    const float fx = float(x % cell) / float(cell), fy = float(y % cell) / float(cell);
+    const float sx = fx * fx * (3 - 2 * fx), sy = fy * fy * (3 - 2 * fy);
+    const float a = lattice(gx, gy, salt), b = lattice(gx + 1, gy, salt);
+    const float c = lattice(gx, gy + 1, salt), d = lattice(gx + 1, gy + 1, salt);
+    return (a + (b - a) * sx) * (1 - sy) + (c + (d - c) * sx) * sy;
+  };
+  std::vector<uint8_t> page(size_t(size) * size * channels);
+  const float edge_a = float(int(hash(seed) % 7) - 3), edge_b = float(int(hash(seed + 1) % 5) - 2);
+  const float edge_c = float(int(hash(seed + 2) % uint32_t(size)));
+  for (int y = 0; y < size; y++) {
+    for (int x = 0; x < size; x++) {
+      const float detail = std::clamp(noise(x, y, 48, seed * 7) * 5.0f + 0.6f, 0.0f, 1.0f);
+      float shared = 0;
+      for (int cell = 64, o = 0; cell >= 1; cell /= 2, o++) {
+        const float amp = 130.0f * std::pow(float(cell) / 64.0f, 0.85f);
+        shared += (cell >= 16 ? amp : amp * detail * detail) * noise(x, y, cell, seed * 131 + o);
+      }
+      if (edge_a * float(x - size / 2) + edge_b * float(y) > edge_c) shared += 45.0f;
+      if (flat) shared = 0.1f * float(x + y) + (x > size / 2 ? 3.0f : 0.0f);
+      for (int c = 0; c < channels; c++) {
+        float v = 128.0f + shared * (1.0f - 0.15f * float(c));
+        for (int cell = 32; cell >= 2 && !flat; cell /= 4) {
+          v += 30.0f * detail * std::pow(float(cell) / 32.0f, 0.85f) *
+               noise(x, y, cell, seed * 977 + uint32_t(c) * 31 + uint32_t(cell));
+        }
+        page[(size_t(y) * size + x) * channels + c] = uint8_t(std::clamp(v, 0.0f, 255.0f));
+      }
+    }
+  }
+  return page;
+}
+
+void count_tokens(const DctSettings& s, const uint8_t* const quant[4], const uint8_t* texels,
+                  int width, int height, TokenCounts& counts);
+
+// Prior token probabilities per histogram from synthetic pages, smoothed toward broader
+// groups (the AC position band and nonzeros left, then every histogram of the kind) so that
+// contexts the synthetic content never reaches still get a sensible shape. Cached: the fuzz
+// harness and tests make many tables.
+const std::vector<std::array<double, kTokens>>& prior_probabilities(const DctSettings& s) {
+  static std::mutex mutex;
+  static std::map<std::tuple<int, int, int>, std::vector<std::array<double, kTokens>>> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  auto key = std::make_tuple(s.quality, s.channels, int(s.layout));
+  if (auto it = cache.find(key); it != cache.end()) return it->second;
+
+  const int n = plane_count(s);
+  uint8_t quant[4][64];
+  const uint8_t* qp[4] = {quant[0], quant[1], quant[2], quant[3]};
+  for (int p = 0; p < n; p++) make_quant(s, p, quant[p]);
+  TokenCounts counts(size_t(n) * kHistPerPlane, std::array<uint32_t, kTokens>{});
+  constexpr int kSize = 128, kPages = 4;
+  for (int i = 0; i < kPages; i++) {
+    const std::vector<uint8_t> page =
+        synthetic_page(kSize, s.channels, uint32_t(i + 1), i == kPages - 1);
+    count_tokens(s, qp, page.data(), kSize, kSize, counts);
+  }
+  auto normalised = [](const std::array<double, kTokens>& w) {
+    double total = 0;
+    for (double v : w) total += v;
+    std::array<double, kTokens> out{};
+    for (int t = 0; t < kTokens; t++) out[t] = total > 0 ? w[t] / total : 1.0 / kTokens;
+    return out;
+  };
+  std::vector<std::array<double, kTokens>> probs(counts.size());
+  for (int p = 0; p < n; p++) {
+    const auto* c = counts.data() + size_t(p) * kHistPerPlane;
+    auto sum_range = [&](int from, int to, int step) {
+      std::array<double, kTokens> w{};
+      for (int i = from; i < to; i += step)
+        for (int t = 0; t < kTokens; t++) w[t] += c[i][t];
+      for (int t = 0; t < kTokens; t++) w[t] += 0.5;  // every token stays possible
+      return normalised(w);
+    };
+    const auto nz_all = sum_range(kNzHist, kDcHist, 1);
+    const auto dc_all = sum_range(kDcHist, kAcHist, 1);
+    const auto ac_all = sum_range(kAcHist, kHistPerPlane, 1);
+    for (int i = 0; i < kHistPerPlane; i++) {
+      std::array<double, kTokens> parent;
+      if (i < kDcHist) {
+        parent = nz_all;
+      } else if (i < kAcHist) {
+        parent = dc_all;
+      } else {
+        const int group = kAcHist + (i - kAcHist) / kNbCtx * kNbCtx;  // same band and rem
+        const auto g = sum_range(group, group + kNbCtx, 1);
+        for (int t = 0; t < kTokens; t++) parent[t] = 0.8 * g[t] + 0.2 * ac_all[t];
+      }
+      std::array<double, kTokens> w{};
+      for (int t = 0; t < kTokens; t++) w[t] = c[i][t] + 4.0 * parent[t];
+      // A thin uniform tail keeps content far from the synthetic pages (noise at high
+      // quality) from costing more than a few bits per token.
+      w = normalised(w);
+      for (int t = 0; t < kTokens; t++) w[t] = 0.97 * w[t] + 0.03 / kTokens;
+      probs[size_t(p) * kHistPerPlane + i] = w;
+    }
+  }
+  return cache.emplace(key, std::move(probs)).first->second;
+}
+
+void count_tokens(const DctSettings& s, const uint8_t* const quant[4], const uint8_t* texels,
+                  int width, int height, TokenCounts& counts) {
+  FloatPlane planes[4];
+  build_planes(s, texels, width, height, planes);
+  std::vector<int16_t> coefs;
+  std::vector<BlockInfo> info;
+  for (int p = 0; p < plane_count(s); p++) {
+    const PlaneDims& d = planes[p].dims;
+    coefs.assign(size_t(d.bw) * d.bh * 64, 0);
+    info.assign(size_t(d.bw) * d.bh, BlockInfo{});
+    quantize_plane(planes[p], quant[p], coefs.data());
+    TokenCounter counter(counts.data() + size_t(p) * kHistPerPlane);
+    code_plane(counter, PlaneModels{}, d.bw, d.bh, coefs.data(), info.data());
+  }
+}
+
 // ---- decoder side: integer-exact ----
 
-// Inverse DCT of a dequantised block (natural order, |F| <= 2047) whose nonzeros lie in rows
-// < nv and columns < nu. Output in 1/8 texel units, clamped to +-4095.
-// Rounding is part of the format: pass 1 keeps 3 fractional bits ((x + 2^8) >> 9), pass 2
-// rounds to 1/8 ((x + 2^11) >> 12). |F| <= 2^11 and |B| <= 2^11 keep every sum inside int32.
-// NV and NU are compile-time bounds (2, 4 or 8) so the loops vectorise cleanly; the rows and
-// columns beyond the last nonzero contribute zeros and are skipped exactly.
-template <int NV, int NU>
-inline void idct_block_n(const int32_t* f, int16_t* out, int stride) {
-  int32_t tmp[8][8];
-  for (int y = 0; y < 8; y++) {
-    int32_t acc[8] = {};
-    for (int v = 0; v < NV; v++) {
-      const int32_t b = kIdctBasis[y][v];
-      for (int u = 0; u < 8; u++) acc[u] += b * f[v * 8 + u];
-    }
-    for (int u = 0; u < 8; u++) tmp[y][u] = (acc[u] + 256) >> 9;
-  }
-  for (int y = 0; y < 8; y++) {
-    int32_t acc[8] = {};
-    for (int u = 0; u < NU; u++) {
-      const int32_t t = tmp[y][u];
-      for (int x = 0; x < 8; x++) acc[x] += t * kIdctBasisT.b[u][x];
-    }
-    for (int x = 0; x < 8; x++) {
-      out[y * stride + x] = int16_t(std::clamp((acc[x] + 2048) >> 12, -4095, 4095));
-    }
-  }
-}
-
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
-__attribute__((target_clones("avx2", "default"), flatten))
-#endif
-void idct_block(const int32_t* f, int nv, int nu, int16_t* out, int stride) {
-  const int rv = nv <= 2 ? 0 : nv <= 4 ? 1 : 2;
-  const int ru = nu <= 2 ? 0 : nu <= 4 ? 1 : 2;
-  switch (rv * 3 + ru) {
-    case 0:
-      return idct_block_n<2, 2>(f, out, stride);
-    case 1:
-      return idct_block_n<2, 4>(f, out, stride);
-    case 2:
-      return idct_block_n<2, 8>(f, out, stride);
-    case 3:
-      return idct_block_n<4, 2>(f, out, stride);
-    case 4:
-      return idct_block_n<4, 4>(f, out, stride);
-    case 5:
-      return idct_block_n<4, 8>(f, out, stride);
-    case 6:
-      return idct_block_n<8, 2>(f, out, stride);
-    case 7:
-      return idct_block_n<8, 4>(f, out, stride);
-    default:
-      return idct_block_n<8, 8>(f, out, stride);
-  }
-}
-
-// Decodes one plane into 1/8-unit samples. Returns false when the range decoder ran out of
-// data (corrupt or truncated).
 struct DecodeScratch {
+  std::vector<TokenModel> models;
+  std::vector<uint8_t> seen;
   std::vector<int16_t> coefs;
   std::vector<BlockInfo> info;
   std::vector<int16_t> samples[4];
-  std::vector<int32_t> row;
-  std::vector<BitModel> models;
 };
 
 void reconstruct_plane(const PlaneDims& d, const uint8_t* quant, const int16_t* coefs,
@@ -501,81 +633,83 @@ void reconstruct_plane(const PlaneDims& d, const uint8_t* quant, const int16_t* 
       const int16_t* z = coefs + (size_t(by) * d.bw + bx) * 64;
       int16_t* out = samples + size_t(by) * 8 * d.w + bx * 8;
       const int last = info[size_t(by) * d.bw + bx].last;
-      int32_t f[64];
       if (last == 0) {
-        // DC only: the same arithmetic as idct_block, without the loops.
-        const int32_t dc = std::clamp(int32_t(z[0]) * quant[0], -kMaxDequantized, kMaxDequantized);
-        const int32_t t = (kIdctBasis[0][0] * dc + 256) >> 9;
-        const int16_t v = int16_t(std::clamp((t * kIdctBasis[0][0] + 2048) >> 12, -4095, 4095));
-        for (int y = 0; y < 8; y++)
-          for (int x = 0; x < 8; x++) out[y * d.w + x] = v;
+        idct_dc_block(std::clamp(int(z[0]) * quant[0], -kMaxDequantized, kMaxDequantized), out,
+                      d.w);
         continue;
       }
-      std::memset(f, 0, sizeof(f));
+      alignas(32) int16_t f[64] = {};
       for (int k = 0; k <= last; k++) {
         const int pos = kZigzag[k];
-        f[pos] = std::clamp(int32_t(z[k]) * quant[pos], -kMaxDequantized, kMaxDequantized);
+        f[pos] = int16_t(std::clamp(int(z[k]) * quant[pos], -kMaxDequantized, kMaxDequantized));
       }
       idct_block(f, kBuckets.max_row[last] + 1, kBuckets.max_col[last] + 1, out, d.w);
     }
   }
 }
 
-inline uint8_t to_u8(int v8) {
-  return uint8_t(std::clamp((v8 + 4) >> 3, 0, 255));
+Status corrupt_page(size_t size, const char* what) {
+  return Error(ErrorCode::kCorrupt,
+               std::string("dct page: ") + what + " (" + std::to_string(size) + " bytes)");
 }
 
-inline void put_ycocg(uint8_t* o, int y8, int co8, int cg8) {
-  const int yy = y8 + 1024, t = yy - cg8;
-  o[0] = to_u8(t + co8);
-  o[1] = to_u8(yy + cg8);
-  o[2] = to_u8(t - co8);
-}
-
-// YCoCg with 4:2:0 chroma to interleaved RGB(A). Chroma comes back to full resolution with the
-// 9-3-3-1 triangle filter (chroma sited at 2x2 centres, edges clamped), computed as a vertical
-// 3:1 blend and then a horizontal 3:1 blend with one rounding, all in 1/8 units.
-void ycocg420_to_rgb(const int16_t* yp, int ystride, const int16_t* co, const int16_t* cg,
-                     int cstride, int width, int height, int ch, uint8_t* texels,
-                     std::vector<int32_t>& rows) {
-  const int cw = width / 2, chh = height / 2;
-  rows.resize(size_t(cw) * 2);
-  int32_t* vco = rows.data();
-  int32_t* vcg = rows.data() + cw;
-  for (int y = 0; y < height; y++) {
-    const int cy = y >> 1;
-    const int ny = std::clamp((y & 1) ? cy + 1 : cy - 1, 0, chh - 1);
-    const int16_t* a0 = co + size_t(cy) * cstride;
-    const int16_t* a1 = co + size_t(ny) * cstride;
-    const int16_t* b0 = cg + size_t(cy) * cstride;
-    const int16_t* b1 = cg + size_t(ny) * cstride;
-    for (int x = 0; x < cw; x++) {
-      vco[x] = 3 * a0[x] + a1[x];
-      vcg[x] = 3 * b0[x] + b1[x];
+// Appends a coded page's length field, rANS part and raw bits.
+template <bool kAdaptive>
+void encode_tokens(const DctTables& t, const FloatPlane* planes, std::vector<uint8_t>& out) {
+  TokenEncoder<kAdaptive> enc;
+  std::vector<TokenModel> models;
+  std::vector<uint8_t> seen;
+  std::vector<int16_t> coefs;
+  std::vector<BlockInfo> info;
+  for (int p = 0; p < plane_count(t.settings); p++) {
+    const PlaneDims& d = planes[p].dims;
+    coefs.assign(size_t(d.bw) * d.bh * 64, 0);
+    info.assign(size_t(d.bw) * d.bh, BlockInfo{});
+    quantize_plane(planes[p], t.quant[p], coefs.data());
+    PlaneModels pm{const_cast<TokenModel*>(t.models[p].data()),
+                   const_cast<uint8_t*>(t.seen[p].data())};  // only read when static
+    if constexpr (kAdaptive) {
+      models = t.models[p];
+      seen = t.seen[p];
+      pm = {models.data(), seen.data()};
     }
-    const int16_t* yr = yp + size_t(y) * ystride;
-    uint8_t* o = texels + size_t(y) * width * ch;
-    for (int cx = 0; cx < cw; cx++) {
-      const int l = cx > 0 ? cx - 1 : 0, r = cx + 1 < cw ? cx + 1 : cw - 1;
-      const int co3 = 3 * vco[cx] + 8, cg3 = 3 * vcg[cx] + 8;
-      put_ycocg(o + size_t(2 * cx) * ch, yr[2 * cx], (co3 + vco[l]) >> 4, (cg3 + vcg[l]) >> 4);
-      put_ycocg(o + size_t(2 * cx + 1) * ch, yr[2 * cx + 1], (co3 + vco[r]) >> 4,
-                (cg3 + vcg[r]) >> 4);
-    }
+    code_plane(enc, pm, d.bw, d.bh, coefs.data(), info.data());
   }
+  std::vector<uint8_t> rans;
+  enc.rans.finish(rans);
+  for (size_t v = rans.size();; v >>= 7) {
+    out.push_back(uint8_t((v & 0x7F) | (v >= 0x80 ? 0x80 : 0)));
+    if (v < 0x80) break;
+  }
+  out.insert(out.end(), rans.begin(), rans.end());
+  enc.bits.finish(out);
 }
 
-// A valid page ends with the marker, overreads at most 5 bytes (the zeros the encoder trimmed
-// plus one) and leaves no byte unread.
-Status check_end(RangeDecoder& dec, size_t size) {
-  const int marker = dec.direct(0, 16);
-  if (marker != kEndMarker || dec.overread() > 8) {
-    return Error(ErrorCode::kCorrupt,
-                 "dct page: data cut short or damaged (" + std::to_string(size) + " bytes)");
+// Decodes every plane's tokens and reconstructs its samples into scratch.samples.
+template <bool kAdaptive>
+Status decode_tokens(const DctTables& t, std::span<const uint8_t> rans,
+                     std::span<const uint8_t> raw, int width, int height, DecodeScratch& scratch) {
+  const size_t size = 1 + rans.size() + raw.size();
+  TokenDecoder<kAdaptive> dec(rans.data(), rans.size(), raw.data(), raw.size());
+  for (int p = 0; p < plane_count(t.settings); p++) {
+    const PlaneDims d = plane_dims(t.settings, p, width, height);
+    const size_t blocks = size_t(d.bw) * d.bh;
+    scratch.coefs.resize(blocks * 64);
+    scratch.info.resize(blocks);
+    scratch.samples[p].resize(size_t(d.w) * d.h);
+    PlaneModels pm{const_cast<TokenModel*>(t.models[p].data()),
+                   const_cast<uint8_t*>(t.seen[p].data())};  // only read when static
+    if constexpr (kAdaptive) {
+      scratch.models = t.models[p];
+      scratch.seen = t.seen[p];
+      pm = {scratch.models.data(), scratch.seen.data()};
+    }
+    code_plane(dec, pm, d.bw, d.bh, scratch.coefs.data(), scratch.info.data());
+    if (dec.ran_dry()) return corrupt_page(size, "data ends early");
+    reconstruct_plane(d, t.quant[p], scratch.coefs.data(), scratch.info.data(),
+                      scratch.samples[p].data());
   }
-  if (!dec.consumed_all()) {
-    return Error(ErrorCode::kCorrupt, "dct page: trailing bytes after the page data");
-  }
+  if (!dec.valid_end()) return corrupt_page(size, "data cut short, damaged or over-long");
   return Status::Ok();
 }
 
@@ -590,18 +724,12 @@ Expected<DctTablesPtr> dct_make_tables(const DctSettings& settings, int width, i
   t->width = width;
   t->height = height;
   const int n = plane_count(settings);
-  for (int p = 0; p < n; p++) {
-    make_quant(settings, p, t->quant[p]);
-    t->models[p].assign(kModelsPerPlane, BitModel{});
-  }
-  if (training_pages.empty()) return t;
+  const uint8_t* quant[4] = {t->quant[0], t->quant[1], t->quant[2], t->quant[3]};
+  for (int p = 0; p < n; p++) make_quant(settings, p, t->quant[p]);
 
   const size_t page_bytes = size_t(width) * height * settings.channels;
-  std::vector<uint32_t> counts[4];
-  for (int p = 0; p < n; p++) counts[p].assign(size_t(kModelsPerPlane) * 2, 0);
-  FloatPlane planes[4];
-  std::vector<int16_t> coefs;
-  std::vector<BlockInfo> info;
+  TokenCounts counts(size_t(n) * kHistPerPlane, std::array<uint32_t, kTokens>{});
+  bool trained = false;
   for (size_t i = 0; i < training_pages.size(); i++) {
     if (training_pages[i].size() != page_bytes) {
       return Error(ErrorCode::kInvalidArgument,
@@ -614,36 +742,36 @@ Expected<DctTablesPtr> dct_make_tables(const DctSettings& settings, int width, i
     for (size_t j = settings.channels; j < page_bytes && constant; j++) {
       constant = px[j] == px[j % settings.channels];
     }
-    counts[0][2 * kConstOff + (constant ? 1 : 0)]++;
-    if (constant) continue;
-    build_planes(settings, px, width, height, planes);
-    for (int p = 0; p < n; p++) {
-      const PlaneDims& d = planes[p].dims;
-      coefs.assign(size_t(d.bw) * d.bh * 64, 0);
-      info.assign(size_t(d.bw) * d.bh, BlockInfo{});
-      quantize_plane(planes[p], t->quant[p], coefs.data());
-      BinCounter counter(t->models[p].data(), reinterpret_cast<uint32_t(*)[2]>(counts[p].data()));
-      code_plane(counter, t->models[p].data(), d.bw, d.bh, coefs.data(), info.data());
-    }
+    if (!constant) count_tokens(settings, quant, px, width, height, counts);
+    trained = trained || !constant;
   }
-  // Initial probability from the counts (a small prior keeps it off the extremes); contexts
-  // seen often start settled, rare ones keep adapting fast.
+  t->adaptive = !trained;
+  // Observed counts plus the prior worth a few observations: well-trained contexts start
+  // settled on the content, rare ones from the prior's shape and adapt fast.
+  constexpr double kPriorWeight = 8.0;
+  const auto& prior = prior_probabilities(settings);
   for (int p = 0; p < n; p++) {
-    for (int i = 0; i < kModelsPerPlane; i++) {
-      const double c0 = counts[p][2 * i], c1 = counts[p][2 * i + 1];
-      if (c0 + c1 < 1) continue;
-      const int p8 = std::clamp(int(std::lround(256.0 * (c0 + 0.5) / (c0 + c1 + 1.0))), 1, 255);
-      BitModel& m = t->models[p][i];
-      m.p = uint16_t(p8 * 16 + 8);
-      m.n = uint8_t(std::min<double>(c0 + c1, dct_detail::kRateCap));
+    t->models[p].resize(kHistPerPlane);
+    t->seen[p].resize(kHistPerPlane);
+    for (int i = 0; i < kHistPerPlane; i++) {
+      const size_t k = size_t(p) * kHistPerPlane + i;
+      double w[kTokens];
+      uint32_t observed = 0;
+      for (int tk = 0; tk < kTokens; tk++) {
+        w[tk] = counts[k][tk] + kPriorWeight * prior[k][tk];
+        observed += counts[k][tk];
+      }
+      t->models[p][i] = make_model(w);
+      t->seen[p][i] = uint8_t(std::min<uint32_t>(observed, dct_detail::kRateCap));
     }
   }
   return t;
 }
 
-// Tables bytes: "VTDC", version, quality, channels, layout, width u16, height u16, then per
-// plane: 64 quantiser steps (natural order), then per context one byte p8 (0: untrained,
-// probability 1/2 and fast adaptation) and, for p8 != 0, one byte of observation count.
+// Tables bytes: "VTDC", version, quality, channels, layout, width u16, height u16, mode (0
+// static models, 1 adaptive), then per plane: 64 quantiser steps (natural order), then per token
+// model its observation count (one byte, <= kRateCap) and 16 initial token frequencies, each minus
+// one as LEB128 (1-2 bytes), summing to kFreqTotal.
 std::vector<uint8_t> dct_serialize_tables(const DctTables& t) {
   std::vector<uint8_t> out(std::begin(kMagic), std::end(kMagic));
   out.push_back(kTablesVersion);
@@ -654,14 +782,20 @@ std::vector<uint8_t> dct_serialize_tables(const DctTables& t) {
   out.push_back(uint8_t(t.width >> 8));
   out.push_back(uint8_t(t.height & 0xFF));
   out.push_back(uint8_t(t.height >> 8));
+  out.push_back(t.adaptive ? 1 : 0);
   for (int p = 0; p < plane_count(t.settings); p++) {
     out.insert(out.end(), t.quant[p], t.quant[p] + 64);
-    for (const BitModel& m : t.models[p]) {
-      if (m.n == 0) {
-        out.push_back(0);
-      } else {
-        out.push_back(uint8_t(std::clamp(m.p >> 4, 1, 255)));
-        out.push_back(m.n);
+    for (int i = 0; i < kHistPerPlane; i++) {
+      const TokenModel& m = t.models[p][i];
+      out.push_back(t.seen[p][i]);
+      for (int tk = 0; tk < kTokens; tk++) {
+        const unsigned v = m.above()[tk] - dct_detail::token_start(m, tk) - 1u;
+        if (v < 0x80) {
+          out.push_back(uint8_t(v));
+        } else {
+          out.push_back(uint8_t(0x80 | (v & 0x7F)));
+          out.push_back(uint8_t(v >> 7));
+        }
       }
     }
   }
@@ -672,12 +806,13 @@ Expected<DctTablesPtr> dct_parse_tables(std::span<const uint8_t> bytes) {
   auto corrupt = [](const std::string& what) {
     return Error(ErrorCode::kCorrupt, "dct tables: " + what);
   };
-  if (bytes.size() < 12)
+  if (bytes.size() < 13)
     return corrupt("truncated header (" + std::to_string(bytes.size()) + " bytes)");
   if (std::memcmp(bytes.data(), kMagic, 4) != 0) return corrupt("bad magic");
   if (bytes[4] != kTablesVersion) {
-    return Error(ErrorCode::kUnsupported,
-                 "dct tables: version " + std::to_string(bytes[4]) + " (this build reads 1)");
+    return Error(ErrorCode::kUnsupported, "dct tables: version " + std::to_string(bytes[4]) +
+                                              " (this build reads " +
+                                              std::to_string(kTablesVersion) + ")");
   }
   DctTablesPtr t(new DctTables);
   t->settings.quality = bytes[5];
@@ -687,23 +822,39 @@ Expected<DctTablesPtr> dct_parse_tables(std::span<const uint8_t> bytes) {
   t->height = bytes[10] | (bytes[11] << 8);
   if (Status s = check_settings(t->settings); !s.ok()) return corrupt(s.message());
   if (Status s = check_size(t->width, t->height); !s.ok()) return corrupt(s.message());
-  size_t pos = 12;
+  if (bytes[12] > 1) return corrupt("bad model mode " + std::to_string(bytes[12]));
+  t->adaptive = bytes[12] == 1;
+  size_t pos = 13;
   for (int p = 0; p < plane_count(t->settings); p++) {
     if (bytes.size() - pos < 64) return corrupt("truncated quantiser table");
     for (int i = 0; i < 64; i++) {
       t->quant[p][i] = bytes[pos++];
       if (t->quant[p][i] == 0) return corrupt("zero quantiser step");
     }
-    t->models[p].assign(kModelsPerPlane, BitModel{});
-    for (BitModel& m : t->models[p]) {
-      if (pos >= bytes.size()) return corrupt("truncated context table");
-      const uint8_t p8 = bytes[pos++];
-      if (p8 == 0) continue;
-      if (pos >= bytes.size()) return corrupt("truncated context table");
-      const uint8_t n = bytes[pos++];
-      if (n == 0 || n > dct_detail::kRateCap) return corrupt("bad context count");
-      m.p = uint16_t(p8 * 16 + 8);
-      m.n = n;
+    t->models[p].resize(kHistPerPlane);
+    t->seen[p].resize(kHistPerPlane);
+    for (int i = 0; i < kHistPerPlane; i++) {
+      TokenModel& m = t->models[p][i];
+      if (pos >= bytes.size()) return corrupt("truncated token models");
+      t->seen[p][i] = bytes[pos++];
+      if (t->seen[p][i] > dct_detail::kRateCap) return corrupt("bad observation count");
+      uint32_t start = 0;
+      for (int tk = 0; tk < kTokens; tk++) {
+        if (pos >= bytes.size()) return corrupt("truncated token frequencies");
+        uint32_t v = bytes[pos++];
+        if (v & 0x80) {
+          if (pos >= bytes.size()) return corrupt("truncated token frequencies");
+          if (bytes[pos] == 0 || bytes[pos] >= (kFreqTotal >> 7)) {
+            return corrupt("bad token frequency");
+          }
+          v = (v & 0x7F) | (uint32_t(bytes[pos++]) << 7);
+        }
+        start += v + 1;
+        m.above()[tk] = uint16_t(std::min(start, kFreqTotal));
+      }
+      if (start != kFreqTotal) {
+        return corrupt("token frequencies do not sum to " + std::to_string(kFreqTotal));
+      }
     }
   }
   if (pos != bytes.size()) {
@@ -717,12 +868,7 @@ Status dct_encode_page(const DctTables& tables, const uint8_t* texels, int width
   VT_RETURN_IF_ERROR(check_size(width, height));
   if (texels == nullptr) return Error(ErrorCode::kInvalidArgument, "dct: null texels");
   const DctSettings& s = tables.settings;
-  const int n = plane_count(s);
-  FloatPlane planes[4];
-  build_planes(s, texels, width, height, planes);
   out.clear();
-  RangeEncoder enc(out);
-  std::vector<BitModel> models = tables.models[0];
   // A page of one colour is flagged and its texel stored raw, so it decodes exactly.
   const size_t texel_count = size_t(width) * height;
   const int ch = s.channels;
@@ -730,24 +876,24 @@ Status dct_encode_page(const DctTables& tables, const uint8_t* texels, int width
   for (size_t i = 1; i < texel_count && constant; i++) {
     constant = std::memcmp(texels, texels + i * ch, size_t(ch)) == 0;
   }
-  if (enc.bit(models[kConstOff], constant)) {
-    for (int c = 0; c < ch; c++) enc.direct(texels[c], 8);
-    enc.direct(kEndMarker, 16);
-    enc.finish();
+  if (constant) {
+    out.push_back(kPageConstant);
+    out.insert(out.end(), texels, texels + ch);
     return Status::Ok();
   }
-  std::vector<int16_t> coefs;
-  std::vector<BlockInfo> info;
-  for (int p = 0; p < n; p++) {
-    const PlaneDims& d = planes[p].dims;
-    coefs.assign(size_t(d.bw) * d.bh * 64, 0);
-    info.assign(size_t(d.bw) * d.bh, BlockInfo{});
-    quantize_plane(planes[p], tables.quant[p], coefs.data());
-    models = tables.models[p];
-    code_plane(enc, models.data(), d.bw, d.bh, coefs.data(), info.data());
+  FloatPlane planes[4];
+  build_planes(s, texels, width, height, planes);
+  out.push_back(kPageCoded);
+  if (tables.adaptive) {
+    encode_tokens<true>(tables, planes, out);
+  } else {
+    encode_tokens<false>(tables, planes, out);
   }
-  enc.direct(kEndMarker, 16);
-  enc.finish();
+  const size_t raw_bytes = texel_count * size_t(ch);
+  if (out.size() > raw_bytes) {
+    out.assign(1, kPageStored);
+    out.insert(out.end(), texels, texels + raw_bytes);
+  }
   return Status::Ok();
 }
 
@@ -758,72 +904,55 @@ Status dct_decode_page(const DctTables& tables, std::span<const uint8_t> data, i
   const DctSettings& s = tables.settings;
   const int n = plane_count(s);
   const int ch = s.channels;
-  thread_local DecodeScratch scratch;
-  RangeDecoder dec(data.data(), data.size());
-  BitModel const_model = tables.models[0][kConstOff];
-  if (dec.bit(const_model)) {
-    uint8_t texel[4];
-    for (int c = 0; c < ch; c++) texel[c] = uint8_t(dec.direct(0, 8));
-    VT_RETURN_IF_ERROR(check_end(dec, data.size()));
+  if (data.empty()) return corrupt_page(0, "empty");
+  if (data[0] == kPageConstant) {
+    if (data.size() != size_t(1 + ch)) return corrupt_page(data.size(), "bad constant page");
     const size_t count = size_t(width) * height;
-    for (size_t i = 0; i < count; i++) std::memcpy(texels + i * ch, texel, size_t(ch));
+    for (size_t i = 0; i < count; i++) std::memcpy(texels + i * ch, data.data() + 1, size_t(ch));
     return Status::Ok();
   }
-  for (int p = 0; p < n; p++) {
-    const PlaneDims d = plane_dims(s, p, width, height);
-    const size_t blocks = size_t(d.bw) * d.bh;
-    scratch.coefs.resize(blocks * 64);
-    scratch.info.resize(blocks);
-    scratch.samples[p].resize(size_t(d.w) * d.h);
-    scratch.models = tables.models[p];
-    code_plane(dec, scratch.models.data(), d.bw, d.bh, scratch.coefs.data(), scratch.info.data());
-    // A valid stream overreads at most 5 bytes; stop early on garbage.
-    if (dec.overread() > 8) {
-      return Error(ErrorCode::kCorrupt, "dct page: data ends early (" +
-                                            std::to_string(data.size()) + " bytes, plane " +
-                                            std::to_string(p) + ")");
-    }
-    reconstruct_plane(d, tables.quant[p], scratch.coefs.data(), scratch.info.data(),
-                      scratch.samples[p].data());
+  if (data[0] == kPageStored) {
+    const size_t raw_bytes = size_t(width) * height * ch;
+    if (data.size() != 1 + raw_bytes) return corrupt_page(data.size(), "bad stored page");
+    std::memcpy(texels, data.data() + 1, raw_bytes);
+    return Status::Ok();
   }
-  VT_RETURN_IF_ERROR(check_end(dec, data.size()));
+  if (data[0] != kPageCoded) return corrupt_page(data.size(), "unknown page kind");
+  size_t pos = 1, rans_size = 0;
+  for (int shift = 0;; shift += 7) {
+    if (pos >= data.size() || shift > 28) return corrupt_page(data.size(), "bad length field");
+    const uint8_t b = data[pos++];
+    rans_size |= size_t(b & 0x7F) << shift;
+    if (!(b & 0x80)) break;
+  }
+  if (rans_size > data.size() - pos) return corrupt_page(data.size(), "data cut short");
+  thread_local DecodeScratch scratch;
+  const std::span<const uint8_t> rans = data.subspan(pos, rans_size);
+  const std::span<const uint8_t> raw = data.subspan(pos + rans_size);
+  VT_RETURN_IF_ERROR(tables.adaptive
+                         ? decode_tokens<true>(tables, rans, raw, width, height, scratch)
+                         : decode_tokens<false>(tables, rans, raw, width, height, scratch));
 
   if (s.layout == DctPlaneLayout::kPlanes) {
     for (int p = 0; p < n; p++) {
-      const int w = plane_dims(s, p, width, height).w;
-      const int16_t* src = scratch.samples[p].data();
-      for (int y = 0; y < height; y++) {
-        uint8_t* o = texels + size_t(y) * width * ch + p;
-        const int16_t* r = src + size_t(y) * w;
-        for (int x = 0; x < width; x++) o[x * ch] = to_u8(r[x] + 1024);
-      }
+      plane_to_channel(scratch.samples[p].data(), plane_dims(s, p, width, height).w, width, height,
+                       ch, p, texels);
     }
     return Status::Ok();
   }
-
   const int16_t* yp = scratch.samples[0].data();
   const int ystride = plane_dims(s, 0, width, height).w;
   const int16_t* co = scratch.samples[1].data();
   const int16_t* cg = scratch.samples[2].data();
   const int cstride = plane_dims(s, 1, width, height).w;
   if (s.layout == DctPlaneLayout::kYCoCg420) {
-    ycocg420_to_rgb(yp, ystride, co, cg, cstride, width, height, ch, texels, scratch.row);
+    ycocg420_to_rgb(yp, ystride, co, cg, cstride, width, height, ch, texels);
   } else {
-    for (int y = 0; y < height; y++) {
-      uint8_t* o = texels + size_t(y) * width * ch;
-      const int16_t* yr = yp + size_t(y) * ystride;
-      const int16_t* cor = co + size_t(y) * cstride;
-      const int16_t* cgr = cg + size_t(y) * cstride;
-      for (int x = 0; x < width; x++) put_ycocg(o + size_t(x) * ch, yr[x], cor[x], cgr[x]);
-    }
+    ycocg_to_rgb(yp, ystride, co, cg, cstride, width, height, ch, texels);
   }
   if (ch == 4) {
-    const int w = plane_dims(s, 3, width, height).w;
-    const int16_t* a = scratch.samples[3].data();
-    for (int y = 0; y < height; y++) {
-      uint8_t* o = texels + size_t(y) * width * 4 + 3;
-      for (int x = 0; x < width; x++) o[x * 4] = to_u8(a[size_t(y) * w + x] + 1024);
-    }
+    plane_to_channel(scratch.samples[3].data(), plane_dims(s, 3, width, height).w, width, height, 4,
+                     3, texels);
   }
   return Status::Ok();
 }

@@ -1,0 +1,249 @@
+// Internal to the page DCT codec: rANS over 16-token alphabets with adaptive frequencies, plus a
+// raw bit stream. A token decodes with one table-free search over 16 cumulative counts and one
+// multiply, and its model then moves toward what it saw with one 16-lane update (the rule AV1
+// uses for its CDFs); two interleaved rANS states let consecutive tokens overlap. The encoder
+// runs the same models forward, records each token's interval, and rANS-codes them backwards.
+// Integer-only: every machine decodes the same tokens.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace vt::dct_detail {
+
+constexpr int kTokens = 16;
+constexpr int kFreqBits = 14;
+constexpr uint32_t kFreqTotal = 1u << kFreqBits;
+constexpr uint32_t kRansLow = 1u << 16;  // states live in [2^16, 2^32); 16-bit renormalisation
+constexpr int kRateCap = 40;             // observations after which a model adapts at its slowest
+
+// One adaptive distribution over the 16 tokens. above[t] = cumulative frequency of tokens 0..t
+// (above[15] = kFreqTotal); every token keeps freq >= 1, so any token can be coded anywhere.
+// cum[7] = 0 is the start of token 0, so finding a start needs no branch.
+struct alignas(16) TokenModel {
+  uint16_t cum[8 + kTokens] = {};
+  uint16_t* above() { return cum + 8; }
+  const uint16_t* above() const { return cum + 8; }
+};
+
+// Adaptation shift from the observation count: fast while a context is new, 1/64 once settled.
+inline int adapt_shift(uint8_t n) {
+  return 4 + (n >= 12) + (n >= kRateCap);
+}
+
+// Moves the model a 2^-shift step toward "token t seen": above[i] heads for i+1 below t and for
+// kFreqTotal - 15 + i from t on. Floor rounding keeps the counts ordered with gaps >= 1.
+inline void adapt(TokenModel& m, uint8_t& n, int t) {
+  const int shift = adapt_shift(n);
+  n = uint8_t(n + (n < kRateCap));
+#if defined(__SSE2__)
+  const __m128i tv = _mm_set1_epi16(int16_t(t - 1));
+  const __m128i lo_idx = _mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m128i hi_idx = _mm_setr_epi16(8, 9, 10, 11, 12, 13, 14, 15);
+  const __m128i one = _mm_set1_epi16(1), span = _mm_set1_epi16(int16_t(kFreqTotal - kTokens));
+  const __m128i sh = _mm_cvtsi32_si128(shift);
+  __m128i* p = reinterpret_cast<__m128i*>(m.above());
+  const __m128i lo = _mm_load_si128(p), hi = _mm_load_si128(p + 1);
+  const __m128i lo_target =
+      _mm_add_epi16(_mm_add_epi16(lo_idx, one), _mm_and_si128(_mm_cmpgt_epi16(lo_idx, tv), span));
+  const __m128i hi_target =
+      _mm_add_epi16(_mm_add_epi16(hi_idx, one), _mm_and_si128(_mm_cmpgt_epi16(hi_idx, tv), span));
+  _mm_store_si128(p, _mm_add_epi16(lo, _mm_sra_epi16(_mm_sub_epi16(lo_target, lo), sh)));
+  _mm_store_si128(p + 1, _mm_add_epi16(hi, _mm_sra_epi16(_mm_sub_epi16(hi_target, hi), sh)));
+#else
+  for (int i = 0; i < kTokens; i++) {
+    const int target = i + 1 + (i >= t ? int(kFreqTotal) - kTokens : 0);
+    m.above()[i] = uint16_t(m.above()[i] + ((target - m.above()[i]) >> shift));  // C++20: floor
+  }
+#endif
+}
+
+// The token whose interval holds `slot` (< kFreqTotal): the number of tokens ending at or
+// before it.
+inline int find_token(const TokenModel& m, uint32_t slot) {
+#if defined(__SSE2__)
+  const __m128i s = _mm_set1_epi16(int16_t(slot + 1));
+  const __m128i* p = reinterpret_cast<const __m128i*>(m.above());
+  const __m128i lo = _mm_cmpgt_epi16(s, _mm_load_si128(p));
+  const __m128i hi = _mm_cmpgt_epi16(s, _mm_load_si128(p + 1));
+  // The set lanes are a prefix (the counts ascend) and lane 15 is never set: count = first clear.
+  return __builtin_ctz(~unsigned(_mm_movemask_epi8(_mm_packs_epi16(lo, hi))));
+#else
+  int t = 0;
+  for (int i = 0; i < kTokens; i++) t += m.above()[i] <= slot;
+  return t;
+#endif
+}
+
+inline uint32_t token_start(const TokenModel& m, int t) {
+  return m.cum[7 + t];
+}
+
+// Collects each token's interval in coding order and rANS-encodes them backwards at the end.
+class RansEncoder {
+ public:
+  void put(const TokenModel& m, int t) {
+    const uint32_t start = token_start(m, t);
+    syms_.push_back({uint16_t(start), uint16_t(m.above()[t] - start)});
+  }
+
+  // Appends the rANS bytes: two 32-bit states (little-endian), then 16-bit words.
+  void finish(std::vector<uint8_t>& out) {
+    uint32_t x[2] = {kRansLow, kRansLow};
+    std::vector<uint16_t> words;  // emitted last-first
+    for (size_t i = syms_.size(); i-- > 0;) {
+      uint32_t& s = x[i & 1];
+      const Sym& y = syms_[i];
+      const uint32_t x_max = (kRansLow >> kFreqBits << 16) * y.freq;
+      if (s >= x_max) {
+        words.push_back(uint16_t(s));
+        s >>= 16;
+      }
+      s = ((s / y.freq) << kFreqBits) + (s % y.freq) + y.start;
+    }
+    for (int k = 0; k < 2; k++)
+      for (int b = 0; b < 4; b++) out.push_back(uint8_t(x[k] >> (8 * b)));
+    for (size_t i = words.size(); i-- > 0;) {
+      out.push_back(uint8_t(words[i]));
+      out.push_back(uint8_t(words[i] >> 8));
+    }
+    syms_.clear();
+  }
+
+ private:
+  struct Sym {
+    uint16_t start, freq;
+  };
+  std::vector<Sym> syms_;
+};
+
+// Reads zeros past the end of its bytes and counts them; a valid stream ends with both states
+// back at their initial value and every byte read (`valid_end`).
+class RansDecoder {
+ public:
+  RansDecoder(const uint8_t* data, size_t size) : p_(data), end_(data + size) {
+    x0_ = next16() | (next16() << 16);
+    x1_ = next16() | (next16() << 16);
+  }
+
+  int get(const TokenModel& m) {
+    const uint32_t slot = x0_ & (kFreqTotal - 1);
+    const int t = find_token(m, slot);
+    const uint32_t start = token_start(m, t);
+    uint32_t x = (m.above()[t] - start) * (x0_ >> kFreqBits) + slot - start;
+    if (x < kRansLow) x = (x << 16) | next16();
+    x0_ = x1_;
+    x1_ = x;
+    return t;
+  }
+
+  bool valid_end() const {
+    return x0_ == kRansLow && x1_ == kRansLow && p_ == end_ && overread_ == 0;
+  }
+  size_t overread() const { return overread_; }
+
+ private:
+  uint32_t next16() {
+    if (end_ - p_ >= 2) {
+      const uint32_t v = uint32_t(p_[0]) | (uint32_t(p_[1]) << 8);
+      p_ += 2;
+      return v;
+    }
+    overread_ += 2;
+    p_ = end_;
+    return 0;
+  }
+
+  const uint8_t* p_;
+  const uint8_t* end_;
+  uint32_t x0_ = 0, x1_ = 0;
+  size_t overread_ = 0;
+};
+
+// Raw bits, least significant first.
+class BitWriter {
+ public:
+  void put(uint32_t value, int nbits) {
+    acc_ |= uint64_t(value) << count_;
+    count_ += nbits;
+    while (count_ >= 8) {
+      bytes_.push_back(uint8_t(acc_));
+      acc_ >>= 8;
+      count_ -= 8;
+    }
+  }
+  // Pads the last byte with zeros and appends everything to `out`.
+  void finish(std::vector<uint8_t>& out) {
+    if (count_ > 0) bytes_.push_back(uint8_t(acc_));
+    out.insert(out.end(), bytes_.begin(), bytes_.end());
+    bytes_.clear();
+    acc_ = 0;
+    count_ = 0;
+  }
+
+ private:
+  std::vector<uint8_t> bytes_;
+  uint64_t acc_ = 0;
+  int count_ = 0;
+};
+
+class BitReader {
+ public:
+  BitReader(const uint8_t* data, size_t size) : p_(data), end_(data + size) {}
+
+  // nbits <= 24.
+  uint32_t get(int nbits) {
+    if (count_ < nbits) refill();
+    const uint32_t v = uint32_t(acc_) & ((1u << nbits) - 1);
+    acc_ >>= nbits;
+    count_ -= nbits;
+    return v;
+  }
+
+  // Valid when every byte was read, no invented byte was consumed, fewer than 8 real bits are
+  // left and those padding bits are zero.
+  bool valid_end() const {
+    const uint64_t invented = uint64_t(overread_) * 8;
+    return p_ == end_ && acc_ == 0 && invented <= uint64_t(count_) &&
+           uint64_t(count_) - invented < 8;
+  }
+
+ private:
+  void refill() {
+    if (end_ - p_ >= 8) {
+      // Branch-light refill: bits past the bytes stepped over are ORed in again, unchanged,
+      // by the next refill.
+      uint64_t v;
+      std::memcpy(&v, p_, 8);
+      if constexpr (__BYTE_ORDER__ == __ORDER_BIG_ENDIAN__) v = __builtin_bswap64(v);
+      acc_ |= v << count_;
+      p_ += (63 - count_) >> 3;
+      count_ |= 56;
+      return;
+    }
+    while (count_ <= 56) {
+      uint64_t b = 0;
+      if (p_ < end_) {
+        b = *p_++;
+      } else {
+        overread_++;
+      }
+      acc_ |= b << count_;
+      count_ += 8;
+    }
+  }
+
+  const uint8_t* p_;
+  const uint8_t* end_;
+  uint64_t acc_ = 0;
+  int count_ = 0;
+  size_t overread_ = 0;
+};
+
+}  // namespace vt::dct_detail
