@@ -5,16 +5,21 @@
 // in the page file), so a coded page carries only a few bytes of header.
 // Decoding is integer-exact: the same bytes give the same texels on every machine.
 //
-// Coded page (no header): one range-coded stream (LZMA-style binary coder, 12-bit adaptive
-// probabilities started from the tables) holding a constant-page flag (then the texel raw), or
-// for each plane (Y, Co, Cg, alpha; or channels 0..3 for kPlanes) its 8x8 blocks in raster
-// order, closed by a 16-bit end marker. Planes hold texels centred on 0 (YCoCg: Y=(R+2G+B)/4,
-// Co=(R-B)/2, Cg=(2G-R-B)/4), 4:2:0 chroma is the 2x2 mean and comes back through a 9-3-3-1
-// filter. Dequantised coefficients are clamped to +-2047 and inverted by a separable integer
-// DCT with a fixed 12-bit basis and specified rounding (codec/dct.cpp, idct_block).
-// Tables bytes: "VTDC", version 1, quality, channels, layout, width and height (u16 LE), then
-// per plane 64 quantiser steps (natural order) and one byte per context (0 = untrained, else
-// probability/16 followed by an observation count).
+// Coded page: a kind byte (0 coded, 1 constant: the texel follows raw, 2 stored: every texel
+// follows raw, used when coding would not make the page smaller). A coded page holds the length
+// of its rANS part (LEB128), the rANS part (two 32-bit states, then 16-bit words; 16-token
+// alphabets at 14-bit precision, codec/dct_rans.h), then a raw bit stream (low bits and signs,
+// least significant bit first). Tokens, per plane (Y, Co, Cg, alpha; or channels 0..3 for
+// kPlanes) and 8x8 block in raster order: the AC nonzero count, the DC residual from a median
+// predictor, then one token per zigzag position while nonzeros remain. Token models are static
+// when the tables were trained and adaptive (AV1-style CDF steps) when they were not. Planes
+// hold texels centred on 0 (YCoCg: Y=(R+2G+B)/4, Co=(R-B)/2, Cg=(2G-R-B)/4); 4:2:0 chroma is
+// the 2x2 mean and comes back through a 9-3-3-1 filter. Dequantised coefficients are clamped to
+// +-2047 and inverted by a separable integer DCT with a fixed 12-bit basis and specified
+// rounding and saturation (codec/dct_transform.h).
+// Tables bytes (version 2): "VTDC", 2, quality, channels, layout, width and height (u16 LE),
+// mode (0 static, 1 adaptive), then per plane 64 quantiser steps (natural order) and per token
+// model an observation count and 16 frequencies (codec/dct.cpp, dct_serialize_tables).
 // Thread safety: tables are read-only once made; encode and decode may run on any number of
 // threads at once. Decoding keeps a per-thread scratch buffer sized by the largest page.
 #pragma once
@@ -49,8 +54,9 @@ struct DctTablesDeleter {
 using DctTablesPtr = std::unique_ptr<DctTables, DctTablesDeleter>;
 
 // Builds tables for the settings. `training_pages` (optional, each width*height*channels
-// bytes) lets the encoder fit its entropy tables to the content (about 5% smaller pages on
-// photographs; the pixels decoded are the same either way). Width and height: multiples of 8
+// bytes) fits static token models to the content: pages decode fastest and smallest with them
+// (on photographs about 12% smaller than untrained tables, whose models adapt while a page is
+// decoded, at about 1.3x the entropy decoding time). The texels decoded are the same either way. Width and height: multiples of 8
 // up to 4096; the YCoCg layouts need 3 or 4 channels. Bad settings give kInvalidArgument.
 Expected<DctTablesPtr> dct_make_tables(
     const DctSettings& settings, int width, int height,
