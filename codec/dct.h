@@ -56,8 +56,9 @@ using DctTablesPtr = std::unique_ptr<DctTables, DctTablesDeleter>;
 // Builds tables for the settings. `training_pages` (optional, each width*height*channels
 // bytes) fits static token models to the content: pages decode fastest and smallest with them
 // (on photographs about 12% smaller than untrained tables, whose models adapt while a page is
-// decoded, at about 1.3x the entropy decoding time). The texels decoded are the same either way. Width and height: multiples of 8
-// up to 4096; the YCoCg layouts need 3 or 4 channels. Bad settings give kInvalidArgument.
+// decoded, at about 1.3x the entropy decoding time). The texels decoded are the same either
+// way. Width and height: multiples of 8 up to 4096; the YCoCg layouts need 3 or 4 channels.
+// Bad settings give kInvalidArgument.
 Expected<DctTablesPtr> dct_make_tables(
     const DctSettings& settings, int width, int height,
     std::span<const std::span<const uint8_t>> training_pages = {});
