@@ -653,6 +653,19 @@ Status corrupt_page(size_t size, const char* what) {
                std::string("dct page: ") + what + " (" + std::to_string(size) + " bytes)");
 }
 
+// Plane p's models for coding one page: adaptive ones are copied into `models` and `seen`
+// (they change as tokens go by); static ones are the tables' own, never written.
+template <bool kAdaptive>
+PlaneModels plane_models(const DctTables& t, int p, std::vector<TokenModel>& models,
+                         std::vector<uint8_t>& seen) {
+  if constexpr (kAdaptive) {
+    models = t.models[p];
+    seen = t.seen[p];
+    return {models.data(), seen.data()};
+  }
+  return {const_cast<TokenModel*>(t.models[p].data()), const_cast<uint8_t*>(t.seen[p].data())};
+}
+
 // Appends a coded page's length field, rANS part and raw bits.
 template <bool kAdaptive>
 void encode_tokens(const DctTables& t, const FloatPlane* planes, std::vector<uint8_t>& out) {
@@ -666,14 +679,8 @@ void encode_tokens(const DctTables& t, const FloatPlane* planes, std::vector<uin
     coefs.assign(size_t(d.bw) * d.bh * 64, 0);
     info.assign(size_t(d.bw) * d.bh, BlockInfo{});
     quantize_plane(planes[p], t.quant[p], coefs.data());
-    PlaneModels pm{const_cast<TokenModel*>(t.models[p].data()),
-                   const_cast<uint8_t*>(t.seen[p].data())};  // only read when static
-    if constexpr (kAdaptive) {
-      models = t.models[p];
-      seen = t.seen[p];
-      pm = {models.data(), seen.data()};
-    }
-    code_plane(enc, pm, d.bw, d.bh, coefs.data(), info.data());
+    code_plane(enc, plane_models<kAdaptive>(t, p, models, seen), d.bw, d.bh, coefs.data(),
+               info.data());
   }
   std::vector<uint8_t> rans;
   enc.rans.finish(rans);
@@ -697,14 +704,8 @@ Status decode_tokens(const DctTables& t, std::span<const uint8_t> rans,
     scratch.coefs.resize(blocks * 64);
     scratch.info.resize(blocks);
     scratch.samples[p].resize(size_t(d.w) * d.h);
-    PlaneModels pm{const_cast<TokenModel*>(t.models[p].data()),
-                   const_cast<uint8_t*>(t.seen[p].data())};  // only read when static
-    if constexpr (kAdaptive) {
-      scratch.models = t.models[p];
-      scratch.seen = t.seen[p];
-      pm = {scratch.models.data(), scratch.seen.data()};
-    }
-    code_plane(dec, pm, d.bw, d.bh, scratch.coefs.data(), scratch.info.data());
+    code_plane(dec, plane_models<kAdaptive>(t, p, scratch.models, scratch.seen), d.bw, d.bh,
+               scratch.coefs.data(), scratch.info.data());
     if (dec.ran_dry()) return corrupt_page(size, "data ends early");
     reconstruct_plane(d, t.quant[p], scratch.coefs.data(), scratch.info.data(),
                       scratch.samples[p].data());
