@@ -372,6 +372,9 @@ class WriterSink final : public PageSink {
                            std::span<const uint8_t> texel) override {
     return w_.add_constant_page(id, layer, texel);
   }
+  Status set_codec_tables(uint32_t layer, std::span<const uint8_t> tables) override {
+    return w_.set_codec_tables(layer, tables);
+  }
 
  private:
   PageFileWriter& w_;
@@ -484,6 +487,13 @@ Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDe
     Level0Reader level0(*in.source, plan, options.non_finite, threads);
 
     // Working-set estimate (bands, windows, page buffers) so that level storage gets the rest.
+    // DCT tables are trained on up to 256 of the layer's own pages or 16 MiB of their texels
+    // (all of level 0 for a 2K layer), held uncoded until then, a chunk of a row at a time.
+    const size_t training_pages =
+        std::clamp<size_t>((size_t(16) << 20) / encoder.page_bytes(), 1, 256);
+    constexpr uint32_t kTrainingChunk = 32;
+    const uint64_t training_hold =
+        encoder.wants_training() ? (training_pages + kTrainingChunk) * encoder.page_bytes() : 0;
     auto working_set = [&](uint32_t width) {
       uint64_t row = uint64_t(width) * wc * sizeof(float);
       uint64_t band_rows = P + 2 * margin;
@@ -495,6 +505,7 @@ Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDe
       ws += row / 2 * (P / 2);                                         // next level's rows
       ws += uint64_t(threads) * S * S * (wc * 4 + 16) * 3;             // page buffers
       ws += uint64_t(g.pages_x(0)) * S * S * 4;                        // encoded pages of a row
+      ws += training_hold;
       return ws;
     };
 
@@ -523,6 +534,42 @@ Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDe
     }
 
     Accum acc;
+    auto emit = [&](const PageId& id, const EncodedPage& e) -> Status {
+      LevelSummary& lsum = sum.levels[id.level];
+      if (e.state == PageState::kConstant) {
+        ++lsum.constant;
+        return sink.add_constant_page(
+            id, li, std::span<const uint8_t>(e.constant, plan.spec.texel_bytes()));
+      }
+      ++lsum.stored;
+      lsum.stored_bytes += e.bytes.size();
+      acc.sse += e.squared_error;
+      acc.samples += e.samples;
+      acc.max_error = std::max(acc.max_error, e.max_error);
+      return sink.add_page(id, li, e.bytes);
+    };
+    // DCT tables are trained on the layer's first non-constant level-0 pages: those pages wait,
+    // uncoded, until enough are found or level 0 ends, and are then coded with the trained
+    // tables like every later page.
+    std::vector<std::pair<PageId, std::vector<uint8_t>>> waiting;
+    auto train_and_flush = [&]() -> Status {
+      std::vector<std::span<const uint8_t>> spans;
+      for (const auto& w : waiting) spans.emplace_back(w.second);
+      VT_ASSIGN_OR_RETURN(std::vector<uint8_t> tables, encoder.train(spans));
+      VT_RETURN_IF_ERROR(sink.set_codec_tables(li, tables));
+      plan.spec.codec_tables = std::move(tables);
+      std::vector<EncodedPage> coded(waiting.size());
+      std::vector<Status> errors(waiting.size());
+      parallel_for(threads, waiting.size(), [&](size_t i) {
+        errors[i] = encoder.encode(waiting[i].second.data(), coded[i]);
+      });
+      for (size_t i = 0; i < waiting.size(); ++i) {
+        VT_RETURN_IF_ERROR(errors[i]);
+        VT_RETURN_IF_ERROR(emit(waiting[i].first, coded[i]));
+      }
+      waiting.clear();
+      return Status::Ok();
+    };
     // Coverage-preserving alpha: level 0's fraction of texels at or above the reference, and a
     // histogram of the next level's alpha gathered as its rows are made.
     const float alpha_ref = options.alpha_coverage_reference;
@@ -571,6 +618,7 @@ Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDe
       std::vector<float> next_rows;
       std::vector<EncodedPage> encoded(px);
       std::vector<uint8_t> present(px);
+      std::vector<std::vector<uint8_t>> held(px);  // texels of pages waiting for training
       const size_t page_texels = size_t(S) * S;
 
       for (uint32_t r = 0; r < py; ++r) {
@@ -586,46 +634,48 @@ Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDe
           }
         }
 
-        // Pages of this row, encoded in parallel.
+        // Pages of this row, encoded in parallel; while the tables wait for training, in
+        // chunks, so that at most a training set and a chunk of uncoded pages are held.
         t0 = Clock::now();
         std::vector<Status> errors(px);
-        parallel_for(threads, px, [&](size_t x) {
-          PageId id{l, uint32_t(x), r};
-          present[x] = covered_all || page_has_coverage(g, id, coverage.data());
-          if (!present[x]) return;
-          thread_local std::vector<float> page;
-          thread_local std::vector<uint8_t> bytes;
-          page.resize(page_texels * wc);
-          bytes.resize(encoder.page_bytes());
-          cut_page(g, id, options.address, band, page.data());
-          store_page(plan, alpha_scale, page.data(), page_texels, bytes.data());
-          errors[x] = encoder.encode(bytes.data(), encoded[x]);
-        });
-        for (uint32_t x = 0; x < px; ++x) {
-          VT_RETURN_IF_ERROR(errors[x].with_context(plan.spec.name + " page (" + std::to_string(l) +
-                                                    ", " + std::to_string(x) + ", " +
-                                                    std::to_string(r) + ")"));
-        }
-        LevelSummary& ls = sum.levels[l];
-        for (uint32_t x = 0; x < px; ++x) {
-          PageId id{l, x, r};
-          if (!present[x]) {
-            ++ls.absent;
-            continue;
+        for (uint32_t x0 = 0; x0 < px;) {
+          const bool training = encoder.wants_training();
+          const uint32_t x1 = training ? std::min(px, x0 + kTrainingChunk) : px;
+          parallel_for(threads, x1 - x0, [&](size_t i) {
+            const uint32_t x = x0 + uint32_t(i);
+            PageId id{l, x, r};
+            present[x] = covered_all || page_has_coverage(g, id, coverage.data());
+            if (!present[x]) return;
+            thread_local std::vector<float> page;
+            thread_local std::vector<uint8_t> bytes;
+            page.resize(page_texels * wc);
+            bytes.resize(encoder.page_bytes());
+            cut_page(g, id, options.address, band, page.data());
+            store_page(plan, alpha_scale, page.data(), page_texels, bytes.data());
+            if (training && !encoder.is_constant(bytes.data())) {
+              held[x] = bytes;
+            } else {
+              errors[x] = encoder.encode(bytes.data(), encoded[x]);
+            }
+          });
+          for (uint32_t x = x0; x < x1; ++x) {
+            PageId id{l, x, r};
+            VT_RETURN_IF_ERROR(errors[x].with_context(plan.spec.name + " page (" +
+                                                      std::to_string(l) + ", " + std::to_string(x) +
+                                                      ", " + std::to_string(r) + ")"));
+            if (!present[x]) {
+              ++sum.levels[l].absent;
+            } else if (!held[x].empty()) {
+              waiting.emplace_back(id, std::move(held[x]));
+              held[x].clear();
+            } else {
+              VT_RETURN_IF_ERROR(emit(id, encoded[x]));
+            }
           }
-          const EncodedPage& e = encoded[x];
-          if (e.state == PageState::kConstant) {
-            ++ls.constant;
-            VT_RETURN_IF_ERROR(sink.add_constant_page(
-                id, li, std::span<const uint8_t>(e.constant, plan.spec.texel_bytes())));
-          } else {
-            ++ls.stored;
-            ls.stored_bytes += e.bytes.size();
-            acc.sse += e.squared_error;
-            acc.samples += e.samples;
-            acc.max_error = std::max(acc.max_error, e.max_error);
-            VT_RETURN_IF_ERROR(sink.add_page(id, li, e.bytes));
+          if (training && (waiting.size() >= training_pages || (x1 == px && r + 1 == py))) {
+            VT_RETURN_IF_ERROR(train_and_flush());
           }
+          x0 = x1;
         }
         t_encode += seconds_since(t0);
 

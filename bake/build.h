@@ -119,6 +119,8 @@ class PageSink {
   virtual Status add_page(const PageId& id, uint32_t layer, std::span<const uint8_t> data) = 0;
   virtual Status add_constant_page(const PageId& id, uint32_t layer,
                                    std::span<const uint8_t> texel) = 0;
+  // A dct layer's trained tables, given before any stored page of the layer.
+  virtual Status set_codec_tables(uint32_t layer, std::span<const uint8_t> tables) = 0;
 };
 
 // Checks the options and works out the file's description (geometry and completed layer specs,

@@ -111,6 +111,7 @@ Expected<PageEncoder> PageEncoder::create(LayerSpec& layer, const PageEncoderOpt
         layer.codec_tables = dct_serialize_tables(**tables);
         e.dct_ =
             std::shared_ptr<DctTables>(std::move(tables).value().release(), DctTablesDeleter());
+        e.dct_settings_ = s;
         break;
       }
     }
@@ -119,17 +120,31 @@ Expected<PageEncoder> PageEncoder::create(LayerSpec& layer, const PageEncoderOpt
   return e;
 }
 
-Status PageEncoder::encode(const uint8_t* texels, EncodedPage& out) const {
+bool PageEncoder::is_constant(const uint8_t* texels) const {
   const size_t n = size_t(page_size_) * page_size_;
+  for (size_t i = 1; i < n; ++i) {
+    if (std::memcmp(texels, texels + i * texel_bytes_, texel_bytes_) != 0) return false;
+  }
+  return true;
+}
+
+Expected<std::vector<uint8_t>> PageEncoder::train(std::span<const std::span<const uint8_t>> pages) {
+  if (codec_ != PageCodec::kDct) {
+    return Status(ErrorCode::kInvalidArgument, "only DCT layers have tables to train");
+  }
+  VT_ASSIGN_OR_RETURN(DctTablesPtr tables,
+                      dct_make_tables(dct_settings_, int(page_size_), int(page_size_), pages));
+  dct_ = std::shared_ptr<DctTables>(tables.release(), DctTablesDeleter());
+  trained_ = true;
+  return dct_serialize_tables(*dct_);
+}
+
+Status PageEncoder::encode(const uint8_t* texels, EncodedPage& out) const {
   out.bytes.clear();
   out.squared_error = 0;
   out.max_error = 0;
   out.samples = 0;
-  bool constant = true;
-  for (size_t i = 1; i < n && constant; ++i) {
-    constant = std::memcmp(texels, texels + i * texel_bytes_, texel_bytes_) == 0;
-  }
-  if (constant) {
+  if (is_constant(texels)) {
     out.state = PageState::kConstant;
     std::memset(out.constant, 0, sizeof(out.constant));
     std::memcpy(out.constant, texels, texel_bytes_);

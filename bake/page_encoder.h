@@ -1,7 +1,7 @@
 // Encoding one layer's pages for the page file: a page whose texels are all one value becomes a
-// constant; other pages are coded with the layer's codec (DCT with tables built once per layer,
-// BC blocks + zstd, raw + zstd). Lossy codecs report the error of the stored page against the
-// texels it was made from.
+// constant; other pages are coded with the layer's codec (DCT with tables built once per layer
+// and best trained on some of its pages, BC blocks + zstd, raw + zstd). Lossy codecs report the
+// error of the stored page against the texels it was made from.
 #pragma once
 
 #include <cstdint>
@@ -49,6 +49,15 @@ class PageEncoder {
   Status encode(const uint8_t* texels, EncodedPage& out) const;
   // Decodes a stored page back to texels (tests and verification). Thread-safe.
   Status decode(std::span<const uint8_t> bytes, uint8_t* texels) const;
+  // True when every texel of the page equals the first (such a page is stored as a constant).
+  bool is_constant(const uint8_t* texels) const;
+
+  // DCT layers start with untrained tables (adaptive token models: about 13% larger pages and
+  // slower decoding than trained ones). train() fits them to some of the layer's own
+  // non-constant pages (each page_bytes()) and returns the new tables' bytes, which the file
+  // must then hold; pages encoded before it used the old tables. Not thread-safe.
+  bool wants_training() const { return codec_ == PageCodec::kDct && !trained_; }
+  Expected<std::vector<uint8_t>> train(std::span<const std::span<const uint8_t>> pages);
 
   PageCodec codec() const { return codec_; }
   size_t page_bytes() const { return size_t(page_size_) * page_size_ * texel_bytes_; }
@@ -62,6 +71,8 @@ class PageEncoder {
   uint32_t texel_bytes_ = 0;
   int zstd_level_ = 3;
   std::shared_ptr<DctTables> dct_;
+  DctSettings dct_settings_;
+  bool trained_ = false;
 };
 
 }  // namespace vt

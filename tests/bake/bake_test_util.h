@@ -41,7 +41,17 @@ class MemorySink final : public PageSink {
     p.bytes.assign(texel.begin(), texel.end());
     return Status::Ok();
   }
+  Status set_codec_tables(uint32_t layer, std::span<const uint8_t> t) override {
+    std::lock_guard<std::mutex> lock(mu_);
+    for (const auto& [key, page] : pages) {
+      if (std::get<0>(key) == layer && page.state == PageState::kStored)
+        return Error(ErrorCode::kInternal, "tables set after a stored page of the layer");
+    }
+    tables[layer].assign(t.begin(), t.end());
+    return Status::Ok();
+  }
   std::map<Key, StoredPage> pages;
+  std::map<uint32_t, std::vector<uint8_t>> tables;  // layers whose tables the build trained
 
  private:
   std::mutex mu_;
@@ -62,6 +72,8 @@ inline std::unique_ptr<BuiltPages> build_in_memory(const BuildOptions& options) 
   auto sum = build_pages(options, out->desc, out->sink);
   EXPECT_TRUE(sum.ok()) << sum.status().message();
   if (!sum.ok()) return nullptr;
+  for (const auto& [layer, tables] : out->sink.tables)
+    out->desc.layers[layer].codec_tables = tables;
   out->summary = *sum;
   return out;
 }
