@@ -445,11 +445,10 @@ Expected<PageFileDesc> plan_build(const BuildOptions& options) {
   }
   nlohmann::json meta = nlohmann::json::parse(options.metadata_json, nullptr, false);
   if (meta.is_discarded() || !meta.is_object()) meta = nlohmann::json::object();
-  meta["build"] = {{"filter", to_string(options.filter)},
-                   {"address", to_string(options.address)},
-                   {"codec", int(options.codec.codec)},
-                   {"dct_quality", options.codec.dct_quality},
-                   {"layers", sources}};
+  meta["build"] = {
+      {"filter", to_string(options.filter)},        {"address", to_string(options.address)},
+      {"codec", int(options.codec.codec)},          {"dct_quality", options.codec.dct_quality},
+      {"dct_adaptive", options.codec.dct_adaptive}, {"layers", sources}};
   desc.metadata_json = meta.dump();
   return desc;
 }

@@ -100,6 +100,7 @@ Expected<PageEncoder> PageEncoder::create(LayerSpec& layer, const PageEncoderOpt
         e.codec_ = PageCodec::kDct;
         DctSettings s;
         s.quality = std::clamp(options.dct_quality, 1, 100);
+        s.adaptive = options.dct_adaptive;
         s.channels = int(layer.channels);
         // Chroma subsampling suits colour only; packed data and normals lose too much to it.
         bool colour =

@@ -21,6 +21,7 @@ enum class CodecKind : uint8_t { kDct = 0, kBc = 1, kRaw = 2 };
 struct PageEncoderOptions {
   CodecKind codec = CodecKind::kDct;
   int dct_quality = 75;
+  bool dct_adaptive = false;  // DctSettings::adaptive: smaller pages, slower decoding
   BcQuality bc_quality = BcQuality::kNormal;
   int zstd_level = 3;
 };

@@ -67,15 +67,25 @@ Status parse_codec(const std::string& text, PageEncoderOptions* options) {
   const std::string arg = colon == std::string::npos ? "" : text.substr(colon + 1);
   const Status bad =
       Error(ErrorCode::kInvalidArgument,
-            "--codec: expected dct[:1-100], bc[:high|fast] or raw, got '" + text + "'");
+            "--codec: expected dct[:1-100][:adaptive], bc[:high|fast] or raw, got '" + text + "'");
   if (kind == "dct") {
     options->codec = CodecKind::kDct;
-    if (colon != std::string::npos) {
-      char* end = nullptr;
-      long quality = std::strtol(arg.c_str(), &end, 10);
-      if (arg.empty() || *end || quality < 1 || quality > 100) return bad;
-      options->dct_quality = int(quality);
+    if (colon == std::string::npos) return Status::Ok();
+    // dct:QUALITY, dct:adaptive or dct:QUALITY:adaptive.
+    std::string rest = arg;
+    const size_t second = rest.find(':');
+    if (second != std::string::npos) {
+      if (rest.substr(second + 1) != "adaptive") return bad;
+      options->dct_adaptive = true;
+      rest = rest.substr(0, second);
+    } else if (rest == "adaptive") {
+      options->dct_adaptive = true;
+      return Status::Ok();
     }
+    char* end = nullptr;
+    long quality = std::strtol(rest.c_str(), &end, 10);
+    if (rest.empty() || *end || quality < 1 || quality > 100) return bad;
+    options->dct_quality = int(quality);
     return Status::Ok();
   }
   if (kind == "bc") {

@@ -79,7 +79,8 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
       ->check(CLI::IsMember({"lscm", "arap"}));
   app.add_option("--supersample", f->supersample, "Transfer samples per texel: 1, 4 or 16")
       ->check(CLI::IsMember({1, 4, 16}));
-  app.add_option("--codec", f->codec, "Page codec: dct[:QUALITY], bc[:high|fast] or raw");
+  app.add_option("--codec", f->codec,
+                 "Page codec: dct[:QUALITY][:adaptive], bc[:high|fast] or raw");
   app.add_flag("--share-instances", f->share_instances,
                "Instances of one mesh share texels (default: each gets its own)");
   app.add_option("--memory-limit", f->memory_limit, "Memory budget, e.g. 512M, 8G (default 8G)");

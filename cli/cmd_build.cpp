@@ -245,7 +245,8 @@ vt::cli::CommandRunner make_build(CLI::App& sub) {
   sub.add_option("--layer", f->layers,
                  "A layer NAME=PATH; NAME albedo, normal, orm, emissive or any custom name");
   sub.add_option("--codec", f->codec,
-                 "dct[:QUALITY] (default, quality 75), bc[:high|fast] or raw (lossless)");
+                 "dct[:QUALITY][:adaptive] (default, quality 75; adaptive: smaller pages, "
+                 "slower decoding), bc[:high|fast] or raw (lossless)");
   sub.add_option("--payload", f->payload, "Payload texels per page side")->capture_default_str();
   sub.add_option("--border", f->border, "Border texels per page side")->capture_default_str();
   sub.add_option("--filter", f->filter, "Mip filter: kaiser, box or lanczos3")

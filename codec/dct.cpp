@@ -746,7 +746,7 @@ Expected<DctTablesPtr> dct_make_tables(const DctSettings& settings, int width, i
     if (!constant) count_tokens(settings, quant, px, width, height, counts);
     trained = trained || !constant;
   }
-  t->adaptive = !trained;
+  t->adaptive = settings.adaptive || !trained;
   // Observed counts plus the prior worth a few observations: well-trained contexts start
   // settled on the content, rare ones from the prior's shape and adapt fast.
   constexpr double kPriorWeight = 8.0;
@@ -825,6 +825,7 @@ Expected<DctTablesPtr> dct_parse_tables(std::span<const uint8_t> bytes) {
   if (Status s = check_size(t->width, t->height); !s.ok()) return corrupt(s.message());
   if (bytes[12] > 1) return corrupt("bad model mode " + std::to_string(bytes[12]));
   t->adaptive = bytes[12] == 1;
+  t->settings.adaptive = t->adaptive;
   size_t pos = 13;
   for (int p = 0; p < plane_count(t->settings); p++) {
     if (bytes.size() - pos < 64) return corrupt("truncated quantiser table");

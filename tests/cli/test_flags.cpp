@@ -17,7 +17,8 @@ bool contains(const std::string& s, const std::string& part) {
 
 TEST(CliFlags, BadCodecIsBadUsageInEveryCommand) {
   for (const char* command : {"build procedural:240x240", "bake missing.gltf"}) {
-    for (const char* codec : {"dct:0", "dct:101", "dct:", "dct:abc", "bc:slow", "raw:1", "jpeg"}) {
+    for (const char* codec : {"dct:0", "dct:101", "dct:", "dct:abc", "dct:50:fast",
+                              "dct:adaptive:50", "dct::adaptive", "bc:slow", "raw:1", "jpeg"}) {
       auto r = run_vtbake(std::string(command) + " -o /nonexistent/x.vtpf --codec " + codec, true);
       EXPECT_EQ(r.exit_code, 2) << command << " --codec " << codec << "\n" << r.out;
       EXPECT_TRUE(contains(r.out, "--codec")) << r.out;
@@ -42,6 +43,11 @@ TEST(CliFlags, GoodCodecAndMemoryLimitReachTheWork) {
   EXPECT_EQ(r.exit_code, 2) << r.out;
   EXPECT_TRUE(contains(r.out, "missing.gltf")) << r.out;
   EXPECT_FALSE(contains(r.out, "--codec")) << r.out;
+  for (const char* codec : {"dct:adaptive", "dct:60:adaptive"}) {
+    auto d = run_vtbake(std::string("bake missing.gltf -o /tmp/x.vtpf --codec ") + codec, true);
+    EXPECT_TRUE(contains(d.out, "missing.gltf")) << codec << "\n" << d.out;
+    EXPECT_FALSE(contains(d.out, "--codec")) << codec << "\n" << d.out;
+  }
 }
 
 }  // namespace

@@ -328,6 +328,37 @@ TEST(Dct, TrainedTablesCodeSimilarPagesSmaller) {
   EXPECT_DOUBLE_EQ(a.psnr, b.psnr);  // training changes the entropy coding only
 }
 
+TEST(Dct, AdaptiveModelsOnTrainedTablesChangeOnlyTheBytes) {
+  std::vector<std::vector<uint8_t>> training;
+  for (uint64_t seed = 1; seed <= 4; seed++) {
+    training.push_back(make_page(Pattern::kMixed, 128, 128, 3, seed));
+  }
+  std::vector<std::span<const uint8_t>> spans(training.begin(), training.end());
+  DctSettings s;
+  auto fixed = dct_make_tables(s, 128, 128, spans);
+  s.adaptive = true;
+  auto adaptive = dct_make_tables(s, 128, 128, spans);
+  ASSERT_TRUE(fixed.ok() && adaptive.ok());
+  const auto fixed_bytes = dct_serialize_tables(**fixed);
+  const auto adaptive_bytes = dct_serialize_tables(**adaptive);
+  EXPECT_EQ(fixed_bytes[12], 0);  // the mode byte
+  EXPECT_EQ(adaptive_bytes[12], 1);
+  auto parsed = dct_parse_tables(adaptive_bytes);
+  ASSERT_TRUE(parsed.ok());
+  const auto page = make_page(Pattern::kText, 128, 128, 3, 9);
+  std::vector<uint8_t> a, b, c;
+  ASSERT_TRUE(dct_encode_page(**fixed, page.data(), 128, 128, a).ok());
+  ASSERT_TRUE(dct_encode_page(**adaptive, page.data(), 128, 128, b).ok());
+  ASSERT_TRUE(dct_encode_page(**parsed, page.data(), 128, 128, c).ok());
+  EXPECT_NE(a, b);
+  EXPECT_EQ(b, c);
+  std::vector<uint8_t> da(page.size()), db(page.size());
+  ASSERT_TRUE(dct_decode_page(**fixed, a, 128, 128, da.data()).ok());
+  ASSERT_TRUE(dct_decode_page(**parsed, b, 128, 128, db.data()).ok());
+  EXPECT_EQ(da, db);
+  EXPECT_FALSE(dct_decode_page(**fixed, b, 128, 128, da.data()).ok());  // modes do not mix
+}
+
 TEST(DctTables, SerialiseParseRoundTrip) {
   const auto page = make_page(Pattern::kMixed, 128, 128, 4, 5);
   const std::span<const uint8_t> one[] = {page};
