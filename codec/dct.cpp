@@ -47,26 +47,27 @@ constexpr uint8_t kZigzag[64] = {0,  1,  8,  16, 9,  2,  3,  10, 17, 24, 32, 25,
                                  35, 42, 49, 56, 57, 50, 43, 36, 29, 22, 15, 23, 30, 37, 44, 51,
                                  58, 59, 52, 45, 38, 31, 39, 46, 53, 60, 61, 54, 47, 55, 62, 63};
 
-// Magnitude classes: tokens 0-3 are the values themselves, 4-7 pairs and quads, 8-15 powers of
-// two from 16 to 2048; `extra` low bits follow raw.
-constexpr uint16_t kTokenBase[kTokens] = {0,  1,  2,  3,   4,   6,   8,    12,
-                                          16, 32, 64, 128, 256, 512, 1024, 2048};
-constexpr uint8_t kTokenExtra[kTokens] = {0, 0, 0, 0, 1, 1, 2, 2, 4, 5, 6, 7, 8, 9, 10, 11};
-// Raw bits after an AC token: the low bits and the sign; none for a zero.
-constexpr uint8_t kFieldBits[kTokens] = {0, 1, 1, 1, 2, 2, 3, 3, 5, 6, 7, 8, 9, 10, 11, 12};
-constexpr int16_t kZeroBlock[64] = {};
+// Tokens of unsigned values (AC count, DC residual magnitude): 0-3 are the values themselves,
+// 4-7 pairs and quads, 8-15 powers of two from 16 to 2048; `extra` low bits follow raw.
+constexpr uint16_t kUintBase[kTokens] = {0,  1,  2,  3,   4,   6,   8,    12,
+                                         16, 32, 64, 128, 256, 512, 1024, 2048};
+constexpr uint8_t kUintExtra[kTokens] = {0, 0, 0, 0, 1, 1, 2, 2, 4, 5, 6, 7, 8, 9, 10, 11};
 
 inline int bit_length(unsigned v) {
   return v == 0 ? 0 : 32 - __builtin_clz(v);
 }
 
 // v <= 4095.
-inline int token_of(unsigned v) {
+inline int uint_token(unsigned v) {
   return v < 4    ? int(v)
          : v < 8  ? 4 + int((v - 4) >> 1)
          : v < 16 ? 6 + int((v - 8) >> 2)
                   : 3 + bit_length(v);
 }
+
+// Raw bits after an AC token: the low bits and the sign; none for a zero.
+constexpr uint8_t kFieldBits[kTokens] = {0, 1, 1, 1, 2, 2, 3, 3, 5, 6, 7, 8, 9, 10, 11, 12};
+constexpr int16_t kZeroBlock[64] = {};
 
 // Token models of one plane (offsets into its model array).
 constexpr int kNzCtx = 11;  // predicted AC count buckets + "no neighbour"
@@ -87,15 +88,17 @@ constexpr uint8_t kPageStored = 2;  // texels raw, when coding would not make th
 
 struct BucketTables {
   uint8_t nz[64];
-  uint8_t rem[64];      // index: nonzeros left (>= 1); histogram offset of its bucket
-  uint16_t ac[64];      // first AC histogram of zigzag position k's band
+  uint8_t rem[64];      // index: nonzeros left (>= 1); model offset of its bucket
+  uint16_t rem_bytes[64];  // the same offsets in bytes
+  alignas(16) uint16_t ac[64];  // first AC model of zigzag position k's band
   uint8_t nb[64];       // index: min(sum of neighbour magnitudes, 63)
   uint8_t max_row[64];  // largest row / column among zigzag positions 0..k
   uint8_t max_col[64];
-  constexpr BucketTables() : nz(), rem(), ac(), nb(), max_row(), max_col() {
+  constexpr BucketTables() : nz(), rem(), rem_bytes(), ac(), nb(), max_row(), max_col() {
     for (int i = 0; i < 64; i++) {
       nz[i] = i <= 3 ? i : i <= 5 ? 4 : i <= 7 ? 5 : i <= 11 ? 6 : i <= 17 ? 7 : i <= 27 ? 8 : 9;
       rem[i] = kNbCtx * (i <= 1 ? 0 : i <= 3 ? i - 1 : i <= 5 ? 3 : i <= 8 ? 4 : i <= 14 ? 5 : 6);
+      rem_bytes[i] = uint16_t(rem[i] * sizeof(TokenModel));
       const int band = i <= 1    ? 0
                        : i <= 2  ? 1
                        : i <= 4  ? 2
@@ -107,7 +110,7 @@ struct BucketTables {
                        : i <= 38 ? 8
                                  : 9;
       ac[i] = uint16_t(kAcHist + band * kRemCtx * kNbCtx);
-      nb[i] = i <= 2 ? i : i <= 4 ? 3 : i <= 8 ? 4 : 5;
+      nb[i] = i <= 2 ? i : i <= 4 ? 3 : i <= 8 ? 4 : 5;  // as ac_contexts computes it
       int r = 0, c = 0;
       for (int k = 0; k <= i; k++) {
         r = std::max(r, kZigzag[k] >> 3);
@@ -201,11 +204,10 @@ struct DctTables {
   int width = 0;
   int height = 0;
   uint8_t quant[4][64] = {};
-  // Token models per plane (kHistPerPlane each) and their observation counts. Trained models
-  // stay fixed (static, the fast path); untrained ones adapt while a page is coded.
+  // Token models per plane (kHistPerPlane each). Trained models stay fixed (static, the fast
+  // path); untrained ones adapt while a page is coded.
   bool adaptive = true;
   std::vector<TokenModel> models[4];
-  std::vector<uint8_t> seen[4];
 };
 
 void DctTablesDeleter::operator()(DctTables* t) const {
@@ -221,155 +223,144 @@ struct BlockInfo {
   uint8_t last;  // zigzag index of the last nonzero coefficient, 0 when only DC
 };
 
-// One plane's token models while a page is coded; they adapt as tokens go by.
-struct PlaneModels {
-  TokenModel* m;
-  uint8_t* seen;
+// A block's neighbours, and the contexts and prediction they give its first two tokens.
+struct BlockNeighbours {
+  const int16_t* left;  // coefficients, zigzag order
+  const int16_t* up;
+  int nz_ctx;
+  int dc_pred;
+  int dc_ctx;
 };
 
-// The three ways of walking a plane's tokens: encoding records them, counting trains the
-// models, decoding reads them. Each has token(models, index, token) and raw(value, bits).
+// `z` is block (bx, by) of a plane bw blocks wide. A missing neighbour is the other one, or
+// zeros for the first block.
+inline BlockNeighbours block_neighbours(const int16_t* z, const BlockInfo* info, int bx, int by,
+                                        int bw) {
+  const int index = by * bw + bx;
+  const bool has_left = bx > 0, has_up = by > 0;
+  BlockNeighbours n;
+  n.left = has_left ? z - 64 : has_up ? z - size_t(bw) * 64 : kZeroBlock;
+  n.up = has_up ? z - size_t(bw) * 64 : n.left;
+  n.nz_ctx = kNzCtx - 1;
+  if (has_left || has_up) {
+    const int a = has_left ? info[index - 1].nz : info[index - bw].nz;
+    const int b = has_up ? info[index - bw].nz : a;
+    n.nz_ctx = kBuckets.nz[(a + b + 1) >> 1];
+  }
+  // DC: a median (LOCO-I) predictor.
+  n.dc_pred = 0;
+  n.dc_ctx = 0;
+  if (has_left && has_up) {
+    const int l = info[index - 1].dc, a = info[index - bw].dc;
+    const int al = info[index - bw - 1].dc;
+    n.dc_pred = std::clamp(l + a - al, std::min(l, a), std::max(l, a));
+    n.dc_ctx = std::min(bit_length(unsigned(std::abs(l - a))), kDcCtx - 1);
+  } else if (has_left) {
+    n.dc_pred = info[index - 1].dc;
+  } else if (has_up) {
+    n.dc_pred = info[index - bw].dc;
+  }
+  return n;
+}
+
+// The AC models of zigzag positions k0..k0+7 (k0 a multiple of 8) before the nonzeros-left term:
+// the position's band plus the bucket of the neighbours' summed magnitude there, times `scale`
+// (1 for model indices, sizeof(TokenModel) for byte offsets). Eight positions at once keep this
+// off the per-token path.
+inline void ac_contexts(const int16_t* left, const int16_t* up, int k0, int scale, uint16_t* out) {
+#if defined(__SSE2__)
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i l = _mm_loadu_si128(reinterpret_cast<const __m128i*>(left + k0));
+  const __m128i u = _mm_loadu_si128(reinterpret_cast<const __m128i*>(up + k0));
+  // |l| + |u| <= 8190: coefficients never exceed kMaxQuantized.
+  const __m128i sum = _mm_add_epi16(_mm_max_epi16(l, _mm_sub_epi16(zero, l)),
+                                    _mm_max_epi16(u, _mm_sub_epi16(zero, u)));
+  // The bucket is [sum >= 1] + [sum >= 2] + [sum >= 3] + [sum >= 5] + [sum >= 9] (kBuckets.nb);
+  // each comparison gives -1 where it holds.
+  __m128i minus_bucket = _mm_cmpgt_epi16(sum, zero);
+  minus_bucket = _mm_add_epi16(minus_bucket, _mm_cmpgt_epi16(sum, _mm_set1_epi16(1)));
+  minus_bucket = _mm_add_epi16(minus_bucket, _mm_cmpgt_epi16(sum, _mm_set1_epi16(2)));
+  minus_bucket = _mm_add_epi16(minus_bucket, _mm_cmpgt_epi16(sum, _mm_set1_epi16(4)));
+  minus_bucket = _mm_add_epi16(minus_bucket, _mm_cmpgt_epi16(sum, _mm_set1_epi16(8)));
+  const __m128i band = _mm_load_si128(reinterpret_cast<const __m128i*>(kBuckets.ac + k0));
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(out),
+                   _mm_mullo_epi16(_mm_sub_epi16(band, minus_bucket), _mm_set1_epi16(int16_t(scale))));
+#else
+  for (int j = 0; j < 8; j++) {
+    const int sum = std::abs(left[k0 + j]) + std::abs(up[k0 + j]);
+    out[j] = uint16_t((kBuckets.ac[k0 + j] + kBuckets.nb[std::min(sum, 63)]) * scale);
+  }
+#endif
+}
+
+// The two ways of walking a plane's tokens for the encoder: encoding records them, counting
+// trains the models. Each has token(models, index, token) and raw(value, bits).
 
 template <bool kAdaptive>
 class TokenEncoder {
  public:
-  static constexpr bool kDecoding = false;
-  int token(PlaneModels& pm, int i, int t) {
-    rans.put(pm.m[i], t);
-    if constexpr (kAdaptive) dct_detail::adapt(pm.m[i], pm.seen[i], t);
-    return t;
+  void token(TokenModel* models, int i, int t) {
+    rans.put(models[i], t);
+    if constexpr (kAdaptive) dct_detail::adapt(models[i], t);
   }
-  uint32_t raw(uint32_t v, int n) {
-    bits.put(v, n);
-    return v;
-  }
+  void raw(uint32_t v, int n) { bits.put(v, n); }
   RansEncoder rans;
   BitWriter bits;
 };
 
 class TokenCounter {
  public:
-  static constexpr bool kDecoding = false;
   explicit TokenCounter(std::array<uint32_t, kTokens>* counts) : counts_(counts) {}
-  int token(PlaneModels&, int i, int t) {
-    counts_[i][t]++;
-    return t;
-  }
-  uint32_t raw(uint32_t v, int) { return v; }
+  void token(TokenModel*, int i, int t) { counts_[i][t]++; }
+  void raw(uint32_t, int) {}
 
  private:
   std::array<uint32_t, kTokens>* counts_;
 };
 
-template <bool kAdaptive>
-class TokenDecoder {
- public:
-  static constexpr bool kDecoding = true;
-  TokenDecoder(const uint8_t* rans, size_t rans_size, const uint8_t* raw, size_t raw_size)
-      : rans_(rans, rans_size), bits_(raw, raw_size) {}
-  int token(PlaneModels& pm, int i, int) {
-    const int t = rans_.get(pm.m[i]);
-    if constexpr (kAdaptive) dct_detail::adapt(pm.m[i], pm.seen[i], t);
-    return t;
-  }
-  uint32_t raw(uint32_t, int n) { return bits_.get(n); }
-  bool valid_end() const { return rans_.valid_end() && bits_.valid_end(); }
-  // A valid stream never invents input; a little slack keeps the check off the hot path.
-  bool ran_dry() const { return rans_.overread() > 64; }
-
- private:
-  RansDecoder rans_;
-  BitReader bits_;
-};
-
-// An unsigned value as a token in histogram i plus its low bits raw.
+// An unsigned value as a token in model i plus its low bits raw.
 template <class Coder>
-int code_uint(Coder& c, PlaneModels& h, int i, int v) {
-  int t = 0;
-  if constexpr (!Coder::kDecoding) t = token_of(unsigned(v));
-  t = c.token(h, i, t);
-  const int extra = kTokenExtra[t];
-  return kTokenBase[t] + (extra ? int(c.raw(uint32_t(v - kTokenBase[t]), extra)) : 0);
+void code_uint(Coder& c, TokenModel* models, int i, unsigned v) {
+  const int t = uint_token(v);
+  c.token(models, i, t);
+  c.raw(v - kUintBase[t], kUintExtra[t]);
 }
 
-// Codes one plane's blocks. Encoding reads `coefs` (quantised, zigzag order, one block after
-// another); decoding writes them. One template so every side selects contexts identically.
+// Codes one plane's blocks from `coefs` (quantised, zigzag order, one block after another).
+// decode_plane mirrors it token for token.
 template <class Coder>
-void code_plane(Coder& c, PlaneModels h, int bw, int bh, int16_t* coefs, BlockInfo* info) {
+void code_plane(Coder& c, TokenModel* models, int bw, int bh, const int16_t* coefs,
+                BlockInfo* info) {
   for (int by = 0; by < bh; by++) {
     for (int bx = 0; bx < bw; bx++) {
       const int index = by * bw + bx;
-      int16_t* z = coefs + size_t(index) * 64;
-      const bool has_left = bx > 0, has_up = by > 0;
-      // A missing neighbour is the other one, or zeros for the first block.
-      const int16_t* left = has_left ? z - 64 : has_up ? z - size_t(bw) * 64 : kZeroBlock;
-      const int16_t* up = has_up ? z - size_t(bw) * 64 : left;
-
-      // AC nonzero count.
+      const int16_t* z = coefs + size_t(index) * 64;
+      const BlockNeighbours n = block_neighbours(z, info, bx, by, bw);
       int nz = 0;
-      if constexpr (!Coder::kDecoding) {
-        for (int k = 1; k < 64; k++) nz += z[k] != 0;
-      }
-      int nz_ctx = kNzCtx - 1;
-      if (has_left || has_up) {
-        const int a = has_left ? info[index - 1].nz : info[index - bw].nz;
-        const int b = has_up ? info[index - bw].nz : a;
-        nz_ctx = kBuckets.nz[(a + b + 1) >> 1];
-      }
-      nz = std::min(code_uint(c, h, kNzHist + nz_ctx, nz), 63);
-
-      // DC: residual from a median (LOCO-I) predictor, magnitude token then sign.
-      int pred = 0, dc_ctx = 0;
-      if (has_left && has_up) {
-        const int l = info[index - 1].dc, a = info[index - bw].dc;
-        const int al = info[index - bw - 1].dc;
-        pred = std::clamp(l + a - al, std::min(l, a), std::max(l, a));
-        dc_ctx = std::min(bit_length(unsigned(std::abs(l - a))), kDcCtx - 1);
-      } else if (has_left) {
-        pred = info[index - 1].dc;
-      } else if (has_up) {
-        pred = info[index - bw].dc;
-      }
-      {
-        int res = 0;
-        if constexpr (!Coder::kDecoding) res = z[0] - pred;
-        int mag = code_uint(c, h, kDcHist + dc_ctx, std::abs(res));
-        if (mag != 0 && c.raw(res < 0, 1)) mag = -mag;
-        if constexpr (Coder::kDecoding) {
-          z[0] = int16_t(std::clamp(pred + mag, -kMaxQuantized, kMaxQuantized));
-        }
-      }
-
-      // AC coefficients. Decoding runs without a branch per position: a zero token reads no
-      // raw bits and writes 0.
-      if constexpr (Coder::kDecoding) std::memset(z + 1, 0, 63 * sizeof(int16_t));
-      // The context takes the nonzeros left as they were two positions back, so a token's
-      // context never waits on the two tokens decoded just before it.
+      for (int k = 1; k < 64; k++) nz += z[k] != 0;
+      code_uint(c, models, kNzHist + n.nz_ctx, unsigned(nz));
+      // The DC residual: a magnitude token, then the sign raw.
+      const int res = z[0] - n.dc_pred;
+      code_uint(c, models, kDcHist + n.dc_ctx, unsigned(std::abs(res)));
+      if (res != 0) c.raw(res < 0, 1);
+      // One token per position while nonzeros remain. The context takes the nonzeros left as
+      // they were two positions back, so that a decoded token's context never waits on the two
+      // tokens just before it.
+      alignas(16) uint16_t ctx[8];
       int rem = nz, rem1 = nz, rem2 = nz, last = 0;
       for (int k = 1; k < 64 && rem > 0; k++) {
-        const int nb_sum = std::abs(left[k]) + std::abs(up[k]);
-        const int i = kBuckets.ac[k] + kBuckets.rem[rem2] + kBuckets.nb[std::min(nb_sum, 63)];
+        if (k == 1 || (k & 7) == 0) ac_contexts(n.left, n.up, k & ~7, 1, ctx);
+        const int i = ctx[k & 7] + kBuckets.rem[rem2];
         rem2 = rem1;
         rem1 = rem;
-        int v = 0, t = 0;
-        if constexpr (!Coder::kDecoding) {
-          v = z[k];
-          t = token_of(unsigned(std::abs(v)));
-        }
-        t = c.token(h, i, t);
+        const int v = z[k], t = uint_token(unsigned(std::abs(v)));
+        c.token(models, i, t);
         // The low bits and the sign are near equiprobable: one raw field.
-        const uint32_t field =
-            c.raw((uint32_t(std::abs(v) - kTokenBase[t]) << 1) | (v < 0), kFieldBits[t]);
-        if constexpr (Coder::kDecoding) {
-          const int mag = kTokenBase[t] + int(field >> 1), neg = -int(field & 1);
-          z[k] = int16_t((mag ^ neg) - neg);
-        }
+        c.raw((uint32_t(std::abs(v) - kUintBase[t]) << 1) | (v < 0), kFieldBits[t]);
         rem -= t != 0;
         last = t != 0 ? k : last;
       }
-      info[index].dc = z[0];
-      info[index].nz = uint8_t(nz);
-      info[index].last = uint8_t(last);
+      info[index] = {z[0], uint8_t(nz), uint8_t(last)};
     }
   }
 }
@@ -612,7 +603,7 @@ void count_tokens(const DctSettings& s, const uint8_t* const quant[4], const uin
     info.assign(size_t(d.bw) * d.bh, BlockInfo{});
     quantize_plane(planes[p], quant[p], coefs.data());
     TokenCounter counter(counts.data() + size_t(p) * kHistPerPlane);
-    code_plane(counter, PlaneModels{}, d.bw, d.bh, coefs.data(), info.data());
+    code_plane(counter, nullptr, d.bw, d.bh, coefs.data(), info.data());
   }
 }
 
@@ -620,11 +611,66 @@ void count_tokens(const DctSettings& s, const uint8_t* const quant[4], const uin
 
 struct DecodeScratch {
   std::vector<TokenModel> models;
-  std::vector<uint8_t> seen;
   std::vector<int16_t> coefs;
   std::vector<BlockInfo> info;
   std::vector<int16_t> samples[4];
 };
+
+template <bool kAdaptive>
+int decode_token(RansDecoder& rans, TokenModel& m) {
+  const int t = rans.get(m);
+  if constexpr (kAdaptive) dct_detail::adapt(m, t);
+  return t;
+}
+
+template <bool kAdaptive>
+int decode_uint(RansDecoder& rans, BitReader& bits, TokenModel& m) {
+  const int t = decode_token<kAdaptive>(rans, m);
+  return kUintBase[t] + int(bits.get(kUintExtra[t]));
+}
+
+// Decodes one plane's blocks into `coefs`: code_plane's mirror, written out for speed (states
+// in registers, no branch per position) with the same context helpers.
+template <bool kAdaptive>
+[[gnu::noinline]] void decode_plane(RansDecoder& rans_state, BitReader& bits_state,
+                                    TokenModel* models, int bw, int bh, int16_t* coefs,
+                                    BlockInfo* info) {
+  // Local copies stay in registers.
+  RansDecoder rans = rans_state;
+  BitReader bits = bits_state;
+  for (int by = 0; by < bh; by++) {
+    for (int bx = 0; bx < bw; bx++) {
+      const int index = by * bw + bx;
+      int16_t* z = coefs + size_t(index) * 64;
+      const BlockNeighbours n = block_neighbours(z, info, bx, by, bw);
+      const int nz =
+          std::min(decode_uint<kAdaptive>(rans, bits, models[kNzHist + n.nz_ctx]), 63);
+      int res = decode_uint<kAdaptive>(rans, bits, models[kDcHist + n.dc_ctx]);
+      if (res != 0 && bits.get(1)) res = -res;
+      z[0] = int16_t(std::clamp(n.dc_pred + res, -kMaxQuantized, kMaxQuantized));
+      // A zero token reads no raw bits and writes 0, so positions need no branch.
+      std::memset(z + 1, 0, 63 * sizeof(int16_t));
+      alignas(16) uint16_t ctx[8];
+      int rem = nz, rem1 = nz, rem2 = nz, k = 1;
+      for (; k < 64 && rem > 0; k++) {
+        if (k == 1 || (k & 7) == 0) ac_contexts(n.left, n.up, k & ~7, sizeof(TokenModel), ctx);
+        TokenModel& m = *reinterpret_cast<TokenModel*>(reinterpret_cast<char*>(models) +
+                                                       ctx[k & 7] + kBuckets.rem_bytes[rem2]);
+        rem2 = rem1;
+        rem1 = rem;
+        const int t = decode_token<kAdaptive>(rans, m);
+        const uint32_t field = bits.get(kFieldBits[t]);
+        const int mag = kUintBase[t] + int(field >> 1), neg = -int(field & 1);
+        z[k] = int16_t((mag ^ neg) - neg);
+        rem -= t != 0;
+      }
+      // A valid block's last token is its last nonzero.
+      info[index] = {z[0], uint8_t(nz), uint8_t(k - 1)};
+    }
+  }
+  rans_state = rans;
+  bits_state = bits;
+}
 
 void reconstruct_plane(const PlaneDims& d, const uint8_t* quant, const int16_t* coefs,
                        const BlockInfo* info, int16_t* samples) {
@@ -653,17 +699,15 @@ Status corrupt_page(size_t size, const char* what) {
                std::string("dct page: ") + what + " (" + std::to_string(size) + " bytes)");
 }
 
-// Plane p's models for coding one page: adaptive ones are copied into `models` and `seen`
-// (they change as tokens go by); static ones are the tables' own, never written.
+// Plane p's models for coding one page: adaptive ones are copied into `models` (they change as
+// tokens go by); static ones are the tables' own, never written.
 template <bool kAdaptive>
-PlaneModels plane_models(const DctTables& t, int p, std::vector<TokenModel>& models,
-                         std::vector<uint8_t>& seen) {
+TokenModel* plane_models(const DctTables& t, int p, std::vector<TokenModel>& models) {
   if constexpr (kAdaptive) {
     models = t.models[p];
-    seen = t.seen[p];
-    return {models.data(), seen.data()};
+    return models.data();
   }
-  return {const_cast<TokenModel*>(t.models[p].data()), const_cast<uint8_t*>(t.seen[p].data())};
+  return const_cast<TokenModel*>(t.models[p].data());
 }
 
 // Appends a coded page's length field, rANS part and raw bits.
@@ -671,7 +715,6 @@ template <bool kAdaptive>
 void encode_tokens(const DctTables& t, const FloatPlane* planes, std::vector<uint8_t>& out) {
   TokenEncoder<kAdaptive> enc;
   std::vector<TokenModel> models;
-  std::vector<uint8_t> seen;
   std::vector<int16_t> coefs;
   std::vector<BlockInfo> info;
   for (int p = 0; p < plane_count(t.settings); p++) {
@@ -679,8 +722,7 @@ void encode_tokens(const DctTables& t, const FloatPlane* planes, std::vector<uin
     coefs.assign(size_t(d.bw) * d.bh * 64, 0);
     info.assign(size_t(d.bw) * d.bh, BlockInfo{});
     quantize_plane(planes[p], t.quant[p], coefs.data());
-    code_plane(enc, plane_models<kAdaptive>(t, p, models, seen), d.bw, d.bh, coefs.data(),
-               info.data());
+    code_plane(enc, plane_models<kAdaptive>(t, p, models), d.bw, d.bh, coefs.data(), info.data());
   }
   std::vector<uint8_t> rans;
   enc.rans.finish(rans);
@@ -697,20 +739,22 @@ template <bool kAdaptive>
 Status decode_tokens(const DctTables& t, std::span<const uint8_t> rans,
                      std::span<const uint8_t> raw, int width, int height, DecodeScratch& scratch) {
   const size_t size = 1 + rans.size() + raw.size();
-  TokenDecoder<kAdaptive> dec(rans.data(), rans.size(), raw.data(), raw.size());
+  RansDecoder rans_dec(rans.data(), rans.size());
+  BitReader bits(raw.data(), raw.size());
   for (int p = 0; p < plane_count(t.settings); p++) {
     const PlaneDims d = plane_dims(t.settings, p, width, height);
     const size_t blocks = size_t(d.bw) * d.bh;
     scratch.coefs.resize(blocks * 64);
     scratch.info.resize(blocks);
     scratch.samples[p].resize(size_t(d.w) * d.h);
-    code_plane(dec, plane_models<kAdaptive>(t, p, scratch.models, scratch.seen), d.bw, d.bh,
-               scratch.coefs.data(), scratch.info.data());
-    if (dec.ran_dry()) return corrupt_page(size, "data ends early");
+    decode_plane<kAdaptive>(rans_dec, bits, plane_models<kAdaptive>(t, p, scratch.models), d.bw,
+                            d.bh, scratch.coefs.data(), scratch.info.data());
+    // A valid stream never invents input; a little slack keeps the check off the hot path.
+    if (rans_dec.overread() > 64) return corrupt_page(size, "data ends early");
     reconstruct_plane(d, t.quant[p], scratch.coefs.data(), scratch.info.data(),
                       scratch.samples[p].data());
   }
-  if (!dec.valid_end()) return corrupt_page(size, "data cut short, damaged or over-long");
+  if (!rans_dec.valid_end() || !bits.valid_end()) return corrupt_page(size, "data cut short, damaged or over-long");
   return Status::Ok();
 }
 
@@ -753,7 +797,6 @@ Expected<DctTablesPtr> dct_make_tables(const DctSettings& settings, int width, i
   const auto& prior = prior_probabilities(settings);
   for (int p = 0; p < n; p++) {
     t->models[p].resize(kHistPerPlane);
-    t->seen[p].resize(kHistPerPlane);
     for (int i = 0; i < kHistPerPlane; i++) {
       const size_t k = size_t(p) * kHistPerPlane + i;
       double w[kTokens];
@@ -763,7 +806,7 @@ Expected<DctTablesPtr> dct_make_tables(const DctSettings& settings, int width, i
         observed += counts[k][tk];
       }
       t->models[p][i] = make_model(w);
-      t->seen[p][i] = uint8_t(std::min<uint32_t>(observed, dct_detail::kRateCap));
+      t->models[p][i].seen() = uint16_t(std::min<uint32_t>(observed, dct_detail::kRateCap));
     }
   }
   return t;
@@ -788,7 +831,7 @@ std::vector<uint8_t> dct_serialize_tables(const DctTables& t) {
     out.insert(out.end(), t.quant[p], t.quant[p] + 64);
     for (int i = 0; i < kHistPerPlane; i++) {
       const TokenModel& m = t.models[p][i];
-      out.push_back(t.seen[p][i]);
+      out.push_back(uint8_t(m.seen()));
       for (int tk = 0; tk < kTokens; tk++) {
         const unsigned v = m.above()[tk] - dct_detail::token_start(m, tk) - 1u;
         if (v < 0x80) {
@@ -834,12 +877,11 @@ Expected<DctTablesPtr> dct_parse_tables(std::span<const uint8_t> bytes) {
       if (t->quant[p][i] == 0) return corrupt("zero quantiser step");
     }
     t->models[p].resize(kHistPerPlane);
-    t->seen[p].resize(kHistPerPlane);
     for (int i = 0; i < kHistPerPlane; i++) {
       TokenModel& m = t->models[p][i];
       if (pos >= bytes.size()) return corrupt("truncated token models");
-      t->seen[p][i] = bytes[pos++];
-      if (t->seen[p][i] > dct_detail::kRateCap) return corrupt("bad observation count");
+      m.seen() = bytes[pos++];
+      if (m.seen() > dct_detail::kRateCap) return corrupt("bad observation count");
       uint32_t start = 0;
       for (int tk = 0; tk < kTokens; tk++) {
         if (pos >= bytes.size()) return corrupt("truncated token frequencies");

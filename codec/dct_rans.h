@@ -25,23 +25,26 @@ constexpr int kRateCap = 40;             // observations after which a model ada
 
 // One adaptive distribution over the 16 tokens. above[t] = cumulative frequency of tokens 0..t
 // (above[15] = kFreqTotal); every token keeps freq >= 1, so any token can be coded anywhere.
-// cum[7] = 0 is the start of token 0, so finding a start needs no branch.
+// cum[7] = 0 is the start of token 0, so finding a start needs no branch; cum[0] counts the
+// observations an adaptive model has made (up to kRateCap), which set its adaptation rate.
 struct alignas(16) TokenModel {
   uint16_t cum[8 + kTokens] = {};
   uint16_t* above() { return cum + 8; }
   const uint16_t* above() const { return cum + 8; }
+  uint16_t& seen() { return cum[0]; }
+  uint16_t seen() const { return cum[0]; }
 };
 
 // Adaptation shift from the observation count: fast while a context is new, 1/64 once settled.
-inline int adapt_shift(uint8_t n) {
+inline int adapt_shift(int n) {
   return 4 + (n >= 12) + (n >= kRateCap);
 }
 
 // Moves the model a 2^-shift step toward "token t seen": above[i] heads for i+1 below t and for
 // kFreqTotal - 15 + i from t on. Floor rounding keeps the counts ordered with gaps >= 1.
-inline void adapt(TokenModel& m, uint8_t& n, int t) {
-  const int shift = adapt_shift(n);
-  n = uint8_t(n + (n < kRateCap));
+inline void adapt(TokenModel& m, int t) {
+  const int shift = adapt_shift(m.seen());
+  m.seen() = uint16_t(m.seen() + (m.seen() < kRateCap));
 #if defined(__SSE2__)
   const __m128i tv = _mm_set1_epi16(int16_t(t - 1));
   const __m128i lo_idx = _mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7);
@@ -198,9 +201,11 @@ class BitReader {
   BitReader(const uint8_t* data, size_t size) : p_(data), end_(data + size) {}
 
   // nbits <= 24.
-  uint32_t get(int nbits) {
+  uint32_t get(int nbits) { return get(nbits, (1u << nbits) - 1); }
+  // The same with mask = 2^nbits - 1 given.
+  uint32_t get(int nbits, uint32_t mask) {
     if (count_ < nbits) refill();
-    const uint32_t v = uint32_t(acc_) & ((1u << nbits) - 1);
+    const uint32_t v = uint32_t(acc_) & mask;
     acc_ >>= nbits;
     count_ -= nbits;
     return v;
