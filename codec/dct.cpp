@@ -65,52 +65,103 @@ inline int uint_token(unsigned v) {
                   : 3 + bit_length(v);
 }
 
-// Raw bits after an AC token: the low bits and the sign; none for a zero.
-constexpr uint8_t kFieldBits[kTokens] = {0, 1, 1, 1, 2, 2, 3, 3, 5, 6, 7, 8, 9, 10, 11, 12};
-constexpr int16_t kZeroBlock[64] = {};
+// AC coefficients go in pairs of zigzag positions (2j+1, 2j+2; the last pair's second is a
+// phantom position 64, always zero): a pair token is c0 + 4 * c1 with c = min(|v|, 3). The signs
+// of the pair's nonzeros follow raw (first position first); each c = 3 is then an escape token
+// for |v| - 3, an unsigned value. Pairs halve the tokens of per-position coding and keep every
+// token's position fixed, so no token's context waits on the token just before it.
+constexpr int kPairs = 32;
+constexpr int kEscapeClass = 3;
+struct PairToken {
+  uint8_t a0, a1;    // magnitude classes of the two positions
+  uint8_t nonzeros;  // raw sign bits that follow
+  uint8_t mask;      // 2^nonzeros - 1
+  uint8_t has0;      // 1 when the first position is nonzero
+  uint8_t escape;    // 1 when a class is kEscapeClass
+  uint8_t pad[2];
+};
+
+// Two int16 coefficients as they lie in memory, first position first.
+constexpr uint32_t coefficient_pair(int v0, int v1) {
+  const uint32_t lo = uint16_t(v0), hi = uint16_t(v1);
+  return __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__ ? lo | (hi << 16) : hi | (lo << 16);
+}
+
+// The pair's coefficients from its magnitudes and sign bits (first nonzero first). A sign bit
+// on a zero would be harmless (-0), and none is read for one.
+constexpr uint32_t signed_pair(int a0, int a1, uint32_t signs, int has0) {
+  const int n0 = -int(signs & unsigned(has0)), n1 = -int(signs >> has0);
+  return coefficient_pair((a0 ^ n0) - n0, (a1 ^ n1) - n1);
+}
+
+inline int pair_class(int v) {
+  return std::min(std::abs(v), kEscapeClass);
+}
+
+// Read as a neighbour where there is none; long enough for the phantom position 64.
+constexpr int16_t kZeroBlock[72] = {};
 
 // Token models of one plane (offsets into its model array).
 constexpr int kNzCtx = 11;  // predicted AC count buckets + "no neighbour"
 constexpr int kDcCtx = 8;   // bit length of the neighbours' DC difference
-constexpr int kBands = 10;  // zigzag position bands
+constexpr int kBands = 10;  // pair position bands
 constexpr int kRemCtx = 7;  // nonzeros left
-constexpr int kNbCtx = 6;   // neighbours' magnitude at the same position
+constexpr int kNbCtx = 6;   // neighbours' magnitude at the pair's positions
 constexpr int kNzHist = 0;
 constexpr int kDcHist = kNzHist + kNzCtx;
-constexpr int kAcHist = kDcHist + kDcCtx;
-constexpr int kHistPerPlane = kAcHist + kBands * kRemCtx * kNbCtx;
+constexpr int kPairHist = kDcHist + kDcCtx;
+constexpr int kEscHist = kPairHist + kBands * kRemCtx * kNbCtx;  // per band and neighbours
+constexpr int kHistPerPlane = kEscHist + kBands * kNbCtx;
 
 constexpr uint8_t kMagic[4] = {'V', 'T', 'D', 'C'};
-constexpr uint8_t kTablesVersion = 2;
+constexpr uint8_t kTablesVersion = 3;
 constexpr uint8_t kPageCoded = 0;
 constexpr uint8_t kPageConstant = 1;
 constexpr uint8_t kPageStored = 2;  // texels raw, when coding would not make the page smaller
 
 struct BucketTables {
   uint8_t nz[64];
-  uint8_t rem[64];      // index: nonzeros left (>= 1); model offset of its bucket
-  uint16_t rem_bytes[64];  // the same offsets in bytes
-  alignas(16) uint16_t ac[64];  // first AC model of zigzag position k's band
+  uint8_t rem[64];  // index: nonzeros left (>= 1); model offset of its bucket
+  uint16_t rem_bytes[64];             // the same offsets in bytes
+  alignas(16) int32_t pair[kPairs];   // first model of pair j's band
+  alignas(16) int32_t esc[kPairs];    // first escape model of pair j's band
   uint8_t nb[64];       // index: min(sum of neighbour magnitudes, 63)
   uint8_t max_row[64];  // largest row / column among zigzag positions 0..k
   uint8_t max_col[64];
-  constexpr BucketTables() : nz(), rem(), rem_bytes(), ac(), nb(), max_row(), max_col() {
+  PairToken pair_token[kTokens];
+  uint32_t pair_value[kTokens][4];  // coefficient_pair of a token without escapes, by sign bits
+  constexpr BucketTables()
+      : nz(),
+        rem(),
+        rem_bytes(),
+        pair(),
+        esc(),
+        nb(),
+        max_row(),
+        max_col(),
+        pair_token(),
+        pair_value() {
+    for (int t = 0; t < kTokens; t++) {
+      const int a0 = t & 3, a1 = t >> 2;
+      const int nonzeros = (a0 != 0) + (a1 != 0);
+      pair_token[t] = {uint8_t(a0),       uint8_t(a1),
+                       uint8_t(nonzeros), uint8_t((1 << nonzeros) - 1),
+                       uint8_t(a0 != 0),  uint8_t(a0 == kEscapeClass || a1 == kEscapeClass),
+                       {}};
+      for (uint32_t signs = 0; signs < 4; signs++) {
+        pair_value[t][signs] = signed_pair(a0, a1, signs & ((1u << nonzeros) - 1), a0 != 0);
+      }
+    }
+    for (int j = 0; j < kPairs; j++) {
+      const int band = j <= 4 ? j : j <= 6 ? 5 : j <= 9 ? 6 : j <= 13 ? 7 : j <= 18 ? 8 : 9;
+      pair[j] = kPairHist + band * kRemCtx * kNbCtx;
+      esc[j] = kEscHist + band * kNbCtx;
+    }
     for (int i = 0; i < 64; i++) {
       nz[i] = i <= 3 ? i : i <= 5 ? 4 : i <= 7 ? 5 : i <= 11 ? 6 : i <= 17 ? 7 : i <= 27 ? 8 : 9;
       rem[i] = kNbCtx * (i <= 1 ? 0 : i <= 3 ? i - 1 : i <= 5 ? 3 : i <= 8 ? 4 : i <= 14 ? 5 : 6);
       rem_bytes[i] = uint16_t(rem[i] * sizeof(TokenModel));
-      const int band = i <= 1    ? 0
-                       : i <= 2  ? 1
-                       : i <= 4  ? 2
-                       : i <= 6  ? 3
-                       : i <= 9  ? 4
-                       : i <= 14 ? 5
-                       : i <= 20 ? 6
-                       : i <= 27 ? 7
-                       : i <= 38 ? 8
-                                 : 9;
-      ac[i] = uint16_t(kAcHist + band * kRemCtx * kNbCtx);
-      nb[i] = i <= 2 ? i : i <= 4 ? 3 : i <= 8 ? 4 : 5;  // as ac_contexts computes it
+      nb[i] = i <= 2 ? i : i <= 4 ? 3 : i <= 8 ? 4 : 5;  // as pair_contexts computes it
       int r = 0, c = 0;
       for (int k = 0; k <= i; k++) {
         r = std::max(r, kZigzag[k] >> 3);
@@ -204,6 +255,11 @@ struct DctTables {
   int width = 0;
   int height = 0;
   uint8_t quant[4][64] = {};
+  // Zigzag order, for the decoder: the steps, and the largest magnitudes that do not saturate
+  // (ceil(kMaxDequantized / step)), so that clamping before the multiply gives the same result
+  // as after it and the product fits 16 bits.
+  alignas(16) int16_t dequant_step[4][64] = {};
+  alignas(16) int16_t dequant_limit[4][64] = {};
   // Token models per plane (kHistPerPlane each). Trained models stay fixed (static, the fast
   // path); untrained ones adapt while a page is coded.
   bool adaptive = true;
@@ -234,7 +290,7 @@ struct BlockNeighbours {
 
 // `z` is block (bx, by) of a plane bw blocks wide. A missing neighbour is the other one, or
 // zeros for the first block.
-inline BlockNeighbours block_neighbours(const int16_t* z, const BlockInfo* info, int bx, int by,
+[[gnu::always_inline]] inline BlockNeighbours block_neighbours(const int16_t* z, const BlockInfo* info, int bx, int by,
                                         int bw) {
   const int index = by * bw + bx;
   const bool has_left = bx > 0, has_up = by > 0;
@@ -263,32 +319,48 @@ inline BlockNeighbours block_neighbours(const int16_t* z, const BlockInfo* info,
   return n;
 }
 
-// The AC models of zigzag positions k0..k0+7 (k0 a multiple of 8) before the nonzeros-left term:
-// the position's band plus the bucket of the neighbours' summed magnitude there, times `scale`
-// (1 for model indices, sizeof(TokenModel) for byte offsets). Eight positions at once keep this
-// off the per-token path.
-inline void ac_contexts(const int16_t* left, const int16_t* up, int k0, int scale, uint16_t* out) {
+// Pair contexts of pairs j0..j0+3 (j0 a multiple of 4), before the nonzeros-left term: the
+// pair's band plus the bucket of the neighbours' summed magnitude over its two positions, times
+// `scale` (1 for model indices, sizeof(TokenModel) for byte offsets), into `pair`; the escape
+// model (band and the same bucket, an index) into `esc`. Four pairs at once keep this off the
+// per-token path.
+inline void pair_contexts(const int16_t* left, const int16_t* up, int j0, int scale,
+                          uint16_t* pair, uint16_t* esc) {
+  const int k0 = 2 * j0 + 1;  // positions k0..k0+7; position 64 is the phantom, counted as 0
 #if defined(__SSE2__)
   const __m128i zero = _mm_setzero_si128();
   const __m128i l = _mm_loadu_si128(reinterpret_cast<const __m128i*>(left + k0));
   const __m128i u = _mm_loadu_si128(reinterpret_cast<const __m128i*>(up + k0));
-  // |l| + |u| <= 8190: coefficients never exceed kMaxQuantized.
-  const __m128i sum = _mm_add_epi16(_mm_max_epi16(l, _mm_sub_epi16(zero, l)),
-                                    _mm_max_epi16(u, _mm_sub_epi16(zero, u)));
+  // |l| + |u| <= 8196: decoded coefficients never exceed 3 + 4095.
+  __m128i sum = _mm_add_epi16(_mm_max_epi16(l, _mm_sub_epi16(zero, l)),
+                              _mm_max_epi16(u, _mm_sub_epi16(zero, u)));
+  if (k0 == 57) sum = _mm_and_si128(sum, _mm_setr_epi16(-1, -1, -1, -1, -1, -1, -1, 0));
+  const __m128i pair_sum = _mm_madd_epi16(sum, _mm_set1_epi16(1));
   // The bucket is [sum >= 1] + [sum >= 2] + [sum >= 3] + [sum >= 5] + [sum >= 9] (kBuckets.nb);
   // each comparison gives -1 where it holds.
-  __m128i minus_bucket = _mm_cmpgt_epi16(sum, zero);
-  minus_bucket = _mm_add_epi16(minus_bucket, _mm_cmpgt_epi16(sum, _mm_set1_epi16(1)));
-  minus_bucket = _mm_add_epi16(minus_bucket, _mm_cmpgt_epi16(sum, _mm_set1_epi16(2)));
-  minus_bucket = _mm_add_epi16(minus_bucket, _mm_cmpgt_epi16(sum, _mm_set1_epi16(4)));
-  minus_bucket = _mm_add_epi16(minus_bucket, _mm_cmpgt_epi16(sum, _mm_set1_epi16(8)));
-  const __m128i band = _mm_load_si128(reinterpret_cast<const __m128i*>(kBuckets.ac + k0));
-  _mm_storeu_si128(reinterpret_cast<__m128i*>(out),
-                   _mm_mullo_epi16(_mm_sub_epi16(band, minus_bucket), _mm_set1_epi16(int16_t(scale))));
+  __m128i minus_bucket = _mm_cmpgt_epi32(pair_sum, zero);
+  minus_bucket = _mm_add_epi32(minus_bucket, _mm_cmpgt_epi32(pair_sum, _mm_set1_epi32(1)));
+  minus_bucket = _mm_add_epi32(minus_bucket, _mm_cmpgt_epi32(pair_sum, _mm_set1_epi32(2)));
+  minus_bucket = _mm_add_epi32(minus_bucket, _mm_cmpgt_epi32(pair_sum, _mm_set1_epi32(4)));
+  minus_bucket = _mm_add_epi32(minus_bucket, _mm_cmpgt_epi32(pair_sum, _mm_set1_epi32(8)));
+  const __m128i p = _mm_sub_epi32(
+      _mm_load_si128(reinterpret_cast<const __m128i*>(kBuckets.pair + j0)), minus_bucket);
+  const __m128i e = _mm_sub_epi32(
+      _mm_load_si128(reinterpret_cast<const __m128i*>(kBuckets.esc + j0)), minus_bucket);
+  // Both fit 16 bits: indices < kHistPerPlane, byte offsets < kHistPerPlane * 48.
+  const __m128i packed = _mm_packs_epi32(p, e);
+  _mm_storel_epi64(reinterpret_cast<__m128i*>(pair),
+                   _mm_mullo_epi16(packed, _mm_set1_epi16(int16_t(scale))));
+  _mm_storel_epi64(reinterpret_cast<__m128i*>(esc), _mm_unpackhi_epi64(packed, packed));
 #else
-  for (int j = 0; j < 8; j++) {
-    const int sum = std::abs(left[k0 + j]) + std::abs(up[k0 + j]);
-    out[j] = uint16_t((kBuckets.ac[k0 + j] + kBuckets.nb[std::min(sum, 63)]) * scale);
+  for (int q = 0; q < 4; q++) {
+    int sum = 0;
+    for (int k = k0 + 2 * q; k < k0 + 2 * q + 2 && k < 64; k++) {
+      sum += std::abs(left[k]) + std::abs(up[k]);
+    }
+    const int bucket = kBuckets.nb[std::min(sum, 63)];
+    pair[q] = uint16_t((kBuckets.pair[j0 + q] + bucket) * scale);
+    esc[q] = uint16_t(kBuckets.esc[j0 + q] + bucket);
   }
 #endif
 }
@@ -343,22 +415,24 @@ void code_plane(Coder& c, TokenModel* models, int bw, int bh, const int16_t* coe
       const int res = z[0] - n.dc_pred;
       code_uint(c, models, kDcHist + n.dc_ctx, unsigned(std::abs(res)));
       if (res != 0) c.raw(res < 0, 1);
-      // One token per position while nonzeros remain. The context takes the nonzeros left as
-      // they were two positions back, so that a decoded token's context never waits on the two
-      // tokens just before it.
-      alignas(16) uint16_t ctx[8];
-      int rem = nz, rem1 = nz, rem2 = nz, last = 0;
-      for (int k = 1; k < 64 && rem > 0; k++) {
-        if (k == 1 || (k & 7) == 0) ac_contexts(n.left, n.up, k & ~7, 1, ctx);
-        const int i = ctx[k & 7] + kBuckets.rem[rem2];
+      // Pair tokens while nonzeros remain. The context takes the nonzeros left as they were
+      // two tokens back, so that a decoded token's context never waits on the token just
+      // before it.
+      uint16_t pair_ctx[4], esc_ctx[4];
+      int rem = nz, rem1 = nz, rem2 = nz, last = 0;  // rem1, rem2: after tokens j - 1, j - 2
+      for (int j = 0, k = 1; rem > 0; j++, k += 2) {
+        if ((j & 3) == 0) pair_contexts(n.left, n.up, j, 1, pair_ctx, esc_ctx);
+        const int i = pair_ctx[j & 3] + kBuckets.rem[rem2];
+        const int v0 = z[k], v1 = k < 63 ? z[k + 1] : 0;
+        const int a0 = pair_class(v0), a1 = pair_class(v1);
+        c.token(models, i, a0 + 4 * a1);
+        c.raw(uint32_t(v0 < 0) | (uint32_t(v1 < 0) << (v0 != 0)), (v0 != 0) + (v1 != 0));
+        if (a0 == kEscapeClass) code_uint(c, models, esc_ctx[j & 3], unsigned(std::abs(v0)) - 3);
+        if (a1 == kEscapeClass) code_uint(c, models, esc_ctx[j & 3], unsigned(std::abs(v1)) - 3);
+        rem -= (v0 != 0) + (v1 != 0);
         rem2 = rem1;
         rem1 = rem;
-        const int v = z[k], t = uint_token(unsigned(std::abs(v)));
-        c.token(models, i, t);
-        // The low bits and the sign are near equiprobable: one raw field.
-        c.raw((uint32_t(std::abs(v) - kUintBase[t]) << 1) | (v < 0), kFieldBits[t]);
-        rem -= t != 0;
-        last = t != 0 ? k : last;
+        last = v1 != 0 ? k + 1 : v0 != 0 ? k : last;
       }
       info[index] = {z[0], uint8_t(nz), uint8_t(last)};
     }
@@ -566,18 +640,21 @@ const std::vector<std::array<double, kTokens>>& prior_probabilities(const DctSet
       return normalised(w);
     };
     const auto nz_all = sum_range(kNzHist, kDcHist, 1);
-    const auto dc_all = sum_range(kDcHist, kAcHist, 1);
-    const auto ac_all = sum_range(kAcHist, kHistPerPlane, 1);
+    const auto dc_all = sum_range(kDcHist, kPairHist, 1);
+    const auto pair_all = sum_range(kPairHist, kEscHist, 1);
+    const auto esc_all = sum_range(kEscHist, kHistPerPlane, 1);
     for (int i = 0; i < kHistPerPlane; i++) {
       std::array<double, kTokens> parent;
       if (i < kDcHist) {
         parent = nz_all;
-      } else if (i < kAcHist) {
+      } else if (i < kPairHist) {
         parent = dc_all;
       } else {
-        const int group = kAcHist + (i - kAcHist) / kNbCtx * kNbCtx;  // same band and rem
+        // The same band (and nonzeros left) over every neighbour bucket.
+        const int group = i - (i - kPairHist) % kNbCtx;
         const auto g = sum_range(group, group + kNbCtx, 1);
-        for (int t = 0; t < kTokens; t++) parent[t] = 0.8 * g[t] + 0.2 * ac_all[t];
+        const auto& all = i < kEscHist ? pair_all : esc_all;
+        for (int t = 0; t < kTokens; t++) parent[t] = 0.8 * g[t] + 0.2 * all[t];
       }
       std::array<double, kTokens> w{};
       for (int t = 0; t < kTokens; t++) w[t] = c[i][t] + 4.0 * parent[t];
@@ -610,6 +687,8 @@ void count_tokens(const DctSettings& s, const uint8_t* const quant[4], const uin
 // ---- decoder side: integer-exact ----
 
 struct DecodeScratch {
+  std::vector<uint8_t> rans;  // the page's rANS bytes and RansDecoder::kPadding zeros
+  std::vector<uint8_t> raw;   // its raw bits and BitReader::kPadding zeros
   std::vector<TokenModel> models;
   std::vector<int16_t> coefs;
   std::vector<BlockInfo> info;
@@ -617,8 +696,8 @@ struct DecodeScratch {
 };
 
 template <bool kAdaptive>
-int decode_token(RansDecoder& rans, TokenModel& m) {
-  const int t = rans.get(m);
+unsigned decode_token(RansDecoder& rans, TokenModel& m) {
+  const unsigned t = rans.get(m);
   if constexpr (kAdaptive) dct_detail::adapt(m, t);
   return t;
 }
@@ -626,13 +705,34 @@ int decode_token(RansDecoder& rans, TokenModel& m) {
 template <bool kAdaptive>
 int decode_uint(RansDecoder& rans, BitReader& bits, TokenModel& m) {
   const int t = decode_token<kAdaptive>(rans, m);
-  return kUintBase[t] + int(bits.get(kUintExtra[t]));
+  return kUintBase[t] + int(bits.take(kUintExtra[t], (1u << kUintExtra[t]) - 1));
+}
+
+inline void zero_block(int16_t* z) {
+#if defined(__SSE2__)
+  // Eight stores; a memset call here costs more than the block's tokens when they are few.
+  for (int i = 0; i < 64; i += 8) _mm_storeu_si128(reinterpret_cast<__m128i*>(z + i), _mm_setzero_si128());
+#else
+  std::memset(z, 0, 64 * sizeof(int16_t));
+#endif
+}
+
+// Models of pairs j0..j0+3 before the nonzeros-left term (as bytes), and their escape models.
+inline void pair_models(const BlockNeighbours& n, int j0, TokenModel* models, char** pair_model,
+                        TokenModel** esc_model) {
+  uint16_t pair_ctx[4], esc_ctx[4];
+  pair_contexts(n.left, n.up, j0, sizeof(TokenModel), pair_ctx, esc_ctx);
+  for (int q = 0; q < 4; q++) {
+    pair_model[q] = reinterpret_cast<char*>(models) + pair_ctx[q];
+    esc_model[q] = models + esc_ctx[q];
+  }
 }
 
 // Decodes one plane's blocks into `coefs`: code_plane's mirror, written out for speed (states
-// in registers, no branch per position) with the same context helpers.
+// in registers, no branch per position) with the same context helpers. False when the rANS
+// data ran out.
 template <bool kAdaptive>
-[[gnu::noinline]] void decode_plane(RansDecoder& rans_state, BitReader& bits_state,
+[[gnu::noinline]] bool decode_plane(RansDecoder& rans_state, BitReader& bits_state,
                                     TokenModel* models, int bw, int bh, int16_t* coefs,
                                     BlockInfo* info) {
   // Local copies stay in registers.
@@ -642,38 +742,103 @@ template <bool kAdaptive>
     for (int bx = 0; bx < bw; bx++) {
       const int index = by * bw + bx;
       int16_t* z = coefs + size_t(index) * 64;
+      // A block reads at most 98 tokens and 100 raw bytes: within the padding when it starts
+      // inside the data.
+      if (rans.overran() || bits.overran()) return false;
+      zero_block(z);  // the DC is written below
       const BlockNeighbours n = block_neighbours(z, info, bx, by, bw);
+      bits.refill();  // enough for both values and the sign
       const int nz =
           std::min(decode_uint<kAdaptive>(rans, bits, models[kNzHist + n.nz_ctx]), 63);
       int res = decode_uint<kAdaptive>(rans, bits, models[kDcHist + n.dc_ctx]);
-      if (res != 0 && bits.get(1)) res = -res;
+      if (res != 0 && bits.take(1, 1)) res = -res;
       z[0] = int16_t(std::clamp(n.dc_pred + res, -kMaxQuantized, kMaxQuantized));
-      // A zero token reads no raw bits and writes 0, so positions need no branch.
-      std::memset(z + 1, 0, 63 * sizeof(int16_t));
-      alignas(16) uint16_t ctx[8];
-      int rem = nz, rem1 = nz, rem2 = nz, k = 1;
-      for (; k < 64 && rem > 0; k++) {
-        if (k == 1 || (k & 7) == 0) ac_contexts(n.left, n.up, k & ~7, sizeof(TokenModel), ctx);
-        TokenModel& m = *reinterpret_cast<TokenModel*>(reinterpret_cast<char*>(models) +
-                                                       ctx[k & 7] + kBuckets.rem_bytes[rem2]);
-        rem2 = rem1;
-        rem1 = rem;
-        const int t = decode_token<kAdaptive>(rans, m);
-        const uint32_t field = bits.get(kFieldBits[t]);
-        const int mag = kUintBase[t] + int(field >> 1), neg = -int(field & 1);
-        z[k] = int16_t((mag ^ neg) - neg);
-        rem -= t != 0;
+      // Models for the first eight pairs up front: most blocks end within them, and a
+      // data-dependent "next four pairs?" branch would mispredict. Pair j's model gains its
+      // nonzeros-left term when token j - 2 is decoded (the first two take the block's count),
+      // so that a token's model is one load and the history needs no registers.
+      char* pair_model[kPairs + 2];
+      TokenModel* esc_model[kPairs];
+      if (nz > 0) {
+        pair_models(n, 0, models, pair_model, esc_model);
+        pair_models(n, 4, models, pair_model + 4, esc_model + 4);
+        pair_model[0] += kBuckets.rem_bytes[nz];
+        pair_model[1] += kBuckets.rem_bytes[nz];
       }
-      // A valid block's last token is its last nonzero.
-      info[index] = {z[0], uint8_t(nz), uint8_t(k - 1)};
+      int rem = nz, j = 0;
+      for (; rem > 0 && j < kPairs; j++) {
+        // The next four before j adds to j + 2: at j = 6, 10, ..., 26.
+        if ((0x4444440u >> j) & 1) {
+          pair_models(n, j + 2, models, pair_model + j + 2, esc_model + j + 2);
+        }
+        TokenModel& m = *reinterpret_cast<TokenModel*>(pair_model[j]);
+        const unsigned t = decode_token<kAdaptive>(rans, m);
+        const PairToken& e = kBuckets.pair_token[t];
+        bits.refill();  // enough for the signs and two escapes
+        const uint32_t signs = bits.take(e.nonzeros, e.mask);
+        uint32_t pair = kBuckets.pair_value[t][signs];
+        if (e.escape) [[unlikely]] {
+          // One copy of the token decoder for both escapes keeps the loop's registers free.
+          TokenModel& em = *esc_model[j];
+          int escapes[2] = {e.a0 == kEscapeClass, e.a1 == kEscapeClass};
+#pragma GCC unroll 1
+          for (int q = 0; q < 2; q++) {
+            if (escapes[q]) escapes[q] = decode_uint<kAdaptive>(rans, bits, em);
+          }
+          pair = signed_pair(e.a0 + escapes[0], e.a1 + escapes[1], signs, e.has0);
+        }
+        // Position 64 of the last pair is the next block's DC, written before it is decoded
+        // (the coefficients have a block of slack at the end).
+        std::memcpy(z + 2 * j + 1, &pair, sizeof(pair));
+        rem -= e.nonzeros;
+        // rem < 0 only in damaged data, and then the loop ends.
+        pair_model[j + 2] += kBuckets.rem_bytes[rem & 63];
+      }
+      // A valid block's last pair holds its last nonzero.
+      info[index] = {z[0], uint8_t(nz), uint8_t(std::min(2 * j, 63))};
     }
   }
   rans_state = rans;
   bits_state = bits;
+  return true;
 }
 
-void reconstruct_plane(const PlaneDims& d, const uint8_t* quant, const int16_t* coefs,
+void set_dequantisation(DctTables& t, int p) {
+  for (int k = 0; k < 64; k++) {
+    const int step = t.quant[p][kZigzag[k]];
+    t.dequant_step[p][k] = int16_t(step);
+    t.dequant_limit[p][k] = int16_t((kMaxDequantized + step - 1) / step);
+  }
+}
+
+// Dequantised coefficients of one block, natural order, into f (zeroed): clamp(z[k] * step,
+// +-kMaxDequantized) for k <= last.
+inline void dequantise_block(const int16_t* z, int last, const int16_t* step, const int16_t* limit,
+                             int16_t* f) {
+  alignas(16) int16_t dq[64];
+#if defined(__SSE2__)
+  const __m128i max = _mm_set1_epi16(kMaxDequantized), min = _mm_set1_epi16(-kMaxDequantized);
+  for (int k = 0; k <= last; k += 8) {
+    const __m128i lim = _mm_load_si128(reinterpret_cast<const __m128i*>(limit + k));
+    __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(z + k));
+    v = _mm_min_epi16(_mm_max_epi16(v, _mm_sub_epi16(_mm_setzero_si128(), lim)), lim);
+    v = _mm_mullo_epi16(v, _mm_load_si128(reinterpret_cast<const __m128i*>(step + k)));
+    _mm_store_si128(reinterpret_cast<__m128i*>(dq + k), _mm_min_epi16(_mm_max_epi16(v, min), max));
+  }
+#else
+  for (int k = 0; k < ((last + 8) & ~7); k++) {
+    dq[k] = int16_t(std::clamp(z[k] * step[k], -kMaxDequantized, kMaxDequantized));
+  }
+#endif
+  // Whole groups of eight: dq is zero past `last`, and f is zeroed.
+  for (int k = 0; k <= last; k += 8) {
+    for (int i = 0; i < 8; i++) f[kZigzag[k + i]] = dq[k + i];
+  }
+}
+
+void reconstruct_plane(const PlaneDims& d, const DctTables& t, int p, const int16_t* coefs,
                        const BlockInfo* info, int16_t* samples) {
+  const uint8_t* quant = t.quant[p];
   for (int by = 0; by < d.bh; by++) {
     for (int bx = 0; bx < d.bw; bx++) {
       const int16_t* z = coefs + (size_t(by) * d.bw + bx) * 64;
@@ -684,11 +849,9 @@ void reconstruct_plane(const PlaneDims& d, const uint8_t* quant, const int16_t* 
                       d.w);
         continue;
       }
-      alignas(32) int16_t f[64] = {};
-      for (int k = 0; k <= last; k++) {
-        const int pos = kZigzag[k];
-        f[pos] = int16_t(std::clamp(int(z[k]) * quant[pos], -kMaxDequantized, kMaxDequantized));
-      }
+      alignas(32) int16_t f[64];
+      zero_block(f);
+      dequantise_block(z, last, t.dequant_step[p], t.dequant_limit[p], f);
       idct_block(f, kBuckets.max_row[last] + 1, kBuckets.max_col[last] + 1, out, d.w);
     }
   }
@@ -739,19 +902,26 @@ template <bool kAdaptive>
 Status decode_tokens(const DctTables& t, std::span<const uint8_t> rans,
                      std::span<const uint8_t> raw, int width, int height, DecodeScratch& scratch) {
   const size_t size = 1 + rans.size() + raw.size();
-  RansDecoder rans_dec(rans.data(), rans.size());
-  BitReader bits(raw.data(), raw.size());
+  if (rans.size() < 8) return corrupt_page(size, "data cut short");
+  scratch.rans.resize(rans.size() + RansDecoder::kPadding);
+  std::memcpy(scratch.rans.data(), rans.data(), rans.size());
+  std::memset(scratch.rans.data() + rans.size(), 0, RansDecoder::kPadding);
+  RansDecoder rans_dec(scratch.rans.data(), rans.size());
+  scratch.raw.resize(raw.size() + BitReader::kPadding);
+  std::memcpy(scratch.raw.data(), raw.data(), raw.size());
+  std::memset(scratch.raw.data() + raw.size(), 0, BitReader::kPadding);
+  BitReader bits(scratch.raw.data(), raw.size());
   for (int p = 0; p < plane_count(t.settings); p++) {
     const PlaneDims d = plane_dims(t.settings, p, width, height);
     const size_t blocks = size_t(d.bw) * d.bh;
-    scratch.coefs.resize(blocks * 64);
+    scratch.coefs.resize((blocks + 1) * 64);
     scratch.info.resize(blocks);
     scratch.samples[p].resize(size_t(d.w) * d.h);
-    decode_plane<kAdaptive>(rans_dec, bits, plane_models<kAdaptive>(t, p, scratch.models), d.bw,
-                            d.bh, scratch.coefs.data(), scratch.info.data());
-    // A valid stream never invents input; a little slack keeps the check off the hot path.
-    if (rans_dec.overread() > 64) return corrupt_page(size, "data ends early");
-    reconstruct_plane(d, t.quant[p], scratch.coefs.data(), scratch.info.data(),
+    if (!decode_plane<kAdaptive>(rans_dec, bits, plane_models<kAdaptive>(t, p, scratch.models),
+                                 d.bw, d.bh, scratch.coefs.data(), scratch.info.data())) {
+      return corrupt_page(size, "data ends early");
+    }
+    reconstruct_plane(d, t, p, scratch.coefs.data(), scratch.info.data(),
                       scratch.samples[p].data());
   }
   if (!rans_dec.valid_end() || !bits.valid_end()) return corrupt_page(size, "data cut short, damaged or over-long");
@@ -770,7 +940,10 @@ Expected<DctTablesPtr> dct_make_tables(const DctSettings& settings, int width, i
   t->height = height;
   const int n = plane_count(settings);
   const uint8_t* quant[4] = {t->quant[0], t->quant[1], t->quant[2], t->quant[3]};
-  for (int p = 0; p < n; p++) make_quant(settings, p, t->quant[p]);
+  for (int p = 0; p < n; p++) {
+    make_quant(settings, p, t->quant[p]);
+    set_dequantisation(*t, p);
+  }
 
   const size_t page_bytes = size_t(width) * height * settings.channels;
   TokenCounts counts(size_t(n) * kHistPerPlane, std::array<uint32_t, kTokens>{});
@@ -876,6 +1049,7 @@ Expected<DctTablesPtr> dct_parse_tables(std::span<const uint8_t> bytes) {
       t->quant[p][i] = bytes[pos++];
       if (t->quant[p][i] == 0) return corrupt("zero quantiser step");
     }
+    set_dequantisation(*t, p);
     t->models[p].resize(kHistPerPlane);
     for (int i = 0; i < kHistPerPlane; i++) {
       TokenModel& m = t->models[p][i];

@@ -69,22 +69,22 @@ inline void adapt(TokenModel& m, int t) {
 
 // The token whose interval holds `slot` (< kFreqTotal): the number of tokens ending at or
 // before it.
-inline int find_token(const TokenModel& m, uint32_t slot) {
+inline unsigned find_token(const TokenModel& m, uint32_t slot) {
 #if defined(__SSE2__)
   const __m128i s = _mm_set1_epi16(int16_t(slot + 1));
   const __m128i* p = reinterpret_cast<const __m128i*>(m.above());
   const __m128i lo = _mm_cmpgt_epi16(s, _mm_load_si128(p));
   const __m128i hi = _mm_cmpgt_epi16(s, _mm_load_si128(p + 1));
   // The set lanes are a prefix (the counts ascend) and lane 15 is never set: count = first clear.
-  return __builtin_ctz(~unsigned(_mm_movemask_epi8(_mm_packs_epi16(lo, hi))));
+  return unsigned(__builtin_ctz(~unsigned(_mm_movemask_epi8(_mm_packs_epi16(lo, hi)))));
 #else
-  int t = 0;
+  unsigned t = 0;
   for (int i = 0; i < kTokens; i++) t += m.above()[i] <= slot;
   return t;
 #endif
 }
 
-inline uint32_t token_start(const TokenModel& m, int t) {
+inline uint32_t token_start(const TokenModel& m, unsigned t) {
   return m.cum[7 + t];
 }
 
@@ -126,47 +126,62 @@ class RansEncoder {
   std::vector<Sym> syms_;
 };
 
-// Reads zeros past the end of its bytes and counts them; a valid stream ends with both states
-// back at their initial value and every byte read (`valid_end`).
+// Decodes from a copy of the rANS bytes followed by kPadding zero bytes, so that renormalising
+// needs neither a bounds check nor a branch (a data-dependent branch there mispredicts on about
+// one token in five). A valid stream reads exactly its bytes and ends with both states back at
+// their initial value (`valid_end`); callers stop once `overran()`, checking at least every
+// kPadding / 2 - 4 tokens.
 class RansDecoder {
  public:
-  RansDecoder(const uint8_t* data, size_t size) : p_(data), end_(data + size) {
-    x0_ = next16() | (next16() << 16);
-    x1_ = next16() | (next16() << 16);
+  static constexpr size_t kPadding = 256;
+
+  // `padded` holds size >= 8 bytes, then kPadding zeros.
+  RansDecoder(const uint8_t* padded, size_t size) : p_(padded + 8), end_(padded + size) {
+    x0_ = read32(padded);
+    x1_ = read32(padded + 4);
   }
 
-  int get(const TokenModel& m) {
+  unsigned get(const TokenModel& m) {
     const uint32_t slot = x0_ & (kFreqTotal - 1);
-    const int t = find_token(m, slot);
+    const unsigned t = find_token(m, slot);
     const uint32_t start = token_start(m, t);
     uint32_t x = (m.above()[t] - start) * (x0_ >> kFreqBits) + slot - start;
-    if (x < kRansLow) x = (x << 16) | next16();
+    // Renormalise without a branch: one would mispredict on about one token in five.
+    uint16_t word;
+    std::memcpy(&word, p_, 2);
+    if constexpr (__BYTE_ORDER__ == __ORDER_BIG_ENDIAN__) word = __builtin_bswap16(word);
+    const uint32_t renormalised = (x << 16) | word;
+#if defined(__x86_64__) && defined(__GNUC__)
+    // Two conditional moves; compilers turn the C++ below back into a branch.
+    const uint8_t* next = p_ + 2;
+    asm("cmpl %[low], %[x]\n\t"
+        "cmovbl %[renormalised], %[x]\n\t"
+        "cmovbq %[next], %[p]"
+        : [x] "+r"(x), [p] "+r"(p_)
+        : [renormalised] "r"(renormalised), [next] "r"(next), [low] "i"(kRansLow)
+        : "cc");
+#else
+    const uint32_t small = x < kRansLow;
+    x = small ? renormalised : x;
+    p_ += small << 1;
+#endif
     x0_ = x1_;
     x1_ = x;
     return t;
   }
 
-  bool valid_end() const {
-    return x0_ == kRansLow && x1_ == kRansLow && p_ == end_ && overread_ == 0;
-  }
-  size_t overread() const { return overread_; }
+  bool overran() const { return p_ > end_; }
+  bool valid_end() const { return x0_ == kRansLow && x1_ == kRansLow && p_ == end_; }
 
  private:
-  uint32_t next16() {
-    if (end_ - p_ >= 2) {
-      const uint32_t v = uint32_t(p_[0]) | (uint32_t(p_[1]) << 8);
-      p_ += 2;
-      return v;
-    }
-    overread_ += 2;
-    p_ = end_;
-    return 0;
+  static uint32_t read32(const uint8_t* p) {
+    return uint32_t(p[0]) | (uint32_t(p[1]) << 8) | (uint32_t(p[2]) << 16) |
+           (uint32_t(p[3]) << 24);
   }
 
   const uint8_t* p_;
   const uint8_t* end_;
   uint32_t x0_ = 0, x1_ = 0;
-  size_t overread_ = 0;
 };
 
 // Raw bits, least significant first.
@@ -196,59 +211,48 @@ class BitWriter {
   int count_ = 0;
 };
 
+// Reads from a copy of the raw bytes followed by kPadding zero bytes, so that a refill is one
+// unaligned load with no bounds check. Callers stop once `overran()`, checking at least every
+// (kPadding - 8) bytes of reads.
 class BitReader {
  public:
-  BitReader(const uint8_t* data, size_t size) : p_(data), end_(data + size) {}
+  static constexpr size_t kPadding = 256;
 
-  // nbits <= 24.
-  uint32_t get(int nbits) { return get(nbits, (1u << nbits) - 1); }
-  // The same with mask = 2^nbits - 1 given.
-  uint32_t get(int nbits, uint32_t mask) {
-    if (count_ < nbits) refill();
+  // `padded` holds `size` bytes, then kPadding zeros.
+  BitReader(const uint8_t* padded, size_t size)
+      : start_(padded), p_(padded), bits_(uint64_t(size) * 8) {}
+
+  // At least 56 bits become available. Bits past those stepped over are ORed in again,
+  // unchanged, by the next refill.
+  void refill() {
+    uint64_t v;
+    std::memcpy(&v, p_, 8);
+    if constexpr (__BYTE_ORDER__ == __ORDER_BIG_ENDIAN__) v = __builtin_bswap64(v);
+    acc_ |= v << count_;
+    p_ += (63 - count_) >> 3;
+    count_ |= 56;
+  }
+  // nbits <= 56 in total since the last refill; mask = 2^nbits - 1.
+  uint32_t take(int nbits, uint32_t mask) {
     const uint32_t v = uint32_t(acc_) & mask;
     acc_ >>= nbits;
     count_ -= nbits;
     return v;
   }
 
-  // Valid when every byte was read, no invented byte was consumed, fewer than 8 real bits are
-  // left and those padding bits are zero.
-  bool valid_end() const {
-    const uint64_t invented = uint64_t(overread_) * 8;
-    return p_ == end_ && acc_ == 0 && invented <= uint64_t(count_) &&
-           uint64_t(count_) - invented < 8;
-  }
+  bool overran() const { return consumed() > bits_; }
+  // Valid when fewer than 8 bits are left and those padding bits are zero (the bits beyond
+  // them are the zeros after the data).
+  bool valid_end() const { return consumed() <= bits_ && bits_ - consumed() < 8 && acc_ == 0; }
 
  private:
-  void refill() {
-    if (end_ - p_ >= 8) {
-      // Branch-light refill: bits past the bytes stepped over are ORed in again, unchanged,
-      // by the next refill.
-      uint64_t v;
-      std::memcpy(&v, p_, 8);
-      if constexpr (__BYTE_ORDER__ == __ORDER_BIG_ENDIAN__) v = __builtin_bswap64(v);
-      acc_ |= v << count_;
-      p_ += (63 - count_) >> 3;
-      count_ |= 56;
-      return;
-    }
-    while (count_ <= 56) {
-      uint64_t b = 0;
-      if (p_ < end_) {
-        b = *p_++;
-      } else {
-        overread_++;
-      }
-      acc_ |= b << count_;
-      count_ += 8;
-    }
-  }
+  uint64_t consumed() const { return uint64_t(p_ - start_) * 8 - uint64_t(count_); }
 
+  const uint8_t* start_;
   const uint8_t* p_;
-  const uint8_t* end_;
+  uint64_t bits_;
   uint64_t acc_ = 0;
   int count_ = 0;
-  size_t overread_ = 0;
 };
 
 }  // namespace vt::dct_detail
