@@ -717,17 +717,6 @@ inline void zero_block(int16_t* z) {
 #endif
 }
 
-// Models of pairs j0..j0+3 before the nonzeros-left term (as bytes), and their escape models.
-inline void pair_models(const BlockNeighbours& n, int j0, TokenModel* models, char** pair_model,
-                        TokenModel** esc_model) {
-  uint16_t pair_ctx[4], esc_ctx[4];
-  pair_contexts(n.left, n.up, j0, sizeof(TokenModel), pair_ctx, esc_ctx);
-  for (int q = 0; q < 4; q++) {
-    pair_model[q] = reinterpret_cast<char*>(models) + pair_ctx[q];
-    esc_model[q] = models + esc_ctx[q];
-  }
-}
-
 // Decodes one plane's blocks into `coefs`: code_plane's mirror, written out for speed (states
 // in registers, no branch per position) with the same context helpers. False when the rANS
 // data ran out.
@@ -754,32 +743,34 @@ template <bool kAdaptive>
       if (res != 0 && bits.take(1, 1)) res = -res;
       z[0] = int16_t(std::clamp(n.dc_pred + res, -kMaxQuantized, kMaxQuantized));
       // Models for the first eight pairs up front: most blocks end within them, and a
-      // data-dependent "next four pairs?" branch would mispredict. Pair j's model gains its
-      // nonzeros-left term when token j - 2 is decoded (the first two take the block's count),
-      // so that a token's model is one load and the history needs no registers.
-      char* pair_model[kPairs + 2];
-      TokenModel* esc_model[kPairs];
+      // data-dependent "next four pairs?" branch would mispredict. Pair j's model offset gains
+      // its nonzeros-left term when token j - 2 is decoded (the first two take the block's
+      // count), so that the history needs no registers.
+      uint16_t pair_ctx[kPairs + 2], esc_ctx[kPairs];
       if (nz > 0) {
-        pair_models(n, 0, models, pair_model, esc_model);
-        pair_models(n, 4, models, pair_model + 4, esc_model + 4);
-        pair_model[0] += kBuckets.rem_bytes[nz];
-        pair_model[1] += kBuckets.rem_bytes[nz];
+        pair_contexts(n.left, n.up, 0, sizeof(TokenModel), pair_ctx, esc_ctx);
+        pair_contexts(n.left, n.up, 4, sizeof(TokenModel), pair_ctx + 4, esc_ctx + 4);
+        pair_ctx[0] = uint16_t(pair_ctx[0] + kBuckets.rem_bytes[nz]);
+        pair_ctx[1] = uint16_t(pair_ctx[1] + kBuckets.rem_bytes[nz]);
       }
       int rem = nz, j = 0;
       for (; rem > 0 && j < kPairs; j++) {
         // The next four before j adds to j + 2: at j = 6, 10, ..., 26.
         if ((0x4444440u >> j) & 1) {
-          pair_models(n, j + 2, models, pair_model + j + 2, esc_model + j + 2);
+          pair_contexts(n.left, n.up, j + 2, sizeof(TokenModel), pair_ctx + j + 2,
+                        esc_ctx + j + 2);
         }
-        TokenModel& m = *reinterpret_cast<TokenModel*>(pair_model[j]);
+        TokenModel& m =
+            *reinterpret_cast<TokenModel*>(reinterpret_cast<char*>(models) + pair_ctx[j]);
         const unsigned t = decode_token<kAdaptive>(rans, m);
         const PairToken& e = kBuckets.pair_token[t];
-        bits.refill();  // enough for the signs and two escapes
+        // A refill gives 56 bits: enough for two tokens' signs and escapes (2 + 2 * 11 each).
+        if ((j & 1) == 0) bits.refill();
         const uint32_t signs = bits.take(e.nonzeros, e.mask);
         uint32_t pair = kBuckets.pair_value[t][signs];
         if (e.escape) [[unlikely]] {
           // One copy of the token decoder for both escapes keeps the loop's registers free.
-          TokenModel& em = *esc_model[j];
+          TokenModel& em = models[esc_ctx[j]];
           int escapes[2] = {e.a0 == kEscapeClass, e.a1 == kEscapeClass};
 #pragma GCC unroll 1
           for (int q = 0; q < 2; q++) {
@@ -792,7 +783,7 @@ template <bool kAdaptive>
         std::memcpy(z + 2 * j + 1, &pair, sizeof(pair));
         rem -= e.nonzeros;
         // rem < 0 only in damaged data, and then the loop ends.
-        pair_model[j + 2] += kBuckets.rem_bytes[rem & 63];
+        pair_ctx[j + 2] = uint16_t(pair_ctx[j + 2] + kBuckets.rem_bytes[rem & 63]);
       }
       // A valid block's last pair holds its last nonzero.
       info[index] = {z[0], uint8_t(nz), uint8_t(std::min(2 * j, 63))};
