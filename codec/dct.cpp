@@ -3,10 +3,10 @@
 // holds the byte length of its rANS part (LEB128), the rANS part (codec/dct_rans.h), then the raw
 // bits. For every plane in order (Y, Co, Cg, alpha or channel 0..3), blocks in raster order; each
 // block codes its AC nonzero count (context: neighbours' counts), its DC as a residual from a
-// median predictor (context: neighbours' DC difference), then for each zigzag position while
-// nonzeros remain one token (0 = zero, else a magnitude class; context: position band, nonzeros
-// left, neighbours' magnitude there) whose low bits and sign follow raw. Token frequencies are
-// static per layer.
+// median predictor (context: neighbours' DC difference), then while nonzeros remain one token
+// per pair of zigzag positions (context: the pair's band, nonzeros left two tokens back, the
+// neighbours' magnitude over the pair), the signs of its nonzeros raw, and an escape token per
+// magnitude of 3 or more. Token frequencies are static per layer unless the tables adapt.
 #include "codec/dct.h"
 
 #include <algorithm>
@@ -76,9 +76,6 @@ struct PairToken {
   uint8_t a0, a1;    // magnitude classes of the two positions
   uint8_t nonzeros;  // raw sign bits that follow
   uint8_t mask;      // 2^nonzeros - 1
-  uint8_t has0;      // 1 when the first position is nonzero
-  uint8_t escape;    // 1 when a class is kEscapeClass
-  uint8_t pad[2];
 };
 
 // Two int16 coefficients as they lie in memory, first position first.
@@ -144,10 +141,7 @@ struct BucketTables {
     for (int t = 0; t < kTokens; t++) {
       const int a0 = t & 3, a1 = t >> 2;
       const int nonzeros = (a0 != 0) + (a1 != 0);
-      pair_token[t] = {uint8_t(a0),       uint8_t(a1),
-                       uint8_t(nonzeros), uint8_t((1 << nonzeros) - 1),
-                       uint8_t(a0 != 0),  uint8_t(a0 == kEscapeClass || a1 == kEscapeClass),
-                       {}};
+      pair_token[t] = {uint8_t(a0), uint8_t(a1), uint8_t(nonzeros), uint8_t((1 << nonzeros) - 1)};
       for (uint32_t signs = 0; signs < 4; signs++) {
         pair_value[t][signs] = signed_pair(a0, a1, signs & ((1u << nonzeros) - 1), a0 != 0);
       }
@@ -418,21 +412,27 @@ void code_plane(Coder& c, TokenModel* models, int bw, int bh, const int16_t* coe
       // Pair tokens while nonzeros remain. The context takes the nonzeros left as they were
       // two tokens back, so that a decoded token's context never waits on the token just
       // before it.
-      uint16_t pair_ctx[4], esc_ctx[4];
+      uint16_t pair_ctx[4], esc_ctx[kPairs];
+      int escaped[64], escapes = 0;  // zigzag positions, in order
       int rem = nz, rem1 = nz, rem2 = nz, last = 0;  // rem1, rem2: after tokens j - 1, j - 2
       for (int j = 0, k = 1; rem > 0; j++, k += 2) {
-        if ((j & 3) == 0) pair_contexts(n.left, n.up, j, 1, pair_ctx, esc_ctx);
+        if ((j & 3) == 0) pair_contexts(n.left, n.up, j, 1, pair_ctx, esc_ctx + j);
         const int i = pair_ctx[j & 3] + kBuckets.rem[rem2];
         const int v0 = z[k], v1 = k < 63 ? z[k + 1] : 0;
         const int a0 = pair_class(v0), a1 = pair_class(v1);
         c.token(models, i, a0 + 4 * a1);
         c.raw(uint32_t(v0 < 0) | (uint32_t(v1 < 0) << (v0 != 0)), (v0 != 0) + (v1 != 0));
-        if (a0 == kEscapeClass) code_uint(c, models, esc_ctx[j & 3], unsigned(std::abs(v0)) - 3);
-        if (a1 == kEscapeClass) code_uint(c, models, esc_ctx[j & 3], unsigned(std::abs(v1)) - 3);
+        if (a0 == kEscapeClass) escaped[escapes++] = k;
+        if (a1 == kEscapeClass) escaped[escapes++] = k + 1;
         rem -= (v0 != 0) + (v1 != 0);
         rem2 = rem1;
         rem1 = rem;
         last = v1 != 0 ? k + 1 : v0 != 0 ? k : last;
+      }
+      // The block's escapes after its pairs: the pair loop then has no branch on them.
+      for (int e = 0; e < escapes; e++) {
+        const int k = escaped[e];
+        code_uint(c, models, esc_ctx[(k - 1) >> 1], unsigned(std::abs(z[k])) - 3);
       }
       info[index] = {z[0], uint8_t(nz), uint8_t(last)};
     }
@@ -753,7 +753,8 @@ template <bool kAdaptive>
         pair_ctx[0] = uint16_t(pair_ctx[0] + kBuckets.rem_bytes[nz]);
         pair_ctx[1] = uint16_t(pair_ctx[1] + kBuckets.rem_bytes[nz]);
       }
-      int rem = nz, j = 0;
+      uint8_t escaped[kPairs * 2 + 1];
+      int rem = nz, j = 0, escapes = 0;
       for (; rem > 0 && j < kPairs; j++) {
         // The next four before j adds to j + 2: at j = 6, 10, ..., 26.
         if ((0x4444440u >> j) & 1) {
@@ -764,26 +765,27 @@ template <bool kAdaptive>
             *reinterpret_cast<TokenModel*>(reinterpret_cast<char*>(models) + pair_ctx[j]);
         const unsigned t = decode_token<kAdaptive>(rans, m);
         const PairToken& e = kBuckets.pair_token[t];
-        // A refill gives 56 bits: enough for two tokens' signs and escapes (2 + 2 * 11 each).
-        if ((j & 1) == 0) bits.refill();
+        // A refill gives 56 bits: enough for 16 pairs' signs.
+        if ((j & 15) == 0) bits.refill();
         const uint32_t signs = bits.take(e.nonzeros, e.mask);
-        uint32_t pair = kBuckets.pair_value[t][signs];
-        if (e.escape) [[unlikely]] {
-          // One copy of the token decoder for both escapes keeps the loop's registers free.
-          TokenModel& em = models[esc_ctx[j]];
-          int escapes[2] = {e.a0 == kEscapeClass, e.a1 == kEscapeClass};
-#pragma GCC unroll 1
-          for (int q = 0; q < 2; q++) {
-            if (escapes[q]) escapes[q] = decode_uint<kAdaptive>(rans, bits, em);
-          }
-          pair = signed_pair(e.a0 + escapes[0], e.a1 + escapes[1], signs, e.has0);
-        }
+        const uint32_t pair = kBuckets.pair_value[t][signs];  // an escape as +-3 for now
         // Position 64 of the last pair is the next block's DC, written before it is decoded
         // (the coefficients have a block of slack at the end).
         std::memcpy(z + 2 * j + 1, &pair, sizeof(pair));
+        // Escaped positions, listed without a branch.
+        escaped[escapes] = uint8_t(2 * j + 1);
+        escapes += e.a0 == kEscapeClass;
+        escaped[escapes] = uint8_t(2 * j + 2);
+        escapes += e.a1 == kEscapeClass;
         rem -= e.nonzeros;
         // rem < 0 only in damaged data, and then the loop ends.
         pair_ctx[j + 2] = uint16_t(pair_ctx[j + 2] + kBuckets.rem_bytes[rem & 63]);
+      }
+      for (int i = 0; i < escapes; i++) {
+        const int k = escaped[i];
+        bits.refill();
+        const int v = decode_uint<kAdaptive>(rans, bits, models[esc_ctx[(k - 1) >> 1]]);
+        z[k] = int16_t(z[k] < 0 ? z[k] - v : z[k] + v);
       }
       // A valid block's last pair holds its last nonzero.
       info[index] = {z[0], uint8_t(nz), uint8_t(std::min(2 * j, 63))};

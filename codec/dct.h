@@ -11,13 +11,14 @@
 // alphabets at 14-bit precision, codec/dct_rans.h), then a raw bit stream (low bits and signs,
 // least significant bit first). Tokens, per plane (Y, Co, Cg, alpha; or channels 0..3 for
 // kPlanes) and 8x8 block in raster order: the AC nonzero count, the DC residual from a median
-// predictor, then one token per zigzag position while nonzeros remain. Token models are static
-// when the tables were trained and adaptive (AV1-style CDF steps) when they were not. Planes
-// hold texels centred on 0 (YCoCg: Y=(R+2G+B)/4, Co=(R-B)/2, Cg=(2G-R-B)/4); 4:2:0 chroma is
-// the 2x2 mean and comes back through a 9-3-3-1 filter. Dequantised coefficients are clamped to
-// +-2047 and inverted by a separable integer DCT with a fixed 12-bit basis and specified
-// rounding and saturation (codec/dct_transform.h).
-// Tables bytes (version 2): "VTDC", 2, quality, channels, layout, width and height (u16 LE),
+// predictor, then while nonzeros remain one token per pair of zigzag positions (the magnitude
+// classes 0, 1, 2 and "3 or more" of both), each "3 or more" followed by an escape token for
+// the rest. Token models are static when the tables were trained and adaptive (AV1-style CDF
+// steps) when they were not. Planes hold texels centred on 0 (YCoCg: Y=(R+2G+B)/4, Co=(R-B)/2,
+// Cg=(2G-R-B)/4); 4:2:0 chroma is the 2x2 mean and comes back through a 9-3-3-1 filter.
+// Dequantised coefficients are clamped to +-2047 and inverted by a separable integer DCT with a
+// fixed 12-bit basis and specified rounding and saturation (codec/dct_transform.h).
+// Tables bytes (version 3): "VTDC", 3, quality, channels, layout, width and height (u16 LE),
 // mode (0 static, 1 adaptive), then per plane 64 quantiser steps (natural order) and per token
 // model an observation count and 16 frequencies (codec/dct.cpp, dct_serialize_tables).
 // Thread safety: tables are read-only once made; encode and decode may run on any number of
