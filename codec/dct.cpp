@@ -76,6 +76,9 @@ struct PairToken {
   uint8_t a0, a1;    // magnitude classes of the two positions
   uint8_t nonzeros;  // raw sign bits that follow
   uint8_t mask;      // 2^nonzeros - 1
+  uint8_t escape0;   // 1 when a0 is kEscapeClass
+  uint8_t escape1;
+  uint8_t pad[2];
 };
 
 // Two int16 coefficients as they lie in memory, first position first.
@@ -141,7 +144,13 @@ struct BucketTables {
     for (int t = 0; t < kTokens; t++) {
       const int a0 = t & 3, a1 = t >> 2;
       const int nonzeros = (a0 != 0) + (a1 != 0);
-      pair_token[t] = {uint8_t(a0), uint8_t(a1), uint8_t(nonzeros), uint8_t((1 << nonzeros) - 1)};
+      pair_token[t] = {uint8_t(a0),
+                       uint8_t(a1),
+                       uint8_t(nonzeros),
+                       uint8_t((1 << nonzeros) - 1),
+                       uint8_t(a0 == kEscapeClass),
+                       uint8_t(a1 == kEscapeClass),
+                       {}};
       for (uint32_t signs = 0; signs < 4; signs++) {
         pair_value[t][signs] = signed_pair(a0, a1, signs & ((1u << nonzeros) - 1), a0 != 0);
       }
@@ -754,7 +763,8 @@ template <bool kAdaptive>
         pair_ctx[1] = uint16_t(pair_ctx[1] + kBuckets.rem_bytes[nz]);
       }
       uint8_t escaped[kPairs * 2 + 1];
-      int rem = nz, j = 0, escapes = 0;
+      int rem = nz, j = 0;
+      size_t escapes = 0;
       for (; rem > 0 && j < kPairs; j++) {
         // The next four before j adds to j + 2: at j = 6, 10, ..., 26.
         if ((0x4444440u >> j) & 1) {
@@ -774,14 +784,14 @@ template <bool kAdaptive>
         std::memcpy(z + 2 * j + 1, &pair, sizeof(pair));
         // Escaped positions, listed without a branch.
         escaped[escapes] = uint8_t(2 * j + 1);
-        escapes += e.a0 == kEscapeClass;
+        escapes += e.escape0;
         escaped[escapes] = uint8_t(2 * j + 2);
-        escapes += e.a1 == kEscapeClass;
+        escapes += e.escape1;
         rem -= e.nonzeros;
         // rem < 0 only in damaged data, and then the loop ends.
         pair_ctx[j + 2] = uint16_t(pair_ctx[j + 2] + kBuckets.rem_bytes[rem & 63]);
       }
-      for (int i = 0; i < escapes; i++) {
+      for (size_t i = 0; i < escapes; i++) {
         const int k = escaped[i];
         bits.refill();
         const int v = decode_uint<kAdaptive>(rans, bits, models[esc_ctx[(k - 1) >> 1]]);
