@@ -121,12 +121,12 @@ constexpr uint8_t kPageStored = 2;  // texels raw, when coding would not make th
 
 struct BucketTables {
   uint8_t nz[64];
-  uint8_t rem[64];  // index: nonzeros left (>= 1); model offset of its bucket
-  uint16_t rem_bytes[64];             // the same offsets in bytes
-  alignas(16) int32_t pair[kPairs];   // first model of pair j's band
-  alignas(16) int32_t esc[kPairs];    // first escape model of pair j's band
-  uint8_t nb[64];       // index: min(sum of neighbour magnitudes, 63)
-  uint8_t max_row[64];  // largest row / column among zigzag positions 0..k
+  uint8_t rem[64];                   // index: nonzeros left (>= 1); model offset of its bucket
+  uint16_t rem_bytes[64];            // the same offsets in bytes
+  alignas(16) int32_t pair[kPairs];  // first model of pair j's band
+  alignas(16) int32_t esc[kPairs];   // first escape model of pair j's band
+  uint8_t nb[64];                    // index: min(sum of neighbour magnitudes, 63)
+  uint8_t max_row[64];               // largest row / column among zigzag positions 0..k
   uint8_t max_col[64];
   PairToken pair_token[kTokens];
   uint32_t pair_value[kTokens][4];  // coefficient_pair of a token without escapes, by sign bits
@@ -293,8 +293,9 @@ struct BlockNeighbours {
 
 // `z` is block (bx, by) of a plane bw blocks wide. A missing neighbour is the other one, or
 // zeros for the first block.
-[[gnu::always_inline]] inline BlockNeighbours block_neighbours(const int16_t* z, const BlockInfo* info, int bx, int by,
-                                        int bw) {
+[[gnu::always_inline]] inline BlockNeighbours block_neighbours(const int16_t* z,
+                                                               const BlockInfo* info, int bx,
+                                                               int by, int bw) {
   const int index = by * bw + bx;
   const bool has_left = bx > 0, has_up = by > 0;
   BlockNeighbours n;
@@ -327,8 +328,8 @@ struct BlockNeighbours {
 // `scale` (1 for model indices, sizeof(TokenModel) for byte offsets), into `pair`; the escape
 // model (band and the same bucket, an index) into `esc`. Four pairs at once keep this off the
 // per-token path.
-inline void pair_contexts(const int16_t* left, const int16_t* up, int j0, int scale,
-                          uint16_t* pair, uint16_t* esc) {
+inline void pair_contexts(const int16_t* left, const int16_t* up, int j0, int scale, uint16_t* pair,
+                          uint16_t* esc) {
   const int k0 = 2 * j0 + 1;  // positions k0..k0+7; position 64 is the phantom, counted as 0
 #if defined(__SSE2__)
   const __m128i zero = _mm_setzero_si128();
@@ -422,7 +423,7 @@ void code_plane(Coder& c, TokenModel* models, int bw, int bh, const int16_t* coe
       // two tokens back, so that a decoded token's context never waits on the token just
       // before it.
       uint16_t pair_ctx[4], esc_ctx[kPairs];
-      int escaped[64], escapes = 0;  // zigzag positions, in order
+      int escaped[64], escapes = 0;                  // zigzag positions, in order
       int rem = nz, rem1 = nz, rem2 = nz, last = 0;  // rem1, rem2: after tokens j - 1, j - 2
       for (int j = 0, k = 1; rem > 0; j++, k += 2) {
         if ((j & 3) == 0) pair_contexts(n.left, n.up, j, 1, pair_ctx, esc_ctx + j);
@@ -720,7 +721,8 @@ int decode_uint(RansDecoder& rans, BitReader& bits, TokenModel& m) {
 inline void zero_block(int16_t* z) {
 #if defined(__SSE2__)
   // Eight stores; a memset call here costs more than the block's tokens when they are few.
-  for (int i = 0; i < 64; i += 8) _mm_storeu_si128(reinterpret_cast<__m128i*>(z + i), _mm_setzero_si128());
+  for (int i = 0; i < 64; i += 8)
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(z + i), _mm_setzero_si128());
 #else
   std::memset(z, 0, 64 * sizeof(int16_t));
 #endif
@@ -746,8 +748,7 @@ template <bool kAdaptive>
       zero_block(z);  // the DC is written below
       const BlockNeighbours n = block_neighbours(z, info, bx, by, bw);
       bits.refill();  // enough for both values and the sign
-      const int nz =
-          std::min(decode_uint<kAdaptive>(rans, bits, models[kNzHist + n.nz_ctx]), 63);
+      const int nz = std::min(decode_uint<kAdaptive>(rans, bits, models[kNzHist + n.nz_ctx]), 63);
       int res = decode_uint<kAdaptive>(rans, bits, models[kDcHist + n.dc_ctx]);
       if (res != 0 && bits.take(1, 1)) res = -res;
       z[0] = int16_t(std::clamp(n.dc_pred + res, -kMaxQuantized, kMaxQuantized));
@@ -768,8 +769,7 @@ template <bool kAdaptive>
       for (; rem > 0 && j < kPairs; j++) {
         // The next four before j adds to j + 2: at j = 6, 10, ..., 26.
         if ((0x4444440u >> j) & 1) {
-          pair_contexts(n.left, n.up, j + 2, sizeof(TokenModel), pair_ctx + j + 2,
-                        esc_ctx + j + 2);
+          pair_contexts(n.left, n.up, j + 2, sizeof(TokenModel), pair_ctx + j + 2, esc_ctx + j + 2);
         }
         TokenModel& m =
             *reinterpret_cast<TokenModel*>(reinterpret_cast<char*>(models) + pair_ctx[j]);
@@ -791,6 +791,7 @@ template <bool kAdaptive>
         // rem < 0 only in damaged data, and then the loop ends.
         pair_ctx[j + 2] = uint16_t(pair_ctx[j + 2] + kBuckets.rem_bytes[rem & 63]);
       }
+      // The escapes follow the block's pairs (see code_plane): each adds to a magnitude of 3.
       for (size_t i = 0; i < escapes; i++) {
         const int k = escaped[i];
         bits.refill();
@@ -927,7 +928,8 @@ Status decode_tokens(const DctTables& t, std::span<const uint8_t> rans,
     reconstruct_plane(d, t, p, scratch.coefs.data(), scratch.info.data(),
                       scratch.samples[p].data());
   }
-  if (!rans_dec.valid_end() || !bits.valid_end()) return corrupt_page(size, "data cut short, damaged or over-long");
+  if (!rans_dec.valid_end() || !bits.valid_end())
+    return corrupt_page(size, "data cut short, damaged or over-long");
   return Status::Ok();
 }
 

@@ -46,7 +46,7 @@ struct DctSettings {
   int channels = 3;  // 1..4
   DctPlaneLayout layout = DctPlaneLayout::kYCoCg420;
   // Token models that adapt while a page is decoded even when the tables are trained: 1-9%
-  // smaller pages (most where the training pages differ from the rest), about 1.3x the entropy
+  // smaller pages (most where the training pages differ from the rest), about 1.2x the entropy
   // decoding time. Untrained tables always adapt.
   bool adaptive = false;
 };
@@ -60,8 +60,8 @@ using DctTablesPtr = std::unique_ptr<DctTables, DctTablesDeleter>;
 
 // Builds tables for the settings. `training_pages` (optional, each width*height*channels
 // bytes) fits static token models to the content: pages decode fastest and smallest with them
-// (on photographs about 12% smaller than untrained tables, whose models adapt while a page is
-// decoded, at about 1.3x the entropy decoding time). The texels decoded are the same either
+// (on photographs about 10% smaller than untrained tables, whose models adapt while a page is
+// decoded, at about 1.2x the entropy decoding time). The texels decoded are the same either
 // way. Width and height: multiples of 8 up to 4096; the YCoCg layouts need 3 or 4 channels.
 // Bad settings give kInvalidArgument.
 Expected<DctTablesPtr> dct_make_tables(

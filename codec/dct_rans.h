@@ -170,13 +170,16 @@ class RansDecoder {
     return t;
   }
 
-  bool overran() const { return p_ > end_; }
-  bool valid_end() const { return x0_ == kRansLow && x1_ == kRansLow && p_ == end_; }
+  bool overran() const {
+    return p_ > end_;
+  }
+  bool valid_end() const {
+    return x0_ == kRansLow && x1_ == kRansLow && p_ == end_;
+  }
 
  private:
   static uint32_t read32(const uint8_t* p) {
-    return uint32_t(p[0]) | (uint32_t(p[1]) << 8) | (uint32_t(p[2]) << 16) |
-           (uint32_t(p[3]) << 24);
+    return uint32_t(p[0]) | (uint32_t(p[1]) << 8) | (uint32_t(p[2]) << 16) | (uint32_t(p[3]) << 24);
   }
 
   const uint8_t* p_;

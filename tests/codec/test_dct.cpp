@@ -291,8 +291,8 @@ TEST(Dct, HighestFrequencyAndLargestCoefficientsRoundTrip) {
   for (int y = 0; y < size; y++) {
     for (int x = 0; x < size; x++) {
       page[size_t(y) * size + x] = (x / 8 + y / 8) % 3 == 0 ? uint8_t(128 + (x + y) % 7)
-                                   : (x + y) % 2       ? uint8_t(255)
-                                                       : uint8_t(0);
+                                   : (x + y) % 2            ? uint8_t(255)
+                                                            : uint8_t(0);
     }
   }
   for (int q : {100, 90}) {
