@@ -16,6 +16,16 @@
 
 namespace vt::test {
 
+// A layer from its semantic and source, the other members at their defaults.
+inline LayerInput layer_input(LayerSemantic semantic, std::shared_ptr<ImageSource> source,
+                              std::string name = "") {
+  LayerInput layer;
+  layer.semantic = semantic;
+  layer.name = std::move(name);
+  layer.source = std::move(source);
+  return layer;
+}
+
 struct StoredPage {
   PageState state = PageState::kAbsent;
   std::vector<uint8_t> bytes;  // stored bytes, or the constant texel

@@ -49,7 +49,7 @@ class NonFinite : public testing::Test {
     t[(10 * w + 2) * 3 + 2] = -1.0f;
     t[(11 * w + 19) * 3 + 0] = -std::numeric_limits<float>::infinity();
     BuildOptions o;
-    o.layers.push_back({LayerSemantic::kAlbedo, "", memory_image(w, h, 3, t, true)});
+    o.layers.push_back(test::layer_input(LayerSemantic::kAlbedo, memory_image(w, h, 3, t, true)));
     o.codec.codec = CodecKind::kRaw;
     o.payload = 8;
     o.non_finite = policy;
@@ -108,7 +108,7 @@ TEST_F(NonFinite, ErrorNamesTheFirstTexel) {
 
 TEST(Build, IdenticalForAnyThreadCountAndOutOfCore) {
   BuildOptions o;
-  o.layers.push_back({LayerSemantic::kAlbedo, "", procedural(203, 150, 4)});
+  o.layers.push_back(test::layer_input(LayerSemantic::kAlbedo, procedural(203, 150, 4)));
   o.payload = 24;
   o.codec.codec = CodecKind::kDct;
   o.threads = 1;
@@ -172,7 +172,7 @@ TEST(Build, DctTablesAreTrainedOnTheLayersOwnPages) {
 
 TEST(Build, WrapOutOfCoreMatchesInMemory) {
   BuildOptions o;
-  o.layers.push_back({LayerSemantic::kAlbedo, "", procedural(77, 131, 3)});
+  o.layers.push_back(test::layer_input(LayerSemantic::kAlbedo, procedural(77, 131, 3)));
   o.payload = 8;
   o.codec.codec = CodecKind::kRaw;
   o.address = AddressMode::kWrap;
@@ -198,7 +198,7 @@ TEST(Build, ConstantPagesFoldedAndCoverageMakesAbsentPages) {
     }
   }
   BuildOptions o;
-  LayerInput in{LayerSemantic::kAlbedo, "", memory_image(w, h, 3, t, false)};
+  LayerInput in = test::layer_input(LayerSemantic::kAlbedo, memory_image(w, h, 3, t, false));
   in.coverage = cov;
   o.layers.push_back(in);
   o.payload = 8;
@@ -221,8 +221,8 @@ TEST(Build, ConstantPagesFoldedAndCoverageMakesAbsentPages) {
   }
   // A plain constant image folds to constants only.
   BuildOptions c;
-  c.layers.push_back({LayerSemantic::kAlbedo, "",
-                      memory_image(w, h, 3, std::vector<float>(w * h * 3, 0.5f), false)});
+  c.layers.push_back(test::layer_input(
+      LayerSemantic::kAlbedo, memory_image(w, h, 3, std::vector<float>(w * h * 3, 0.5f), false)));
   c.payload = 8;
   auto cb = test::build_in_memory(c);
   ASSERT_TRUE(cb);
@@ -232,9 +232,9 @@ TEST(Build, ConstantPagesFoldedAndCoverageMakesAbsentPages) {
 
 TEST(Build, CodecsAndLayers) {
   BuildOptions o;
-  o.layers.push_back({LayerSemantic::kAlbedo, "", procedural(96, 96, 3)});
+  o.layers.push_back(test::layer_input(LayerSemantic::kAlbedo, procedural(96, 96, 3)));
   o.layers.push_back(
-      {LayerSemantic::kNormal, "", procedural(96, 96, 3, ProceduralPattern::kNormal)});
+      test::layer_input(LayerSemantic::kNormal, procedural(96, 96, 3, ProceduralPattern::kNormal)));
   o.payload = 24;
   for (CodecKind k : {CodecKind::kDct, CodecKind::kBc}) {
     o.codec.codec = k;
@@ -268,8 +268,8 @@ TEST(Build, CodecsAndLayers) {
 TEST(Build, RejectsBadOptions) {
   BuildOptions o;
   EXPECT_FALSE(plan_build(o).ok());
-  o.layers.push_back({LayerSemantic::kAlbedo, "", procedural(16, 16)});
-  o.layers.push_back({LayerSemantic::kOrm, "", procedural(17, 16)});
+  o.layers.push_back(test::layer_input(LayerSemantic::kAlbedo, procedural(16, 16)));
+  o.layers.push_back(test::layer_input(LayerSemantic::kOrm, procedural(17, 16)));
   EXPECT_EQ(plan_build(o).status().code(), ErrorCode::kInvalidArgument);
   o.layers.pop_back();
   o.payload = 9;  // page size not a multiple of 4
@@ -297,8 +297,8 @@ TEST(Build, FileWrittenAndReadBack) {
     auto src = open_image_file((dir / name).string());
     ASSERT_TRUE(src.ok()) << src.status().message();
     BuildOptions o;
-    o.layers.push_back(
-        {LayerSemantic::kAlbedo, "", std::shared_ptr<ImageSource>(std::move(src).value())});
+    o.layers.push_back(test::layer_input(LayerSemantic::kAlbedo,
+                                         std::shared_ptr<ImageSource>(std::move(src).value())));
     o.payload = 24;
     o.codec.codec = CodecKind::kRaw;
     o.output = (dir / (std::string(name) + ".vtpf")).string();
@@ -373,8 +373,8 @@ TEST(Build, OpaqueAlphaDropped) {
       auto src = open_image_file(png);
       ASSERT_TRUE(src.ok()) << src.status().message();
       BuildOptions o;
-      o.layers.push_back(
-          {LayerSemantic::kAlbedo, "", std::shared_ptr<ImageSource>(std::move(src).value())});
+      o.layers.push_back(test::layer_input(LayerSemantic::kAlbedo,
+                                           std::shared_ptr<ImageSource>(std::move(src).value())));
       o.payload = 24;
       o.codec.codec = codec;
       o.output = png + ".vtpf";
@@ -433,7 +433,7 @@ TEST(Build, CoveragePreservingAlpha) {
   }
   auto fractions = [&](float reference) {
     BuildOptions o;
-    o.layers.push_back({LayerSemantic::kAlbedo, "", memory_image(w, h, 4, t, false)});
+    o.layers.push_back(test::layer_input(LayerSemantic::kAlbedo, memory_image(w, h, 4, t, false)));
     o.codec.codec = CodecKind::kRaw;
     o.payload = 24;
     o.alpha_coverage_reference = reference;

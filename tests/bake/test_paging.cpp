@@ -43,7 +43,8 @@ class BorderRule : public testing::TestWithParam<BorderCase> {};
 TEST_P(BorderRule, EveryPageOfEveryLevel) {
   const BorderCase& c = GetParam();
   BuildOptions o;
-  o.layers.push_back({LayerSemantic::kAlbedo, "", noise_source(c.width, c.height, c.float_texels)});
+  o.layers.push_back(
+      test::layer_input(LayerSemantic::kAlbedo, noise_source(c.width, c.height, c.float_texels)));
   o.codec.codec = CodecKind::kRaw;
   o.payload = c.payload;
   o.border = c.border;
@@ -101,7 +102,8 @@ TEST(Pyramid, StreamedLevelsEqualWholeLevelFilter) {
   for (MipFilter f : {MipFilter::kBox, MipFilter::kKaiser, MipFilter::kLanczos3}) {
     for (AddressMode m : {AddressMode::kClamp, AddressMode::kWrap}) {
       BuildOptions o;
-      o.layers.push_back({LayerSemantic::kCustom, "data", noise_source(83, 59, true)});
+      o.layers.push_back(
+          test::layer_input(LayerSemantic::kCustom, noise_source(83, 59, true), "data"));
       o.codec.codec = CodecKind::kRaw;
       o.payload = 8;
       o.filter = f;

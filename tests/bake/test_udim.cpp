@@ -9,6 +9,7 @@
 
 #include "bake/build.h"
 #include "bake/image_source.h"
+#include "bake_test_util.h"
 #include "format/page_file.h"
 #include "format/page_file_inspect.h"
 
@@ -65,7 +66,8 @@ TEST(Udim, GridAssembledExactlyWithMissingTilesBlack) {
   };
 
   BuildOptions o;
-  o.layers.push_back({LayerSemantic::kAlbedo, "", std::shared_ptr<ImageSource>(std::move(*src))});
+  o.layers.push_back(
+      test::layer_input(LayerSemantic::kAlbedo, std::shared_ptr<ImageSource>(std::move(*src))));
   o.payload = 24;  // pages straddle tile edges
   o.codec.codec = CodecKind::kRaw;
   o.output = (dir / "grid.vtpf").string();
