@@ -831,7 +831,8 @@ inline void dequantise_block(const int16_t* z, int last, const int16_t* step, co
   }
 #else
   for (int k = 0; k < ((last + 8) & ~7); k++) {
-    dq[k] = int16_t(std::clamp(z[k] * step[k], -kMaxDequantized, kMaxDequantized));
+    const int v = std::clamp(int(z[k]), -int(limit[k]), int(limit[k])) * step[k];
+    dq[k] = int16_t(std::clamp(v, -kMaxDequantized, kMaxDequantized));
   }
 #endif
   // Whole groups of eight: dq is zero past `last`, and f is zeroed.
