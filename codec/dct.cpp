@@ -460,75 +460,113 @@ void build_planes(const DctSettings& s, const uint8_t* texels, int width, int he
                   FloatPlane* planes) {
   const int ch = s.channels;
   const int n = plane_count(s);
-  for (int p = 0; p < n; p++) {
-    planes[p].dims = plane_dims(s, p, width, height);
-    planes[p].v.assign(size_t(planes[p].dims.w) * planes[p].dims.h, 0.0f);
+  const size_t count = size_t(width) * height;
+  // Full-resolution values of every plane first (each texel's colour transform once), then
+  // 4:2:0 means and edge padding from them.
+  thread_local std::vector<float> full;  // per thread: no allocation per page
+  full.resize(count * size_t(n));
+  if (s.layout == DctPlaneLayout::kPlanes) {
+    for (int p = 0; p < n; p++) {
+      float* f = full.data() + size_t(p) * count;
+      for (size_t i = 0; i < count; i++) f[i] = float(texels[i * size_t(ch) + size_t(p)]) - 128.0f;
+    }
+  } else {
+    float* y = full.data();
+    float* co = y + count;
+    float* cg = co + count;
+    for (size_t i = 0; i < count; i++) {
+      const uint8_t* t = texels + i * size_t(ch);
+      const float r = t[0], g = t[1], b = t[2];
+      y[i] = (r + 2 * g + b) * 0.25f - 128.0f;
+      co[i] = (r - b) * 0.5f;
+      cg[i] = (2 * g - r - b) * 0.25f;
+    }
+    if (n == 4) {
+      float* a = cg + count;
+      for (size_t i = 0; i < count; i++) a[i] = float(texels[i * 4 + 3]) - 128.0f;
+    }
   }
-  auto at = [&](int x, int y, int c) { return float(texels[(size_t(y) * width + x) * ch + c]); };
-  // Full-resolution values of plane p at (x, y) before any subsampling.
-  auto full = [&](int p, int x, int y) -> float {
-    if (s.layout == DctPlaneLayout::kPlanes || p == 3) return at(x, y, p) - 128.0f;
-    const float r = at(x, y, 0), g = at(x, y, 1), b = at(x, y, 2);
-    if (p == 0) return (r + 2 * g + b) * 0.25f - 128.0f;
-    if (p == 1) return (r - b) * 0.5f;
-    return (2 * g - r - b) * 0.25f;
-  };
   for (int p = 0; p < n; p++) {
     FloatPlane& fp = planes[p];
+    fp.dims = plane_dims(s, p, width, height);
+    fp.v.resize(size_t(fp.dims.w) * fp.dims.h);
+    const float* src = full.data() + size_t(p) * count;
     const bool half = plane_is_half(s, p);
     const int sw = half ? (width + 1) / 2 : width, sh = half ? (height + 1) / 2 : height;
     for (int y = 0; y < fp.dims.h; y++) {
-      for (int x = 0; x < fp.dims.w; x++) {
-        const int sx = std::min(x, sw - 1), sy = std::min(y, sh - 1);
-        float value;
-        if (half) {
-          const int x0 = 2 * sx, y0 = 2 * sy;
-          const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
-          value = 0.25f * (full(p, x0, y0) + full(p, x1, y0) + full(p, x0, y1) + full(p, x1, y1));
-        } else {
-          value = full(p, sx, sy);
+      const int sy = std::min(y, sh - 1);
+      float* row = fp.v.data() + size_t(y) * fp.dims.w;
+      if (half) {
+        const float* r0 = src + size_t(2 * sy) * width;
+        const float* r1 = src + size_t(std::min(2 * sy + 1, height - 1)) * width;
+        for (int x = 0; x < sw; x++) {
+          const int x0 = 2 * x, x1 = std::min(x0 + 1, width - 1);
+          row[x] = 0.25f * (r0[x0] + r0[x1] + r1[x0] + r1[x1]);
         }
-        fp.v[size_t(y) * fp.dims.w + x] = value;
+      } else {
+        std::memcpy(row, src + size_t(sy) * width, size_t(sw) * sizeof(float));
       }
+      for (int x = sw; x < fp.dims.w; x++) row[x] = row[sw - 1];
     }
   }
+  // Kept for the next page of usual sizes, not for huge ones.
+  if (full.size() > (size_t(1) << 22)) std::vector<float>().swap(full);
 }
 
+// The orthonormal DCT-II basis, float: b[u][x].
 struct ForwardBasis {
-  double b[8][8];  // b[u][x]
+  float b[8][8];
   ForwardBasis() {
     for (int u = 0; u < 8; u++) {
       const double s = u == 0 ? std::sqrt(0.125) : 0.5;
-      for (int x = 0; x < 8; x++) b[u][x] = s * std::cos((2 * x + 1) * u * M_PI / 16.0);
+      for (int x = 0; x < 8; x++) b[u][x] = float(s * std::cos((2 * x + 1) * u * M_PI / 16.0));
     }
   }
 };
 
-// Forward DCT and deadzone quantisation of every block of a plane into zigzag order.
+// Forward DCT and deadzone quantisation of every block of a plane into zigzag order. Written as
+// broadcast multiply-adds over whole rows so that compilers vectorise it.
 void quantize_plane(const FloatPlane& fp, const uint8_t* quant, int16_t* coefs) {
   static const ForwardBasis basis;
+  float bt[8][8];  // bt[x][u] = b[u][x]
+  for (int u = 0; u < 8; u++)
+    for (int x = 0; x < 8; x++) bt[x][u] = basis.b[u][x];
+  alignas(16) float inv_step[64];
+  // Rounding offset below 1/2 on AC: cheaper, and near MSE-optimal for Laplacian data.
+  alignas(16) float rounding[64];
+  for (int i = 0; i < 64; i++) {
+    inv_step[i] = 1.0f / float(quant[i]);
+    rounding[i] = i == 0 ? 0.5f : 0.36f;
+  }
   const PlaneDims& d = fp.dims;
   for (int by = 0; by < d.bh; by++) {
     for (int bx = 0; bx < d.bw; bx++) {
-      double tmp[8][8];  // tmp[y][u]
       const float* src = fp.v.data() + size_t(by) * 8 * d.w + bx * 8;
+      float tmp[8][8];  // tmp[y][u]: rows transformed
       for (int y = 0; y < 8; y++) {
-        for (int u = 0; u < 8; u++) {
-          double acc = 0;
-          for (int x = 0; x < 8; x++) acc += basis.b[u][x] * src[size_t(y) * d.w + x];
-          tmp[y][u] = acc;
+        float acc[8] = {};
+        for (int x = 0; x < 8; x++) {
+          const float v = src[size_t(y) * d.w + x];
+          for (int u = 0; u < 8; u++) acc[u] += v * bt[x][u];
         }
+        std::memcpy(tmp[y], acc, sizeof(acc));
+      }
+      alignas(16) float c[64];  // c[v * 8 + u]
+      for (int v = 0; v < 8; v++) {
+        float acc[8] = {};
+        for (int y = 0; y < 8; y++) {
+          const float b = basis.b[v][y];
+          for (int u = 0; u < 8; u++) acc[u] += b * tmp[y][u];
+        }
+        std::memcpy(c + v * 8, acc, sizeof(acc));
+      }
+      alignas(16) int32_t q[64];  // natural order
+      for (int i = 0; i < 64; i++) {
+        const int mag = std::min(int(std::fabs(c[i]) * inv_step[i] + rounding[i]), kMaxDequantized);
+        q[i] = c[i] < 0.0f ? -mag : mag;
       }
       int16_t* z = coefs + (size_t(by) * d.bw + bx) * 64;
-      for (int k = 0; k < 64; k++) {
-        const int pos = kZigzag[k], v = pos >> 3, u = pos & 7;
-        double acc = 0;
-        for (int y = 0; y < 8; y++) acc += basis.b[v][y] * tmp[y][u];
-        // Rounding offset below 1/2 on AC: cheaper, and near MSE-optimal for Laplacian data.
-        const double a = std::abs(acc) / quant[pos] + (k == 0 ? 0.5 : 0.36);
-        const int mag = std::min(int(a), kMaxDequantized);
-        z[k] = int16_t(acc < 0 ? -mag : mag);
-      }
+      for (int k = 0; k < 64; k++) z[k] = q[kZigzag[k]];
     }
   }
 }
@@ -881,14 +919,15 @@ TokenModel* plane_models(const DctTables& t, int p, std::vector<TokenModel>& mod
 // Appends a coded page's length field, rANS part and raw bits.
 template <bool kAdaptive>
 void encode_tokens(const DctTables& t, const FloatPlane* planes, std::vector<uint8_t>& out) {
-  TokenEncoder<kAdaptive> enc;
-  std::vector<TokenModel> models;
-  std::vector<int16_t> coefs;
-  std::vector<BlockInfo> info;
+  // Per thread, so that a page costs no allocations; finish() leaves the encoder empty.
+  thread_local TokenEncoder<kAdaptive> enc;
+  thread_local std::vector<TokenModel> models;
+  thread_local std::vector<int16_t> coefs;   // every element written by quantize_plane
+  thread_local std::vector<BlockInfo> info;  // and by code_plane before it is read
   for (int p = 0; p < plane_count(t.settings); p++) {
     const PlaneDims& d = planes[p].dims;
-    coefs.assign(size_t(d.bw) * d.bh * 64, 0);
-    info.assign(size_t(d.bw) * d.bh, BlockInfo{});
+    coefs.resize(size_t(d.bw) * d.bh * 64);
+    info.resize(size_t(d.bw) * d.bh);
     quantize_plane(planes[p], t.quant[p], coefs.data());
     code_plane(enc, plane_models<kAdaptive>(t, p, models), d.bw, d.bh, coefs.data(), info.data());
   }

@@ -22,7 +22,8 @@
 // mode (0 static, 1 adaptive), then per plane 64 quantiser steps (natural order) and per token
 // model an observation count and 16 frequencies (codec/dct.cpp, dct_serialize_tables).
 // Thread safety: tables are read-only once made; encode and decode may run on any number of
-// threads at once. Decoding keeps a per-thread scratch buffer sized by the largest page.
+// threads at once. Encoding and decoding keep per-thread scratch buffers sized by the largest
+// page.
 #pragma once
 
 #include <cstddef>

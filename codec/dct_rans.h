@@ -99,22 +99,22 @@ class RansEncoder {
   // Appends the rANS bytes: two 32-bit states (little-endian), then 16-bit words.
   void finish(std::vector<uint8_t>& out) {
     uint32_t x[2] = {kRansLow, kRansLow};
-    std::vector<uint16_t> words;  // emitted last-first
+    words_.clear();
     for (size_t i = syms_.size(); i-- > 0;) {
       uint32_t& s = x[i & 1];
       const Sym& y = syms_[i];
       const uint32_t x_max = (kRansLow >> kFreqBits << 16) * y.freq;
       if (s >= x_max) {
-        words.push_back(uint16_t(s));
+        words_.push_back(uint16_t(s));
         s >>= 16;
       }
       s = ((s / y.freq) << kFreqBits) + (s % y.freq) + y.start;
     }
     for (int k = 0; k < 2; k++)
       for (int b = 0; b < 4; b++) out.push_back(uint8_t(x[k] >> (8 * b)));
-    for (size_t i = words.size(); i-- > 0;) {
-      out.push_back(uint8_t(words[i]));
-      out.push_back(uint8_t(words[i] >> 8));
+    for (size_t i = words_.size(); i-- > 0;) {
+      out.push_back(uint8_t(words_[i]));
+      out.push_back(uint8_t(words_[i] >> 8));
     }
     syms_.clear();
   }
@@ -124,6 +124,7 @@ class RansEncoder {
     uint16_t start, freq;
   };
   std::vector<Sym> syms_;
+  std::vector<uint16_t> words_;  // emitted last-first; kept for its capacity
 };
 
 // Decodes from a copy of the rANS bytes followed by kPadding zero bytes, so that renormalising
