@@ -67,18 +67,17 @@ inline int uint_token(unsigned v) {
 
 // AC coefficients go in pairs of zigzag positions (2j+1, 2j+2; the last pair's second is a
 // phantom position 64, always zero): a pair token is c0 + 4 * c1 with c = min(|v|, 3). The signs
-// of the pair's nonzeros follow raw (first position first); each c = 3 is then an escape token
-// for |v| - 3, an unsigned value. Pairs halve the tokens of per-position coding and keep every
-// token's position fixed, so no token's context waits on the token just before it.
+// of the pair's nonzeros follow raw (first position first). After the block's pairs, each c = 3
+// in position order has an escape token for |v| - 3, an unsigned value. Pairs halve the tokens
+// of per-position coding and keep every token's position fixed, so no token's context waits on
+// the token just before it.
 constexpr int kPairs = 32;
 constexpr int kEscapeClass = 3;
 struct PairToken {
-  uint8_t a0, a1;    // magnitude classes of the two positions
   uint8_t nonzeros;  // raw sign bits that follow
   uint8_t mask;      // 2^nonzeros - 1
-  uint8_t escape0;   // 1 when a0 is kEscapeClass
+  uint8_t escape0;   // 1 when the first position's class is kEscapeClass
   uint8_t escape1;
-  uint8_t pad[2];
 };
 
 // Two int16 coefficients as they lie in memory, first position first.
@@ -144,13 +143,8 @@ struct BucketTables {
     for (int t = 0; t < kTokens; t++) {
       const int a0 = t & 3, a1 = t >> 2;
       const int nonzeros = (a0 != 0) + (a1 != 0);
-      pair_token[t] = {uint8_t(a0),
-                       uint8_t(a1),
-                       uint8_t(nonzeros),
-                       uint8_t((1 << nonzeros) - 1),
-                       uint8_t(a0 == kEscapeClass),
-                       uint8_t(a1 == kEscapeClass),
-                       {}};
+      pair_token[t] = {uint8_t(nonzeros), uint8_t((1 << nonzeros) - 1), uint8_t(a0 == kEscapeClass),
+                       uint8_t(a1 == kEscapeClass)};
       for (uint32_t signs = 0; signs < 4; signs++) {
         pair_value[t][signs] = signed_pair(a0, a1, signs & ((1u << nonzeros) - 1), a0 != 0);
       }
