@@ -789,6 +789,7 @@ template <bool kAdaptive>
       // its nonzeros-left term when token j - 2 is decoded (the first two take the block's
       // count), so that the history needs no registers.
       uint16_t pair_ctx[kPairs + 2], esc_ctx[kPairs];
+      pair_ctx[kPairs] = pair_ctx[kPairs + 1] = 0;  // only added to, by the last two pairs
       if (nz > 0) {
         pair_contexts(n.left, n.up, 0, sizeof(TokenModel), pair_ctx, esc_ctx);
         pair_contexts(n.left, n.up, 4, sizeof(TokenModel), pair_ctx + 4, esc_ctx + 4);
