@@ -10,11 +10,8 @@
 #include <cmath>
 #include <cstring>
 
-// Keep a * b + c as two roundings in every build: the AVX-512 clone below would otherwise fuse
-// them (FMA) and give different bytes from the baseline build.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC optimize("fp-contract=off")
-#endif
+// a * b + c stays two roundings in every build, the AVX-512 clone below included: the codec is
+// compiled with -ffp-contract=off (codec/CMakeLists.txt).
 
 namespace vt {
 namespace {
