@@ -936,20 +936,23 @@ void encode_tokens(const DctTables& t, const FloatPlane* planes, std::vector<uin
   enc.bits.finish(out);
 }
 
+// `bytes` followed by `padding` zeros, in `buffer`.
+const uint8_t* padded_copy(std::span<const uint8_t> bytes, size_t padding,
+                           std::vector<uint8_t>& buffer) {
+  buffer.resize(bytes.size() + padding);
+  if (!bytes.empty()) std::memcpy(buffer.data(), bytes.data(), bytes.size());
+  std::memset(buffer.data() + bytes.size(), 0, padding);
+  return buffer.data();
+}
+
 // Decodes every plane's tokens and reconstructs its samples into scratch.samples.
 template <bool kAdaptive>
 Status decode_tokens(const DctTables& t, std::span<const uint8_t> rans,
                      std::span<const uint8_t> raw, int width, int height, DecodeScratch& scratch) {
   const size_t size = 1 + rans.size() + raw.size();
   if (rans.size() < 8) return corrupt_page(size, "data cut short");
-  scratch.rans.resize(rans.size() + RansDecoder::kPadding);
-  std::memcpy(scratch.rans.data(), rans.data(), rans.size());
-  std::memset(scratch.rans.data() + rans.size(), 0, RansDecoder::kPadding);
-  RansDecoder rans_dec(scratch.rans.data(), rans.size());
-  scratch.raw.resize(raw.size() + BitReader::kPadding);
-  std::memcpy(scratch.raw.data(), raw.data(), raw.size());
-  std::memset(scratch.raw.data() + raw.size(), 0, BitReader::kPadding);
-  BitReader bits(scratch.raw.data(), raw.size());
+  RansDecoder rans_dec(padded_copy(rans, RansDecoder::kPadding, scratch.rans), rans.size());
+  BitReader bits(padded_copy(raw, BitReader::kPadding, scratch.raw), raw.size());
   for (int p = 0; p < plane_count(t.settings); p++) {
     const PlaneDims d = plane_dims(t.settings, p, width, height);
     const size_t blocks = size_t(d.bw) * d.bh;
