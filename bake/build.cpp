@@ -3,17 +3,16 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <limits>
-#include <thread>
 
 #include "bake/color.h"
 #include "bake/level_store.h"
 #include "bake/paging.h"
+#include "common/parallel.h"
 
 namespace vt {
 namespace {
@@ -23,31 +22,6 @@ constexpr float kFloatMax = std::numeric_limits<float>::max();
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
-}
-
-int thread_count(int requested) {
-  if (requested > 0) return requested;
-  unsigned n = std::thread::hardware_concurrency();
-  return n == 0 ? 1 : int(n);
-}
-
-// Runs fn(i) for i in [0, n) on up to `threads` threads. Work items write only their own
-// results, so the outcome does not depend on the thread count.
-template <typename Fn>
-void parallel_for(int threads, size_t n, Fn&& fn) {
-  if (threads <= 1 || n <= 1) {
-    for (size_t i = 0; i < n; ++i) fn(i);
-    return;
-  }
-  std::atomic<size_t> next{0};
-  auto worker = [&] {
-    for (size_t i; (i = next.fetch_add(1)) < n;) fn(i);
-  };
-  std::vector<std::thread> pool;
-  size_t extra = std::min<size_t>(size_t(threads), n) - 1;
-  for (size_t t = 0; t < extra; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
 }
 
 bool is_colour(LayerSemantic s) {
@@ -144,7 +118,7 @@ class Level0Reader {
     for (uint32_t y = y0; y < y1; ++y) {
       if (!counted_[y]) VT_RETURN_IF_ERROR(scan_row(y, raw_.data() + size_t(y - y0) * w * sc));
     }
-    parallel_for(threads_, y1 - y0,
+    parallel_for(y1 - y0, threads_,
                  [&](size_t k) { convert_row(raw_.data() + k * w * sc, out + k * w * wc); });
     return Status::Ok();
   }
@@ -559,7 +533,7 @@ Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDe
       plan.spec.codec_tables = std::move(tables);
       std::vector<EncodedPage> coded(waiting.size());
       std::vector<Status> errors(waiting.size());
-      parallel_for(threads, waiting.size(), [&](size_t i) {
+      parallel_for(waiting.size(), threads, [&](size_t i) {
         errors[i] = encoder.encode(waiting[i].second.data(), coded[i]);
       });
       for (size_t i = 0; i < waiting.size(); ++i) {
@@ -640,7 +614,7 @@ Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDe
         for (uint32_t x0 = 0; x0 < px;) {
           const bool training = encoder.wants_training();
           const uint32_t x1 = training ? std::min(px, x0 + kTrainingChunk) : px;
-          parallel_for(threads, x1 - x0, [&](size_t i) {
+          parallel_for(x1 - x0, threads, [&](size_t i) {
             const uint32_t x = x0 + uint32_t(i);
             PageId id{l, x, r};
             present[x] = covered_all || page_has_coverage(g, id, coverage.data());
@@ -687,7 +661,7 @@ Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDe
             next_rows.resize(size_t(y1 - y0) * next->row_floats());
             constexpr uint32_t kRowsPerTask = 8;
             size_t tasks = (y1 - y0 + kRowsPerTask - 1) / kRowsPerTask;
-            parallel_for(threads, tasks, [&](size_t t) {
+            parallel_for(tasks, threads, [&](size_t t) {
               uint32_t a = y0 + uint32_t(t) * kRowsPerTask;
               uint32_t b = std::min(y1, a + kRowsPerTask);
               downsample_rows(kernel, plan.rules, band, a, b,

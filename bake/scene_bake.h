@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "bake/build.h"
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 #include "bake/transfer.h"
 #include "bake/unwrap/unwrap.h"
 #include "common/status.h"

@@ -1,6 +1,7 @@
 // Material transfer (see transfer.h). Work is split into bands of atlas rows; each band walks
 // the triangles that overlap it in index order, so the result does not depend on threads.
 #include "bake/transfer.h"
+#include "common/parallel.h"
 
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
@@ -148,21 +149,10 @@ double distance2_to(const RasterTri& t, double px, double py) {
 template <class Body>
 void for_each_band(uint32_t bands, int threads, const std::function<void(double)>& progress,
                    Body&& body) {
-  unsigned n = threads > 0 ? unsigned(threads) : std::max(1u, std::thread::hardware_concurrency());
-  n = std::min<unsigned>(n, std::max<uint32_t>(bands, 1));
-  std::atomic<uint32_t> next{0}, done{0};
-  auto work = [&](bool report) {
-    for (uint32_t b; (b = next.fetch_add(1)) < bands;) {
-      body(b);
-      uint32_t d = done.fetch_add(1) + 1;
-      if (report && progress) progress(double(d) / bands);
-    }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned i = 1; i < n; ++i) pool.emplace_back(work, false);
-  work(true);
-  for (auto& t : pool) t.join();
-  if (progress) progress(1.0);
+  std::function<void(size_t)> on_done;
+  if (progress) on_done = [&](size_t d) { progress(bands ? double(d) / bands : 1.0); };
+  parallel_for(
+      bands, threads, [&](size_t b) { body(uint32_t(b)); }, on_done);
 }
 
 // Per-texel state of the rasteriser inside one band.

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 #include "common/status.h"
 #include "format/page_file.h"
 

@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/build.h"
-#include "bake/procedural.h"
+#include "samples/procedural.h"
 #include "cli/cli_util.h"
 #include "cli/command.h"
 

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "bake/procedural.h"
+#include "samples/procedural.h"
 #include "cli/command.h"
 
 namespace {

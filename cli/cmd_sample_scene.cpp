@@ -1,8 +1,8 @@
-// `vtbake sample-scene DIR`: writes the procedural sample scene (bake/sample_scene.h) that
+// `vtbake sample-scene DIR`: writes the procedural sample scene (samples/sample_scene.h) that
 // `vtbake bake` bakes with no download.
 #include <cstdio>
 
-#include "bake/sample_scene.h"
+#include "samples/sample_scene.h"
 #include "cli/command.h"
 
 namespace {

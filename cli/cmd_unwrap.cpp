@@ -6,7 +6,7 @@
 #include <string>
 #include <thread>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 #include "bake/unwrap/unwrap.h"
 #include "cli/command.h"
 

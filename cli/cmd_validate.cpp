@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 #include "cli/command.h"
 #include "format/page_file.h"
 #include "render/camera.h"

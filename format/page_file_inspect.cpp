@@ -1,6 +1,7 @@
 // Page-file inspection: statistics from the index, checksum verification over threads, and
 // level reassembly with ancestor fill for absent pages.
 #include "format/page_file_inspect.h"
+#include "common/parallel.h"
 
 #include <algorithm>
 #include <atomic>
@@ -63,36 +64,26 @@ VerifyReport verify_pages(const PageFileReader& reader, int threads) {
           auto e = reader.entry({level, x, y}, layer);
           if (e.ok() && e->state == PageState::kStored) items.push_back({{level, x, y}, layer});
         }
-  if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
-  threads = int(std::min<size_t>(size_t(threads), std::max<size_t>(1, items.size())));
 
   // A reader opened without checksum verification still gets every page checked here.
   std::vector<Status> results(items.size());
-  std::atomic<size_t> next{0};
-  auto work = [&] {
-    for (size_t i; (i = next.fetch_add(1)) < items.size();) {
-      auto e = reader.entry(items[i].id, items[i].layer);
-      if (!e.ok()) {
-        results[i] = e.status();
-        continue;
-      }
-      auto bytes = reader.read_stored(items[i].id, items[i].layer);
-      if (!bytes.ok()) {
-        results[i] = bytes.status();
-      } else if (XXH3_64bits(bytes->data(), bytes->size()) != e->checksum) {
-        results[i] =
-            Error(ErrorCode::kCorrupt,
-                  reader.path() + ": page (level " + std::to_string(items[i].id.level) + ", x " +
-                      std::to_string(items[i].id.x) + ", y " + std::to_string(items[i].id.y) +
-                      ") layer " + std::to_string(items[i].layer) +
-                      ": checksum mismatch in stored bytes");
-      }
+  parallel_for(items.size(), threads, [&](size_t i) {
+    auto e = reader.entry(items[i].id, items[i].layer);
+    if (!e.ok()) {
+      results[i] = e.status();
+      return;
     }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (auto& th : pool) th.join();
+    auto bytes = reader.read_stored(items[i].id, items[i].layer);
+    if (!bytes.ok()) {
+      results[i] = bytes.status();
+    } else if (XXH3_64bits(bytes->data(), bytes->size()) != e->checksum) {
+      results[i] = Error(
+          ErrorCode::kCorrupt,
+          reader.path() + ": page (level " + std::to_string(items[i].id.level) + ", x " +
+              std::to_string(items[i].id.x) + ", y " + std::to_string(items[i].id.y) + ") layer " +
+              std::to_string(items[i].layer) + ": checksum mismatch in stored bytes");
+    }
+  });
 
   VerifyReport report;
   report.pages_checked = items.size();

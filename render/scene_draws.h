@@ -1,4 +1,4 @@
-// From the scene model (bake/scene) to what the renderer draws: world-space meshes (instances
+// From the scene model (scene/) to what the renderer draws: world-space meshes (instances
 // flattened) with the UVs of the virtual texture, and the reference meshes with their own UVs
 // and textures (base colour x factor, as the bake's albedo layer holds it).
 #pragma once
@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 #include "common/status.h"
 #include "render/camera.h"
 #include "render/renderer.h"

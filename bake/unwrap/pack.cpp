@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "bake/unwrap/unwrap_internal.h"
+#include "common/parallel.h"
 
 namespace vt::unwrap::detail {
 namespace {
@@ -152,18 +153,13 @@ PackResult pack_charts(const std::vector<PackChart>& charts, int width, int padd
   result.width = width;
   // Profiles are independent per chart: build them in parallel, place serially (deterministic).
   std::vector<std::array<Profile, 4>> profiles(charts.size());
-  int workers = std::max(1, std::min<int>(threads, static_cast<int>(charts.size() / 64 + 1)));
-  auto build = [&](int w) {
-    for (size_t c = w; c < charts.size(); c += workers) {
-      Grid g = grid_of(charts[c]);
-      auto cells = footprint(charts[c], g);
-      for (int r = 0; r < 4; ++r) profiles[c][r] = profile(cells, g, r, padding);
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int w = 1; w < workers; ++w) pool.emplace_back(build, w);
-  build(0);
-  for (auto& t : pool) t.join();
+  // Small chart sets are not worth a thread each.
+  const int workers = std::min(thread_count(threads), int(charts.size() / 64 + 1));
+  parallel_for(charts.size(), workers, [&](size_t c) {
+    Grid g = grid_of(charts[c]);
+    auto cells = footprint(charts[c], g);
+    for (int r = 0; r < 4; ++r) profiles[c][r] = profile(cells, g, r, padding);
+  });
 
   std::vector<size_t> order(charts.size());
   std::iota(order.begin(), order.end(), size_t{0});

@@ -15,6 +15,7 @@
 
 #include "bake/unwrap/unwrap.h"
 #include "bake/unwrap/unwrap_internal.h"
+#include "common/parallel.h"
 
 namespace vt::unwrap {
 namespace {
@@ -507,19 +508,6 @@ ChartVerdict parameterize(const Surface& s, Chart* c, const UnwrapOptions& opt) 
   return ChartVerdict::kOk;
 }
 
-template <typename Fn>
-void parallel_for(size_t count, int threads, Fn fn) {
-  std::atomic<size_t> next{0};
-  auto work = [&] {
-    for (size_t i; (i = next.fetch_add(1)) < count;) fn(i);
-  };
-  std::vector<std::thread> pool;
-  int n = std::max(1, std::min<int>(threads, static_cast<int>(count)));
-  for (int t = 1; t < n; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-}
-
 // ---- scaling and rotation ---------------------------------------------------------------
 
 // Rotates chart-local points to the smallest-area bounding box (hull edge directions), then
@@ -646,7 +634,7 @@ Expected<UnwrapResult> unwrap_scene(const scene::Scene& in, const UnwrapOptions&
   if (opt.texels_per_unit == 0 && opt.size_pages <= 0)
     return Error(ErrorCode::kInvalidArgument, "give texels per unit or a positive size in pages");
   VT_RETURN_IF_ERROR(scene::validate_geometry(in));
-  int threads = opt.threads > 0 ? opt.threads : std::max(1u, std::thread::hardware_concurrency());
+  const int threads = thread_count(opt.threads);
 
   UnwrapResult result;
   UnwrapStats& st = result.stats;

@@ -10,7 +10,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "bake/sample_scene.h"
+#include "samples/sample_scene.h"
 #include "bake/transfer.h"
 #include "bake/unwrap/unwrap.h"
 

@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <limits>
 
-#include "bake/procedural.h"
+#include "samples/procedural.h"
 #include "bake_test_util.h"
 #include "format/page_file.h"
 #include "format/page_file_inspect.h"

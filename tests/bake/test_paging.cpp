@@ -5,7 +5,7 @@
 
 #include <cstring>
 
-#include "bake/procedural.h"
+#include "samples/procedural.h"
 #include "bake_test_util.h"
 
 namespace vt {

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 #include "format/page_file.h"
 #include "render/renderer.h"
 #include "render/report.h"

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "bake/sample_scene.h"
-#include "bake/scene/scene.h"
+#include "samples/sample_scene.h"
+#include "scene/scene.h"
 #include "format/page_file.h"
 
 namespace vt::test {

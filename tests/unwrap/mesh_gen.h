@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <random>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 #include "bake/unwrap/unwrap.h"
 
 namespace vt::test {

@@ -1,4 +1,4 @@
-#include "bake/procedural.h"
+#include "samples/procedural.h"
 
 #include <algorithm>
 #include <cmath>

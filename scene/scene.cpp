@@ -1,5 +1,5 @@
 // Scene hierarchy flattening, geometry validation and matrix helpers.
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 
 #include <cmath>
 #include <string>

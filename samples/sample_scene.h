@@ -8,7 +8,7 @@
 #include <functional>
 #include <string>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 #include "common/status.h"
 
 namespace vt {

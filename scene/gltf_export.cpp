@@ -7,7 +7,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "bake/scene/scene_io_util.h"
+#include "scene/scene_io_util.h"
 
 namespace vt::scene {
 namespace {

@@ -6,7 +6,7 @@
 #include <map>
 #include <unordered_map>
 
-#include "bake/scene/scene_io_util.h"
+#include "scene/scene_io_util.h"
 
 namespace vt::scene::detail {
 namespace {

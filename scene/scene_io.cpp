@@ -3,8 +3,8 @@
 #include <cstdio>
 #include <memory>
 
-#include "bake/scene/scene.h"
-#include "bake/scene/scene_io_util.h"
+#include "scene/scene.h"
+#include "scene/scene_io_util.h"
 
 namespace vt::scene {
 namespace detail {

@@ -7,11 +7,11 @@
 #include <fstream>
 #include <iterator>
 
-#include "bake/sample_scene.h"
+#include "samples/sample_scene.h"
 #include "bake/scene_bake.h"
 #include "bake/transfer.h"
 #include "format/page_file.h"
-#include "transfer_test_util.h"
+#include "tests/transfer/transfer_test_util.h"
 
 namespace vt {
 namespace {

@@ -1,5 +1,5 @@
 // The procedural sample scene and a small glTF (.gltf + .bin) writer (see sample_scene.h).
-#include "bake/sample_scene.h"
+#include "samples/sample_scene.h"
 
 #include <cmath>
 #include <cstring>

@@ -3,7 +3,7 @@
 #include <draco/io/ply_decoder.h>
 #include <draco/mesh/mesh.h>
 
-#include "bake/scene/scene_io_util.h"
+#include "scene/scene_io_util.h"
 
 namespace vt::scene::detail {
 namespace {

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "mesh_gen.h"
+#include "tests/unwrap/mesh_gen.h"
 
 namespace vt::test {
 namespace {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "bake/scene/scene.h"
+#include "scene/scene.h"
 #include "common/status.h"
 
 namespace vt::scene::detail {

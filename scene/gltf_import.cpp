@@ -4,7 +4,7 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 
-#include "bake/scene/scene_io_util.h"
+#include "scene/scene_io_util.h"
 
 namespace vt::scene::detail {
 namespace {
