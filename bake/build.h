@@ -1,10 +1,13 @@
-// The build pipeline: level-0 texels of one or more layers in, a page file out. For each layer
-// it converts the input to linear working space, filters the mip pyramid (pyramid.h), dilates
-// uncovered texels (pull-push), cuts bordered pages (paging.h), encodes them (page_encoder.h)
-// on all cores and streams them to the writer. Memory stays within BuildOptions::memory_limit:
-// level 0 is read in bands of page rows and never held whole (unless a coverage mask asks for
-// pull-push), coarser levels too large for the budget live in scratch files beside the output.
-// The output bytes do not depend on the thread count.
+// The build pipeline: level-0 texels of one or more layers in, a page file out, as three steps.
+// The plan (build_plan.h) decides everything up front: each layer's conversion to linear working
+// space and its encoder with DCT tables trained on the layer's own pages, the file's final
+// header, where each level lives. The tasks (build_tasks.h) cut the work into page rows of a
+// level: filter the mip pyramid (pyramid.h), dilate uncovered texels (pull-push), cut bordered
+// pages (paging.h), encode them (page_encoder.h) on all cores. build_pages runs the tasks and
+// streams the pages to a sink. Memory stays within BuildOptions::memory_limit: level 0 is read
+// in bands of page rows and never held whole (unless a coverage mask asks for pull-push),
+// coarser levels too large for the budget live in scratch files beside the output. The output
+// bytes do not depend on the thread count.
 #pragma once
 
 #include <cstdint>
@@ -40,6 +43,9 @@ struct LayerInput {
   // are absent; the levels must then fit in the memory limit.
   std::shared_ptr<const std::vector<uint8_t>> coverage;
   bool alpha_dropped = false;  // set by drop_opaque_alpha: the source's alpha was all 1
+  // The build may take an in-memory source's texels (ImageSource::release_texels) as its
+  // level 0 and convert them in place instead of copying them; the source is empty afterwards.
+  bool consume_source = false;
 };
 
 // Progress of the running build, reported from the calling thread after every page row.
@@ -110,6 +116,8 @@ struct BuildSummary {
   uint64_t scratch_bytes = 0;       // largest scratch file use at any time
   uint64_t level_memory_bytes = 0;  // largest in-memory level storage at any time
   std::vector<StageTime> stages;
+  uint64_t plan_hash = 0;           // BuildPlan::hash
+  std::vector<uint64_t> task_keys;  // per task of make_build_tasks (0 for level tasks)
 };
 
 // Receives the pages of a build; PageFileWriter is the usual one, tests collect them.
@@ -119,22 +127,18 @@ class PageSink {
   virtual Status add_page(const PageId& id, uint32_t layer, std::span<const uint8_t> data) = 0;
   virtual Status add_constant_page(const PageId& id, uint32_t layer,
                                    std::span<const uint8_t> texel) = 0;
-  // A dct layer's trained tables, given before any stored page of the layer.
-  virtual Status set_codec_tables(uint32_t layer, std::span<const uint8_t> tables) = 0;
 };
 
-// Checks the options and works out the file's description (geometry and completed layer specs,
-// codec tables included) without reading any texel.
-Expected<PageFileDesc> plan_build(const BuildOptions& options);
+struct BuildPlan;  // build_plan.h: plan_build(options)
 
-// Runs the pipeline into `sink` (whose file must have been created with plan_build's desc).
-Expected<BuildSummary> build_pages(const BuildOptions& options, const PageFileDesc& desc,
-                                   PageSink& sink);
+// Runs the plan's tasks into `sink` (for a file: a writer created with plan.desc). The plan's
+// level-0 sources are read once and consumed: run a plan once.
+Expected<BuildSummary> build_pages(const BuildPlan& plan, PageSink& sink);
 
 // Alpha is kept only where some texel is not opaque: for every albedo layer whose source has
 // alpha (2 or 4 channels), reads the source once in bounded bands and, when every alpha is
 // >= 1, replaces the source by one without the alpha channel (so the layer is RGB, BC1 rather
-// than BC3) and sets LayerInput::alpha_dropped. Must run before plan_build.
+// than BC3) and sets LayerInput::alpha_dropped. Runs before plan_build.
 Status drop_opaque_alpha(BuildOptions& options);
 
 // drop_opaque_alpha + plan_build + a PageFileWriter at options.output + build_pages + finish.

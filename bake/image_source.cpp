@@ -1,16 +1,33 @@
 #include "bake/image_source.h"
 
 #include <OpenImageIO/imageio.h>
+#define XXH_STATIC_LINKING_ONLY  // XXH3_state_t on the stack
+#include <xxhash.h>
 
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 
 namespace vt {
 namespace {
 
 namespace OIIO = OIIO_NAMESPACE;
+
+Expected<uint64_t> hash_file(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return Status(ErrorCode::kIo, path + ": cannot read to hash it");
+  XXH3_state_t state;
+  XXH3_64bits_reset(&state);
+  std::vector<char> buf(size_t(1) << 20);
+  while (f) {
+    f.read(buf.data(), std::streamsize(buf.size()));
+    XXH3_64bits_update(&state, buf.data(), size_t(f.gcount()));
+  }
+  if (f.bad()) return Status(ErrorCode::kIo, path + ": read error while hashing");
+  return XXH3_64bits_digest(&state);
+}
 
 class FileImageSource final : public ImageSource {
  public:
@@ -26,6 +43,9 @@ class FileImageSource final : public ImageSource {
   }
 
   const ImageInfo& info() const override { return info_; }
+
+  // The file's bytes decide its texels; hashing them is far cheaper than decoding.
+  Expected<uint64_t> content_hash() override { return hash_file(path_); }
 
   Status read_rows(uint32_t y0, uint32_t y1, float* out) override {
     if (y0 > y1 || y1 > info_.height) {
@@ -101,6 +121,32 @@ Status MemoryImageSource::read_rows(uint32_t y0, uint32_t y1, float* out) {
   }
   std::memcpy(out, texels_.data() + y0 * row, (y1 - y0) * row * sizeof(float));
   return Status::Ok();
+}
+
+Expected<uint64_t> ImageSource::content_hash() {
+  const ImageInfo& in = info();
+  const size_t row = size_t(in.width) * in.channels;
+  const uint32_t band =
+      uint32_t(std::clamp<size_t>((size_t(4) << 20) / std::max<size_t>(row, 1), 1, in.height));
+  std::vector<float> rows(size_t(band) * row);
+  XXH3_state_t state;
+  XXH3_64bits_reset(&state);
+  for (uint32_t y = 0; y < in.height; y += band) {
+    const uint32_t y1 = std::min(in.height, y + band);
+    VT_RETURN_IF_ERROR(read_rows(y, y1, rows.data()));
+    XXH3_64bits_update(&state, rows.data(), size_t(y1 - y) * row * sizeof(float));
+  }
+  return XXH3_64bits_digest(&state);
+}
+
+Expected<uint64_t> MemoryImageSource::content_hash() {
+  return XXH3_64bits(texels_.data(), texels_.size() * sizeof(float));
+}
+
+Expected<uint64_t> DropChannelSource::content_hash() {
+  VT_ASSIGN_OR_RETURN(uint64_t inner, source_->content_hash());
+  const uint64_t parts[2] = {inner, channel_};
+  return XXH3_64bits(parts, sizeof parts);
 }
 
 Status write_image_file(ImageSource& source, const std::string& path, uint32_t tile) {
@@ -193,6 +239,18 @@ class UdimImageSource final : public ImageSource {
         tile_h_(tile_h),
         tiles_(std::move(tiles)) {}
   const ImageInfo& info() const override { return info_; }
+
+  Expected<uint64_t> content_hash() override {
+    std::vector<uint64_t> parts{tiles_u_, tiles_v_};
+    for (const auto& tile : tiles_) {
+      uint64_t h = 0;  // a missing tile is black
+      if (tile) {
+        VT_ASSIGN_OR_RETURN(h, tile->content_hash());
+      }
+      parts.push_back(h);
+    }
+    return XXH3_64bits(parts.data(), parts.size() * sizeof(uint64_t));
+  }
 
   Status read_rows(uint32_t y0, uint32_t y1, float* out) override {
     if (y0 > y1 || y1 > info_.height) {

@@ -30,6 +30,14 @@ class ImageSource {
   // Reads rows [y0, y1) into out (width * channels * (y1 - y0) floats). Reads are cheapest in
   // increasing y; going back may re-decode a file.
   virtual Status read_rows(uint32_t y0, uint32_t y1, float* out) = 0;
+  // A hash of the texels this source hands out (same texels, same hash): the content part of a
+  // build plan's identity. The default reads every row; sources that know a cheaper exact
+  // identity (a file's bytes, a generator's parameters) override it.
+  virtual Expected<uint64_t> content_hash();
+  // Hands over the whole image (width * height * channels floats) when the source holds it in
+  // memory, leaving the source empty, so that a build can convert it in place rather than copy
+  // it; empty when the source cannot.
+  virtual std::vector<float> release_texels() { return {}; }
 };
 
 // Opens an image file OpenImageIO can read (first subimage, level 0). Errors name the file.
@@ -42,6 +50,8 @@ class MemoryImageSource final : public ImageSource {
       : info_(std::move(info)), texels_(std::move(texels)) {}
   const ImageInfo& info() const override { return info_; }
   Status read_rows(uint32_t y0, uint32_t y1, float* out) override;
+  Expected<uint64_t> content_hash() override;
+  std::vector<float> release_texels() override { return std::move(texels_); }
   const std::vector<float>& texels() const { return texels_; }
 
  private:
@@ -70,6 +80,7 @@ class DropChannelSource final : public ImageSource {
   DropChannelSource(std::shared_ptr<ImageSource> source, uint32_t channel);
   const ImageInfo& info() const override { return info_; }
   Status read_rows(uint32_t y0, uint32_t y1, float* out) override;
+  Expected<uint64_t> content_hash() override;
 
  private:
   std::shared_ptr<ImageSource> source_;

@@ -6,6 +6,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include "bake/pyramid.h"
+
 namespace vt {
 
 Expected<std::unique_ptr<LevelStore>> LevelStore::create(uint32_t width, uint32_t height,
@@ -33,6 +35,25 @@ Expected<std::unique_ptr<LevelStore>> LevelStore::create(uint32_t width, uint32_
   return s;
 }
 
+std::unique_ptr<LevelStore> LevelStore::adopt(uint32_t width, uint32_t height, uint32_t channels,
+                                              std::vector<float> texels) {
+  std::unique_ptr<LevelStore> s(new LevelStore());
+  s->width_ = width;
+  s->height_ = height;
+  s->channels_ = channels;
+  s->memory_ = std::move(texels);
+  s->memory_.resize(size_t(width) * height * channels);
+  return s;
+}
+
+Status LevelStore::set_coverage_and_dilate(std::vector<uint8_t> coverage) {
+  if (!in_memory() || coverage.size() != size_t(width_) * height_)
+    return Error(ErrorCode::kInternal, "coverage of a level not held in memory, or of wrong size");
+  coverage_ = std::move(coverage);
+  pull_push(memory_.data(), coverage_.data(), width_, height_, channels_);
+  return Status::Ok();
+}
+
 LevelStore::~LevelStore() {
   if (fd_ >= 0) close(fd_);
 }
@@ -58,8 +79,9 @@ Status LevelStore::write_rows(uint32_t y0, uint32_t rows, const float* data) {
   return Status::Ok();
 }
 
-Status LevelStore::read_rows(uint32_t y0, uint32_t rows, float* out) const {
-  if (uint64_t(y0) + rows > height_) return Error(ErrorCode::kInternal, "level rows past end");
+Status LevelStore::read(uint32_t y0, uint32_t y1, float* out) {
+  if (y0 > y1 || y1 > height_) return Error(ErrorCode::kInternal, "level rows past end");
+  const uint32_t rows = y1 - y0;
   if (in_memory()) {
     std::memcpy(out, memory_.data() + size_t(y0) * row_floats(),
                 size_t(rows) * row_floats() * sizeof(float));

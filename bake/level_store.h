@@ -1,5 +1,6 @@
 // Rows of one pyramid level kept for the next pass: in memory when the budget allows, otherwise
-// in an unlinked scratch file (removed by the OS even if the process dies).
+// in an unlinked scratch file (removed by the OS even if the process dies). Layers with a
+// coverage mask keep the level's mask beside it.
 #pragma once
 
 #include <cstdint>
@@ -7,32 +8,41 @@
 #include <string>
 #include <vector>
 
+#include "bake/level_source.h"
 #include "common/status.h"
 
 namespace vt {
 
-class LevelStore {
+class LevelStore final : public LevelSource {
  public:
   // width x height texels of `channels` floats; in a scratch file under `scratch_dir` unless
   // `in_memory`.
   static Expected<std::unique_ptr<LevelStore>> create(uint32_t width, uint32_t height,
                                                       uint32_t channels, bool in_memory,
                                                       const std::string& scratch_dir);
-  ~LevelStore();
+  // An in-memory level over texels the caller hands over (width * height * channels floats).
+  static std::unique_ptr<LevelStore> adopt(uint32_t width, uint32_t height, uint32_t channels,
+                                           std::vector<float> texels);
+  ~LevelStore() override;
   LevelStore(const LevelStore&) = delete;
   LevelStore& operator=(const LevelStore&) = delete;
 
-  uint32_t width() const { return width_; }
-  uint32_t height() const { return height_; }
-  uint32_t channels() const { return channels_; }
+  uint32_t width() const override { return width_; }
+  uint32_t height() const override { return height_; }
+  uint32_t channels() const override { return channels_; }
   bool in_memory() const { return fd_ < 0; }
   uint64_t bytes() const { return uint64_t(width_) * height_ * channels_ * sizeof(float); }
-  size_t row_floats() const { return size_t(width_) * channels_; }
 
   Status write_rows(uint32_t y0, uint32_t rows, const float* data);
-  Status read_rows(uint32_t y0, uint32_t rows, float* out) const;
+  Status read(uint32_t y0, uint32_t y1, float* out) override;
   // The texels of an in-memory store (nullptr for a scratch file).
   float* data() { return in_memory() ? memory_.data() : nullptr; }
+
+  const uint8_t* coverage() const override {
+    return coverage_.empty() ? nullptr : coverage_.data();
+  }
+  // Sets the level's mask and dilates its uncovered texels (pull-push); in-memory stores only.
+  Status set_coverage_and_dilate(std::vector<uint8_t> coverage);
 
  private:
   LevelStore() = default;
@@ -40,6 +50,7 @@ class LevelStore {
   int fd_ = -1;
   std::string path_;
   std::vector<float> memory_;
+  std::vector<uint8_t> coverage_;
 };
 
 }  // namespace vt

@@ -50,6 +50,7 @@ std::vector<LayerInput> layer_inputs(TransferResult& transfer) {
         break;
     }
     in.source = std::make_shared<MemoryImageSource>(info, std::move(layer.texels));
+    in.consume_source = true;  // the build converts the transfer's buffers in place
     layer.texels.clear();
     inputs.push_back(std::move(in));
   }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <xxhash.h>
+
 namespace vt {
 namespace {
 
@@ -31,6 +33,11 @@ ProceduralImageSource::ProceduralImageSource(ProceduralPattern pattern, uint32_t
   info_.is_float = false;
   info_.alpha_channel = info_.channels == 4 ? 3 : -1;
   info_.color_space = pattern == ProceduralPattern::kAlbedo ? "sRGB" : "raw";
+}
+
+Expected<uint64_t> ProceduralImageSource::content_hash() {
+  const uint32_t parts[5] = {uint32_t(pattern_), info_.width, info_.height, info_.channels, seed_};
+  return XXH3_64bits(parts, sizeof parts);
 }
 
 Status ProceduralImageSource::read_rows(uint32_t y0, uint32_t y1, float* out) {

@@ -22,6 +22,8 @@ class ProceduralImageSource final : public ImageSource {
                         uint32_t channels = 3, uint32_t seed = 1);
   const ImageInfo& info() const override { return info_; }
   Status read_rows(uint32_t y0, uint32_t y1, float* out) override;
+  // The generator's parameters decide every texel.
+  Expected<uint64_t> content_hash() override;
 
  private:
   ProceduralPattern pattern_;

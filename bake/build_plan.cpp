@@ -1,0 +1,334 @@
+#include "bake/build_plan.h"
+
+#include <xxhash.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+
+#include "bake/level_source.h"
+#include "bake/paging.h"
+#include "bake/row_window.h"
+#include "common/parallel.h"
+
+#ifndef VTBAKE_VERSION
+#define VTBAKE_VERSION "unknown"
+#endif
+
+namespace vt {
+namespace {
+
+constexpr float kFloatMax = std::numeric_limits<float>::max();
+
+bool is_colour(LayerSemantic s) {
+  return s == LayerSemantic::kAlbedo || s == LayerSemantic::kEmissive;
+}
+
+Expected<LayerPlan> plan_layer(const LayerInput& in, const BuildOptions& options) {
+  LayerPlan p;
+  const ImageInfo& info = in.source->info();
+  p.spec.semantic = in.semantic;
+  p.spec.name = in.name.empty() ? to_string(in.semantic) : in.name;
+  p.spec.address_mode = options.address;
+  p.source_channels = info.channels;
+  if (info.channels < 1 || info.channels > 4) {
+    return Status(ErrorCode::kUnsupported, p.spec.name + ": 1-4 channels expected");
+  }
+  const bool want_float = info.is_float && options.codec.codec == CodecKind::kRaw;
+  if (in.semantic == LayerSemantic::kNormal) {
+    if (info.channels < 2) {
+      return Status(ErrorCode::kInvalidArgument, p.spec.name + ": a normal map needs 2+ channels");
+    }
+    p.normal = true;
+    p.decode_unorm_normal = !info.is_float;
+    p.work_channels = 3;
+    p.spec.channels = 2;
+    p.spec.texel_type = TexelType::kU8;
+    p.rules.renormalize_xyz = true;
+    for (int c = 0; c < 3; ++c) p.rules.min_value[c] = -1, p.rules.max_value[c] = 1;
+  } else if (is_colour(in.semantic)) {
+    const bool has_alpha = info.channels == 2 || info.channels == 4;
+    p.colour = true;
+    p.work_channels = has_alpha ? 4 : 3;
+    p.alpha = has_alpha ? 3 : -1;
+    p.spec.channels = uint8_t(p.work_channels);
+    p.spec.texel_type = want_float ? TexelType::kF32 : TexelType::kU8;
+    std::string src_space = in.color_space.empty() ? info.color_space : in.color_space;
+    if (src_space.empty()) src_space = info.is_float ? "linear" : "sRGB";
+    auto to_lin = ColorConverter::create(src_space, "linear");
+    if (!to_lin.ok()) return to_lin.status().with_context(p.spec.name);
+    p.to_linear = std::move(to_lin).value();
+    auto to_store = ColorConverter::create("linear", want_float ? "linear" : "sRGB");
+    if (!to_store.ok()) return to_store.status().with_context(p.spec.name);
+    p.to_storage = std::move(to_store).value();
+    p.spec.color_space = want_float ? ColorSpace::kLinear : ColorSpace::kSrgb;
+    for (uint32_t c = 0; c < p.work_channels; ++c) p.rules.min_value[c] = 0;
+    if (p.alpha >= 0) p.rules.max_value[p.alpha] = 1;
+  } else {
+    // ORM and custom layers are data: no colour conversion.
+    p.work_channels = info.channels;
+    p.spec.channels = uint8_t(info.channels);
+    p.spec.texel_type = want_float ? TexelType::kF32 : TexelType::kU8;
+    if (!want_float) {
+      for (uint32_t c = 0; c < p.work_channels; ++c)
+        p.rules.min_value[c] = 0, p.rules.max_value[c] = 1;
+    }
+  }
+  p.rules.address = options.address;
+  return p;
+}
+
+Status check_inputs(const BuildOptions& options) {
+  if (options.layers.empty() || options.layers.size() > 16) {
+    return Status(ErrorCode::kInvalidArgument, "a build needs 1 to 16 layers");
+  }
+  const ImageInfo* first = nullptr;
+  for (size_t i = 0; i < options.layers.size(); ++i) {
+    const LayerInput& in = options.layers[i];
+    if (!in.source) return Status(ErrorCode::kInvalidArgument, "layer without a source");
+    const ImageInfo& info = in.source->info();
+    if (!first) first = &info;
+    if (info.width != first->width || info.height != first->height) {
+      return Status(ErrorCode::kInvalidArgument,
+                    "layer " + std::to_string(i) + " is " + std::to_string(info.width) + "x" +
+                        std::to_string(info.height) + ", layer 0 is " +
+                        std::to_string(first->width) + "x" + std::to_string(first->height));
+    }
+    if (in.coverage && in.coverage->size() != size_t(info.width) * info.height) {
+      return Status(ErrorCode::kInvalidArgument,
+                    "layer " + std::to_string(i) + ": coverage mask size differs from image size");
+    }
+  }
+  return Status::Ok();
+}
+
+// The level-0 pages DCT tables are trained on: with at most `limit` present pages, all of
+// them; otherwise `limit` pages spread evenly over the level in raster order. Constant pages
+// carry no statistics and are left out. Returns their texels as stored, in raster order.
+Expected<std::vector<std::vector<uint8_t>>> training_sample(const BuildPlan& plan,
+                                                            const LayerInput& in,
+                                                            const LayerPlan& layer, size_t limit) {
+  const PageGeometry& g = plan.desc.geometry;
+  const uint32_t P = g.payload, S = g.page_size(), px = g.pages_x(0), py = g.pages_y(0);
+  const uint8_t* coverage = layer.level0->coverage();
+  std::vector<PageId> present;
+  for (uint32_t y = 0; y < py; ++y)
+    for (uint32_t x = 0; x < px; ++x)
+      if (!coverage || page_has_coverage(g, PageId{0, x, y}, coverage))
+        present.push_back(PageId{0, x, y});
+  std::vector<PageId> chosen;
+  if (present.size() <= limit) {
+    chosen = present;
+  } else {
+    for (size_t k = 0; k < limit; ++k)
+      chosen.push_back(present[(2 * k + 1) * present.size() / (2 * limit)]);
+  }
+
+  // A streamed level 0 is read again for the build: this read must not count bad values.
+  std::shared_ptr<LevelSource> source = layer.level0;
+  if (!coverage) {
+    VT_ASSIGN_OR_RETURN(source, open_level0(in, layer, plan.options, false));
+  }
+  RowWindow window(*source, plan.options.address);
+  if (plan.options.address == AddressMode::kWrap) {
+    VT_RETURN_IF_ERROR(window.pin(P + 2 * plan.margin, plan.margin));
+  }
+  const size_t page_texels = size_t(S) * S;
+  std::vector<std::vector<uint8_t>> pages;
+  for (size_t i = 0; i < chosen.size();) {
+    const uint32_t r = chosen[i].y;
+    size_t end = i;
+    while (end < chosen.size() && chosen[end].y == r) ++end;
+    VT_ASSIGN_OR_RETURN(RowBand band,
+                        window.fetch(int64_t(r) * P - plan.margin, P + 2 * plan.margin));
+    std::vector<std::vector<uint8_t>> row(end - i);
+    parallel_for(end - i, plan.threads, [&](size_t k) {
+      thread_local std::vector<float> texels;
+      texels.resize(page_texels * layer.work_channels);
+      cut_page(g, chosen[i + k], plan.options.address, band, texels.data());
+      row[k].resize(layer.encoder->page_bytes());
+      layer.store_page(texels.data(), page_texels, 1.0f, row[k].data());
+    });
+    for (auto& page : row)
+      if (!layer.encoder->is_constant(page.data())) pages.push_back(std::move(page));
+    i = end;
+  }
+  return pages;
+}
+
+// Bytes the build holds beside the level images while it works on a level `width` wide.
+uint64_t working_set(const BuildPlan& plan, const LayerPlan& layer, uint32_t width) {
+  const PageGeometry& g = plan.desc.geometry;
+  const uint32_t P = g.payload, S = g.page_size(), wc = layer.work_channels;
+  const uint64_t row = uint64_t(width) * wc * sizeof(float);
+  const uint64_t band_rows = P + 2 * plan.margin;
+  // Window, band, read buffer and the allocator's slack on them; 64 MiB for the libraries,
+  // the writer's index and thread stacks (measured: ~190 MiB at 16K wide RGB).
+  uint64_t ws = row * band_rows * 4 + (uint64_t(64) << 20);
+  if (plan.options.address == AddressMode::kWrap) ws += row * (band_rows + plan.margin);
+  ws += uint64_t(plan.threads) * (row / 2 * 2 * (16 + plan.kernel.taps()));  // downsample
+  ws += row / 2 * (P / 2);                                                   // next level's rows
+  ws += uint64_t(plan.threads) * S * S * (wc * 4 + 16) * 3;                  // page buffers
+  ws += uint64_t(g.pages_x(0)) * S * S * 4;  // encoded pages of a row
+  return ws;
+}
+
+// Which levels live in memory: level l + 1 does if it and level l fit in what the working set
+// leaves; coverage layers keep every level (pull-push needs the whole level).
+std::vector<bool> choose_level_memory(const BuildPlan& plan, const LayerPlan& layer,
+                                      bool coverage) {
+  const PageGeometry& g = plan.desc.geometry;
+  const uint64_t limit = plan.options.memory_limit;
+  auto level_bytes = [&](uint32_t l) {
+    return uint64_t(g.level_width(l)) * g.level_height(l) * layer.work_channels * sizeof(float);
+  };
+  std::vector<bool> in_memory(g.level_count());
+  in_memory[0] = coverage;
+  for (uint32_t l = 0; l + 1 < g.level_count(); ++l) {
+    const uint64_t cur = in_memory[l] ? level_bytes(l) : 0;
+    const uint64_t ws = working_set(plan, layer, g.level_width(l));
+    in_memory[l + 1] = coverage || (ws < limit && cur + level_bytes(l + 1) <= limit - ws);
+  }
+  return in_memory;
+}
+
+std::string build_metadata(const BuildOptions& options, const std::vector<LayerPlan>& layers) {
+  nlohmann::json sources = nlohmann::json::array();
+  for (size_t i = 0; i < layers.size(); ++i)
+    sources.push_back(
+        {{"layer", layers[i].spec.name}, {"color_space", options.layers[i].color_space}});
+  nlohmann::json meta = nlohmann::json::parse(options.metadata_json, nullptr, false);
+  if (meta.is_discarded() || !meta.is_object()) meta = nlohmann::json::object();
+  meta["build"] = {
+      {"filter", to_string(options.filter)},        {"address", to_string(options.address)},
+      {"codec", int(options.codec.codec)},          {"dct_quality", options.codec.dct_quality},
+      {"dct_adaptive", options.codec.dct_adaptive}, {"layers", sources}};
+  return meta.dump();
+}
+
+// Everything that decides the output bytes: settings, tool version and the sources' content.
+// Thread count, memory limit and paths do not (the output does not depend on them).
+Expected<uint64_t> plan_hash(const BuildPlan& plan) {
+  const BuildOptions& o = plan.options;
+  nlohmann::json j = {{"tool", VTBAKE_VERSION},
+                      {"metadata", plan.desc.metadata_json},
+                      {"payload", o.payload},
+                      {"border", o.border},
+                      {"non_finite", int(o.non_finite)},
+                      {"alpha_coverage", o.alpha_coverage_reference},
+                      {"bc_quality", int(o.codec.bc_quality)},
+                      {"zstd_level", o.codec.zstd_level}};
+  for (size_t i = 0; i < o.layers.size(); ++i) {
+    const LayerInput& in = o.layers[i];
+    VT_ASSIGN_OR_RETURN(uint64_t content, in.source->content_hash());
+    const uint64_t coverage =
+        in.coverage ? XXH3_64bits(in.coverage->data(), in.coverage->size()) : 0;
+    j["layers"].push_back({{"semantic", int(in.semantic)},
+                           {"name", plan.layers[i].spec.name},
+                           {"color_space", in.color_space},
+                           {"content", content},
+                           {"coverage", coverage}});
+  }
+  const std::string text = j.dump();
+  return XXH3_64bits(text.data(), text.size());
+}
+
+std::string scratch_dir_for(const BuildOptions& o) {
+  if (!o.scratch_dir.empty()) return o.scratch_dir;
+  std::string dir = std::filesystem::path(o.output).parent_path().string();
+  return dir.empty() ? "." : dir;
+}
+
+}  // namespace
+
+void LayerPlan::store_page(float* texels, size_t count, float alpha_scale, uint8_t* out) const {
+  const uint32_t wc = work_channels;
+  if (alpha >= 0) {
+    for (size_t i = 0; i < count; ++i) {
+      float* t = texels + i * wc;
+      float a = t[alpha];
+      for (int c = 0; c < 3; ++c) t[c] = a > 0 ? std::min(t[c] / a, kFloatMax) : 0.0f;
+      if (alpha_scale != 1.0f) t[alpha] = std::min(1.0f, a * alpha_scale);
+    }
+  }
+  if (spec.texel_type == TexelType::kF32) {
+    if (to_storage) to_storage->apply(texels, count, int(wc));
+    std::memcpy(out, texels, count * wc * sizeof(float));
+    return;
+  }
+  if (to_storage) {
+    to_storage->apply_to_u8(texels, count, int(wc), out);
+    return;
+  }
+  auto q = [](float v) -> uint8_t {
+    if (!(v > 0)) return 0;
+    if (v >= 1) return 255;
+    return uint8_t(v * 255.0f + 0.5f);
+  };
+  if (normal) {
+    for (size_t i = 0; i < count; ++i) {
+      out[i * 2 + 0] = q(texels[i * 3 + 0] * 0.5f + 0.5f);
+      out[i * 2 + 1] = q(texels[i * 3 + 1] * 0.5f + 0.5f);
+    }
+    return;
+  }
+  for (size_t i = 0; i < count * wc; ++i) out[i] = q(texels[i]);
+}
+
+Expected<BuildPlan> plan_build(const BuildOptions& options) {
+  VT_RETURN_IF_ERROR(check_inputs(options));
+  BuildPlan plan;
+  plan.options = options;
+  plan.threads = thread_count(options.threads);
+  plan.kernel = make_downsample_kernel(options.filter);
+  plan.scratch_dir = scratch_dir_for(options);
+  PageFileDesc& desc = plan.desc;
+  for (const LayerInput& in : options.layers) {
+    VT_ASSIGN_OR_RETURN(LayerPlan layer, plan_layer(in, options));
+    for (const LayerPlan& other : plan.layers) {
+      if (other.spec.name == layer.spec.name) {
+        return Status(ErrorCode::kInvalidArgument, "two layers named '" + layer.spec.name + "'");
+      }
+    }
+    plan.layers.push_back(std::move(layer));
+  }
+  const ImageInfo& first = options.layers[0].source->info();
+  desc.geometry.width = first.width;
+  desc.geometry.height = first.height;
+  desc.geometry.payload = options.payload;
+  desc.geometry.border = options.border;
+  VT_RETURN_IF_ERROR(desc.geometry.validate());
+  const uint32_t S = desc.geometry.page_size();
+  plan.margin = std::max<uint32_t>(desc.geometry.border, uint32_t(plan.kernel.reach()));
+  for (LayerPlan& layer : plan.layers) {
+    VT_ASSIGN_OR_RETURN(PageEncoder encoder, PageEncoder::create(layer.spec, options.codec, S));
+    layer.encoder = std::make_shared<const PageEncoder>(std::move(encoder));
+  }
+  desc.metadata_json = build_metadata(options, plan.layers);
+
+  for (size_t i = 0; i < plan.layers.size(); ++i) {
+    LayerPlan& layer = plan.layers[i];
+    const LayerInput& in = options.layers[i];
+    VT_ASSIGN_OR_RETURN(layer.level0, open_level0(in, layer, options));
+    layer.level_in_memory = choose_level_memory(plan, layer, in.coverage != nullptr);
+    if (!layer.encoder->wants_training()) continue;
+    // DCT tables are trained on up to 256 of the layer's own pages or 16 MiB of their texels
+    // (all of level 0 for a 2K layer).
+    const size_t limit =
+        std::clamp<size_t>((size_t(16) << 20) / layer.encoder->page_bytes(), 1, 256);
+    VT_ASSIGN_OR_RETURN(auto pages, training_sample(plan, in, layer, limit));
+    std::vector<std::span<const uint8_t>> spans(pages.begin(), pages.end());
+    PageEncoder trained = *layer.encoder;
+    auto tables = trained.train(spans);
+    if (!tables.ok()) return tables.status().with_context(layer.spec.name);
+    layer.spec.codec_tables = std::move(tables).value();
+    layer.encoder = std::make_shared<const PageEncoder>(std::move(trained));
+  }
+  for (const LayerPlan& layer : plan.layers) desc.layers.push_back(layer.spec);
+  VT_ASSIGN_OR_RETURN(plan.hash, plan_hash(plan));
+  return plan;
+}
+
+}  // namespace vt

@@ -1,0 +1,62 @@
+// The first step of a build: everything decided before the first page is encoded. plan_build is
+// a function of the options and the sources' texels alone: the final file description (DCT
+// tables trained up front on a spread sample of the layers' own level-0 pages), each layer's
+// conversion and encoder, where each level lives (memory or scratch file), and a hash that
+// names the plan (settings, tool version, source content). The writer is created from
+// plan.desc and only ever takes pages.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bake/build.h"
+#include "bake/color.h"
+#include "bake/page_encoder.h"
+#include "bake/pyramid.h"
+
+namespace vt {
+
+class LevelSource;
+
+// How one layer goes from its source to stored texels.
+struct LayerPlan {
+  LayerSpec spec;  // as written: codec, runtime format, trained tables
+  uint32_t source_channels = 0;
+  uint32_t work_channels = 0;  // channels of the level images (normals: xyz)
+  int alpha = -1;              // alpha channel in the level images, or -1
+  bool normal = false;
+  bool decode_unorm_normal = false;  // source normals are n * 0.5 + 0.5
+  bool colour = false;               // albedo or emissive: linear light, premultiplied alpha
+  std::shared_ptr<const ColorConverter> to_linear;
+  std::shared_ptr<const ColorConverter> to_storage;
+  DownsampleRules rules;
+  std::shared_ptr<const PageEncoder> encoder;  // made once, with the final tables
+  // Level 0 in its working form (linear, premultiplied, normals decoded). Streams from the
+  // source, or for layers with a coverage mask is held whole and dilated (pull-push).
+  std::shared_ptr<LevelSource> level0;
+  // level_in_memory[l]: level l is held in memory (else in a scratch file). Level 0 streams
+  // unless the layer has coverage.
+  std::vector<bool> level_in_memory;
+
+  // Linear working texels of a page (modified) to the layer's stored bytes.
+  void store_page(float* texels, size_t count, float alpha_scale, uint8_t* out) const;
+};
+
+struct BuildPlan {
+  BuildOptions options;  // as given (after drop_opaque_alpha)
+  PageFileDesc desc;     // the file's final header
+  std::vector<LayerPlan> layers;
+  int threads = 1;
+  DownsampleKernel kernel;
+  uint32_t margin = 0;  // rows a band reads past its pages: max(border, filter reach)
+  std::string scratch_dir;
+  uint64_t hash = 0;  // settings + tool version + every source's content
+};
+
+// Checks the options, reads each DCT layer's training sample and works out the plan. Errors
+// name the layer at fault.
+Expected<BuildPlan> plan_build(const BuildOptions& options);
+
+}  // namespace vt

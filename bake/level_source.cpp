@@ -1,0 +1,239 @@
+#include "bake/level_source.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "bake/build_plan.h"
+#include "bake/level_store.h"
+#include "common/parallel.h"
+
+namespace vt {
+namespace {
+
+constexpr float kFloatMax = std::numeric_limits<float>::max();
+
+// Source rows to the layer's working form: non-finite values fixed by policy (and counted once
+// per texel), colour converted to linear, alpha premultiplied, normals decoded and renormalised.
+class Level0Converter {
+ public:
+  Level0Converter(const LayerPlan& plan, uint32_t width, uint32_t height, NonFinitePolicy policy,
+                  int threads)
+      : plan_(plan), width_(width), policy_(policy), threads_(threads), counted_(height, false) {}
+
+  const NonFiniteReport& report() const { return report_; }
+
+  // Counts and reports bad values of source row y once, in raster order; with kError the first
+  // bad texel seen fails the read.
+  Status scan_row(uint32_t y, const float* row) {
+    if (counted_[y]) return Status::Ok();
+    counted_[y] = true;
+    const uint32_t sc = plan_.source_channels;
+    for (uint32_t x = 0; x < width_; ++x) {
+      for (uint32_t c = 0; c < sc; ++c) {
+        const float v = row[size_t(x) * sc + c];
+        const bool bad_nf = !std::isfinite(v);
+        const bool bad_neg = !bad_nf && plan_.colour && v < 0;
+        if (!bad_nf && !bad_neg) continue;
+        const bool first =
+            !report_.any() || y < report_.first_y || (y == report_.first_y && x < report_.first_x);
+        if (bad_nf) ++report_.non_finite;
+        if (bad_neg) ++report_.negative;
+        if (first) {
+          report_.first_x = x, report_.first_y = y, report_.first_channel = c;
+          report_.first_value = v;
+        }
+      }
+    }
+    if (policy_ == NonFinitePolicy::kError && report_.any()) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "%s value %g at texel (%u, %u) channel %u",
+                    std::isfinite(report_.first_value) ? "negative" : "non-finite",
+                    double(report_.first_value), report_.first_x, report_.first_y,
+                    report_.first_channel);
+      return Error(ErrorCode::kInvalidArgument, buf);
+    }
+    return Status::Ok();
+  }
+
+  // Converts `rows` source rows into working rows, on all threads. `src` may equal `dst` when
+  // the source and working channel counts are the same (each texel is read before written).
+  void convert(const float* src, float* dst, uint32_t rows) const {
+    const size_t in_row = size_t(width_) * plan_.source_channels;
+    const size_t out_row = size_t(width_) * plan_.work_channels;
+    parallel_for(rows, threads_,
+                 [&](size_t k) { convert_row(src + k * in_row, dst + k * out_row); });
+  }
+
+ private:
+  float fix(float v, bool colour) const {
+    if (std::isnan(v)) return 0.0f;
+    if (std::isinf(v)) {
+      if (v < 0) return colour ? 0.0f : -kFloatMax;
+      return policy_ == NonFinitePolicy::kClamp ? kFloatMax : 0.0f;
+    }
+    if (colour && v < 0) return 0.0f;
+    return v;
+  }
+
+  void convert_row(const float* src, float* dst) const {
+    const uint32_t w = width_, sc = plan_.source_channels, wc = plan_.work_channels;
+    const bool colour = plan_.colour;
+    for (uint32_t x = 0; x < w; ++x) {
+      const float* s = src + size_t(x) * sc;
+      float* d = dst + size_t(x) * wc;
+      if (plan_.normal) {
+        double n[3];
+        for (int c = 0; c < 3; ++c) {
+          double v = c < int(sc) ? fix(s[c], false) : 0.0;
+          n[c] = plan_.decode_unorm_normal ? v * 2.0 - 1.0 : v;
+        }
+        if (sc == 2) n[2] = std::sqrt(std::max(0.0, 1.0 - n[0] * n[0] - n[1] * n[1]));
+        double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(len > 1e-30) || !std::isfinite(len)) n[0] = 0, n[1] = 0, n[2] = 1, len = 1;
+        for (int c = 0; c < 3; ++c) d[c] = float(n[c] / len);
+      } else if (colour) {
+        if (sc <= 2) {
+          float g = fix(s[0], true);
+          float a = sc == 2 ? fix(s[1], true) : 0.0f;
+          d[0] = d[1] = d[2] = g;
+          if (sc == 2) d[3] = a;
+        } else {
+          for (uint32_t c = 0; c < sc; ++c) d[c] = fix(s[c], true);
+        }
+      } else {
+        for (uint32_t c = 0; c < sc; ++c) d[c] = fix(s[c], false);
+      }
+    }
+    if (!colour) return;
+    plan_.to_linear->apply(dst, w, int(wc));
+    for (uint32_t x = 0; x < w; ++x) {
+      float* d = dst + size_t(x) * wc;
+      for (uint32_t c = 0; c < wc; ++c) {
+        // The transfer curve may map an in-range value a hair below zero or up to inf.
+        if (!(d[c] >= 0)) d[c] = 0;
+        if (d[c] > kFloatMax) d[c] = kFloatMax;
+      }
+      if (plan_.alpha >= 0) {
+        float a = std::min(d[plan_.alpha], 1.0f);
+        d[plan_.alpha] = a;
+        for (int c = 0; c < 3; ++c) d[c] *= a;
+      }
+    }
+  }
+
+  const LayerPlan& plan_;
+  uint32_t width_;
+  NonFinitePolicy policy_;
+  int threads_;
+  std::vector<bool> counted_;
+  NonFiniteReport report_;
+};
+
+// Level 0 read from the source and converted as the build asks for rows.
+class StreamedLevel0 final : public LevelSource {
+ public:
+  StreamedLevel0(std::shared_ptr<ImageSource> source, const LayerPlan& plan, NonFinitePolicy policy,
+                 int threads, bool count)
+      : source_(std::move(source)),
+        plan_(plan),
+        converter_(plan, source_->info().width, source_->info().height, policy, threads),
+        count_(count) {}
+
+  uint32_t width() const override { return source_->info().width; }
+  uint32_t height() const override { return source_->info().height; }
+  uint32_t channels() const override { return plan_.work_channels; }
+  NonFiniteReport non_finite() const override { return converter_.report(); }
+
+  Status read(uint32_t y0, uint32_t y1, float* out) override {
+    const size_t in_row = size_t(width()) * plan_.source_channels;
+    raw_.resize(size_t(y1 - y0) * in_row);
+    VT_RETURN_IF_ERROR(source_->read_rows(y0, y1, raw_.data()));
+    if (count_) {
+      for (uint32_t y = y0; y < y1; ++y)
+        VT_RETURN_IF_ERROR(converter_.scan_row(y, raw_.data() + size_t(y - y0) * in_row));
+    }
+    converter_.convert(raw_.data(), out, y1 - y0);
+    return Status::Ok();
+  }
+
+ private:
+  std::shared_ptr<ImageSource> source_;
+  const LayerPlan& plan_;
+  Level0Converter converter_;
+  bool count_;
+  std::vector<float> raw_;
+};
+
+// Level 0 converted whole, with its coverage mask, and dilated.
+class HeldLevel0 final : public LevelSource {
+ public:
+  HeldLevel0(std::unique_ptr<LevelStore> store, NonFiniteReport report)
+      : store_(std::move(store)), report_(report) {}
+  uint32_t width() const override { return store_->width(); }
+  uint32_t height() const override { return store_->height(); }
+  uint32_t channels() const override { return store_->channels(); }
+  Status read(uint32_t y0, uint32_t y1, float* out) override { return store_->read(y0, y1, out); }
+  const uint8_t* coverage() const override { return store_->coverage(); }
+  NonFiniteReport non_finite() const override { return report_; }
+
+ private:
+  std::unique_ptr<LevelStore> store_;
+  NonFiniteReport report_;
+};
+
+Expected<std::shared_ptr<LevelSource>> hold_level0(const LayerInput& input, const LayerPlan& plan,
+                                                   const BuildOptions& options) {
+  const ImageInfo& info = input.source->info();
+  const uint32_t w = info.width, h = info.height, wc = plan.work_channels;
+  const uint64_t bytes = uint64_t(w) * h * wc * sizeof(float);
+  if (bytes * 5 / 4 * 2 > options.memory_limit) {
+    return Status(ErrorCode::kResourceLimit,
+                  plan.spec.name + ": a layer with a coverage mask keeps its levels in memory; " +
+                      std::to_string(bytes >> 20) + " MiB per level does not fit the memory limit");
+  }
+  Level0Converter converter(plan, w, h, options.non_finite, thread_count(options.threads));
+  const size_t in_row = size_t(w) * plan.source_channels, out_row = size_t(w) * wc;
+  // Scene bakes hand over their transfer buffers: converted in place, level 0 costs no copy.
+  std::vector<float> texels;
+  if (input.consume_source && plan.source_channels == wc) texels = input.source->release_texels();
+  const bool in_place = texels.size() == size_t(h) * out_row;
+  std::unique_ptr<LevelStore> store;
+  if (in_place) {
+    store = LevelStore::adopt(w, h, wc, std::move(texels));
+  } else {
+    VT_ASSIGN_OR_RETURN(store, LevelStore::create(w, h, wc, true, ""));
+  }
+  std::vector<float> raw;
+  constexpr uint32_t kChunk = 256;
+  for (uint32_t y = 0; y < h; y += kChunk) {
+    const uint32_t y1 = std::min(h, y + kChunk);
+    float* dst = store->data() + size_t(y) * out_row;
+    const float* src = dst;
+    if (!in_place) {
+      raw.resize(size_t(y1 - y) * in_row);
+      VT_RETURN_IF_ERROR(input.source->read_rows(y, y1, raw.data()));
+      src = raw.data();
+    }
+    for (uint32_t r = y; r < y1; ++r)
+      VT_RETURN_IF_ERROR(converter.scan_row(r, src + size_t(r - y) * in_row));
+    converter.convert(src, dst, y1 - y);
+  }
+  VT_RETURN_IF_ERROR(store->set_coverage_and_dilate(*input.coverage));
+  return std::shared_ptr<LevelSource>(new HeldLevel0(std::move(store), converter.report()));
+}
+
+}  // namespace
+
+Expected<std::shared_ptr<LevelSource>> open_level0(const LayerInput& input, const LayerPlan& plan,
+                                                   const BuildOptions& options,
+                                                   bool count_bad_values) {
+  if (input.coverage) return hold_level0(input, plan, options);
+  return std::shared_ptr<LevelSource>(new StreamedLevel0(
+      input.source, plan, options.non_finite, thread_count(options.threads), count_bad_values));
+}
+
+}  // namespace vt
