@@ -175,10 +175,11 @@ class LayerRun {
     return uint64_t(s.width()) * s.height() * s.channels() * sizeof(float);
   }
 
-  // hash(plan hash, task, alpha scale, input rows): equal keys mean equal output.
+  // hash(layer's task seed, task, alpha scale, input rows): equal keys mean equal output.
   uint64_t band_key(const RowBand& band, uint32_t row) const {
     XXH3_state_t state;
-    XXH3_64bits_reset_withSeed(&state, plan_.hash);
+    XXH3_INITSTATE(&state);  // reset_withSeed reads the state's old seed
+    XXH3_64bits_reset_withSeed(&state, layer_.task_seed);
     const uint32_t id[3] = {li_, level_, row};
     XXH3_64bits_update(&state, id, sizeof id);
     XXH3_64bits_update(&state, &alpha_.scale, sizeof alpha_.scale);

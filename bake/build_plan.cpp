@@ -1,5 +1,6 @@
 #include "bake/build_plan.h"
 
+#define XXH_STATIC_LINKING_ONLY  // XXH3_state_t on the stack
 #include <xxhash.h>
 #include <nlohmann/json.hpp>
 
@@ -208,9 +209,10 @@ std::string build_metadata(const BuildOptions& options, const std::vector<LayerP
   return meta.dump();
 }
 
-// Everything that decides the output bytes: settings, tool version and the sources' content.
-// Thread count, memory limit and paths do not (the output does not depend on them).
-Expected<uint64_t> plan_hash(const BuildPlan& plan) {
+// The settings that decide the output bytes besides the texels: tool version, geometry,
+// filter, codec and the layers' names. Thread count, memory limit and paths do not (the output
+// does not depend on them).
+std::string settings_text(const BuildPlan& plan) {
   const BuildOptions& o = plan.options;
   nlohmann::json j = {{"tool", VTBAKE_VERSION},
                       {"metadata", plan.desc.metadata_json},
@@ -220,19 +222,36 @@ Expected<uint64_t> plan_hash(const BuildPlan& plan) {
                       {"alpha_coverage", o.alpha_coverage_reference},
                       {"bc_quality", int(o.codec.bc_quality)},
                       {"zstd_level", o.codec.zstd_level}};
-  for (size_t i = 0; i < o.layers.size(); ++i) {
-    const LayerInput& in = o.layers[i];
+  for (const LayerInput& in : o.layers)
+    j["layers"].push_back({{"semantic", int(in.semantic)}, {"color_space", in.color_space}});
+  return j.dump();
+}
+
+// The plan's identity: its settings and every source's content (and coverage).
+Expected<uint64_t> plan_hash(const BuildPlan& plan, const std::string& settings) {
+  std::vector<uint64_t> parts{XXH3_64bits(settings.data(), settings.size())};
+  for (const LayerInput& in : plan.options.layers) {
     VT_ASSIGN_OR_RETURN(uint64_t content, in.source->content_hash());
-    const uint64_t coverage =
-        in.coverage ? XXH3_64bits(in.coverage->data(), in.coverage->size()) : 0;
-    j["layers"].push_back({{"semantic", int(in.semantic)},
-                           {"name", plan.layers[i].spec.name},
-                           {"color_space", in.color_space},
-                           {"content", content},
-                           {"coverage", coverage}});
+    parts.push_back(content);
+    parts.push_back(in.coverage ? XXH3_64bits(in.coverage->data(), in.coverage->size()) : 0);
   }
-  const std::string text = j.dump();
-  return XXH3_64bits(text.data(), text.size());
+  return XXH3_64bits(parts.data(), parts.size() * sizeof(uint64_t));
+}
+
+// What a layer's task keys start from: the settings and the layer as written (codec tables
+// included), but not its source, so that a task's key changes only with its own input rows.
+uint64_t task_seed(const std::string& settings, const LayerSpec& spec) {
+  XXH3_state_t state;
+  XXH3_64bits_reset(&state);
+  XXH3_64bits_update(&state, settings.data(), settings.size());
+  const uint8_t fields[7] = {uint8_t(spec.semantic),       spec.channels,
+                             uint8_t(spec.texel_type),     uint8_t(spec.codec),
+                             uint8_t(spec.runtime_format), uint8_t(spec.color_space),
+                             uint8_t(spec.address_mode)};
+  XXH3_64bits_update(&state, fields, sizeof fields);
+  XXH3_64bits_update(&state, spec.name.data(), spec.name.size());
+  XXH3_64bits_update(&state, spec.codec_tables.data(), spec.codec_tables.size());
+  return XXH3_64bits_digest(&state);
 }
 
 std::string scratch_dir_for(const BuildOptions& o) {
@@ -327,7 +346,9 @@ Expected<BuildPlan> plan_build(const BuildOptions& options) {
     layer.encoder = std::make_shared<const PageEncoder>(std::move(trained));
   }
   for (const LayerPlan& layer : plan.layers) desc.layers.push_back(layer.spec);
-  VT_ASSIGN_OR_RETURN(plan.hash, plan_hash(plan));
+  const std::string settings = settings_text(plan);
+  VT_ASSIGN_OR_RETURN(plan.hash, plan_hash(plan, settings));
+  for (LayerPlan& layer : plan.layers) layer.task_seed = task_seed(settings, layer.spec);
   return plan;
 }
 

@@ -39,6 +39,8 @@ struct LayerPlan {
   // level_in_memory[l]: level l is held in memory (else in a scratch file). Level 0 streams
   // unless the layer has coverage.
   std::vector<bool> level_in_memory;
+  // Where this layer's task keys start: the settings and the layer's spec, tables included.
+  uint64_t task_seed = 0;
 
   // Linear working texels of a page (modified) to the layer's stored bytes.
   void store_page(float* texels, size_t count, float alpha_scale, uint8_t* out) const;
@@ -52,7 +54,7 @@ struct BuildPlan {
   DownsampleKernel kernel;
   uint32_t margin = 0;  // rows a band reads past its pages: max(border, filter reach)
   std::string scratch_dir;
-  uint64_t hash = 0;  // settings + tool version + every source's content
+  uint64_t hash = 0;  // the plan's identity: settings, tool version, every source's content
 };
 
 // Checks the options, reads each DCT layer's training sample and works out the plan. Errors

@@ -2,9 +2,9 @@
 // row of one level of one layer (with the filter margin), and gives that row's encoded pages and
 // its share of the next level's rows. A level task completes a level that needs all of its
 // rows at once (pull-push dilation of a coverage layer, coverage-preserving alpha). Tasks are
-// deterministic: a task's key, hash(plan hash, its input rows), names its output, which update
-// mode and sharding over a build farm rely on. Dependencies are explicit; build_pages runs the
-// tasks in list order, which respects them.
+// deterministic: a band's key, hash(the layer's task seed, the task, its input rows), names its
+// output, so that update mode and sharding over a build farm can tell what must be redone.
+// Dependencies are explicit; build_pages runs the tasks in list order, which respects them.
 #pragma once
 
 #include <cstdint>

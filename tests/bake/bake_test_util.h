@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bake/build.h"
+#include "bake/build_plan.h"
 #include "bake/page_encoder.h"
 #include "bake/paging.h"
 
@@ -51,17 +52,7 @@ class MemorySink final : public PageSink {
     p.bytes.assign(texel.begin(), texel.end());
     return Status::Ok();
   }
-  Status set_codec_tables(uint32_t layer, std::span<const uint8_t> t) override {
-    std::lock_guard<std::mutex> lock(mu_);
-    for (const auto& [key, page] : pages) {
-      if (std::get<0>(key) == layer && page.state == PageState::kStored)
-        return Error(ErrorCode::kInternal, "tables set after a stored page of the layer");
-    }
-    tables[layer].assign(t.begin(), t.end());
-    return Status::Ok();
-  }
   std::map<Key, StoredPage> pages;
-  std::map<uint32_t, std::vector<uint8_t>> tables;  // layers whose tables the build trained
 
  private:
   std::mutex mu_;
@@ -75,15 +66,13 @@ struct BuiltPages {
 
 inline std::unique_ptr<BuiltPages> build_in_memory(const BuildOptions& options) {
   auto out = std::make_unique<BuiltPages>();
-  auto desc = plan_build(options);
-  EXPECT_TRUE(desc.ok()) << desc.status().message();
-  if (!desc.ok()) return nullptr;
-  out->desc = *desc;
-  auto sum = build_pages(options, out->desc, out->sink);
+  auto plan = plan_build(options);
+  EXPECT_TRUE(plan.ok()) << plan.status().message();
+  if (!plan.ok()) return nullptr;
+  out->desc = plan->desc;
+  auto sum = build_pages(*plan, out->sink);
   EXPECT_TRUE(sum.ok()) << sum.status().message();
   if (!sum.ok()) return nullptr;
-  for (const auto& [layer, tables] : out->sink.tables)
-    out->desc.layers[layer].codec_tables = tables;
   out->summary = *sum;
   return out;
 }

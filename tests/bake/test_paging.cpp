@@ -6,7 +6,7 @@
 #include <cstring>
 
 #include "samples/procedural.h"
-#include "bake_test_util.h"
+#include "tests/bake/bake_test_util.h"
 
 namespace vt {
 namespace {

@@ -7,10 +7,10 @@
 #include <fstream>
 #include <iterator>
 
-#include "samples/sample_scene.h"
 #include "bake/scene_bake.h"
 #include "bake/transfer.h"
 #include "format/page_file.h"
+#include "samples/sample_scene.h"
 #include "tests/transfer/transfer_test_util.h"
 
 namespace vt {

@@ -9,9 +9,9 @@
 
 #include "bake/build.h"
 #include "bake/image_source.h"
-#include "bake_test_util.h"
 #include "format/page_file.h"
 #include "format/page_file_inspect.h"
+#include "tests/bake/bake_test_util.h"
 
 namespace vt {
 namespace {

@@ -1,0 +1,248 @@
+// The build's plan (trained tables up front, plan hash), its tasks (dependencies, content keys)
+// and the level store the tasks write.
+#include <gtest/gtest.h>
+
+#include <zstd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <set>
+
+#include "bake/build_plan.h"
+#include "bake/build_tasks.h"
+#include "bake/level_source.h"
+#include "bake/level_store.h"
+#include "codec/dct.h"
+#include "samples/procedural.h"
+#include "tests/bake/bake_test_util.h"
+
+namespace vt {
+namespace {
+
+std::shared_ptr<ImageSource> procedural(uint32_t w, uint32_t h, uint32_t seed = 11) {
+  return std::make_shared<ProceduralImageSource>(ProceduralPattern::kAlbedo, w, h, 3, seed);
+}
+
+std::vector<float> procedural_texels(uint32_t w, uint32_t h) {
+  std::vector<float> t(size_t(w) * h * 3);
+  EXPECT_TRUE(procedural(w, h)->read_rows(0, h, t.data()).ok());
+  return t;
+}
+
+std::shared_ptr<ImageSource> memory_image(uint32_t w, uint32_t h, std::vector<float> texels) {
+  ImageInfo info;
+  info.width = w, info.height = h, info.channels = 3, info.color_space = "sRGB";
+  return std::make_shared<MemoryImageSource>(info, std::move(texels));
+}
+
+BuildOptions raw_options(std::shared_ptr<ImageSource> source) {
+  BuildOptions o;
+  o.layers.push_back(test::layer_input(LayerSemantic::kAlbedo, std::move(source)));
+  o.payload = 8;
+  o.codec.codec = CodecKind::kRaw;
+  return o;
+}
+
+TEST(BuildPlan, HashNamesSettingsAndContentButNotThreadsOrMemory) {
+  BuildOptions o = raw_options(procedural(100, 60));
+  auto a = plan_build(o);
+  o.threads = 3;
+  o.memory_limit = 1;
+  auto same = plan_build(o);
+  o.filter = MipFilter::kBox;
+  auto other_filter = plan_build(o);
+  o = raw_options(procedural(100, 60, 12));  // other texels, same size
+  auto other_content = plan_build(o);
+  ASSERT_TRUE(a.ok() && same.ok() && other_filter.ok() && other_content.ok());
+  EXPECT_EQ(a->hash, same->hash);
+  EXPECT_NE(a->hash, other_filter->hash);
+  EXPECT_NE(a->hash, other_content->hash);
+}
+
+// More level-0 pages than a training set holds: the tables come from pages spread evenly over
+// the level (raster order), not from its first rows.
+TEST(BuildPlan, TablesAreTrainedOnASpreadSampleOfALargeLevel) {
+  const uint32_t w = 8 * 24, h = 8 * 20;  // 480 pages of 8x8 payload
+  BuildOptions o = raw_options(procedural(w, h));
+  auto raw = test::build_in_memory(o);
+  ASSERT_TRUE(raw);
+  o.codec.codec = CodecKind::kDct;
+  auto plan = plan_build(o);
+  ASSERT_TRUE(plan.ok());
+
+  const PageGeometry& g = plan->desc.geometry;
+  const uint32_t S = g.page_size();
+  const size_t n = size_t(g.pages_x(0)) * g.pages_y(0), limit = 256;
+  ASSERT_GT(n, limit);
+  std::vector<std::vector<uint8_t>> sample;
+  for (size_t k = 0; k < limit; ++k) {
+    const size_t i = (2 * k + 1) * n / (2 * limit);
+    const auto& page =
+        raw->sink.pages.at({0, 0, uint32_t(i / g.pages_x(0)), uint32_t(i % g.pages_x(0))});
+    if (page.state != PageState::kStored) continue;  // constant pages teach nothing
+    std::vector<uint8_t> texels(size_t(S) * S * 3);
+    ASSERT_EQ(ZSTD_decompress(texels.data(), texels.size(), page.bytes.data(), page.bytes.size()),
+              texels.size());
+    sample.push_back(std::move(texels));
+  }
+  std::vector<std::span<const uint8_t>> spans(sample.begin(), sample.end());
+  DctSettings s;
+  s.quality = o.codec.dct_quality;
+  s.channels = 3;
+  s.layout = DctPlaneLayout::kYCoCg420;
+  auto expected = dct_make_tables(s, int(S), int(S), spans);
+  ASSERT_TRUE(expected.ok());
+  EXPECT_EQ(plan->desc.layers[0].codec_tables, dct_serialize_tables(**expected));
+}
+
+TEST(BuildTasks, BandsDependOnExactlyTheRowsTheyRead) {
+  for (AddressMode mode : {AddressMode::kClamp, AddressMode::kWrap}) {
+    BuildOptions o = raw_options(procedural(77, 131));
+    o.address = mode;
+    o.filter = MipFilter::kLanczos3;
+    auto plan = plan_build(o);
+    ASSERT_TRUE(plan.ok());
+    const PageGeometry& g = plan->desc.geometry;
+    const std::vector<BuildTask> tasks = make_build_tasks(*plan);
+    size_t bands = 0;
+    for (uint32_t l = 0; l < g.level_count(); ++l) bands += g.pages_y(l);
+    ASSERT_EQ(tasks.size(), bands);  // no whole-level work without coverage or alpha
+    const uint32_t P = g.payload, half = P / 2, m = plan->margin;
+    for (size_t i = 0; i < tasks.size(); ++i) {
+      const BuildTask& t = tasks[i];
+      ASSERT_EQ(t.kind, BuildTask::Kind::kBand);
+      if (t.level == 0) {
+        EXPECT_TRUE(t.deps.empty());
+        continue;
+      }
+      std::set<uint32_t> rows_read, rows_written;
+      for (int64_t y = int64_t(t.row) * P - m; y < int64_t(t.row) * P + P + m; ++y)
+        rows_read.insert(uint32_t(address_texel(y, g.level_height(t.level), mode)));
+      for (uint32_t d : t.deps) {
+        ASSERT_LT(d, i);
+        const BuildTask& dep = tasks[d];
+        EXPECT_EQ(dep.level + 1, t.level);
+        bool useful = false;
+        for (uint32_t y = dep.row * half;
+             y < std::min(g.level_height(t.level), dep.row * half + half); ++y) {
+          rows_written.insert(y);
+          useful |= rows_read.count(y) > 0;
+        }
+        EXPECT_TRUE(useful) << "task " << i << " depends on task " << d << " for nothing";
+      }
+      for (uint32_t y : rows_read) EXPECT_TRUE(rows_written.count(y)) << "row " << y;
+    }
+  }
+}
+
+TEST(BuildTasks, CoverageLevelsWaitForTheWholeLevelBefore) {
+  const uint32_t w = 64, h = 40;
+  auto coverage = std::make_shared<std::vector<uint8_t>>(size_t(w) * h, 0);
+  for (uint32_t y = 5; y < 30; ++y)
+    for (uint32_t x = 3; x < 50; ++x) (*coverage)[size_t(y) * w + x] = 1;
+  BuildOptions o = raw_options(memory_image(w, h, procedural_texels(w, h)));
+  o.layers[0].coverage = coverage;
+  auto plan = plan_build(o);
+  ASSERT_TRUE(plan.ok());
+  const std::vector<BuildTask> tasks = make_build_tasks(*plan);
+  const PageGeometry& g = plan->desc.geometry;
+  for (uint32_t l = 1; l < g.level_count(); ++l) {
+    auto it = std::find_if(tasks.begin(), tasks.end(), [&](const BuildTask& t) {
+      return t.kind == BuildTask::Kind::kLevel && t.level == l;
+    });
+    ASSERT_NE(it, tasks.end()) << "level " << l;
+    EXPECT_EQ(it->deps.size(), g.pages_y(l - 1));
+    const uint32_t whole = uint32_t(it - tasks.begin());
+    for (const BuildTask& t : tasks)
+      if (t.kind == BuildTask::Kind::kBand && t.level == l)
+        EXPECT_EQ(t.deps, std::vector<uint32_t>{whole});
+  }
+}
+
+// A band's key is its input: change one texel near the bottom and only the bands that read it,
+// and those fed by them, change key.
+TEST(BuildTasks, KeysChangeOnlyWithTheirInputRows) {
+  const uint32_t w = 64, h = 80;
+  std::vector<float> texels = procedural_texels(w, h);
+  auto a = test::build_in_memory(raw_options(memory_image(w, h, texels)));
+  BuildOptions threaded = raw_options(memory_image(w, h, texels));
+  threaded.threads = 4;
+  auto a4 = test::build_in_memory(threaded);
+  auto again = test::build_in_memory(raw_options(memory_image(w, h, texels)));
+  texels[(size_t(h - 2) * w + 10) * 3] += 0.25f;
+  BuildOptions changed = raw_options(memory_image(w, h, texels));
+  auto b = test::build_in_memory(changed);
+  ASSERT_TRUE(a && a4 && again && b);
+  EXPECT_EQ(a->summary.task_keys, again->summary.task_keys);
+  EXPECT_EQ(a->summary.task_keys, a4->summary.task_keys);
+  auto plan = plan_build(changed);
+  ASSERT_TRUE(plan.ok());
+  const std::vector<BuildTask> tasks = make_build_tasks(*plan);
+  ASSERT_EQ(tasks.size(), a->summary.task_keys.size());
+  const uint32_t rows0 = plan->desc.geometry.pages_y(0);
+  for (size_t i = 0; i < tasks.size(); ++i) {
+    if (tasks[i].level != 0) continue;
+    if (tasks[i].row + 2 < rows0) {
+      EXPECT_EQ(a->summary.task_keys[i], b->summary.task_keys[i]) << "row " << tasks[i].row;
+    } else if (tasks[i].row + 1 == rows0) {
+      EXPECT_NE(a->summary.task_keys[i], b->summary.task_keys[i]);
+    }
+  }
+  EXPECT_NE(a->summary.plan_hash, b->summary.plan_hash);
+}
+
+// Scene bakes hand their buffers over: the build converts them in place and writes the same
+// pages as from a copy.
+TEST(LevelSource, ConsumedSourceIsConvertedInPlaceWithTheSameResult) {
+  const uint32_t w = 48, h = 40;
+  auto coverage = std::make_shared<std::vector<uint8_t>>(size_t(w) * h, 1);
+  for (uint32_t x = 0; x < w; ++x) (*coverage)[x] = 0;
+  BuildOptions copy = raw_options(memory_image(w, h, procedural_texels(w, h)));
+  copy.layers[0].coverage = coverage;
+  BuildOptions consume = raw_options(memory_image(w, h, procedural_texels(w, h)));
+  consume.layers[0].coverage = coverage;
+  consume.layers[0].consume_source = true;
+  auto source = std::static_pointer_cast<MemoryImageSource>(consume.layers[0].source);
+  auto a = test::build_in_memory(copy);
+  auto b = test::build_in_memory(consume);
+  ASSERT_TRUE(a && b);
+  EXPECT_TRUE(source->texels().empty());  // taken, not copied
+  EXPECT_EQ(a->sink.pages.size(), b->sink.pages.size());
+  for (const auto& [key, page] : a->sink.pages) EXPECT_EQ(page.bytes, b->sink.pages.at(key).bytes);
+}
+
+TEST(LevelStore, MemoryAndScratchHoldTheSameRows) {
+  const uint32_t w = 37, h = 23, ch = 3;
+  std::vector<float> rows(size_t(w) * h * ch);
+  for (size_t i = 0; i < rows.size(); ++i) rows[i] = float(i) * 0.5f;
+  for (bool in_memory : {true, false}) {
+    auto store =
+        LevelStore::create(w, h, ch, in_memory, std::filesystem::temp_directory_path().string());
+    ASSERT_TRUE(store.ok());
+    EXPECT_EQ((*store)->in_memory(), in_memory);
+    ASSERT_TRUE((*store)->write_rows(0, 10, rows.data()).ok());
+    ASSERT_TRUE((*store)->write_rows(10, h - 10, rows.data() + size_t(10) * w * ch).ok());
+    std::vector<float> back(size_t(5) * w * ch);
+    ASSERT_TRUE((*store)->read(7, 12, back.data()).ok());
+    EXPECT_TRUE(std::equal(back.begin(), back.end(), rows.begin() + size_t(7) * w * ch));
+    EXPECT_FALSE((*store)->read(20, h + 1, back.data()).ok());
+    EXPECT_FALSE((*store)->write_rows(h - 1, 2, rows.data()).ok());
+    EXPECT_EQ((*store)->set_coverage_and_dilate(std::vector<uint8_t>(size_t(w) * h, 1)).ok(),
+              in_memory);
+  }
+}
+
+TEST(LevelStore, DilationFillsUncoveredTexelsFromCoveredOnes) {
+  const uint32_t w = 16, h = 8;
+  std::vector<float> texels(size_t(w) * h, 0.0f);
+  std::vector<uint8_t> coverage(size_t(w) * h, 0);
+  for (uint32_t y = 2; y < 4; ++y)
+    for (uint32_t x = 2; x < 6; ++x) texels[y * w + x] = 0.75f, coverage[y * w + x] = 1;
+  auto store = LevelStore::adopt(w, h, 1, texels);
+  ASSERT_TRUE(store->set_coverage_and_dilate(coverage).ok());
+  ASSERT_NE(store->coverage(), nullptr);
+  for (size_t i = 0; i < texels.size(); ++i) EXPECT_FLOAT_EQ(store->data()[i], 0.75f) << i;
+}
+
+}  // namespace
+}  // namespace vt
