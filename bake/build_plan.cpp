@@ -105,27 +105,43 @@ Status check_inputs(const BuildOptions& options) {
   return Status::Ok();
 }
 
-// The level-0 pages DCT tables are trained on: with at most `limit` present pages, all of
-// them; otherwise `limit` pages spread evenly over the level in raster order. Constant pages
-// carry no statistics and are left out. Returns their texels as stored, in raster order.
+// Which level-0 pages DCT tables are trained on: with at most `limit` present pages, all of
+// them; otherwise pages spread evenly over at least 16 page rows spread evenly down the level
+// (and over each row), so that a random-access source reads only those bands.
+std::vector<PageId> training_pages(const PageGeometry& g, const uint8_t* coverage, size_t limit) {
+  const uint32_t px = g.pages_x(0), py = g.pages_y(0);
+  std::vector<std::vector<PageId>> rows(py);
+  size_t present = 0;
+  for (uint32_t y = 0; y < py; ++y)
+    for (uint32_t x = 0; x < px; ++x)
+      if (!coverage || page_has_coverage(g, PageId{0, x, y}, coverage)) {
+        rows[y].push_back(PageId{0, x, y});
+        ++present;
+      }
+  std::vector<PageId> chosen;
+  if (present <= limit) {
+    for (const auto& row : rows) chosen.insert(chosen.end(), row.begin(), row.end());
+    return chosen;
+  }
+  const size_t want_rows = std::min<size_t>(py, std::max<size_t>(16, (limit + px - 1) / px));
+  const size_t per_row = std::max<size_t>(1, limit / want_rows);
+  for (size_t k = 0; k < want_rows && chosen.size() < limit; ++k) {
+    const auto& row = rows[(2 * k + 1) * py / (2 * want_rows)];
+    const size_t n = std::min({per_row, row.size(), limit - chosen.size()});
+    for (size_t j = 0; j < n; ++j) chosen.push_back(row[(2 * j + 1) * row.size() / (2 * n)]);
+  }
+  return chosen;
+}
+
+// The texels, as stored, of the training pages that are not constant (those carry no
+// statistics), in raster order.
 Expected<std::vector<std::vector<uint8_t>>> training_sample(const BuildPlan& plan,
                                                             const LayerInput& in,
                                                             const LayerPlan& layer, size_t limit) {
   const PageGeometry& g = plan.desc.geometry;
-  const uint32_t P = g.payload, S = g.page_size(), px = g.pages_x(0), py = g.pages_y(0);
+  const uint32_t P = g.payload, S = g.page_size();
   const uint8_t* coverage = layer.level0->coverage();
-  std::vector<PageId> present;
-  for (uint32_t y = 0; y < py; ++y)
-    for (uint32_t x = 0; x < px; ++x)
-      if (!coverage || page_has_coverage(g, PageId{0, x, y}, coverage))
-        present.push_back(PageId{0, x, y});
-  std::vector<PageId> chosen;
-  if (present.size() <= limit) {
-    chosen = present;
-  } else {
-    for (size_t k = 0; k < limit; ++k)
-      chosen.push_back(present[(2 * k + 1) * present.size() / (2 * limit)]);
-  }
+  const std::vector<PageId> chosen = training_pages(g, coverage, limit);
 
   // A streamed level 0 is read again for the build: this read must not count bad values.
   std::shared_ptr<LevelSource> source = layer.level0;
