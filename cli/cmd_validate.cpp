@@ -59,7 +59,8 @@ vt::cli::CommandRunner make_validate(CLI::App& app) {
   app.add_option("--unwrapped", f.unwrapped,
                  "The unwrapped scene `vtbake bake` wrote (default: PAGE_FILE with .glb)");
   auto* views = app.add_option("--views", f.views, "Automatic camera views around the scene")
-                    ->check(CLI::Range(1, 64));
+                    ->check(CLI::Range(1, 64))
+                    ->capture_default_str();
   auto* cameras = app.add_option("--cameras", f.cameras_file,
                                  "Camera file (JSON, format below) instead of automatic views");
   views->excludes(cameras);
@@ -73,9 +74,12 @@ vt::cli::CommandRunner make_validate(CLI::App& app) {
                  "Fail when a view's worst 16x16 tile is below this, dB (sample scene: 25-27 dB)")
       ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
-  app.add_option("--slots", f.slots, "Physical cache slots per side")->check(CLI::Range(1, 128));
+  app.add_option("--slots", f.slots, "Physical cache slots per side")
+      ->check(CLI::Range(1, 128))
+      ->capture_default_str();
   app.add_option("--max-frames", f.max_frames, "Give up converging after this many frames")
-      ->check(CLI::Range(1, 1000));
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
   app.add_flag("--hardware", f.prefer_hardware, "Prefer a hardware Vulkan device over lavapipe");
   app.add_option("--out", f.out_dir,
                  "Folder for the PNGs and report.json (default PAGE_FILE.validate)");
