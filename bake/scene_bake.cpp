@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "bake/build_summary_json.h"
+
 namespace vt {
 namespace {
 
@@ -77,13 +79,14 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   auto report = [&](const char* stage, double f) {
     if (options.progress) options.progress({stage, f});
   };
-  if (options.output.empty()) return Error(ErrorCode::kInvalidArgument, "no output path");
+  const std::string& output = options.build.output;
+  if (output.empty()) return Error(ErrorCode::kInvalidArgument, "no output path");
   if (input.triangle_count() == 0) {
     return Error(ErrorCode::kInvalidArgument, "the scene has no triangles to bake");
   }
   SceneBakeSummary summary;
-  summary.output = options.output;
-  summary.unwrapped = options.unwrapped.empty()  ? default_unwrapped(options.output)
+  summary.output = output;
+  summary.unwrapped = options.unwrapped.empty()  ? default_unwrapped(output)
                       : options.unwrapped == "-" ? ""
                                                  : options.unwrapped;
 
@@ -91,8 +94,8 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   auto t0 = Clock::now();
   report("unwrap", 0.0);
   unwrap::UnwrapOptions uo = options.unwrap;
-  uo.page_payload = int(options.payload);
-  uo.threads = options.threads;
+  uo.page_payload = int(options.build.payload);
+  uo.threads = options.build.threads;
   auto unwrapped = unwrap::unwrap_scene(input, uo);
   if (!unwrapped.ok()) return unwrapped.status().with_context("unwrap");
   summary.unwrap = unwrapped->stats;
@@ -105,7 +108,7 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   const uint32_t W = uint32_t(unwrapped->stats.atlas_width),
                  H = uint32_t(unwrapped->stats.atlas_height);
   uint64_t transfer_bytes = uint64_t(W) * H * (13 * sizeof(float) + 1 + 24);
-  if (transfer_bytes > options.memory_limit) {
+  if (transfer_bytes > options.build.memory_limit) {
     return Error(ErrorCode::kResourceLimit,
                  "transfer: an atlas of " + std::to_string(W) + "x" + std::to_string(H) +
                      " texels needs about " + std::to_string(transfer_bytes >> 20) +
@@ -114,8 +117,10 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   TransferOptions to;
   to.width = W, to.height = H;
   to.supersample = options.supersample;
-  to.threads = options.threads;
-  to.scratch_dir = std::filesystem::path(options.output).parent_path().string();
+  to.threads = options.build.threads;
+  to.scratch_dir = options.build.scratch_dir.empty()
+                       ? std::filesystem::path(output).parent_path().string()
+                       : options.build.scratch_dir;
   to.progress = [&](double f) { report("transfer", f); };
   auto transfer = transfer_materials(unwrapped->scene, to);
   if (!transfer.ok()) return transfer.status().with_context("transfer");
@@ -124,15 +129,9 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
 
   // Pyramid, paging, encode.
   t0 = Clock::now();
-  BuildOptions bo;
+  BuildOptions bo = options.build;
   bo.layers = layer_inputs(*transfer);
-  bo.output = options.output;
-  bo.codec = options.codec;
-  bo.payload = options.payload;
-  bo.border = options.border;
   bo.address = AddressMode::kClamp;
-  bo.memory_limit = options.memory_limit;
-  bo.threads = options.threads;
   nlohmann::json meta = {
       {"tool", "vtbake bake"},
       {"scene", input.source_path},
@@ -160,67 +159,36 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
     summary.stages.push_back({"write scene", seconds_since(t0)});
   }
 
-  const PageGeometry& g = summary.build.geometry;
-  for (const LayerSummary& layer : summary.build.layers) {
-    for (uint32_t l = 0; l < g.level_count(); ++l) {
-      summary.raw_bytes +=
-          uint64_t(g.level_width(l)) * g.level_height(l) * layer.spec.texel_bytes();
-    }
-  }
-  summary.ratio =
-      summary.build.file_bytes ? double(summary.raw_bytes) / double(summary.build.file_bytes) : 0;
   summary.seconds = seconds_since(start);
   return summary;
 }
 
-std::string summary_json(const SceneBakeSummary& s) {
-  nlohmann::json layers = nlohmann::json::array();
-  for (const LayerSummary& l : s.build.layers) {
-    layers.push_back({{"name", l.name},
-                      {"channels", l.spec.channels},
-                      {"codec", to_string(l.spec.codec)},
-                      {"runtime_format", to_string(l.spec.runtime_format)},
-                      {"color_space", to_string(l.spec.color_space)},
-                      {"psnr_db", std::isfinite(l.psnr_db) ? nlohmann::json(l.psnr_db)
-                                                           : nlohmann::json(nullptr)},
-                      {"max_error", l.max_error}});
-  }
+nlohmann::json to_json(const SceneBakeSummary& s) {
   nlohmann::json stages = nlohmann::json::object();
   for (const StageTime& st : s.stages) stages[st.name] = st.seconds;
-  nlohmann::json build_stages = nlohmann::json::object();
-  for (const StageTime& st : s.build.stages) build_stages[st.name] = st.seconds;
-  const auto& g = s.build.geometry;
-  nlohmann::json j = {
+  const unwrap::UnwrapStats& u = s.unwrap;
+  const TransferStats& t = s.transfer;
+  return {
       {"output", s.output},
       {"unwrapped", s.unwrapped},
       {"triangles", s.triangles},
       {"atlas",
-       {{"width", g.width},
-        {"height", g.height},
-        {"charts", s.unwrap.charts},
-        {"texels_per_unit", s.unwrap.texels_per_unit},
-        {"utilisation", s.unwrap.utilisation},
-        {"stretch_l2", s.unwrap.stretch_l2}}},
+       {{"width", u.atlas_width},
+        {"height", u.atlas_height},
+        {"charts", u.charts},
+        {"texels_per_unit", u.texels_per_unit},
+        {"utilisation", u.utilisation},
+        {"stretch_l2", u.stretch_l2}}},
       {"transfer",
-       {{"covered_texels", s.transfer.covered_texels},
-        {"edge_only_texels", s.transfer.edge_only_texels},
-        {"contested_texels", s.transfer.contested_texels},
-        {"samples", s.transfer.samples},
-        {"texels_per_second",
-         s.transfer.seconds > 0 ? double(s.transfer.covered_texels) / s.transfer.seconds : 0.0}}},
-      {"layers", layers},
-      {"pages",
-       {{"total", s.build.pages},
-        {"stored", s.build.stored},
-        {"constant", s.build.constant},
-        {"absent", s.build.absent},
-        {"levels", g.level_count()}}},
-      {"bytes", {{"file", s.build.file_bytes}, {"raw", s.raw_bytes}, {"ratio", s.ratio}}},
+       {{"covered_texels", t.covered_texels},
+        {"edge_only_texels", t.edge_only_texels},
+        {"contested_texels", t.contested_texels},
+        {"samples", t.samples},
+        {"texels_per_second", t.seconds > 0 ? double(t.covered_texels) / t.seconds : 0.0}}},
+      {"build", to_json(s.build)},
       {"seconds", stages},
-      {"build_seconds", build_stages},
       {"total_seconds", s.seconds},
   };
-  return j.dump(2);
 }
 
 }  // namespace vt

@@ -4,14 +4,15 @@
 
 #include <cstdint>
 #include <functional>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 
 #include "bake/build.h"
-#include "scene/scene.h"
 #include "bake/transfer.h"
 #include "bake/unwrap/unwrap.h"
 #include "common/status.h"
+#include "scene/scene.h"
 
 namespace vt {
 
@@ -22,16 +23,19 @@ struct SceneBakeProgress {
 };
 
 struct SceneBakeOptions {
-  std::string output;            // the .vtpf path
+  // The build of the transferred layers, as `vtbake build` takes it: output (the .vtpf path),
+  // codec, payload and border, filter, alpha coverage, non-finite policy, scratch_dir (transfer
+  // and build; "" = beside the output), memory_limit (transfer buffers + build) and threads
+  // (every stage). bake_scene sets what the scene decides: layers, address mode (clamp: charts
+  // do not tile), metadata and progress.
+  BuildOptions build;
   std::string unwrapped;         // the unwrapped scene (.glb); "" = output with .glb, "-" = none
-  unwrap::UnwrapOptions unwrap;  // page_payload is taken from `payload`
+  unwrap::UnwrapOptions unwrap;  // page_payload and threads are taken from `build`
   int supersample = 1;           // 1, 4 or 16 transfer samples per texel
-  PageEncoderOptions codec;
-  uint32_t payload = 120;
-  uint32_t border = 4;
-  int threads = 0;                            // 0 = all cores
-  uint64_t memory_limit = uint64_t(8) << 30;  // transfer buffers + build
   std::function<void(const SceneBakeProgress&)> progress;
+
+  // A scene bake holds the transfer's buffers too: 8 GiB by default rather than the build's 2.
+  SceneBakeOptions() { build.memory_limit = uint64_t(8) << 30; }
 };
 
 struct SceneBakeSummary {
@@ -39,9 +43,7 @@ struct SceneBakeSummary {
   uint64_t triangles = 0;  // unwrapped (instances counted separately)
   unwrap::UnwrapStats unwrap;
   TransferStats transfer;
-  BuildSummary build;
-  uint64_t raw_bytes = 0;         // every level of every layer as uncompressed stored texels
-  double ratio = 0;               // raw_bytes / file bytes
+  BuildSummary build;             // raw bytes and ratio: bake/build_summary_json.h
   std::vector<StageTime> stages;  // load, unwrap, transfer, build, write scene
   double seconds = 0;
 };
@@ -52,8 +54,9 @@ Expected<SceneBakeSummary> bake_scene(const std::string& scene_path,
 // Bakes a scene already in memory.
 Expected<SceneBakeSummary> bake_scene(const scene::Scene& scene, const SceneBakeOptions& options);
 
-// The summary as one JSON object (for --json and build farms).
-std::string summary_json(const SceneBakeSummary& summary);
+// The summary as one JSON object (for --json and build farms, docs/REPORTS.md); the build part
+// is to_json(summary.build) under "build".
+nlohmann::json to_json(const SceneBakeSummary& summary);
 
 // The transfer's texels as build inputs (linear colour, data, float normals) with coverage.
 std::vector<LayerInput> layer_inputs(TransferResult& transfer);

@@ -29,8 +29,8 @@ s = j["seconds"]
 tr = j["transfer"]
 print(f"| {sys.argv[3]} | {j['triangles']:,} | {j['atlas']['width']}x{j['atlas']['height']} | {sys.argv[4]} "
       f"| {tr['covered_texels']:,} | {s['transfer']:.2f} | {tr['texels_per_second']/1e6:.2f} "
-      f"| {s['unwrap']:.2f} | {s['build']:.2f} | {j['total_seconds']:.2f} | {j['bytes']['file']:,} "
-      f"| {j['bytes']['ratio']:.1f} | {rss/1024:.0f} |")
+      f"| {s['unwrap']:.2f} | {s['build']:.2f} | {j['total_seconds']:.2f} | {j['build']['bytes']['file']:,} "
+      f"| {j['build']['bytes']['ratio']:.1f} | {rss/1024:.0f} |")
 EOF
 }
 

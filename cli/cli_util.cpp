@@ -124,4 +124,13 @@ Status parse_byte_size(const std::string& text, uint64_t* bytes) {
   return Status::Ok();
 }
 
+std::string format_byte_size(uint64_t bytes) {
+  for (auto [unit, shift] : {std::pair{"G", 30}, std::pair{"M", 20}, std::pair{"K", 10}}) {
+    if (bytes != 0 && bytes % (uint64_t(1) << shift) == 0) {
+      return std::to_string(bytes >> shift) + unit;
+    }
+  }
+  return std::to_string(bytes);
+}
+
 }  // namespace vt::cli

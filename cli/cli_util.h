@@ -11,11 +11,15 @@
 
 namespace vt::cli {
 
-// kExitBadInput for errors in what the user gave (flags, missing or malformed input), else
-// kExitFailure (the work itself failed: a write, a resource limit, an internal error).
+// The one exit-code rule for a failed Status, used by every command: kExitBadInput for errors
+// in what the user gave (kInvalidArgument, kNotFound, kCorrupt, kUnsupported: a flag, a missing
+// or malformed input, no Vulkan device), else kExitFailure (the work itself failed: kIo on a
+// write, kResourceLimit, kCancelled, kInternal). A check that runs and finds a fault (a bad page,
+// a view below its bounds) is kExitFailure too, chosen by the command.
 int exit_code_for(const Status& status);
 
-// Prints "vtbake COMMAND: MESSAGE" on stderr and returns exit_code_for(status).
+// Prints "vtbake COMMAND: MESSAGE" on stderr and returns exit_code_for(status). Every command
+// reports a failed Status through this.
 int report_error(const char* command, const Status& status);
 
 // Prints "vtbake COMMAND: MESSAGE" on stderr and returns kExitBadInput (a wrong flag or input).
@@ -45,5 +49,7 @@ Status parse_codec(const std::string& text, PageEncoderOptions* options);
 // --memory-limit and other byte sizes: a positive number with an optional K, M or G (KiB, MiB,
 // GiB) suffix; no suffix means bytes.
 Status parse_byte_size(const std::string& text, uint64_t* bytes);
+// The shortest exact spelling parse_byte_size reads back: 8G, 512M, 64K or plain bytes.
+std::string format_byte_size(uint64_t bytes);
 
 }  // namespace vt::cli

@@ -5,33 +5,21 @@
 #include <cstdio>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
+#include "bake/build_summary_json.h"
 #include "bake/scene_bake.h"
+#include "cli/build_flags.h"
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/unwrap_flags.h"
 
 namespace {
 
-using vt::cli::kExitBadInput;
-using vt::cli::kExitFailure;
-using vt::cli::kExitOk;
-
-struct BakeFlags {
+struct BakeArgs {
   std::string scene;
-  std::string output;
-  std::string unwrapped;
-  double texels_per_unit = 0;
-  int size_pages = 0;
-  int padding = 4;
-  std::string method = "lscm";
-  int supersample = 1;
-  std::string codec = "dct";
-  bool share_instances = false;
-  std::string memory_limit = "8G";
+  vt::SceneBakeOptions options;
 };
-
-int bad(const std::string& msg) {
-  return vt::cli::bad_usage("bake", msg);
-}
 
 void print_summary(const vt::SceneBakeSummary& s) {
   const auto& g = s.build.geometry;
@@ -57,48 +45,26 @@ void print_summary(const vt::SceneBakeSummary& s) {
               (unsigned long long)s.build.stored, (unsigned long long)s.build.constant,
               (unsigned long long)s.build.absent);
   std::printf("  bytes      %llu in the file, %llu raw texels, ratio %.1f:1\n",
-              (unsigned long long)s.build.file_bytes, (unsigned long long)s.raw_bytes, s.ratio);
+              (unsigned long long)s.build.file_bytes,
+              (unsigned long long)vt::raw_texel_bytes(s.build), vt::compression_ratio(s.build));
   std::printf("  time      ");
   for (const auto& st : s.stages) std::printf(" %s %.2f s,", st.name.c_str(), st.seconds);
   std::printf(" total %.2f s\n", s.seconds);
 }
 
 vt::cli::CommandRunner make_bake(CLI::App& app) {
-  auto f = std::make_shared<BakeFlags>();
-  app.add_option("scene", f->scene, "Scene to bake (.gltf, .glb, .obj, .ply, .drc)")->required();
-  app.add_option("-o,--output", f->output, "Page file to write (.vtpf)")->required();
-  app.add_option("--unwrapped", f->unwrapped,
+  auto args = std::make_shared<BakeArgs>();
+  vt::SceneBakeOptions& o = args->options;
+  app.add_option("scene", args->scene, "Scene to bake (.gltf, .glb, .obj, .ply, .drc)")->required();
+  app.add_option("--unwrapped", o.unwrapped,
                  "Where to write the unwrapped scene (.glb; default OUT.glb; '-' = not written)");
-  auto* tpu = app.add_option("--texels-per-unit", f->texels_per_unit, "World texel density")
-                  ->check(CLI::PositiveNumber);
-  auto* size = app.add_option("--size", f->size_pages, "Atlas side in pages (default 16)")
-                   ->check(CLI::Range(1, 1024));
-  tpu->excludes(size);
-  app.add_option("--padding", f->padding, "Empty texels between charts")->check(CLI::Range(0, 64));
-  app.add_option("--method", f->method, "Parameterisation: lscm or arap")
-      ->check(CLI::IsMember({"lscm", "arap"}));
-  app.add_option("--supersample", f->supersample, "Transfer samples per texel: 1, 4 or 16")
+  app.add_option("--supersample", o.supersample, "Transfer samples per texel: 1, 4 or 16")
       ->check(CLI::IsMember({1, 4, 16}));
-  app.add_option("--codec", f->codec,
-                 "Page codec: dct[:QUALITY][:adaptive], bc[:high|fast] or raw");
-  app.add_flag("--share-instances", f->share_instances,
-               "Instances of one mesh share texels (default: each gets its own)");
-  app.add_option("--memory-limit", f->memory_limit, "Memory budget, e.g. 512M, 8G (default 8G)");
-  return [f](const vt::cli::GlobalOptions& global) -> int {
-    vt::SceneBakeOptions o;
-    o.output = f->output;
-    o.unwrapped = f->unwrapped;
-    o.unwrap.texels_per_unit = f->texels_per_unit;
-    if (f->size_pages > 0) o.unwrap.size_pages = f->size_pages;
-    o.unwrap.padding = f->padding;
-    o.unwrap.method = f->method == "arap" ? vt::unwrap::Method::kArap : vt::unwrap::Method::kLscm;
-    o.unwrap.share_instances = f->share_instances;
-    o.supersample = f->supersample;
-    if (vt::Status st = vt::cli::parse_codec(f->codec, &o.codec); !st.ok())
-      return bad(st.message());
-    if (vt::Status st = vt::cli::parse_byte_size(f->memory_limit, &o.memory_limit); !st.ok())
-      return bad("--memory-limit: " + st.message());
-    o.threads = global.threads;
+  vt::cli::add_unwrap_flags(app, o.unwrap);
+  vt::cli::add_build_flags(app, o.build);
+  return [args](const vt::cli::GlobalOptions& global) -> int {
+    vt::SceneBakeOptions& o = args->options;
+    o.build.threads = global.threads;
     // Stage, its fraction, elapsed time; redrawn at once when the stage changes.
     vt::cli::ProgressLine progress(global.quiet);
     std::string stage;
@@ -108,15 +74,15 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
       progress.print("%-12s %5.1f%%  %6.1f s   ", p.stage, 100.0 * p.fraction,
                      progress.elapsed_seconds());
     };
-    auto summary = vt::bake_scene(f->scene, o);
+    auto summary = vt::bake_scene(args->scene, o);
     progress.done();
     if (!summary.ok()) return vt::cli::report_error("bake", summary.status());
     if (global.json) {
-      std::printf("%s\n", vt::summary_json(*summary).c_str());
+      std::printf("%s\n", vt::to_json(*summary).dump(2).c_str());
     } else {
       print_summary(*summary);
     }
-    return kExitOk;
+    return vt::cli::kExitOk;
   };
 }
 

@@ -7,30 +7,21 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/build.h"
-#include "samples/procedural.h"
+#include "bake/build_summary_json.h"
+#include "cli/build_flags.h"
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "samples/procedural.h"
 
 namespace {
 
-using vt::cli::kExitBadInput;
-using vt::cli::kExitFailure;
 using vt::cli::kExitOk;
 
-struct BuildFlags {
+struct BuildArgs {
   std::vector<std::string> images;
   std::vector<std::string> layers;  // SEMANTIC=PATH or NAME=PATH
-  std::string output;
-  std::string codec = "dct";
-  uint32_t payload = 120;
-  uint32_t border = 4;
-  std::string filter = "kaiser";
-  std::string address = "clamp";
-  std::string memory_limit = "2G";
   std::string colorspace;
-  std::string fix_nonfinite = "black";
-  std::string scratch_dir;
-  float alpha_coverage = 0;
+  vt::BuildOptions options;
 };
 
 bool parse_semantic(const std::string& s, vt::LayerSemantic* sem) {
@@ -64,62 +55,6 @@ void show_progress(vt::cli::ProgressLine& line, const vt::BuildProgress& p) {
              rate, eta);
 }
 
-nlohmann::json summary_json(const vt::BuildOptions& o, const vt::BuildSummary& s, double wall) {
-  nlohmann::json j;
-  j["output"] = o.output;
-  j["width"] = s.geometry.width;
-  j["height"] = s.geometry.height;
-  j["payload"] = s.geometry.payload;
-  j["border"] = s.geometry.border;
-  j["pages"] = s.pages;
-  j["stored_pages"] = s.stored;
-  j["constant_pages"] = s.constant;
-  j["absent_pages"] = s.absent;
-  j["stored_bytes"] = s.stored_bytes;
-  j["file_bytes"] = s.file_bytes;
-  j["scratch_bytes"] = s.scratch_bytes;
-  j["level_memory_bytes"] = s.level_memory_bytes;
-  j["levels"] = nlohmann::json::array();
-  for (size_t l = 0; l < s.levels.size(); ++l) {
-    const vt::LevelSummary& v = s.levels[l];
-    j["levels"].push_back({{"level", l},
-                           {"width", v.width},
-                           {"height", v.height},
-                           {"pages_x", v.pages_x},
-                           {"pages_y", v.pages_y},
-                           {"stored", v.stored},
-                           {"constant", v.constant},
-                           {"absent", v.absent},
-                           {"bytes", v.stored_bytes},
-                           {"scratch", v.scratch}});
-  }
-  j["layers"] = nlohmann::json::array();
-  for (const vt::LayerSummary& l : s.layers) {
-    nlohmann::json lj = {{"name", l.name},
-                         {"semantic", vt::to_string(l.spec.semantic)},
-                         {"channels", l.spec.channels},
-                         {"texel_type", vt::to_string(l.spec.texel_type)},
-                         {"codec", vt::to_string(l.spec.codec)},
-                         {"runtime_format", vt::to_string(l.spec.runtime_format)},
-                         {"color_space", vt::to_string(l.spec.color_space)},
-                         {"max_error", l.max_error},
-                         {"non_finite", l.non_finite.non_finite},
-                         {"negative", l.non_finite.negative}};
-    if (l.alpha_dropped) lj["alpha_dropped"] = "opaque";
-    // JSON has no infinity: a lossless layer's PSNR is null.
-    lj["psnr_db"] = std::isfinite(l.psnr_db) ? nlohmann::json(l.psnr_db) : nlohmann::json();
-    if (l.non_finite.any()) {
-      lj["first_bad_texel"] = {l.non_finite.first_x, l.non_finite.first_y,
-                               l.non_finite.first_channel};
-    }
-    j["layers"].push_back(lj);
-  }
-  j["stages"] = nlohmann::json::object();
-  for (const vt::StageTime& t : s.stages) j["stages"][t.name] = t.seconds;
-  j["wall_seconds"] = wall;
-  return j;
-}
-
 void print_text(const vt::BuildOptions& o, const vt::BuildSummary& s, double wall) {
   std::printf(
       "%s: %u x %u texels, %zu levels, %llu pages (%llu stored, %llu constant, %llu "
@@ -150,32 +85,9 @@ void print_text(const vt::BuildOptions& o, const vt::BuildSummary& s, double wal
   std::printf("\n");
 }
 
-int run_build(const BuildFlags& f, const vt::cli::GlobalOptions& global) {
-  vt::BuildOptions o;
-  o.output = f.output;
-  o.payload = f.payload;
-  o.border = f.border;
+int run_build(BuildArgs& f, const vt::cli::GlobalOptions& global) {
+  vt::BuildOptions& o = f.options;
   o.threads = global.threads;
-  o.scratch_dir = f.scratch_dir;
-  o.alpha_coverage_reference = f.alpha_coverage;
-  if (vt::Status st = vt::cli::parse_codec(f.codec, &o.codec); !st.ok()) return bad(st.message());
-  auto filter = vt::parse_mip_filter(f.filter.c_str());
-  if (!filter.ok()) return bad(filter.status().message());
-  o.filter = *filter;
-  if (f.address == "clamp") {
-    o.address = vt::AddressMode::kClamp;
-  } else if (f.address == "wrap") {
-    o.address = vt::AddressMode::kWrap;
-  } else {
-    return bad("unknown --address '" + f.address + "' (expected clamp or wrap)");
-  }
-  if (vt::Status st = vt::cli::parse_byte_size(f.memory_limit, &o.memory_limit); !st.ok()) {
-    return bad("--memory-limit: " + st.message());
-  }
-  auto policy = vt::parse_non_finite_policy(f.fix_nonfinite);
-  if (!policy.ok()) return bad(policy.status().message());
-  o.non_finite = *policy;
-
   // Positional images: the first is the albedo, the others custom layers named by file.
   std::vector<std::pair<std::string, std::string>> inputs;  // layer name, path
   for (size_t i = 0; i < f.images.size(); ++i) {
@@ -201,7 +113,7 @@ int run_build(const BuildFlags& f, const vt::cli::GlobalOptions& global) {
       in.source = std::make_shared<vt::ProceduralImageSource>(pattern, pw, ph, 3, 1);
     } else {
       auto src = vt::is_udim_pattern(path) ? vt::open_udim_image(path) : vt::open_image_file(path);
-      if (!src.ok()) return bad(src.status().message());
+      if (!src.ok()) return vt::cli::report_error("build", src.status());
       in.source = std::shared_ptr<vt::ImageSource>(std::move(src).value());
     }
     vt::LayerSemantic sem;
@@ -229,7 +141,10 @@ int run_build(const BuildFlags& f, const vt::cli::GlobalOptions& global) {
   double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!summary.ok()) return vt::cli::report_error("build", summary.status());
   if (global.json) {
-    std::printf("%s\n", summary_json(o, *summary, wall).dump(2).c_str());
+    nlohmann::json j = {{"output", o.output}};
+    j.update(vt::to_json(*summary));
+    j["wall_seconds"] = wall;
+    std::printf("%s\n", j.dump(2).c_str());
   } else if (!global.quiet) {
     print_text(o, *summary, wall);
   }
@@ -237,34 +152,24 @@ int run_build(const BuildFlags& f, const vt::cli::GlobalOptions& global) {
 }
 
 vt::cli::CommandRunner make_build(CLI::App& sub) {
-  auto f = std::make_shared<BuildFlags>();
+  auto f = std::make_shared<BuildArgs>();
   sub.add_option("images", f->images,
                  "Input images (the first becomes the albedo layer); procedural:WxH for the "
                  "generated pattern; tex.<UDIM>.png for a UDIM grid of tiles (missing ones black)");
-  sub.add_option("-o,--output", f->output, "Output page file (.vtpf)")->required();
   sub.add_option("--layer", f->layers,
                  "A layer NAME=PATH; NAME albedo, normal, orm, emissive or any custom name");
-  sub.add_option("--codec", f->codec,
-                 "dct[:QUALITY][:adaptive] (default, quality 75; adaptive: smaller pages, "
-                 "slower decoding), bc[:high|fast] or raw (lossless)");
-  sub.add_option("--payload", f->payload, "Payload texels per page side")->capture_default_str();
-  sub.add_option("--border", f->border, "Border texels per page side")->capture_default_str();
-  sub.add_option("--filter", f->filter, "Mip filter: kaiser, box or lanczos3")
-      ->capture_default_str();
-  sub.add_option("--address", f->address, "Edge rule for borders: clamp or wrap")
-      ->capture_default_str();
-  sub.add_option("--memory-limit", f->memory_limit, "Memory budget, e.g. 512M, 2G")
-      ->capture_default_str();
   sub.add_option("--colorspace", f->colorspace,
                  "Colour space of the inputs (linear, sRGB, raw); default from file metadata");
-  sub.add_option("--fix-nonfinite", f->fix_nonfinite,
-                 "NaN/Inf/negative colour values: black, clamp or error")
-      ->capture_default_str();
-  sub.add_option("--alpha-coverage", f->alpha_coverage,
-                 "Keep the fraction of texels with alpha >= this value (e.g. 0.5) at every level")
-      ->check(CLI::Range(0.0f, 1.0f));
-  sub.add_option("--scratch-dir", f->scratch_dir,
-                 "Where levels larger than memory go (default: beside the output)");
+  vt::BuildOptions& o = f->options;
+  sub.add_option_function<std::string>(
+         "--address",
+         [&o](const std::string& name) {
+           o.address = name == "wrap" ? vt::AddressMode::kWrap : vt::AddressMode::kClamp;
+         },
+         "Edge rule for borders: clamp or wrap")
+      ->check(CLI::IsMember({"clamp", "wrap"}))
+      ->default_str(vt::to_string(o.address));
+  vt::cli::add_build_flags(sub, o);
   return [f](const vt::cli::GlobalOptions& global) { return run_build(*f, global); };
 }
 

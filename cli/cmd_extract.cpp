@@ -5,6 +5,7 @@
 
 #include <cstdio>
 
+#include "cli/cli_util.h"
 #include "cli/command.h"
 #include "format/page_file.h"
 #include "format/page_file_inspect.h"
@@ -38,29 +39,20 @@ vt::cli::CommandRunner make_extract(CLI::App& sub) {
   sub.add_option("-o,--output", opt->output, "Output image (.exr, .png, ...)")->required();
   return [opt](const vt::cli::GlobalOptions& global) {
     auto reader = vt::PageFileReader::open(opt->path);
-    if (!reader.ok()) {
-      std::fprintf(stderr, "vtbake extract: %s\n", reader.status().message().c_str());
-      return int(vt::cli::kExitBadInput);
-    }
+    if (!reader.ok()) return vt::cli::report_error("extract", reader.status());
     auto image = vt::extract_level(**reader, opt->level, opt->layer);
-    if (!image.ok()) {
-      std::fprintf(stderr, "vtbake extract: %s\n", image.status().message().c_str());
-      return int(image.status().code() == vt::ErrorCode::kInvalidArgument ? vt::cli::kExitBadInput
-                                                                          : vt::cli::kExitFailure);
-    }
+    if (!image.ok()) return vt::cli::report_error("extract", image.status());
     auto out = OIIO::ImageOutput::create(opt->output);
     if (!out) {
-      std::fprintf(stderr, "vtbake extract: %s: cannot write this kind of image: %s\n",
-                   opt->output.c_str(), OIIO::geterror().c_str());
-      return int(vt::cli::kExitBadInput);
+      return vt::cli::bad_usage(
+          "extract", opt->output + ": cannot write this kind of image: " + OIIO::geterror());
     }
     const OIIO::TypeDesc type = oiio_type(image->texel_type);
     OIIO::ImageSpec spec(int(image->width), int(image->height), int(image->channels), type);
     if (!out->open(opt->output, spec) || !out->write_image(type, image->texels.data()) ||
         !out->close()) {
-      std::fprintf(stderr, "vtbake extract: %s: %s\n", opt->output.c_str(),
-                   out->geterror().c_str());
-      return int(vt::cli::kExitFailure);
+      return vt::cli::report_error(
+          "extract", vt::Error(vt::ErrorCode::kIo, opt->output + ": " + out->geterror()));
     }
     if (!global.quiet)
       std::printf(

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "cli/cli_util.h"
 #include "cli/command.h"
 #include "format/page_file.h"
 #include "format/page_file_inspect.h"
@@ -91,10 +92,7 @@ vt::cli::CommandRunner make_info(CLI::App& sub) {
   sub.add_option("file", *path, "Page file (.vtpf)")->required();
   return [path](const vt::cli::GlobalOptions& global) {
     auto reader = vt::PageFileReader::open(*path);
-    if (!reader.ok()) {
-      std::fprintf(stderr, "vtbake info: %s\n", reader.status().message().c_str());
-      return int(vt::cli::kExitBadInput);
-    }
+    if (!reader.ok()) return vt::cli::report_error("info", reader.status());
     const vt::PageFileStats stats = vt::page_file_stats(**reader);
     if (global.json)
       std::printf("%s\n", info_json(**reader, stats).dump().c_str());

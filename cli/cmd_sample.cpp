@@ -4,8 +4,9 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "samples/procedural.h"
+#include "cli/cli_util.h"
 #include "cli/command.h"
+#include "samples/procedural.h"
 
 namespace {
 
@@ -21,8 +22,8 @@ int run_sample(const SampleFlags& f, const vt::cli::GlobalOptions& global) {
   std::error_code ec;
   std::filesystem::create_directories(f.dir, ec);
   if (ec) {
-    std::fprintf(stderr, "vtbake sample: %s: %s\n", f.dir.c_str(), ec.message().c_str());
-    return vt::cli::kExitFailure;
+    return vt::cli::report_error("sample",
+                                 vt::Error(vt::ErrorCode::kIo, f.dir + ": " + ec.message()));
   }
   struct Item {
     const char* file;
@@ -35,10 +36,7 @@ int run_sample(const SampleFlags& f, const vt::cli::GlobalOptions& global) {
     std::string path =
         (std::filesystem::path(f.dir) / (std::string(item.file) + "." + f.ext)).string();
     vt::Status s = vt::write_image_file(src, path);
-    if (!s.ok()) {
-      std::fprintf(stderr, "vtbake sample: %s\n", s.message().c_str());
-      return vt::cli::kExitFailure;
-    }
+    if (!s.ok()) return vt::cli::report_error("sample", s);
     if (!global.quiet && !global.json) {
       std::printf("%s: %u x %u\n", path.c_str(), f.width, f.height);
     }

@@ -2,8 +2,9 @@
 // `vtbake bake` bakes with no download.
 #include <cstdio>
 
-#include "samples/sample_scene.h"
+#include "cli/cli_util.h"
 #include "cli/command.h"
+#include "samples/sample_scene.h"
 
 namespace {
 
@@ -20,10 +21,7 @@ vt::cli::CommandRunner make_sample_scene(CLI::App& app) {
       ->check(CLI::Range(16, 8192));
   return [dir, opt](const vt::cli::GlobalOptions& global) -> int {
     vt::Status s = vt::write_sample_scene(*dir, *opt);
-    if (!s.ok()) {
-      std::fprintf(stderr, "vtbake sample-scene: %s\n", s.message().c_str());
-      return vt::cli::kExitFailure;
-    }
+    if (!s.ok()) return vt::cli::report_error("sample-scene", s);
     if (global.json) {
       std::printf("{\"scene\":\"%s/scene.gltf\"}\n", dir->c_str());
     } else if (!global.quiet) {

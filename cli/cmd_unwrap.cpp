@@ -6,17 +6,16 @@
 #include <string>
 #include <thread>
 
-#include "scene/scene.h"
 #include "bake/unwrap/unwrap.h"
+#include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/unwrap_flags.h"
+#include "scene/scene.h"
 
 namespace {
 
 struct Args {
   std::string input, output, report, picture;
-  double texels_per_unit = 0;
-  int size_pages = 0;
-  std::string method = "lscm";
   vt::unwrap::UnwrapOptions options;
 };
 
@@ -33,61 +32,27 @@ vt::cli::CommandRunner make_unwrap(CLI::App& sub) {
   sub.add_option("scene", args->input, "Input scene: .gltf, .glb, .obj, .ply or .drc")->required();
   sub.add_option("-o,--output", args->output, "Output .glb with the atlas UV set added")
       ->required();
-  auto* tpu = sub.add_option("--texels-per-unit", args->texels_per_unit, "World texel density")
-                  ->check(CLI::PositiveNumber);
-  sub.add_option("--size", args->size_pages,
-                 "Target atlas side in pages (density derived), default 16")
-      ->check(CLI::PositiveNumber)
-      ->excludes(tpu);
-  sub.add_option("--padding", args->options.padding, "Empty texels between charts (default 4)")
-      ->check(CLI::Range(0, 1024));
-  sub.add_option("--method", args->method, "Chart parameterisation: lscm (default) or arap")
-      ->check(CLI::IsMember({"lscm", "arap"}));
-  sub.add_flag("--share-instances", args->options.share_instances,
-               "Instances of a mesh share one chart set (default: unique texels per instance)");
-  sub.add_option("--max-stretch", args->options.max_chart_stretch,
-                 "Charts with L2 stretch above this are split and redone (default 1.05)")
-      ->check(CLI::Range(1.0, 100.0));
-  sub.add_option("--split-rounds", args->options.max_split_rounds,
-                 "Stretch split-and-redo rounds (default 4; 0 = none)")
-      ->check(CLI::Range(0, 64));
-  sub.add_option("--chart-angle", args->options.max_chart_angle_deg,
-                 "Largest normal deviation inside a chart, degrees (default 60)")
-      ->check(CLI::Range(1.0, 179.0));
+  vt::cli::add_unwrap_flags(sub, args->options);
   sub.add_option("--report", args->report, "Report JSON path (default OUT.report.json)");
   sub.add_option("--picture", args->picture, "Atlas PNG path (default OUT.atlas.png)");
-  return [args](const vt::cli::GlobalOptions& global) {
+  return [args](const vt::cli::GlobalOptions& global) -> int {
     using Clock = std::chrono::steady_clock;
     auto& a = *args;
-    a.options.texels_per_unit = a.texels_per_unit;
-    if (a.texels_per_unit == 0) a.options.size_pages = a.size_pages > 0 ? a.size_pages : 16;
-    a.options.method = a.method == "arap" ? vt::unwrap::Method::kArap : vt::unwrap::Method::kLscm;
     a.options.threads = global.threads;
     if (a.report.empty()) a.report = stem(a.output) + ".report.json";
     if (a.picture.empty()) a.picture = stem(a.output) + ".atlas.png";
 
     auto t0 = Clock::now();
     auto scene = vt::scene::load_scene(a.input);
-    if (!scene.ok()) {
-      std::fprintf(stderr, "vtbake unwrap: %s\n", scene.status().message().c_str());
-      return vt::cli::kExitBadInput;
-    }
+    if (!scene.ok()) return vt::cli::report_error("unwrap", scene.status());
     double load_s = std::chrono::duration<double>(Clock::now() - t0).count();
     if (!global.quiet)
       std::fprintf(stderr, "loaded %s: %zu meshes, %zu triangles (%.2f s)\n", a.input.c_str(),
                    scene->meshes.size(), scene->triangle_count(), load_s);
     auto result = vt::unwrap::unwrap_scene(*scene, a.options);
-    if (!result.ok()) {
-      std::fprintf(stderr, "vtbake unwrap: %s: %s\n", a.input.c_str(),
-                   result.status().message().c_str());
-      return result.status().code() == vt::ErrorCode::kInternal ? vt::cli::kExitFailure
-                                                                : vt::cli::kExitBadInput;
-    }
+    if (!result.ok()) return vt::cli::report_error("unwrap", result.status().with_context(a.input));
     vt::Status st = vt::scene::save_glb(result->scene, a.output);
-    if (!st.ok()) {
-      std::fprintf(stderr, "vtbake unwrap: %s\n", st.message().c_str());
-      return vt::cli::kExitFailure;
-    }
+    if (!st.ok()) return vt::cli::report_error("unwrap", st);
     std::string report = vt::unwrap::report_json(result->stats);
     std::ofstream(a.report) << report << "\n";
     st = vt::unwrap::write_atlas_picture(*result, a.picture);

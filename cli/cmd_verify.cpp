@@ -1,8 +1,9 @@
 // `vtbake verify FILE`: checks the header, the index and every stored page's checksum.
-// Exit 0: intact; 1: at least one bad page; 2: not a readable page file.
+// Exit 0: intact; 1: at least one bad page; else the exit-code rule (cli/cli_util.h).
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "cli/cli_util.h"
 #include "cli/command.h"
 #include "format/page_file.h"
 #include "format/page_file_inspect.h"
@@ -20,8 +21,7 @@ vt::cli::CommandRunner make_verify(CLI::App& sub) {
         nlohmann::json j = {{"file", *path}, {"ok", false}, {"error", reader.status().message()}};
         std::printf("%s\n", j.dump().c_str());
       }
-      std::fprintf(stderr, "vtbake verify: %s\n", reader.status().message().c_str());
-      return int(vt::cli::kExitBadInput);
+      return vt::cli::report_error("verify", reader.status());
     }
     const vt::VerifyReport report = vt::verify_pages(**reader, global.threads);
     const bool ok = report.bad_pages.empty();

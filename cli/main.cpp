@@ -26,8 +26,8 @@ int main(int argc, char** argv) {
       "vtbake " VTBAKE_VERSION
       " - offline virtual-texture baking: scenes and images into tiled page files (.vtpf)"};
   app.footer(
-      "Exit status: 0 the work succeeded; 1 the work ran and failed (a bad page, a threshold "
-      "missed); 2 bad usage or bad input.");
+      "Exit status: 0 the work succeeded; 1 the work ran and failed (a write, a memory limit, a "
+      "bad page, a threshold missed); 2 bad usage or bad input (docs/REPORTS.md).");
   app.require_subcommand(1);
   app.fallthrough();  // global flags may follow the subcommand: `vtbake info --json f.vtpf`
   app.set_version_flag("--version", VTBAKE_VERSION);

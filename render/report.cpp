@@ -88,7 +88,7 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
-Status write_report_json(const std::string& path, const ValidationReport& r) {
+std::string report_json(const ValidationReport& r) {
   using nlohmann::json;
   json views = json::array();
   for (const ViewReport& v : r.views) {
@@ -130,9 +130,13 @@ Status write_report_json(const std::string& path, const ValidationReport& r) {
                 {"max_coverage_mismatch", r.thresholds.max_coverage_mismatch}}},
               {"passed", r.passed()},
               {"views", views}};
+  return doc.dump(2);
+}
+
+Status write_report_json(const std::string& path, const ValidationReport& r) {
   std::ofstream f(path, std::ios::binary | std::ios::trunc);
   if (!f) return Error(ErrorCode::kIo, path + ": cannot open for writing");
-  f << doc.dump(2) << '\n';
+  f << report_json(r) << '\n';
   f.close();
   if (!f) return Error(ErrorCode::kIo, path + ": write failed");
   return Status::Ok();

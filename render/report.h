@@ -20,6 +20,8 @@ Rgba8Image residency_heat_map(const VirtualFrame& frame);
 // Writes RGB (alpha dropped: renders clear to transparent black) PNG. Errors name the file.
 Status write_png(const std::string& path, const Rgba8Image& image);
 
+// The report as JSON (docs/REPORTS.md): what report.json holds and `vtbake validate --json` prints.
+std::string report_json(const ValidationReport& report);
 Status write_report_json(const std::string& path, const ValidationReport& report);
 
 }  // namespace vt::render

@@ -3,9 +3,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 
 #include "codec/metrics.h"
+#include "format/page_file.h"
 #include "render/report.h"
+#include "render/scene_draws.h"
+#include "runtime/page_source.h"
+#include "scene/scene.h"
 
 namespace vt::render {
 namespace {
@@ -242,6 +247,7 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
   report.layer = options.layer;
   report.width = renderer.options().width;
   report.height = renderer.options().height;
+  report.out_dir = options.out_dir;
   ConvergeOptions converge = options.converge;
   converge.layer = options.layer;
   for (uint32_t v = 0; v < cameras.size(); ++v) {
@@ -287,6 +293,101 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
     }
     report.views.push_back(std::move(view));
   }
+  return report;
+}
+
+namespace {
+
+// What validate_bake reads, all of it before any Vulkan work.
+struct BakeInputs {
+  std::vector<Camera> cameras;  // from the camera file; empty = automatic views
+  std::shared_ptr<const PageFileReader> reader;
+  SceneDraws reference, virt;
+  uint32_t layer = 0;
+};
+
+// The layer to validate: by name, or the albedo layer; only albedo has a reference render.
+Expected<uint32_t> find_layer(const PageFileReader& reader, const BakeValidationOptions& o) {
+  for (uint32_t i = 0; i < reader.layers().size(); ++i) {
+    const LayerSpec& l = reader.layers()[i];
+    if (!(o.layer.empty() ? l.semantic == LayerSemantic::kAlbedo : l.name == o.layer)) continue;
+    if (l.semantic != LayerSemantic::kAlbedo) {
+      return Error(ErrorCode::kInvalidArgument, "layer '" + o.layer +
+                                                    "' is not albedo: only albedo has a "
+                                                    "reference render");
+    }
+    return i;
+  }
+  return Error(ErrorCode::kNotFound, o.page_file + ": no " +
+                                         (o.layer.empty() ? "albedo" : "'" + o.layer + "'") +
+                                         " layer to validate");
+}
+
+Expected<BakeInputs> read_bake_inputs(const BakeValidationOptions& o) {
+  BakeInputs in;
+  if (!o.cameras_file.empty()) {
+    VT_ASSIGN_OR_RETURN(in.cameras,
+                        load_cameras_json(o.cameras_file, float(o.width) / float(o.height)));
+  }
+  const std::string unwrapped =
+      o.unwrapped.empty() ? std::filesystem::path(o.page_file).replace_extension(".glb").string()
+                          : o.unwrapped;
+  VT_ASSIGN_OR_RETURN(in.reader, PageFileReader::open(o.page_file));
+  VT_ASSIGN_OR_RETURN(scene::Scene original, scene::load_scene(o.scene));
+  VT_ASSIGN_OR_RETURN(scene::Scene baked, scene::load_scene(unwrapped));
+  VT_ASSIGN_OR_RETURN(in.reference, reference_scene_draws(original));
+  VT_ASSIGN_OR_RETURN(in.virt, virtual_scene_draws(baked));
+  if (in.reference.meshes.empty() || in.virt.meshes.empty()) {
+    return Error(ErrorCode::kInvalidArgument, o.scene + ": nothing to draw");
+  }
+  VT_ASSIGN_OR_RETURN(in.layer, find_layer(*in.reader, o));
+  return in;
+}
+
+}  // namespace
+
+Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
+  VT_ASSIGN_OR_RETURN(BakeInputs in, read_bake_inputs(o));
+  VulkanOptions vo;
+  vo.prefer_hardware = o.prefer_hardware;
+  VT_ASSIGN_OR_RETURN(std::unique_ptr<VulkanContext> ctx, VulkanContext::create(vo));
+  PageFileSourceOptions so;
+  so.bc7_as_rgba8 = ctx->is_lavapipe();  // lavapipe samples BC7 15-25x slower than BC1
+  VT_ASSIGN_OR_RETURN(std::unique_ptr<PageSource> source, make_page_file_source(in.reader, so));
+
+  RenderOptions ro;
+  ro.width = o.width;
+  ro.height = o.height;
+  VT_ASSIGN_OR_RETURN(std::unique_ptr<Renderer> renderer, Renderer::create(*ctx, ro));
+  VT_RETURN_IF_ERROR(renderer->set_meshes(in.virt.meshes));
+  VT_RETURN_IF_ERROR(renderer->set_reference_meshes(in.reference.meshes));
+  VT_RETURN_IF_ERROR(renderer->set_reference_textures(in.reference.textures));
+
+  const float aspect = float(o.width) / float(o.height);
+  const std::vector<Camera> cameras =
+      !in.cameras.empty()
+          ? in.cameras
+          : orbit_views(in.reference.bounds_min, in.reference.bounds_max, int(o.views), aspect);
+  ValidateOptions vopt;
+  vopt.layer = in.layer;
+  vopt.address_mode = in.reader->layers()[in.layer].address_mode;
+  vopt.streamer.slots_x = vopt.streamer.slots_y = o.slots;
+  vopt.converge.max_frames = o.max_frames;
+  vopt.thresholds = o.thresholds;
+  vopt.out_dir = o.out_dir.empty()
+                     ? std::filesystem::path(o.page_file).replace_extension(".validate").string()
+                     : o.out_dir;
+  std::error_code ec;
+  std::filesystem::create_directories(vopt.out_dir, ec);
+  if (ec) return Error(ErrorCode::kIo, vopt.out_dir + ": cannot create: " + ec.message());
+
+  VT_ASSIGN_OR_RETURN(
+      ValidationReport report,
+      validate_views(*renderer, std::shared_ptr<const PageSource>(std::move(source)), cameras,
+                     vopt));
+  report.page_file = o.page_file;
+  report.device = ctx->device_name();
+  VT_RETURN_IF_ERROR(write_report_json(vopt.out_dir + "/report.json", report));
   return report;
 }
 

@@ -108,6 +108,7 @@ struct ValidationReport {
   uint32_t width = 0, height = 0;
   Thresholds thresholds;
   std::vector<ViewReport> views;
+  std::string out_dir;  // where the PNGs (and, from validate_bake, report.json) went; "" = none
   bool passed() const;
 };
 
@@ -128,5 +129,28 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
                                           std::shared_ptr<const PageSource> source,
                                           std::span<const Camera> cameras,
                                           const ValidateOptions& options);
+
+// A bake against the scene it came from, as `vtbake validate` runs it.
+struct BakeValidationOptions {
+  std::string scene;      // the original scene (.gltf, .glb, .obj, .ply, .drc)
+  std::string page_file;  // the bake (.vtpf)
+  std::string unwrapped;  // the unwrapped scene the bake wrote; "" = page_file with .glb
+  std::string out_dir;    // PNGs and report.json; "" = page_file with .validate
+  std::string layer;      // the layer's name; "" = the albedo layer (the only one with a reference)
+  std::string cameras_file;  // a camera file (camera.h); "" = `views` automatic orbit views
+  uint32_t views = 6;
+  uint32_t width = 1280, height = 720;
+  Thresholds thresholds = scene_thresholds();
+  uint32_t slots = 32;           // physical cache slots per side
+  uint32_t max_frames = 48;      // per view, before giving up converging
+  bool prefer_hardware = false;  // a hardware Vulkan device rather than lavapipe
+};
+
+// Reads the camera file (first, so that a bad one fails fast), the page file and both scenes,
+// renders every view through the virtual-texture path and from the original materials
+// (validate_views) and writes the PNGs and report.json into out_dir. A view out of bounds is a
+// report that has not passed(), not an error; errors are bad input (kInvalidArgument,
+// kNotFound, kCorrupt), no usable Vulkan device (kUnsupported) or a failed write (kIo).
+Expected<ValidationReport> validate_bake(const BakeValidationOptions& options);
 
 }  // namespace vt::render

@@ -6,7 +6,9 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <nlohmann/json.hpp>
 
+#include "bake/build_summary_json.h"
 #include "bake/scene_bake.h"
 #include "bake/transfer.h"
 #include "format/page_file.h"
@@ -38,14 +40,14 @@ RoundTrip bake_and_compare(const scene::Scene& s, const test::ScratchDir& dir, d
                            uint32_t w, uint32_t h) {
   RoundTrip out;
   SceneBakeOptions o;
-  o.output = dir.file("out.vtpf");
+  o.build.output = dir.file("out.vtpf");
   o.unwrap.texels_per_unit = tpu;
-  o.codec.codec = CodecKind::kRaw;
+  o.build.codec.codec = CodecKind::kRaw;
   auto summary = bake_scene(s, o);
   EXPECT_TRUE(summary.ok()) << summary.status().message();
   if (!summary.ok()) return out;
   EXPECT_EQ(summary->transfer.contested_texels, 0u);
-  auto reader = PageFileReader::open(o.output);
+  auto reader = PageFileReader::open(o.build.output);
   EXPECT_TRUE(reader.ok()) << reader.status().message();
   auto unwrapped = scene::load_scene(dir.file("out.glb"));
   EXPECT_TRUE(unwrapped.ok()) << unwrapped.status().message();
@@ -211,12 +213,12 @@ TEST(SceneBake, NormalMappedSphereKeepsItsNormals) {
   scene::Scene s = test::single_mesh_scene(sphere, m);
   s.materials[0].normal_texture.image = test::add_image(s, dir.file("n.png"));
   SceneBakeOptions o;
-  o.output = dir.file("out.vtpf");
+  o.build.output = dir.file("out.vtpf");
   o.unwrap.texels_per_unit = 48;
-  o.codec.codec = CodecKind::kRaw;
+  o.build.codec.codec = CodecKind::kRaw;
   auto summary = bake_scene(s, o);
   ASSERT_TRUE(summary.ok()) << summary.status().message();
-  auto reader = PageFileReader::open(o.output);
+  auto reader = PageFileReader::open(o.build.output);
   ASSERT_TRUE(reader.ok());
   int nl = test::find_layer(**reader, LayerSemantic::kNormal);
   ASSERT_GE(nl, 0);
@@ -401,12 +403,12 @@ TEST(SceneBake, SampleSceneBakesWithEveryLayer) {
   so.ground_cells = 4;
   ASSERT_TRUE(write_sample_scene(dir.file("sample"), so).ok());
   SceneBakeOptions o;
-  o.output = dir.file("sample.vtpf");
+  o.build.output = dir.file("sample.vtpf");
   o.unwrap.size_pages = 4;
   auto summary = bake_scene(dir.file("sample/scene.gltf"), o);
   ASSERT_TRUE(summary.ok()) << summary.status().message();
   EXPECT_EQ(summary->transfer.contested_texels, 0u);
-  auto reader = PageFileReader::open(o.output);
+  auto reader = PageFileReader::open(o.build.output);
   ASSERT_TRUE(reader.ok());
   EXPECT_TRUE((*reader)->verify().ok());
   // Albedo with alpha (the masked leaf), normal, ORM, emissive.
@@ -416,7 +418,7 @@ TEST(SceneBake, SampleSceneBakesWithEveryLayer) {
   EXPECT_GE(test::find_layer(**reader, LayerSemantic::kOrm), 0);
   EXPECT_GE(test::find_layer(**reader, LayerSemantic::kEmissive), 0);
   EXPECT_GT(summary->build.stored, 0u);
-  EXPECT_GT(summary->ratio, 1.0);
+  EXPECT_GT(compression_ratio(summary->build), 1.0);
   auto un = scene::load_scene(dir.file("sample.glb"));
   ASSERT_TRUE(un.ok()) << un.status().message();
   EXPECT_EQ(un->instances().size(), 7u);
@@ -535,6 +537,58 @@ TEST(SceneBake, FilteredMipLevelsOptionIsUsedAndAgreesOnSmoothTextures) {
   for (const auto& e : std::filesystem::directory_iterator(dir.file("")))
     left += e.path().filename().string().rfind("vtbake-transfer-", 0) == 0;
   EXPECT_EQ(left, 0u);
+}
+
+// The nested BuildOptions reach the build as `vtbake build` would set them, except what the
+// scene decides: the address mode (charts do not tile), the layers and the metadata.
+TEST(SceneBake, NestedBuildOptionsReachTheBuild) {
+  test::ScratchDir dir;
+  ASSERT_TRUE(write_texture(dir.file("cube.png"), 64, 64, 3, smooth_colour).ok());
+  scene::Scene s = test::single_mesh_scene(make_box(1, 1, 1), scene::Material{});
+  s.materials[0].base_color_texture.image = test::add_image(s, dir.file("cube.png"));
+  SceneBakeOptions o;
+  EXPECT_EQ(o.build.memory_limit, uint64_t(8) << 30);  // the transfer's buffers count too
+  o.build.output = dir.file("box.vtpf");
+  o.build.codec.codec = CodecKind::kRaw;
+  o.build.payload = 56;
+  o.build.border = 2;
+  o.build.filter = MipFilter::kBox;
+  o.build.address = AddressMode::kWrap;
+  o.build.metadata_json = R"({"ignored":true})";
+  o.unwrap.texels_per_unit = 64;
+  auto summary = bake_scene(s, o);
+  ASSERT_TRUE(summary.ok()) << summary.status().message();
+  auto reader = PageFileReader::open(o.build.output);
+  ASSERT_TRUE(reader.ok()) << reader.status().message();
+  EXPECT_EQ((*reader)->geometry().payload, 56u);
+  EXPECT_EQ((*reader)->geometry().border, 2u);
+  EXPECT_EQ((*reader)->geometry().width % 56, 0u);  // the unwrap packs whole 56-texel pages
+  for (const LayerSpec& l : (*reader)->layers()) EXPECT_EQ(l.address_mode, AddressMode::kClamp);
+  auto meta = nlohmann::json::parse((*reader)->metadata_json());
+  EXPECT_EQ(meta["tool"], "vtbake bake");
+  EXPECT_FALSE(meta.contains("ignored"));
+
+  // The report's build part is the build's own JSON.
+  nlohmann::json j = to_json(*summary);
+  EXPECT_EQ(j["build"], to_json(summary->build));
+  EXPECT_EQ(j["build"]["payload"], 56);
+  EXPECT_EQ(j["build"]["pages"]["stored"], summary->build.stored);
+  EXPECT_EQ(j["build"]["bytes"]["file"], summary->build.file_bytes);
+  EXPECT_EQ(j["output"], o.build.output);
+  EXPECT_EQ(j["atlas"]["width"], (*reader)->geometry().width);
+
+  // The filter is the caller's: Kaiser gives the same level 0 and other coarser levels.
+  o.build.output = dir.file("kaiser.vtpf");
+  o.build.filter = MipFilter::kKaiser;
+  ASSERT_TRUE(bake_scene(s, o).ok());
+  auto kaiser = PageFileReader::open(o.build.output);
+  ASSERT_TRUE(kaiser.ok());
+  EXPECT_EQ(test::read_level0(**kaiser, 0).texels, test::read_level0(**reader, 0).texels);
+  auto bytes = [](const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  };
+  EXPECT_NE(bytes(dir.file("kaiser.vtpf")), bytes(dir.file("box.vtpf")));
 }
 
 }  // namespace

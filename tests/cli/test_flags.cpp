@@ -50,5 +50,58 @@ TEST(CliFlags, GoodCodecAndMemoryLimitReachTheWork) {
   }
 }
 
+TEST(CliFlags, BuildFlagsAreSharedByBuildAndBake) {
+  // Each bad value fails at parse time, naming its flag, in both commands.
+  for (const char* command : {"build procedural:240x240", "bake missing.gltf"}) {
+    for (const char* flag :
+         {"--filter gauss", "--fix-nonfinite zero", "--alpha-coverage 2", "--payload x"}) {
+      auto r = run_vtbake(std::string(command) + " -o /nonexistent/x.vtpf " + flag, true);
+      EXPECT_EQ(r.exit_code, 2) << command << " " << flag << "\n" << r.out;
+      const std::string name = std::string(flag).substr(0, std::string(flag).find(' '));
+      EXPECT_TRUE(contains(r.out, name)) << r.out;
+    }
+  }
+  // Good values parse, so the bake gets as far as the missing scene.
+  auto r = run_vtbake(
+      "bake missing.gltf -o /tmp/x.vtpf --filter box --alpha-coverage 0.5 --fix-nonfinite clamp "
+      "--scratch-dir /tmp --memory-limit 1G --payload 56 --border 2",
+      true);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_TRUE(contains(r.out, "missing.gltf: cannot open file")) << r.out;
+}
+
+TEST(CliFlags, UnwrapFlagsHaveOneRangeInUnwrapAndBake) {
+  for (const char* command :
+       {"unwrap missing.gltf -o /tmp/x.glb", "bake missing.gltf -o /tmp/x.vtpf"}) {
+    // --padding takes the unwrapper's own bound, 0..1024, everywhere (bake stopped at 64).
+    auto ok = run_vtbake(std::string(command) + " --padding 100 --chart-angle 45", true);
+    EXPECT_EQ(ok.exit_code, 2) << ok.out;
+    EXPECT_TRUE(contains(ok.out, "missing.gltf")) << ok.out;
+    EXPECT_FALSE(contains(ok.out, "--padding")) << ok.out;
+    for (const char* flag : {"--padding 1025", "--size 0", "--size 1025", "--method abf",
+                             "--max-stretch 0.5", "--size 4 --texels-per-unit 10"}) {
+      auto r = run_vtbake(std::string(command) + " " + flag, true);
+      EXPECT_EQ(r.exit_code, 2) << command << " " << flag << "\n" << r.out;
+      EXPECT_TRUE(contains(r.out, std::string(flag).substr(0, std::string(flag).find(' '))))
+          << r.out;
+    }
+  }
+}
+
+// One exit-code rule (cli/cli_util.h): bad input 2, a failed write 1, whatever the command.
+TEST(CliExitCodes, BadInputIsTwoAndAFailedWriteIsOne) {
+  for (const char* command :
+       {"info /tmp", "verify /tmp", "extract /tmp --level 0 -o /tmp/x.png",
+        "unwrap /tmp/missing.gltf -o /tmp/x.glb", "bake /tmp/missing.gltf -o /tmp/x.vtpf",
+        "build /tmp/missing.png -o /tmp/x.vtpf"}) {
+    auto r = run_vtbake(command, true);
+    EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.out;
+    EXPECT_TRUE(contains(r.out, "vtbake ")) << r.out;
+  }
+  auto w = run_vtbake("build procedural:64x64 -o /nonexistent/folder/x.vtpf", true);
+  EXPECT_EQ(w.exit_code, 1) << w.out;
+  EXPECT_TRUE(contains(w.out, "vtbake build: /nonexistent/folder/x.vtpf")) << w.out;
+}
+
 }  // namespace
 }  // namespace vt

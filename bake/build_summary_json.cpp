@@ -1,0 +1,83 @@
+// The build summary's JSON (see build_summary_json.h).
+#include "bake/build_summary_json.h"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+namespace vt {
+namespace {
+
+nlohmann::json level_json(uint32_t level, const LevelSummary& v) {
+  return {{"level", level},         {"width", v.width},     {"height", v.height},
+          {"pages_x", v.pages_x},   {"pages_y", v.pages_y}, {"stored", v.stored},
+          {"constant", v.constant}, {"absent", v.absent},   {"bytes", v.stored_bytes},
+          {"scratch", v.scratch}};
+}
+
+nlohmann::json layer_json(const LayerSummary& l) {
+  nlohmann::json j = {{"name", l.name},
+                      {"semantic", to_string(l.spec.semantic)},
+                      {"channels", l.spec.channels},
+                      {"texel_type", to_string(l.spec.texel_type)},
+                      {"codec", to_string(l.spec.codec)},
+                      {"runtime_format", to_string(l.spec.runtime_format)},
+                      {"color_space", to_string(l.spec.color_space)},
+                      // JSON has no infinity: a lossless layer's PSNR is null.
+                      {"psnr_db", std::isfinite(l.psnr_db) ? nlohmann::json(l.psnr_db) : nullptr},
+                      {"max_error", l.max_error},
+                      {"alpha_dropped", l.alpha_dropped},
+                      {"non_finite", l.non_finite.non_finite},
+                      {"negative", l.non_finite.negative}};
+  if (l.non_finite.any()) {
+    j["first_bad_texel"] = {{"x", l.non_finite.first_x},
+                            {"y", l.non_finite.first_y},
+                            {"channel", l.non_finite.first_channel}};
+  }
+  return j;
+}
+
+}  // namespace
+
+uint64_t raw_texel_bytes(const BuildSummary& s) {
+  const PageGeometry& g = s.geometry;
+  uint64_t bytes = 0;
+  for (const LayerSummary& layer : s.layers) {
+    for (uint32_t l = 0; l < g.level_count(); ++l) {
+      bytes += uint64_t(g.level_width(l)) * g.level_height(l) * layer.spec.texel_bytes();
+    }
+  }
+  return bytes;
+}
+
+double compression_ratio(const BuildSummary& s) {
+  return s.file_bytes ? double(raw_texel_bytes(s)) / double(s.file_bytes) : 0;
+}
+
+nlohmann::json to_json(const BuildSummary& s) {
+  nlohmann::json levels = nlohmann::json::array();
+  for (size_t l = 0; l < s.levels.size(); ++l)
+    levels.push_back(level_json(uint32_t(l), s.levels[l]));
+  nlohmann::json layers = nlohmann::json::array();
+  for (const LayerSummary& l : s.layers) layers.push_back(layer_json(l));
+  nlohmann::json seconds = nlohmann::json::object();
+  for (const StageTime& t : s.stages) seconds[t.name] = t.seconds;
+  return {
+      {"width", s.geometry.width},
+      {"height", s.geometry.height},
+      {"payload", s.geometry.payload},
+      {"border", s.geometry.border},
+      {"pages",
+       {{"total", s.pages}, {"stored", s.stored}, {"constant", s.constant}, {"absent", s.absent}}},
+      {"bytes",
+       {{"file", s.file_bytes},
+        {"stored", s.stored_bytes},
+        {"raw", raw_texel_bytes(s)},
+        {"ratio", compression_ratio(s)},
+        {"scratch_peak", s.scratch_bytes},
+        {"level_memory_peak", s.level_memory_bytes}}},
+      {"levels", levels},
+      {"layers", layers},
+      {"seconds", seconds}};
+}
+
+}  // namespace vt

@@ -1,0 +1,59 @@
+// The build flags (see build_flags.h).
+#include "cli/build_flags.h"
+
+#include "cli/cli_util.h"
+
+namespace vt::cli {
+namespace {
+
+// A library parse error as CLI11's, so that a bad value fails at parse time like a range check.
+void throw_if_error(const char* flag, const Status& status) {
+  if (status.ok()) return;
+  const std::string& message = status.message();
+  if (message.rfind(flag, 0) == 0) throw CLI::ValidationError(message);
+  throw CLI::ValidationError(flag, message);
+}
+
+}  // namespace
+
+void add_build_flags(CLI::App& app, BuildOptions& o) {
+  app.add_option("-o,--output", o.output, "Output page file (.vtpf)")->required();
+  app.add_option_function<std::string>(
+      "--codec",
+      [&o](const std::string& text) { throw_if_error("--codec", parse_codec(text, &o.codec)); },
+      "dct[:QUALITY][:adaptive] (default, quality 75; adaptive: smaller pages, slower "
+      "decoding), bc[:high|fast] or raw (lossless)");
+  app.add_option("--payload", o.payload, "Payload texels per page side")->capture_default_str();
+  app.add_option("--border", o.border, "Border texels per page side")->capture_default_str();
+  app.add_option_function<std::string>(
+         "--filter",
+         [&o](const std::string& name) {
+           auto filter = parse_mip_filter(name.c_str());
+           throw_if_error("--filter", filter.status());
+           o.filter = *filter;
+         },
+         "Mip filter: kaiser, box or lanczos3")
+      ->default_str(to_string(o.filter));
+  app.add_option("--alpha-coverage", o.alpha_coverage_reference,
+                 "Keep the fraction of texels with alpha >= this value (e.g. 0.5) at every level")
+      ->check(CLI::Range(0.0f, 1.0f));
+  app.add_option_function<std::string>(
+      "--fix-nonfinite",
+      [&o](const std::string& name) {
+        auto policy = parse_non_finite_policy(name);
+        throw_if_error("--fix-nonfinite", policy.status());
+        o.non_finite = *policy;
+      },
+      "NaN/Inf/negative colour values: black (default), clamp or error");
+  app.add_option_function<std::string>(
+         "--memory-limit",
+         [&o](const std::string& text) {
+           throw_if_error("--memory-limit", parse_byte_size(text, &o.memory_limit));
+         },
+         "Memory budget, e.g. 512M, 2G")
+      ->default_str(format_byte_size(o.memory_limit));
+  app.add_option("--scratch-dir", o.scratch_dir,
+                 "Where levels larger than memory go (default: beside the output)");
+}
+
+}  // namespace vt::cli

@@ -1,0 +1,42 @@
+// The unwrap flags (see unwrap_flags.h).
+#include "cli/unwrap_flags.h"
+
+namespace vt::cli {
+
+void add_unwrap_flags(CLI::App& app, unwrap::UnwrapOptions& o) {
+  auto* tpu = app.add_option("--texels-per-unit", o.texels_per_unit,
+                             "World texel density (default: derived from --size)")
+                  ->check(CLI::PositiveNumber);
+  // 1024 pages is far past the atlas limit (UnwrapOptions::max_atlas_texels), which then
+  // reports the size; the bound only keeps size * payload from overflowing.
+  app.add_option("--size", o.size_pages, "Target atlas side in pages (density derived)")
+      ->check(CLI::Range(1, 1024))
+      ->capture_default_str()
+      ->excludes(tpu);
+  // The unwrapper's own bound.
+  app.add_option("--padding", o.padding, "Empty texels between charts")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
+  app.add_option_function<std::string>(
+         "--method",
+         [&o](const std::string& name) {
+           o.method = name == "arap" ? unwrap::Method::kArap : unwrap::Method::kLscm;
+         },
+         "Chart parameterisation: lscm (default) or arap")
+      ->check(CLI::IsMember({"lscm", "arap"}));
+  app.add_flag("--share-instances", o.share_instances,
+               "Instances of a mesh share one chart set (default: unique texels per instance)");
+  app.add_option("--max-stretch", o.max_chart_stretch,
+                 "Charts with L2 stretch above this are split and redone")
+      ->check(CLI::Range(1.0, 100.0))
+      ->capture_default_str();
+  app.add_option("--split-rounds", o.max_split_rounds, "Stretch split-and-redo rounds (0 = none)")
+      ->check(CLI::Range(0, 64))
+      ->capture_default_str();
+  app.add_option("--chart-angle", o.max_chart_angle_deg,
+                 "Largest normal deviation inside a chart, degrees")
+      ->check(CLI::Range(1.0, 179.0))
+      ->capture_default_str();
+}
+
+}  // namespace vt::cli

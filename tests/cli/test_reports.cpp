@@ -1,0 +1,85 @@
+// The --json reports (docs/REPORTS.md): `vtbake build --json` and `vtbake bake --json` carry one
+// schema for the build, the scene bake nesting it under "build".
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+
+#include "tests/cli/cli_test_util.h"
+
+namespace vt {
+namespace {
+
+using vt::testing::run_vtbake;
+
+std::set<std::string> keys(const nlohmann::json& j) {
+  std::set<std::string> k;
+  for (auto it = j.begin(); it != j.end(); ++it) k.insert(it.key());
+  return k;
+}
+
+class Reports : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = (std::filesystem::temp_directory_path() / ("vt_reports_" + std::to_string(::getpid())))
+               .string();
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string dir_;
+};
+
+TEST_F(Reports, BuildJsonIsTheNestedSchema) {
+  auto r = run_vtbake("--json build procedural:300x200 --codec raw -o " + dir_ + "/b.vtpf", false);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(keys(j),
+            (std::set<std::string>{"output", "width", "height", "payload", "border", "pages",
+                                   "bytes", "levels", "layers", "seconds", "wall_seconds"}));
+  EXPECT_EQ(j["output"], dir_ + "/b.vtpf");
+  EXPECT_EQ(j["width"], 300);
+  const auto& p = j["pages"];
+  EXPECT_EQ(
+      p["total"].get<uint64_t>(),
+      p["stored"].get<uint64_t>() + p["constant"].get<uint64_t>() + p["absent"].get<uint64_t>());
+  EXPECT_EQ(j["bytes"]["file"].get<uint64_t>(), std::filesystem::file_size(dir_ + "/b.vtpf"));
+  EXPECT_EQ(j["bytes"]["raw"], (300 * 200 + 150 * 100 + 75 * 50) * 3);  // 3 levels of RGB8
+  EXPECT_TRUE(j["layers"][0]["psnr_db"].is_null());                     // raw is lossless
+  EXPECT_GT(j["seconds"].size(), 0u);
+}
+
+TEST_F(Reports, SceneBakeNestsTheBuildSchema) {
+  ASSERT_EQ(run_vtbake("-q sample-scene " + dir_ +
+                           "/scene --ground-cells 2 --sphere-segments 8 --texture-size 32",
+                       false)
+                .exit_code,
+            0);
+  auto r = run_vtbake("--json bake " + dir_ + "/scene/scene.gltf -o " + dir_ +
+                          "/s.vtpf --size 2 --payload 56 --unwrapped -",
+                      false);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(keys(j), (std::set<std::string>{"output", "unwrapped", "triangles", "atlas", "transfer",
+                                            "build", "seconds", "total_seconds"}));
+  EXPECT_EQ(j["unwrapped"], "");
+  EXPECT_EQ(keys(j["build"]),
+            (std::set<std::string>{"width", "height", "payload", "border", "pages", "bytes",
+                                   "levels", "layers", "seconds"}));
+  EXPECT_EQ(j["build"]["payload"], 56);  // the shared build flags reach the scene bake
+  EXPECT_EQ(j["build"]["width"], j["atlas"]["width"]);
+  EXPECT_EQ(j["build"]["bytes"]["file"].get<uint64_t>(),
+            std::filesystem::file_size(dir_ + "/s.vtpf"));
+  EXPECT_EQ(keys(j["build"]["layers"][0]),
+            keys(nlohmann::json::parse(
+                run_vtbake("--json build procedural:64x64 -o " + dir_ + "/c.vtpf", false)
+                    .out)["layers"][0]));
+  for (const char* stage : {"load", "unwrap", "transfer", "build"}) {
+    EXPECT_TRUE(j["seconds"].contains(stage)) << stage;
+  }
+}
+
+}  // namespace
+}  // namespace vt
