@@ -10,6 +10,8 @@
 #include <sstream>
 #include <vector>
 
+#include "common/srgb.h"
+
 namespace vt {
 namespace {
 
@@ -32,11 +34,10 @@ OCIO::ConstConfigRcPtr make_config() {
   auto srgb = OCIO::ColorSpace::Create();
   srgb->setName("sRGB");
   srgb->setFamily("vtbake");
-  // IEC 61966-2-1: linear segment below 0.04045, 2.4 power above; ExponentWithLinear is the
-  // exact curve (not the 2.2 approximation).
+  // common/srgb.h's curve: ExponentWithLinear is the exact one (not the 2.2 approximation).
   auto curve = OCIO::ExponentWithLinearTransform::Create();
-  curve->setGamma({2.4, 2.4, 2.4, 1.0});
-  curve->setOffset({0.055, 0.055, 0.055, 0.0});
+  curve->setGamma({kSrgbGamma, kSrgbGamma, kSrgbGamma, 1.0});
+  curve->setOffset({kSrgbOffset, kSrgbOffset, kSrgbOffset, 0.0});
   curve->setDirection(OCIO::TRANSFORM_DIR_FORWARD);
   srgb->setTransform(curve, OCIO::COLORSPACE_DIR_TO_REFERENCE);
   config->addColorSpace(srgb);

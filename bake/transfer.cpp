@@ -2,6 +2,7 @@
 // the triangles that overlap it in index order, so the result does not depend on threads.
 #include "bake/transfer.h"
 #include "common/parallel.h"
+#include "common/srgb.h"
 
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
@@ -242,10 +243,6 @@ std::vector<std::vector<uint32_t>> bin_triangles(const std::vector<RasterTri>& t
 }
 
 // ---- Materials -------------------------------------------------------------------------------
-
-float srgb_to_linear(float v) {
-  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
-}
 
 struct ImageSlot {
   OIIO::TextureSystem::TextureHandle* handle = nullptr;

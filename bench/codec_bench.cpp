@@ -2,19 +2,17 @@
 // over the same pages, `repeats` times, and the median pass is reported.
 #include "bench/codec_bench.h"
 
-#include <jpeglib.h>
-
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cmath>
-#include <csetjmp>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "bench/jpeg_anchor.h"
 #include "codec/bc.h"
 #include "codec/dct.h"
 #include "codec/metrics.h"
@@ -214,122 +212,52 @@ Status run_bc(const PageSet& set, const BcSetting& s, const CodecBenchOptions& o
 
 // ---- page codecs: DCT and abbreviated JPEG ----
 
+// A page codec as the benchmark drives it: every page encoded into `coded`, timed.
 struct PageCodecResult {
   std::vector<std::vector<uint8_t>> coded;
   size_t table_bytes = 0;
   double encode_s = 0;
 };
 
-struct JpegError {
-  jpeg_error_mgr mgr;
-  std::jmp_buf jump;
-  char message[JMSG_LENGTH_MAX];
-};
-
-void jpeg_error_exit(j_common_ptr cinfo) {
-  JpegError* e = reinterpret_cast<JpegError*>(cinfo->err);
-  (*cinfo->err->format_message)(cinfo, e->message);
-  std::longjmp(e->jump, 1);
+// Encodes every page with `encode(texels, out) -> Status`, `repeats` times.
+template <typename Encode>
+Expected<PageCodecResult> encode_pages(const PageSet& set, int repeats, size_t table_bytes,
+                                       Encode&& encode) {
+  PageCodecResult r;
+  r.table_bytes = table_bytes;
+  r.coded.assign(set.pages.size(), {});
+  Status status;
+  r.encode_s = time_passes(repeats, [&] {
+    for (size_t i = 0; i < set.pages.size(); ++i) {
+      Status st = encode(set.pages[i].texels.data(), r.coded[i]);
+      if (!st.ok()) status = st;
+    }
+  });
+  VT_RETURN_IF_ERROR(status);
+  return r;
 }
 
-// Per-page abbreviated JPEG streams (4:2:0, standard Huffman tables) sharing one table set.
-class JpegPages {
- public:
-  JpegPages(int size, int quality) : size_(size), quality_(quality) {}
-
-  Status encode(const PageSet& set, int repeats, PageCodecResult& r) {
-    jpeg_compress_struct c{};
-    JpegError err{};
-    c.err = jpeg_std_error(&err.mgr);
-    err.mgr.error_exit = jpeg_error_exit;
-    if (setjmp(err.jump)) {
-      jpeg_destroy_compress(&c);
-      return Error(ErrorCode::kInternal, std::string("libjpeg: ") + err.message);
-    }
-    jpeg_create_compress(&c);
-    c.image_width = JDIMENSION(size_);
-    c.image_height = JDIMENSION(size_);
-    c.input_components = 3;
-    c.in_color_space = JCS_RGB;
-    jpeg_set_defaults(&c);
-    jpeg_set_quality(&c, quality_, TRUE);
-    unsigned char* buf = nullptr;
-    unsigned long len = 0;
-    jpeg_mem_dest(&c, &buf, &len);
-    jpeg_write_tables(&c);
-    tables_.assign(buf, buf + len);
-    std::free(buf);
-    r.table_bytes = tables_.size();
-    r.coded.assign(set.pages.size(), {});
-    r.encode_s = time_passes(repeats, [&] {
-      for (size_t i = 0; i < set.pages.size(); ++i) {
-        buf = nullptr;
-        len = 0;
-        jpeg_mem_dest(&c, &buf, &len);
-        jpeg_suppress_tables(&c, TRUE);
-        jpeg_start_compress(&c, FALSE);
-        const uint8_t* t = set.pages[i].texels.data();
-        while (c.next_scanline < c.image_height) {
-          JSAMPROW row = const_cast<JSAMPROW>(t + size_t(c.next_scanline) * size_ * 3);
-          jpeg_write_scanlines(&c, &row, 1);
-        }
-        jpeg_finish_compress(&c);
-        r.coded[i].assign(buf, buf + len);
-        std::free(buf);
-      }
-    });
-    jpeg_destroy_compress(&c);
-    return Status::Ok();
-  }
-
-  // Decodes every page; `after` runs on each decoded page (inside the timed region).
-  template <typename F>
-  Status decode_all(const PageCodecResult& r, int repeats, double& seconds, F&& after) {
-    jpeg_decompress_struct d{};
-    JpegError err{};
-    d.err = jpeg_std_error(&err.mgr);
-    err.mgr.error_exit = jpeg_error_exit;
-    std::vector<uint8_t> out(size_t(size_) * size_ * 3);
-    if (setjmp(err.jump)) {
-      jpeg_destroy_decompress(&d);
-      return Error(ErrorCode::kCorrupt, std::string("libjpeg: ") + err.message);
-    }
-    jpeg_create_decompress(&d);
-    jpeg_mem_src(&d, tables_.data(), (unsigned long)tables_.size());
-    if (jpeg_read_header(&d, FALSE) != JPEG_HEADER_TABLES_ONLY) {
-      jpeg_destroy_decompress(&d);
-      return Error(ErrorCode::kInternal, "libjpeg: the table stream is not tables-only");
-    }
-    seconds = time_passes(repeats, [&] {
-      for (size_t i = 0; i < r.coded.size(); ++i) {
-        jpeg_mem_src(&d, r.coded[i].data(), (unsigned long)r.coded[i].size());
-        jpeg_read_header(&d, TRUE);
-        d.out_color_space = JCS_RGB;
-        jpeg_start_decompress(&d);
-        while (d.output_scanline < d.output_height) {
-          JSAMPROW row = out.data() + size_t(d.output_scanline) * size_ * 3;
-          jpeg_read_scanlines(&d, &row, 1);
-        }
-        jpeg_finish_decompress(&d);
-        after(i, out.data());
-      }
-    });
-    jpeg_destroy_decompress(&d);
-    return Status::Ok();
-  }
-
- private:
-  int size_, quality_;
-  std::vector<uint8_t> tables_;
-};
-
 // Fills the page-codec rows: the codec alone, and the runtime path with BC1 after it.
+// `decode(coded, texels) -> Status` decodes one page.
 template <typename Decode>
 Status page_codec_rows(const PageSet& set, const CodecBenchOptions& o, const std::string& name,
-                       const PageCodecResult& coded, Decode&& decode_all,
+                       const PageCodecResult& coded, Decode&& decode,
                        std::vector<CodecBenchRow>& rows) {
   const int size = o.page_size;
   const size_t page_texels = size_t(size) * size;
+  std::vector<uint8_t> decoded(page_texels * 3);
+  // Decodes every page `repeats` times; `after` runs on each decoded page, inside the timing.
+  auto decode_all = [&](int repeats, double& seconds, auto&& after) -> Status {
+    Status status;
+    seconds = time_passes(repeats, [&] {
+      for (size_t i = 0; i < coded.coded.size(); ++i) {
+        Status st = decode(coded.coded[i], decoded.data());
+        if (!st.ok()) status = st;
+        after(i, static_cast<const uint8_t*>(decoded.data()));
+      }
+    });
+    return status;
+  };
   size_t bytes = coded.table_bytes;
   for (const auto& c : coded.coded) bytes += c.size();
   const double texels = double(set.pages.size()) * double(page_texels);
@@ -396,43 +324,36 @@ Status run_dct(const PageSet& set, const CodecBenchOptions& o, int quality,
   const size_t step = std::max<size_t>(1, set.pages.size() / 64);
   for (size_t i = 0; i < set.pages.size(); i += step) training.emplace_back(set.pages[i].texels);
   VT_ASSIGN_OR_RETURN(DctTablesPtr tables, dct_make_tables(settings, size, size, training));
-  PageCodecResult coded;
-  coded.table_bytes = dct_serialize_tables(*tables).size();
-  coded.coded.assign(set.pages.size(), {});
-  Status status;
-  coded.encode_s = time_passes(o.repeats, [&] {
-    for (size_t i = 0; i < set.pages.size(); ++i) {
-      coded.coded[i].clear();
-      Status st = dct_encode_page(*tables, set.pages[i].texels.data(), size, size, coded.coded[i]);
-      if (!st.ok()) status = st;
-    }
-  });
-  VT_RETURN_IF_ERROR(status);
-  std::vector<uint8_t> out(size_t(size) * size * 3);
-  auto decode_all = [&](int repeats, double& seconds, auto&& after) -> Status {
-    Status st_all;
-    seconds = time_passes(repeats, [&] {
-      for (size_t i = 0; i < coded.coded.size(); ++i) {
-        Status st = dct_decode_page(*tables, coded.coded[i], size, size, out.data());
-        if (!st.ok()) st_all = st;
-        after(i, out.data());
-      }
-    });
-    return st_all;
+  VT_ASSIGN_OR_RETURN(PageCodecResult coded,
+                      encode_pages(set, o.repeats, dct_serialize_tables(*tables).size(),
+                                   [&](const uint8_t* texels, std::vector<uint8_t>& out) {
+                                     out.clear();
+                                     return dct_encode_page(*tables, texels, size, size, out);
+                                   }));
+  auto decode = [&](const std::vector<uint8_t>& page, uint8_t* texels) {
+    return dct_decode_page(*tables, page, size, size, texels);
   };
-  return page_codec_rows(set, o, "DCT q" + std::to_string(quality), coded, decode_all, rows);
+  return page_codec_rows(set, o, "DCT q" + std::to_string(quality), coded, decode, rows);
 }
 
 Status run_jpeg(const PageSet& set, const CodecBenchOptions& o, int quality,
                 std::vector<CodecBenchRow>& rows) {
-  JpegPages jpeg(o.page_size, quality);
-  PageCodecResult coded;
-  VT_RETURN_IF_ERROR(jpeg.encode(set, o.repeats, coded));
-  auto decode_all = [&](int repeats, double& seconds, auto&& after) -> Status {
-    return jpeg.decode_all(coded, repeats, seconds, after);
+  JpegAnchorSettings settings;
+  settings.page_size = o.page_size;
+  settings.quality = quality;
+  VT_ASSIGN_OR_RETURN(JpegPageEncoder encoder, JpegPageEncoder::create(settings));
+  VT_ASSIGN_OR_RETURN(PageCodecResult coded,
+                      encode_pages(set, o.repeats, encoder.tables().size(),
+                                   [&](const uint8_t* texels, std::vector<uint8_t>& out) {
+                                     return encoder.encode(texels, out);
+                                   }));
+  VT_ASSIGN_OR_RETURN(JpegPageDecoder decoder,
+                      JpegPageDecoder::create(o.page_size, encoder.tables()));
+  auto decode = [&](const std::vector<uint8_t>& page, uint8_t* texels) {
+    return decoder.decode(page, texels);
   };
   return page_codec_rows(set, o, "JPEG q" + std::to_string(quality) + " 4:2:0 abbreviated", coded,
-                         decode_all, rows);
+                         decode, rows);
 }
 
 // ---- normal maps: BC5 with the angular error ----

@@ -1,4 +1,4 @@
-// `vtbake bench codec`: accuracy versus time of the page and block codecs on real images cut
+// `vtbake-bench codec`: accuracy versus time of the page and block codecs on real images cut
 // into pages. For every setting: bits per texel, PSNR, single-threaded encode and decode speed;
 // for the page codecs also the runtime path (page decode + BC1 encode) in pages/s per core and
 // the PSNR after BC1. Compared in the same run with libjpeg-turbo (per-page abbreviated streams

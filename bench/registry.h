@@ -1,7 +1,7 @@
-// The kinds of `vtbake bench`: each kind (codec, ...) is one entry with its own options, run
-// from cli/cmd_bench.cpp as `vtbake bench KIND [options] [INPUTS...]`. The registry is an
-// explicit list (registry.cpp) rather than static self-registration, which a static library
-// would silently drop at link time. Adding a kind: a bench/<kind>_bench.cpp with a function
+// The kinds of `vtbake-bench`: each kind (codec, ...) is one entry with its own options, run
+// from bench/tool/vtbake_bench.cpp as `vtbake-bench KIND [options] [INPUTS...]`. The registry
+// is an explicit list (registry.cpp) rather than static self-registration, which a static
+// library would silently drop at link time. Adding a kind: a bench/<kind>_bench.cpp with a function
 // returning its BenchKind, and one line in bench_kinds().
 #pragma once
 

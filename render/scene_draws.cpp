@@ -7,16 +7,13 @@
 #include <cmath>
 #include <limits>
 
+#include "common/srgb.h"
+
 namespace vt::render {
 namespace {
 
-float srgb_to_linear(float c) {
-  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-}
 uint8_t linear_to_srgb8(float c) {
-  c = std::clamp(c, 0.0f, 1.0f);
-  float s = c <= 0.0031308f ? c * 12.92f : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
-  return uint8_t(std::lround(s * 255.0f));
+  return uint8_t(std::lround(linear_to_srgb(std::clamp(c, 0.0f, 1.0f)) * 255.0f));
 }
 
 struct Bounds {

@@ -1,19 +1,24 @@
-// The procedural sample scene and a small glTF (.gltf + .bin) writer (see sample_scene.h).
+// The procedural sample scene (see sample_scene.h).
 #include "samples/sample_scene.h"
 
 #include <cmath>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <map>
-#include <nlohmann/json.hpp>
 
 #include "bake/image_source.h"
+#include "scene/gltf_export.h"
 
 namespace vt {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+
+// How scene.gltf has always been spelled: samplers name their filters, texture references
+// their UV set, materials their sidedness (users' incremental builds hash the file).
+const scene::GltfWriteOptions kSampleSceneGltf = {.generator = "vtbake sample-scene",
+                                                  .write_texcoord_0 = true,
+                                                  .write_single_sided = true,
+                                                  .write_opaque = false,
+                                                  .sampler_filters = true};
 
 using scene::Vec2;
 using scene::Vec3;
@@ -198,145 +203,6 @@ Status write_texture(const std::string& path, uint32_t width, uint32_t height, u
   return write_image_file(source, path);
 }
 
-Status write_gltf(const scene::Scene& s, const std::string& path) {
-  namespace fs = std::filesystem;
-  using nlohmann::json;
-  fs::path out(path);
-  fs::path folder = out.parent_path();
-  std::string bin_name = out.stem().string() + ".bin";
-  std::vector<uint8_t> bin;
-  json views = json::array(), accessors = json::array();
-  auto add = [&](const void* data, size_t bytes, int components, int component_type,
-                 const char* type, size_t count, int target, json minmax = nullptr) {
-    while (bin.size() % 4) bin.push_back(0);
-    size_t offset = bin.size();
-    bin.resize(offset + bytes);
-    if (bytes) std::memcpy(bin.data() + offset, data, bytes);
-    views.push_back(
-        {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}, {"target", target}});
-    json acc = {{"bufferView", views.size() - 1},
-                {"componentType", component_type},
-                {"count", count},
-                {"type", type}};
-    if (!minmax.is_null()) acc["min"] = minmax[0], acc["max"] = minmax[1];
-    accessors.push_back(acc);
-    (void)components;
-    return accessors.size() - 1;
-  };
-  json meshes = json::array();
-  for (const auto& m : s.meshes) {
-    json prims = json::array();
-    for (const auto& p : m.primitives) {
-      json attr;
-      Vec3 lo = {INFINITY, INFINITY, INFINITY}, hi = {-INFINITY, -INFINITY, -INFINITY};
-      for (const auto& v : p.positions)
-        for (int c = 0; c < 3; ++c) lo[c] = std::min(lo[c], v[c]), hi[c] = std::max(hi[c], v[c]);
-      attr["POSITION"] = add(p.positions.data(), p.positions.size() * 12, 3, 5126, "VEC3",
-                             p.positions.size(), 34962, json::array({lo, hi}));
-      if (!p.normals.empty())
-        attr["NORMAL"] =
-            add(p.normals.data(), p.normals.size() * 12, 3, 5126, "VEC3", p.normals.size(), 34962);
-      if (!p.tangents.empty())
-        attr["TANGENT"] = add(p.tangents.data(), p.tangents.size() * 16, 4, 5126, "VEC4",
-                              p.tangents.size(), 34962);
-      for (size_t n = 0; n < p.uvs.size(); ++n) {
-        attr["TEXCOORD_" + std::to_string(n)] =
-            add(p.uvs[n].data(), p.uvs[n].size() * 8, 2, 5126, "VEC2", p.uvs[n].size(), 34962);
-      }
-      if (!p.colors.empty())
-        attr["COLOR_0"] =
-            add(p.colors.data(), p.colors.size() * 16, 4, 5126, "VEC4", p.colors.size(), 34962);
-      json prim = {{"attributes", attr},
-                   {"indices", add(p.indices.data(), p.indices.size() * 4, 1, 5125, "SCALAR",
-                                   p.indices.size(), 34963)},
-                   {"mode", 4}};
-      if (p.material >= 0) prim["material"] = p.material;
-      prims.push_back(prim);
-    }
-    meshes.push_back({{"name", m.name}, {"primitives", prims}});
-  }
-  json textures = json::array(), samplers = json::array();
-  std::map<std::pair<int, int>, size_t> sampler_of;
-  auto wrap = [](scene::WrapMode w) {
-    return w == scene::WrapMode::kClampToEdge      ? 33071
-           : w == scene::WrapMode::kMirroredRepeat ? 33648
-                                                   : 10497;
-  };
-  auto tex = [&](const scene::TextureRef& r) {
-    auto key = std::make_pair(wrap(r.wrap_s), wrap(r.wrap_t));
-    auto it = sampler_of.find(key);
-    if (it == sampler_of.end()) {
-      samplers.push_back(
-          {{"wrapS", key.first}, {"wrapT", key.second}, {"magFilter", 9729}, {"minFilter", 9987}});
-      it = sampler_of.emplace(key, samplers.size() - 1).first;
-    }
-    textures.push_back({{"source", r.image}, {"sampler", it->second}});
-    return json{{"index", textures.size() - 1}, {"texCoord", r.texcoord}};
-  };
-  json materials = json::array();
-  for (const auto& m : s.materials) {
-    json pbr = {{"baseColorFactor", m.base_color_factor},
-                {"metallicFactor", m.metallic_factor},
-                {"roughnessFactor", m.roughness_factor}};
-    if (m.base_color_texture.valid()) pbr["baseColorTexture"] = tex(m.base_color_texture);
-    if (m.metallic_roughness_texture.valid())
-      pbr["metallicRoughnessTexture"] = tex(m.metallic_roughness_texture);
-    json mat = {{"name", m.name},
-                {"pbrMetallicRoughness", pbr},
-                {"emissiveFactor", m.emissive_factor},
-                {"doubleSided", m.double_sided}};
-    if (m.normal_texture.valid())
-      (mat["normalTexture"] = tex(m.normal_texture))["scale"] = m.normal_scale;
-    if (m.occlusion_texture.valid())
-      (mat["occlusionTexture"] = tex(m.occlusion_texture))["strength"] = m.occlusion_strength;
-    if (m.emissive_texture.valid()) mat["emissiveTexture"] = tex(m.emissive_texture);
-    if (m.alpha_mode == scene::AlphaMode::kMask)
-      mat["alphaMode"] = "MASK", mat["alphaCutoff"] = m.alpha_cutoff;
-    if (m.alpha_mode == scene::AlphaMode::kBlend) mat["alphaMode"] = "BLEND";
-    materials.push_back(mat);
-  }
-  json images = json::array();
-  for (const auto& im : s.images) {
-    if (im.embedded())
-      return Error(ErrorCode::kUnsupported, path + ": embedded images are not written to .gltf");
-    std::string uri = fs::path(im.path)
-                          .lexically_relative(folder.empty() ? fs::path(".") : folder)
-                          .generic_string();
-    if (uri.empty()) uri = im.path;
-    json j = {{"uri", uri}, {"name", im.name}};
-    if (!im.mime_type.empty()) j["mimeType"] = im.mime_type;
-    images.push_back(j);
-  }
-  json nodes = json::array();
-  for (const auto& n : s.nodes) {
-    json j = {{"name", n.name}};
-    if (n.local != scene::kIdentity) j["matrix"] = n.local;
-    if (n.mesh >= 0) j["mesh"] = n.mesh;
-    if (!n.children.empty()) j["children"] = n.children;
-    nodes.push_back(j);
-  }
-  json doc = {{"asset", {{"version", "2.0"}, {"generator", "vtbake sample-scene"}}},
-              {"scene", 0},
-              {"scenes", json::array({{{"nodes", s.roots}}})},
-              {"nodes", nodes},
-              {"meshes", meshes},
-              {"materials", materials},
-              {"accessors", accessors},
-              {"bufferViews", views},
-              {"buffers", json::array({{{"uri", bin_name}, {"byteLength", bin.size()}}})}};
-  if (!textures.empty()) doc["textures"] = textures, doc["samplers"] = samplers;
-  if (!images.empty()) doc["images"] = images;
-  {
-    std::ofstream f(folder / bin_name, std::ios::binary);
-    f.write(reinterpret_cast<const char*>(bin.data()), std::streamsize(bin.size()));
-    if (!f) return Error(ErrorCode::kIo, (folder / bin_name).string() + ": cannot write");
-  }
-  std::ofstream f(path);
-  f << doc.dump(1) << "\n";
-  if (!f) return Error(ErrorCode::kIo, path + ": cannot write");
-  return Status::Ok();
-}
-
 Status write_sample_scene(const std::string& dir, const SampleSceneOptions& o) {
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -500,7 +366,7 @@ Status write_sample_scene(const std::string& dir, const SampleSceneOptions& o) {
   node("torus", torus_mesh, translate_scale(-1.0, 0.3, 2.0, 1.0, 0.5));
   node("leaf card", card_mesh, translate_scale(3.0, 0.0, 2.0, 1.0, -0.6));
   sc.source_path = (fs::path(dir) / "scene.gltf").string();
-  return write_gltf(sc, sc.source_path);
+  return scene::save_gltf(sc, sc.source_path, kSampleSceneGltf);
 }
 
 }  // namespace vt

@@ -8,8 +8,8 @@
 #include <functional>
 #include <string>
 
-#include "scene/scene.h"
 #include "common/status.h"
+#include "scene/scene.h"
 
 namespace vt {
 
@@ -21,10 +21,6 @@ struct SampleSceneOptions {
 
 // Writes DIR/scene.gltf, DIR/scene.bin and the textures (PNG, one EXR). Creates DIR.
 Status write_sample_scene(const std::string& dir, const SampleSceneOptions& options = {});
-
-// Writes a scene whose images are files as glTF 2.0 text (.gltf) with one .bin beside it;
-// image uris are written relative to the .gltf's folder.
-Status write_gltf(const scene::Scene& scene, const std::string& path);
 
 // Procedural meshes (normals and TEXCOORD_0, glTF orientation: v down), material index 0.
 scene::Primitive make_grid(float size, uint32_t cells, float uv_repeat);  // y = 0, facing +y

@@ -1,4 +1,7 @@
-// glTF 2.0 binary export: one BIN chunk holding every attribute, index list and embedded image.
+// glTF 2.0 export: DocumentBuilder makes the one document; save_glb and save_gltf only choose
+// its container (see gltf_export.h).
+#include "scene/gltf_export.h"
+
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -6,6 +9,8 @@
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <utility>
+#include <vector>
 
 #include "scene/scene_io_util.h"
 
@@ -14,27 +19,66 @@ namespace {
 
 using json = nlohmann::json;
 
-struct Writer {
-  json doc;
-  std::vector<uint8_t> bin;
+constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;  // bufferView targets
+constexpr int kFloat = 5126, kUnsignedInt = 5125;                 // accessor component types
+constexpr int kLinear = 9729, kLinearMipmapLinear = 9987;         // sampler filters
 
-  size_t add_view(const void* data, size_t size, int target) {
-    while (bin.size() % 4) bin.push_back(0);
-    size_t offset = bin.size();
-    const auto* p = static_cast<const uint8_t*>(data);
-    bin.insert(bin.end(), p, p + size);
-    json view = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", size}};
-    if (target) view["target"] = target;
-    doc["bufferViews"].push_back(view);
-    return doc["bufferViews"].size() - 1;
+int wrap_code(WrapMode m) {
+  return m == WrapMode::kClampToEdge ? 33071 : m == WrapMode::kMirroredRepeat ? 33648 : 10497;
+}
+
+// The document and the one buffer its views point into: embedded images first, then every
+// primitive's attributes and indices, each view 4-byte aligned.
+class DocumentBuilder {
+ public:
+  DocumentBuilder(const GltfWriteOptions& options, std::string out_folder)
+      : options_(options), out_folder_(std::move(out_folder)) {
+    doc_["asset"] = {{"version", "2.0"}, {"generator", options.generator}};
+    doc_["bufferViews"] = json::array();
+    doc_["accessors"] = json::array();
   }
 
+  // `path` names the output in errors.
+  Status add(const Scene& scene, const std::string& path) {
+    add_images(scene);
+    add_materials(scene);
+    VT_RETURN_IF_ERROR(add_meshes(scene, path));
+    add_nodes(scene);
+    doc_["scenes"] = json::array({json{{"nodes", scene.roots}}});
+    doc_["scene"] = 0;
+    return Status::Ok();
+  }
+
+  // Pads the buffer and records its length; `bin_uri` is empty for a .glb's BIN chunk.
+  std::pair<json, std::vector<uint8_t>> finish(const std::string& bin_uri) && {
+    while (bin_.size() % 4) bin_.push_back(0);
+    json buffer = {{"byteLength", bin_.size()}};
+    if (!bin_uri.empty()) buffer["uri"] = bin_uri;
+    doc_["buffers"] = json::array({buffer});
+    if (doc_["bufferViews"].empty()) doc_.erase("bufferViews");
+    if (doc_["accessors"].empty()) doc_.erase("accessors");
+    return {std::move(doc_), std::move(bin_)};
+  }
+
+ private:
+  size_t add_view(const void* data, size_t size, int target) {
+    while (bin_.size() % 4) bin_.push_back(0);
+    size_t offset = bin_.size();
+    const auto* p = static_cast<const uint8_t*>(data);
+    bin_.insert(bin_.end(), p, p + size);
+    json view = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", size}};
+    if (target) view["target"] = target;
+    doc_["bufferViews"].push_back(view);
+    return doc_["bufferViews"].size() - 1;
+  }
+
+  // min/max (POSITION) skip non-finite values, which glTF bounds cannot hold.
   template <int N>
   size_t add_floats(const std::vector<std::array<float, N>>& values, bool min_max) {
     static const char* kTypes[] = {"", "SCALAR", "VEC2", "VEC3", "VEC4"};
-    size_t view = add_view(values.data(), values.size() * sizeof(values[0]), 34962);
+    size_t view = add_view(values.data(), values.size() * sizeof(values[0]), kArrayBuffer);
     json acc = {{"bufferView", view},
-                {"componentType", 5126},
+                {"componentType", kFloat},
                 {"count", values.size()},
                 {"type", kTypes[N]}};
     if (min_max && !values.empty()) {
@@ -50,140 +94,152 @@ struct Writer {
       acc["min"] = lo;
       acc["max"] = hi;
     }
-    doc["accessors"].push_back(acc);
-    return doc["accessors"].size() - 1;
+    doc_["accessors"].push_back(acc);
+    return doc_["accessors"].size() - 1;
   }
-};
 
-int wrap_code(WrapMode m) {
-  return m == WrapMode::kClampToEdge ? 33071 : m == WrapMode::kMirroredRepeat ? 33648 : 10497;
-}
+  size_t add_indices(const std::vector<uint32_t>& indices) {
+    size_t view = add_view(indices.data(), indices.size() * 4, kElementArrayBuffer);
+    doc_["accessors"].push_back({{"bufferView", view},
+                                 {"componentType", kUnsignedInt},
+                                 {"count", indices.size()},
+                                 {"type", "SCALAR"}});
+    return doc_["accessors"].size() - 1;
+  }
 
-}  // namespace
-
-Status save_glb(const Scene& scene, const std::string& path) {
-  Writer w;
-  w.doc["asset"] = {{"version", "2.0"}, {"generator", "vtbake"}};
-  w.doc["bufferViews"] = json::array();
-  w.doc["accessors"] = json::array();
-  std::string out_folder = detail::parent_folder(path);
-
-  for (const Image& im : scene.images) {
-    json j;
-    if (!im.name.empty()) j["name"] = im.name;
-    if (im.embedded()) {
-      j["bufferView"] = w.add_view(im.bytes.data(), im.bytes.size(), 0);
-      j["mimeType"] = im.mime_type.empty() ? "image/png" : im.mime_type;
-    } else {
-      std::error_code ec;
-      auto base = std::filesystem::absolute(out_folder.empty() ? "." : out_folder, ec);
-      auto rel = std::filesystem::relative(std::filesystem::absolute(im.path, ec), base, ec);
-      j["uri"] = ec || rel.empty() ? im.path : rel.generic_string();
-      if (!im.mime_type.empty()) j["mimeType"] = im.mime_type;
+  void add_images(const Scene& scene) {
+    for (const Image& im : scene.images) {
+      json j;
+      if (!im.name.empty()) j["name"] = im.name;
+      if (im.embedded()) {
+        j["bufferView"] = add_view(im.bytes.data(), im.bytes.size(), 0);
+        j["mimeType"] = im.mime_type.empty() ? "image/png" : im.mime_type;
+      } else {
+        std::error_code ec;
+        auto base = std::filesystem::absolute(out_folder_.empty() ? "." : out_folder_, ec);
+        auto rel = std::filesystem::relative(std::filesystem::absolute(im.path, ec), base, ec);
+        j["uri"] = ec || rel.empty() ? im.path : rel.generic_string();
+        if (!im.mime_type.empty()) j["mimeType"] = im.mime_type;
+      }
+      doc_["images"].push_back(j);
     }
-    w.doc["images"].push_back(j);
   }
-  // One texture (and sampler) per distinct slot use.
-  auto texture = [&](const TextureRef& ref) -> json {
+
+  // One texture per slot use; samplers shared by equal wrap modes.
+  json texture(const TextureRef& ref) {
     json sampler = {{"wrapS", wrap_code(ref.wrap_s)}, {"wrapT", wrap_code(ref.wrap_t)}};
+    if (options_.sampler_filters) {
+      sampler["magFilter"] = kLinear;
+      sampler["minFilter"] = kLinearMipmapLinear;
+    }
     size_t s = 0;
-    auto& samplers = w.doc["samplers"];
+    auto& samplers = doc_["samplers"];
     for (; s < samplers.size(); ++s)
       if (samplers[s] == sampler) break;
     if (s == samplers.size()) samplers.push_back(sampler);
-    w.doc["textures"].push_back({{"source", ref.image}, {"sampler", s}});
-    json info = {{"index", w.doc["textures"].size() - 1}};
-    if (ref.texcoord) info["texCoord"] = ref.texcoord;
+    doc_["textures"].push_back({{"source", ref.image}, {"sampler", s}});
+    json info = {{"index", doc_["textures"].size() - 1}};
+    if (ref.texcoord || options_.write_texcoord_0) info["texCoord"] = ref.texcoord;
     return info;
-  };
-  for (const Material& m : scene.materials) {
-    json j;
-    if (!m.name.empty()) j["name"] = m.name;
-    json pbr = {{"baseColorFactor", m.base_color_factor},
-                {"metallicFactor", m.metallic_factor},
-                {"roughnessFactor", m.roughness_factor}};
-    if (m.base_color_texture.valid()) pbr["baseColorTexture"] = texture(m.base_color_texture);
-    if (m.metallic_roughness_texture.valid())
-      pbr["metallicRoughnessTexture"] = texture(m.metallic_roughness_texture);
-    j["pbrMetallicRoughness"] = pbr;
-    if (m.normal_texture.valid()) {
-      j["normalTexture"] = texture(m.normal_texture);
-      j["normalTexture"]["scale"] = m.normal_scale;
-    }
-    if (m.occlusion_texture.valid()) {
-      j["occlusionTexture"] = texture(m.occlusion_texture);
-      j["occlusionTexture"]["strength"] = m.occlusion_strength;
-    }
-    j["emissiveFactor"] = m.emissive_factor;
-    if (m.emissive_texture.valid()) j["emissiveTexture"] = texture(m.emissive_texture);
-    j["alphaMode"] = m.alpha_mode == AlphaMode::kMask    ? "MASK"
-                     : m.alpha_mode == AlphaMode::kBlend ? "BLEND"
-                                                         : "OPAQUE";
-    if (m.alpha_mode == AlphaMode::kMask) j["alphaCutoff"] = m.alpha_cutoff;
-    if (m.double_sided) j["doubleSided"] = true;
-    w.doc["materials"].push_back(j);
   }
-  for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
-    const Mesh& mesh = scene.meshes[mi];
-    json jm;
-    if (!mesh.name.empty()) jm["name"] = mesh.name;
-    jm["primitives"] = json::array();
-    for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
-      const Primitive& p = mesh.primitives[pi];
-      for (uint32_t i : p.indices)
-        if (i >= p.positions.size())
-          return Error(ErrorCode::kInvalidArgument,
-                       path + ": mesh " + std::to_string(mi) + " primitive " + std::to_string(pi) +
-                           ": index " + std::to_string(i) + " out of range");
-      json attrs;
-      attrs["POSITION"] = w.add_floats<3>(p.positions, true);
-      if (p.normals.size() == p.positions.size() && !p.normals.empty())
-        attrs["NORMAL"] = w.add_floats<3>(p.normals, false);
-      if (p.tangents.size() == p.positions.size() && !p.tangents.empty())
-        attrs["TANGENT"] = w.add_floats<4>(p.tangents, false);
-      for (size_t n = 0; n < p.uvs.size(); ++n)
-        attrs["TEXCOORD_" + std::to_string(n)] = w.add_floats<2>(p.uvs[n], false);
-      if (p.colors.size() == p.positions.size() && !p.colors.empty())
-        attrs["COLOR_0"] = w.add_floats<4>(p.colors, false);
-      json jp = {{"attributes", attrs}, {"mode", 4}};
-      size_t view = w.add_view(p.indices.data(), p.indices.size() * 4, 34963);
-      w.doc["accessors"].push_back({{"bufferView", view},
-                                    {"componentType", 5125},
-                                    {"count", p.indices.size()},
-                                    {"type", "SCALAR"}});
-      jp["indices"] = w.doc["accessors"].size() - 1;
-      if (p.material >= 0) jp["material"] = p.material;
-      jm["primitives"].push_back(jp);
-    }
-    w.doc["meshes"].push_back(jm);
-  }
-  for (const Node& n : scene.nodes) {
-    json j;
-    if (!n.name.empty()) j["name"] = n.name;
-    if (n.local != kIdentity) j["matrix"] = n.local;
-    if (n.mesh >= 0) j["mesh"] = n.mesh;
-    if (!n.children.empty()) j["children"] = n.children;
-    w.doc["nodes"].push_back(j);
-  }
-  w.doc["scenes"] = json::array({json{{"nodes", scene.roots}}});
-  w.doc["scene"] = 0;
-  while (w.bin.size() % 4) w.bin.push_back(0);
-  w.doc["buffers"] = json::array({json{{"byteLength", w.bin.size()}}});
-  if (w.doc["bufferViews"].empty()) w.doc.erase("bufferViews");
-  if (w.doc["accessors"].empty()) w.doc.erase("accessors");
 
-  std::string text = w.doc.dump();
-  while (text.size() % 4) text.push_back(' ');
-  uint32_t total = static_cast<uint32_t>(12 + 8 + text.size() + 8 + w.bin.size());
+  void add_materials(const Scene& scene) {
+    for (const Material& m : scene.materials) {
+      json j;
+      if (!m.name.empty()) j["name"] = m.name;
+      json pbr = {{"baseColorFactor", m.base_color_factor},
+                  {"metallicFactor", m.metallic_factor},
+                  {"roughnessFactor", m.roughness_factor}};
+      if (m.base_color_texture.valid()) pbr["baseColorTexture"] = texture(m.base_color_texture);
+      if (m.metallic_roughness_texture.valid())
+        pbr["metallicRoughnessTexture"] = texture(m.metallic_roughness_texture);
+      j["pbrMetallicRoughness"] = pbr;
+      if (m.normal_texture.valid()) {
+        j["normalTexture"] = texture(m.normal_texture);
+        j["normalTexture"]["scale"] = m.normal_scale;
+      }
+      if (m.occlusion_texture.valid()) {
+        j["occlusionTexture"] = texture(m.occlusion_texture);
+        j["occlusionTexture"]["strength"] = m.occlusion_strength;
+      }
+      j["emissiveFactor"] = m.emissive_factor;
+      if (m.emissive_texture.valid()) j["emissiveTexture"] = texture(m.emissive_texture);
+      if (m.alpha_mode != AlphaMode::kOpaque || options_.write_opaque)
+        j["alphaMode"] = m.alpha_mode == AlphaMode::kMask    ? "MASK"
+                         : m.alpha_mode == AlphaMode::kBlend ? "BLEND"
+                                                             : "OPAQUE";
+      if (m.alpha_mode == AlphaMode::kMask) j["alphaCutoff"] = m.alpha_cutoff;
+      if (m.double_sided || options_.write_single_sided) j["doubleSided"] = m.double_sided;
+      doc_["materials"].push_back(j);
+    }
+  }
+
+  Status add_meshes(const Scene& scene, const std::string& path) {
+    for (size_t mi = 0; mi < scene.meshes.size(); ++mi) {
+      const Mesh& mesh = scene.meshes[mi];
+      json jm;
+      if (!mesh.name.empty()) jm["name"] = mesh.name;
+      jm["primitives"] = json::array();
+      for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
+        const Primitive& p = mesh.primitives[pi];
+        for (uint32_t i : p.indices)
+          if (i >= p.positions.size())
+            return Error(ErrorCode::kInvalidArgument,
+                         path + ": mesh " + std::to_string(mi) + " primitive " +
+                             std::to_string(pi) + ": index " + std::to_string(i) + " out of range");
+        jm["primitives"].push_back(primitive(p));
+      }
+      doc_["meshes"].push_back(jm);
+    }
+    return Status::Ok();
+  }
+
+  // Attributes whose count differs from the positions' are left out, as glTF requires.
+  json primitive(const Primitive& p) {
+    const size_t n = p.positions.size();
+    json attrs;
+    attrs["POSITION"] = add_floats<3>(p.positions, true);
+    if (p.normals.size() == n && n) attrs["NORMAL"] = add_floats<3>(p.normals, false);
+    if (p.tangents.size() == n && n) attrs["TANGENT"] = add_floats<4>(p.tangents, false);
+    for (size_t k = 0; k < p.uvs.size(); ++k)
+      attrs["TEXCOORD_" + std::to_string(k)] = add_floats<2>(p.uvs[k], false);
+    if (p.colors.size() == n && n) attrs["COLOR_0"] = add_floats<4>(p.colors, false);
+    json jp = {{"attributes", attrs}, {"mode", 4}};
+    jp["indices"] = add_indices(p.indices);
+    if (p.material >= 0) jp["material"] = p.material;
+    return jp;
+  }
+
+  void add_nodes(const Scene& scene) {
+    for (const Node& n : scene.nodes) {
+      json j;
+      if (!n.name.empty()) j["name"] = n.name;
+      if (n.local != kIdentity) j["matrix"] = n.local;
+      if (n.mesh >= 0) j["mesh"] = n.mesh;
+      if (!n.children.empty()) j["children"] = n.children;
+      doc_["nodes"].push_back(j);
+    }
+  }
+
+  const GltfWriteOptions& options_;
+  std::string out_folder_;  // image uris are written relative to it
+  json doc_;
+  std::vector<uint8_t> bin_;
+};
+
+struct Bytes {
+  const void* data;
+  size_t size;
+};
+
+// Writes `parts` to PATH.tmp and renames it into place: PATH is never half-written.
+Status write_file(const std::string& path, std::initializer_list<Bytes> parts) {
   std::string tmp = path + ".tmp";
   std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(tmp.c_str(), "wb"), &std::fclose);
   if (!f) return Error(ErrorCode::kIo, path + ": cannot create file");
-  auto put32 = [&](uint32_t v) { return std::fwrite(&v, 4, 1, f.get()) == 1; };
-  bool ok = std::fwrite("glTF", 4, 1, f.get()) == 1 && put32(2) && put32(total) &&
-            put32(static_cast<uint32_t>(text.size())) && put32(0x4E4F534A) &&
-            std::fwrite(text.data(), 1, text.size(), f.get()) == text.size() &&
-            put32(static_cast<uint32_t>(w.bin.size())) && put32(0x004E4942) &&
-            (w.bin.empty() || std::fwrite(w.bin.data(), 1, w.bin.size(), f.get()) == w.bin.size());
+  bool ok = true;
+  for (const Bytes& part : parts)
+    ok = ok && (part.size == 0 || std::fwrite(part.data, 1, part.size, f.get()) == part.size);
   ok = std::fclose(f.release()) == 0 && ok;
   if (!ok) {
     std::remove(tmp.c_str());
@@ -194,6 +250,37 @@ Status save_glb(const Scene& scene, const std::string& path) {
     return Error(ErrorCode::kIo, path + ": cannot rename into place");
   }
   return Status::Ok();
+}
+
+}  // namespace
+
+Status save_glb(const Scene& scene, const std::string& path) {
+  const GltfWriteOptions options;
+  DocumentBuilder builder(options, detail::parent_folder(path));
+  VT_RETURN_IF_ERROR(builder.add(scene, path));
+  auto [doc, bin] = std::move(builder).finish("");
+  std::string text = doc.dump();
+  while (text.size() % 4) text.push_back(' ');
+  // Header (magic, version, total length), then the JSON and BIN chunks (length, type, data).
+  const uint32_t header[5] = {0x46546C67, 2,
+                              static_cast<uint32_t>(12 + 8 + text.size() + 8 + bin.size()),
+                              static_cast<uint32_t>(text.size()), 0x4E4F534A};
+  const uint32_t bin_header[2] = {static_cast<uint32_t>(bin.size()), 0x004E4942};
+  return write_file(path, {{header, sizeof(header)},
+                           {text.data(), text.size()},
+                           {bin_header, sizeof(bin_header)},
+                           {bin.data(), bin.size()}});
+}
+
+Status save_gltf(const Scene& scene, const std::string& path, const GltfWriteOptions& options) {
+  const std::string folder = detail::parent_folder(path);
+  const std::string bin_name = std::filesystem::path(path).stem().string() + ".bin";
+  DocumentBuilder builder(options, folder);
+  VT_RETURN_IF_ERROR(builder.add(scene, path));
+  auto [doc, bin] = std::move(builder).finish(bin_name);
+  VT_RETURN_IF_ERROR(write_file(folder + bin_name, {{bin.data(), bin.size()}}));
+  std::string text = doc.dump(1) + "\n";
+  return write_file(path, {{text.data(), text.size()}});
 }
 
 }  // namespace vt::scene

@@ -2,7 +2,8 @@
 // triangle primitives, glTF metallic-roughness materials, images (by file or embedded), and a
 // node hierarchy that flattens into mesh instances with world matrices.
 // Import: glTF 2.0 (.gltf/.glb, KHR_draco_mesh_compression), Wavefront OBJ (+MTL), PLY, Draco
-// (.drc). Export: glTF 2.0 binary (.glb). Errors name the file and the problem.
+// (.drc). Export: glTF 2.0 binary (.glb), and text (.gltf + .bin) in scene/gltf_export.h.
+// Errors name the file and the problem.
 #pragma once
 
 #include <array>

@@ -4,7 +4,7 @@
 //   bc_bench [google benchmark flags]
 //
 // Counters: texels/s (Mtexel/s = items_per_second / 1e6). The Kodak figures with PSNR come
-// from `vtbake bench codec` (docs/BENCHMARKS.md).
+// from `vtbake-bench codec` (docs/BENCHMARKS.md).
 #include <benchmark/benchmark.h>
 
 #include <cmath>

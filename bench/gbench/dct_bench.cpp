@@ -10,12 +10,10 @@
 // of 5 passes over all pages), bytes ratio against JPEG at equal PSNR (log-rate interpolated),
 // and the runtime path DCT decode + BC1 (real-time level, bc_encode_image) in pages/s.
 #include <benchmark/benchmark.h>
-#include <jpeglib.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <csetjmp>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -23,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/jpeg_anchor.h"
 #include "codec/bc.h"
 #include "codec/dct.h"
 
@@ -33,6 +32,8 @@
 namespace {
 
 using namespace vt;
+using bench::JpegPageDecoder;
+using bench::JpegPageEncoder;
 using Page = std::vector<uint8_t>;
 constexpr int kPage = 128;
 
@@ -105,97 +106,37 @@ double median_seconds(int runs, F&& f) {
   return t[t.size() / 2];
 }
 
-// ---- libjpeg-turbo abbreviated streams ----
-
-struct JpegError {
-  jpeg_error_mgr mgr;
-  jmp_buf jump;
-};
-void jpeg_fail(j_common_ptr cinfo) {
-  longjmp(reinterpret_cast<JpegError*>(cinfo->err)->jump, 1);
-}
+// ---- libjpeg-turbo abbreviated streams (bench/jpeg_anchor.h) ----
 
 struct JpegCoded {
   std::vector<uint8_t> tables;  // tables-only stream, shared by every page
   std::vector<std::vector<uint8_t>> pages;
 };
 
+[[noreturn]] void die(const Status& status) {
+  std::fprintf(stderr, "%s\n", status.message().c_str());
+  std::exit(1);
+}
+
 JpegCoded jpeg_encode(const std::vector<Page>& pages, int quality, bool subsample) {
+  auto encoder =
+      JpegPageEncoder::create({.page_size = kPage, .quality = quality, .subsample = subsample});
+  if (!encoder.ok()) die(encoder.status());
   JpegCoded out;
-  jpeg_compress_struct c;
-  JpegError err;
-  c.err = jpeg_std_error(&err.mgr);
-  err.mgr.error_exit = jpeg_fail;
-  if (setjmp(err.jump)) {
-    jpeg_destroy_compress(&c);
-    return {};
+  out.tables = encoder->tables();
+  out.pages.resize(pages.size());
+  for (size_t i = 0; i < pages.size(); i++) {
+    Status st = encoder->encode(pages[i].data(), out.pages[i]);
+    if (!st.ok()) die(st);
   }
-  jpeg_create_compress(&c);
-  c.image_width = kPage;
-  c.image_height = kPage;
-  c.input_components = 3;
-  c.in_color_space = JCS_RGB;
-  jpeg_set_defaults(&c);
-  jpeg_set_quality(&c, quality, TRUE);
-  const int h = subsample ? 2 : 1;
-  c.comp_info[0].h_samp_factor = h;
-  c.comp_info[0].v_samp_factor = h;
-  unsigned char* buf = nullptr;
-  unsigned long size = 0;
-  jpeg_mem_dest(&c, &buf, &size);
-  jpeg_write_tables(&c);
-  out.tables.assign(buf, buf + size);
-  free(buf);
-  for (const Page& p : pages) {
-    buf = nullptr;
-    size = 0;
-    jpeg_mem_dest(&c, &buf, &size);
-    jpeg_suppress_tables(&c, TRUE);
-    jpeg_start_compress(&c, FALSE);  // abbreviated: no tables in the page
-    for (int y = 0; y < kPage; y++) {
-      JSAMPROW row = const_cast<JSAMPROW>(p.data() + size_t(y) * kPage * 3);
-      jpeg_write_scanlines(&c, &row, 1);
-    }
-    jpeg_finish_compress(&c);
-    out.pages.emplace_back(buf, buf + size);
-    free(buf);
-  }
-  jpeg_destroy_compress(&c);
   return out;
 }
 
-class JpegDecoder {
- public:
-  explicit JpegDecoder(const std::vector<uint8_t>& tables) {
-    d_.err = jpeg_std_error(&err_.mgr);
-    err_.mgr.error_exit = jpeg_fail;
-    jpeg_create_decompress(&d_);
-    if (setjmp(err_.jump)) return;
-    jpeg_mem_src(&d_, tables.data(), tables.size());
-    jpeg_read_header(&d_, FALSE);  // tables only: kept for the pages
-  }
-  ~JpegDecoder() { jpeg_destroy_decompress(&d_); }
-  bool decode(const std::vector<uint8_t>& data, uint8_t* rgb) {
-    if (setjmp(err_.jump)) {
-      jpeg_abort_decompress(&d_);
-      return false;
-    }
-    jpeg_mem_src(&d_, data.data(), data.size());
-    jpeg_read_header(&d_, TRUE);
-    d_.out_color_space = JCS_RGB;
-    jpeg_start_decompress(&d_);
-    while (d_.output_scanline < d_.output_height) {
-      JSAMPROW row = rgb + size_t(d_.output_scanline) * kPage * 3;
-      jpeg_read_scanlines(&d_, &row, 1);
-    }
-    jpeg_finish_decompress(&d_);
-    return true;
-  }
-
- private:
-  jpeg_decompress_struct d_;
-  JpegError err_;
-};
+JpegPageDecoder jpeg_decoder(const std::vector<uint8_t>& tables) {
+  auto decoder = JpegPageDecoder::create(kPage, tables);
+  if (!decoder.ok()) die(decoder.status());
+  return std::move(decoder).value();
+}
 
 // ---- measurements ----
 
@@ -216,16 +157,16 @@ Point measure_jpeg(const std::vector<Page>& pages, int quality, bool subsample) 
   JpegCoded coded;
   const double enc = median_seconds(3, [&] { coded = jpeg_encode(pages, quality, subsample); });
   pt.table_bytes = coded.tables.size();
-  JpegDecoder dec(coded.tables);
+  JpegPageDecoder dec = jpeg_decoder(coded.tables);
   Page out(size_t(kPage) * kPage * 3);
   double se = 0, bytes = 0;
   for (size_t i = 0; i < pages.size(); i++) {
-    dec.decode(coded.pages[i], out.data());
+    (void)dec.decode(coded.pages[i], out.data());
     se += squared_error(pages[i], out);
     bytes += double(coded.pages[i].size());
   }
   const double d = median_seconds(5, [&] {
-    for (const auto& c : coded.pages) dec.decode(c, out.data());
+    for (const auto& c : coded.pages) (void)dec.decode(c, out.data());
   });
   const double texels = double(pages.size()) * kPage * kPage;
   pt.bpt = bytes * 8 / texels;
@@ -257,10 +198,7 @@ Point measure_dct(const Folds& folds, const DctSettings& s, bool trained, int ch
       for (const Page& p : folds.pages[1 - f]) training.push_back(p);
     }
     auto tables = dct_make_tables(s, kPage, kPage, training);
-    if (!tables.ok()) {
-      std::fprintf(stderr, "%s\n", tables.status().message().c_str());
-      std::exit(1);
-    }
+    if (!tables.ok()) die(tables.status());
     pt.table_bytes = dct_serialize_tables(**tables).size();
     std::vector<std::vector<uint8_t>> coded(pages.size());
     enc_s += median_seconds(3, [&] {
@@ -495,10 +433,10 @@ int speed(int rounds) {
       dse += squared_error(pages[i], out);
     }
     const JpegCoded jc = jpeg_encode(pages, pr[1], true);
-    JpegDecoder jd(jc.tables);
+    JpegPageDecoder jd = jpeg_decoder(jc.tables);
     double jbytes = 0, jse = 0;
     for (size_t i = 0; i < pages.size(); i++) {
-      jd.decode(jc.pages[i], out.data());
+      (void)jd.decode(jc.pages[i], out.data());
       jbytes += double(jc.pages[i].size());
       jse += squared_error(pages[i], out);
     }
@@ -507,7 +445,7 @@ int speed(int rounds) {
       double t0 = now_s();
       for (const auto& c : coded) (void)dct_decode_page(**tables, c, kPage, kPage, out.data());
       double t1 = now_s();
-      for (const auto& c : jc.pages) jd.decode(c, out.data());
+      for (const auto& c : jc.pages) (void)jd.decode(c, out.data());
       double t2 = now_s();
       td.push_back(t1 - t0);
       tj.push_back(t2 - t1);
@@ -586,11 +524,11 @@ void BM_JpegDecode(benchmark::State& state) {
   const auto& pages = fixture().pages;
   if (pages.empty()) return state.SkipWithError("no Kodak images");
   const JpegCoded coded = jpeg_encode(pages, int(state.range(0)), true);
-  JpegDecoder dec(coded.tables);
+  JpegPageDecoder dec = jpeg_decoder(coded.tables);
   Page out(pages[0].size());
   size_t i = 0;
   for (auto _ : state) {
-    dec.decode(coded.pages[i], out.data());
+    (void)dec.decode(coded.pages[i], out.data());
     benchmark::DoNotOptimize(out.data());
     i = (i + 1) % coded.pages.size();
   }

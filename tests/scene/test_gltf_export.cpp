@@ -1,0 +1,170 @@
+// The glTF exporter's one document in its two containers: a .glb and a .gltf + .bin of the same
+// scene carry the same JSON and the same buffer, both load back as the scene, and the write
+// options change only the values glTF would default.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <tuple>
+
+#include "scene/gltf_export.h"
+#include "tests/unwrap/mesh_gen.h"
+
+namespace vt::test {
+namespace {
+
+using nlohmann::json;
+
+std::string temp(const std::string& name) {
+  return ::testing::TempDir() + "vt_gltf_export_" + name;
+}
+
+std::string read_all(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+uint32_t u32_at(const std::string& bytes, size_t offset) {
+  uint32_t v = 0;
+  for (int k = 3; k >= 0; --k) v = v << 8 | uint8_t(bytes[offset + k]);
+  return v;
+}
+
+// A ball with every attribute, a file image, an embedded image and two materials.
+Scene textured_ball() {
+  Scene s = scene_of(sphere(8, 4), "ball");
+  auto& p = s.meshes[0].primitives[0];
+  p.normals = p.positions;
+  p.uvs.assign(2, {});
+  for (const auto& v : p.positions) p.uvs[0].push_back({v[0], v[1]});
+  for (const auto& v : p.positions) p.uvs[1].push_back({v[1], v[2]});
+  p.tangents.assign(p.positions.size(), {1, 0, 0, -1});
+  p.colors.assign(p.positions.size(), {0.25f, 0.5f, 0.75f, 1});
+  p.material = 1;
+  scene::Image file;
+  file.name = "albedo";
+  file.path = ::testing::TempDir() + "textures/albedo.png";
+  file.mime_type = "image/png";
+  scene::Image embedded;
+  embedded.mime_type = "image/jpeg";
+  embedded.bytes = {0xFF, 0xD8, 0xFF, 1, 2};  // not a multiple of 4: the buffer pads after it
+  s.images = {file, embedded};
+  scene::Material plain;
+  plain.name = "plain";
+  scene::Material textured;
+  textured.name = "textured";
+  textured.base_color_texture.image = 0;
+  textured.normal_texture.image = 1;
+  textured.normal_texture.texcoord = 1;
+  textured.normal_texture.wrap_t = scene::WrapMode::kMirroredRepeat;
+  textured.alpha_mode = scene::AlphaMode::kMask;
+  textured.alpha_cutoff = 0.25f;
+  textured.double_sided = true;
+  s.materials = {plain, textured};
+  s.nodes[0].local[12] = -2.5;
+  return s;
+}
+
+json glb_json(const std::string& bytes) {
+  EXPECT_EQ(bytes.substr(0, 4), "glTF");
+  EXPECT_EQ(u32_at(bytes, 8), bytes.size());
+  return json::parse(bytes.substr(20, u32_at(bytes, 12)));
+}
+
+TEST(GltfExport, GlbAndGltfHoldTheSameDocumentAndBuffer) {
+  const Scene s = textured_ball();
+  ASSERT_TRUE(scene::save_glb(s, temp("same.glb")).ok());
+  ASSERT_TRUE(scene::save_gltf(s, temp("same.gltf")).ok());
+  const std::string glb = read_all(temp("same.glb"));
+  json from_glb = glb_json(glb);
+  json from_gltf = json::parse(read_all(temp("same.gltf")));
+  EXPECT_EQ(from_gltf["buffers"][0]["uri"], "vt_gltf_export_same.bin");
+  from_gltf["buffers"][0].erase("uri");
+  EXPECT_EQ(from_glb, from_gltf);
+
+  const size_t json_size = u32_at(glb, 12);
+  const size_t bin_size = u32_at(glb, 20 + json_size);
+  EXPECT_EQ(u32_at(glb, 24 + json_size), 0x004E4942u);  // "BIN\0"
+  EXPECT_EQ(glb.substr(28 + json_size, bin_size), read_all(temp("same.bin")));
+  EXPECT_EQ(bin_size % 4, 0u);
+  EXPECT_EQ(from_glb["images"][0]["uri"], "textures/albedo.png");
+  EXPECT_FALSE(std::filesystem::exists(temp("same.gltf.tmp")));
+}
+
+TEST(GltfExport, GltfLoadsBackAsTheScene) {
+  const Scene s = textured_ball();
+  ASSERT_TRUE(scene::save_gltf(s, temp("back.gltf")).ok());
+  auto back = scene::load_scene(temp("back.gltf"));
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  // Every attribute, the indices and the material, bit for bit.
+  auto contents = [](const scene::Primitive& p) {
+    return std::tie(p.positions, p.normals, p.tangents, p.uvs, p.colors, p.indices, p.material);
+  };
+  EXPECT_TRUE(contents(back->meshes[0].primitives[0]) == contents(s.meshes[0].primitives[0]));
+  ASSERT_EQ(back->images.size(), 2u);
+  EXPECT_EQ(back->images[0].path, s.images[0].path);
+  EXPECT_EQ(back->images[1].bytes, s.images[1].bytes);
+  EXPECT_EQ(back->images[1].mime_type, "image/jpeg");
+  const scene::Material& m = back->materials[1];
+  EXPECT_EQ(m.normal_texture.texcoord, 1);
+  EXPECT_EQ(m.normal_texture.wrap_t, scene::WrapMode::kMirroredRepeat);
+  EXPECT_EQ(m.alpha_mode, scene::AlphaMode::kMask);
+  EXPECT_FLOAT_EQ(m.alpha_cutoff, 0.25f);
+  EXPECT_TRUE(m.double_sided);
+  EXPECT_FALSE(back->materials[0].double_sided);
+  EXPECT_DOUBLE_EQ(back->nodes[0].local[12], -2.5);
+}
+
+TEST(GltfExport, OptionsSpellOutOnlyWhatGltfDefaults) {
+  const Scene s = textured_ball();
+  ASSERT_TRUE(scene::save_gltf(s, temp("compact.gltf")).ok());
+  scene::GltfWriteOptions o;
+  o.generator = "test";
+  o.write_texcoord_0 = true;
+  o.write_single_sided = true;
+  o.write_opaque = false;
+  o.sampler_filters = true;
+  ASSERT_TRUE(scene::save_gltf(s, temp("spelled.gltf"), o).ok());
+  const json compact = json::parse(read_all(temp("compact.gltf")));
+  const json spelled = json::parse(read_all(temp("spelled.gltf")));
+
+  EXPECT_EQ(compact["asset"]["generator"], "vtbake");
+  EXPECT_EQ(spelled["asset"]["generator"], "test");
+  const json& base_compact = compact["materials"][1]["pbrMetallicRoughness"]["baseColorTexture"];
+  const json& base_spelled = spelled["materials"][1]["pbrMetallicRoughness"]["baseColorTexture"];
+  EXPECT_FALSE(base_compact.contains("texCoord"));
+  EXPECT_EQ(base_spelled["texCoord"], 0);
+  EXPECT_EQ(compact["materials"][1]["normalTexture"]["texCoord"], 1);  // never a default
+  EXPECT_FALSE(compact["materials"][0].contains("doubleSided"));
+  EXPECT_EQ(spelled["materials"][0]["doubleSided"], false);
+  EXPECT_EQ(compact["materials"][0]["alphaMode"], "OPAQUE");
+  EXPECT_FALSE(spelled["materials"][0].contains("alphaMode"));
+  EXPECT_EQ(spelled["materials"][1]["alphaMode"], "MASK");  // only the default is dropped
+  EXPECT_FALSE(compact["samplers"][0].contains("minFilter"));
+  EXPECT_EQ(spelled["samplers"][0]["minFilter"], 9987);
+  EXPECT_EQ(spelled["samplers"][0]["magFilter"], 9729);
+  // Same geometry either way: the options touch no accessor.
+  EXPECT_EQ(compact["accessors"], spelled["accessors"]);
+  EXPECT_EQ(compact["samplers"].size(), 2u);  // repeat/repeat and repeat/mirrored
+}
+
+TEST(GltfExport, BadIndexIsAnErrorAndLeavesNoFile) {
+  Scene s = textured_ball();
+  s.meshes[0].primitives[0].indices[4] = 100000;
+  for (const std::string name : {"bad.glb", "bad.gltf"}) {
+    std::filesystem::remove(temp(name));
+    const Status st =
+        name.ends_with(".glb") ? scene::save_glb(s, temp(name)) : scene::save_gltf(s, temp(name));
+    ASSERT_FALSE(st.ok());
+    EXPECT_NE(st.message().find("mesh 0 primitive 0: index 100000 out of range"), std::string::npos)
+        << st.message();
+    EXPECT_FALSE(std::filesystem::exists(temp(name)));
+    EXPECT_FALSE(std::filesystem::exists(temp(name) + ".tmp"));
+  }
+  EXPECT_FALSE(std::filesystem::exists(temp("bad.bin")));
+}
+
+}  // namespace
+}  // namespace vt::test
