@@ -70,8 +70,8 @@ Expected<PageEncoder> PageEncoder::create(LayerSpec& layer, const PageEncoderOpt
         auto made = dct_make_tables(dct, int(page_size), int(page_size));
         if (!made.ok()) return made.status().with_context("layer '" + layer.name + "'");
         layer.codec_tables = dct_serialize_tables(**made);
-        tables = std::shared_ptr<const DctTables>(std::move(made).value().release(),
-                                                  DctTablesDeleter());
+        tables =
+            std::shared_ptr<const DctTables>(std::move(made).value().release(), DctTablesDeleter());
         break;
       }
     }

@@ -41,8 +41,8 @@ Expected<LayerCodec> LayerCodec::create(const LayerSpec& spec, uint32_t page_siz
     if (!dct_tables) {
       auto parsed = dct_parse_tables(spec.codec_tables);
       if (!parsed.ok()) return parsed.status().with_context("dct tables");
-      dct_tables = std::shared_ptr<const DctTables>(std::move(parsed).value().release(),
-                                                    DctTablesDeleter());
+      dct_tables =
+          std::shared_ptr<const DctTables>(std::move(parsed).value().release(), DctTablesDeleter());
     }
     VT_RETURN_IF_ERROR(check_dct_shape(*dct_tables, spec, page_size));
     c.dct_ = std::move(dct_tables);
@@ -112,10 +112,9 @@ Status LayerCodec::bc_blocks(std::span<const uint8_t> data, std::span<uint8_t> b
     return Error(ErrorCode::kInvalidArgument,
                  std::string(to_string(codec_)) + " pages hold no BC blocks");
   if (blocks.size() != bc_page_bytes())
-    return Error(ErrorCode::kInvalidArgument, "BC block buffer of " +
-                                                  std::to_string(blocks.size()) +
-                                                  " bytes, expected " +
-                                                  std::to_string(bc_page_bytes()));
+    return Error(ErrorCode::kInvalidArgument,
+                 "BC block buffer of " + std::to_string(blocks.size()) + " bytes, expected " +
+                     std::to_string(bc_page_bytes()));
   return zstd_decompress_exact(data, blocks);
 }
 

@@ -275,8 +275,7 @@ Status PageFileReaderImpl::parse_layers(uint64_t pos, uint64_t end) {
   if (pos != end) return corrupt("layer table does not end at the header checksum");
   for (size_t i = 0; i < layers_.size(); ++i) {
     auto codec = LayerCodec::create(layers_[i], geometry_.page_size());
-    if (!codec.ok())
-      return corrupt("layer " + std::to_string(i) + ": " + codec.status().message());
+    if (!codec.ok()) return corrupt("layer " + std::to_string(i) + ": " + codec.status().message());
     codecs_.push_back(std::move(codec).value());
   }
   return Status::Ok();

@@ -10,7 +10,7 @@ namespace {
 
 RuntimeFormatInfo bc_row(RuntimeFormat format, const char* name, BcFormat bc) {
   return {format, name, uint32_t(bc_block_bytes(bc) * 8 / 16), uint32_t(bc_format_channels(bc)),
-          false, bc};
+          false,  bc};
 }
 
 // Indexed by RuntimeFormat value.

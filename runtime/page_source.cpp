@@ -67,8 +67,8 @@ class PageFileSource final : public PageSource {
     }
     const RuntimeFormatInfo& upload = *runtime_format_info(plan.upload);
     if (upload.bc) {
-      return bc_encode_image(*upload.bc, options_.bc_quality, texels.data(), ps, ps, int(plan.channels),
-                             out.data())
+      return bc_encode_image(*upload.bc, options_.bc_quality, texels.data(), ps, ps,
+                             int(plan.channels), out.data())
           .with_context(where);
     }
     // Uncompressed 8-bit: channel i of the upload reads stored channel i, 0 when missing

@@ -70,7 +70,18 @@ TEST(PageFileInspect, VerifyFindsEveryBadPage) {
       EXPECT_EQ(report.bad_pages[0].status.code(), ErrorCode::kCorrupt);
       EXPECT_NE(report.bad_pages[0].status.message().find(bad), std::string::npos);
     }
+    // verify() and verify_page check the bytes whatever the reader's options.
+    const VerifyReport report = verify_pages(**r, 1);
+    const BadPage& first = report.bad_pages[0];
+    EXPECT_EQ((*r)->verify().message(), first.status.message());
+    EXPECT_NE(first.status.message().find(page_name(first.id, first.layer) + ": checksum"),
+              std::string::npos)
+        << first.status.message();
+    EXPECT_EQ((*r)->verify_page(first.id, first.layer).code(), ErrorCode::kCorrupt);
   }
+  EXPECT_TRUE((*reader)->verify().ok());
+  for (auto& p : f.pages) EXPECT_TRUE((*reader)->verify_page(p.id, p.layer).ok());
+  EXPECT_EQ((*reader)->verify_page({0, 99, 0}, 0).code(), ErrorCode::kInvalidArgument);
 }
 
 TEST(PageFileInspect, ExtractReassemblesEveryLevelExactly) {
