@@ -1,7 +1,7 @@
-// Encoding one layer's pages for the page file: a page whose texels are all one value becomes a
-// constant; other pages are coded with the layer's codec (DCT with tables built once per layer
-// and best trained on some of its pages, BC blocks + zstd, raw + zstd). Lossy codecs report the
-// error of the stored page against the texels it was made from.
+// Encoding one layer's pages for the page file: the baker's choices for a layer (codec, runtime
+// format, DCT settings and training) over format/layer_codec.h, which codes the pages. A page
+// whose texels are all one value becomes a constant; lossy codecs report the error of the stored
+// page against the texels it was made from.
 #pragma once
 
 #include <cstdint>
@@ -11,6 +11,7 @@
 #include "codec/bc.h"
 #include "codec/dct.h"
 #include "common/status.h"
+#include "format/layer_codec.h"
 #include "format/page_file.h"
 
 namespace vt {
@@ -57,21 +58,19 @@ class PageEncoder {
   // slower decoding than trained ones). train() fits them to some of the layer's own
   // non-constant pages (each page_bytes()) and returns the new tables' bytes, which the file
   // must then hold; pages encoded before it used the old tables. Not thread-safe.
-  bool wants_training() const { return codec_ == PageCodec::kDct && !trained_; }
+  bool wants_training() const { return codec() == PageCodec::kDct && !trained_; }
   Expected<std::vector<uint8_t>> train(std::span<const std::span<const uint8_t>> pages);
 
-  PageCodec codec() const { return codec_; }
-  size_t page_bytes() const { return size_t(page_size_) * page_size_ * texel_bytes_; }
+  PageCodec codec() const { return layer_.codec(); }
+  size_t page_bytes() const { return layer_.page_bytes(); }
 
  private:
-  PageCodec codec_ = PageCodec::kRawZstd;
-  BcFormat bc_format_ = BcFormat::kBc1;
-  BcQuality bc_quality_ = BcQuality::kNormal;
-  uint32_t page_size_ = 0;
-  uint32_t channels_ = 0;
-  uint32_t texel_bytes_ = 0;
-  int zstd_level_ = 3;
-  std::shared_ptr<DctTables> dct_;
+  PageEncoder(LayerCodec layer, const LayerSpec& spec, const PageEncoderOptions& options)
+      : layer_(std::move(layer)), spec_(spec), settings_{options.zstd_level, options.bc_quality} {}
+
+  LayerCodec layer_;
+  LayerSpec spec_;  // the completed layer, for remaking layer_ with trained tables
+  LayerEncodeSettings settings_;
   DctSettings dct_settings_;
   bool trained_ = false;
 };

@@ -267,6 +267,10 @@ void DctTablesDeleter::operator()(DctTables* t) const {
   delete t;
 }
 
+DctTablesShape dct_tables_shape(const DctTables& tables) {
+  return {tables.settings.channels, tables.width, tables.height};
+}
+
 namespace {
 
 // Per-block side information the neighbours' contexts read.

@@ -71,6 +71,12 @@ Expected<DctTablesPtr> dct_make_tables(
 std::vector<uint8_t> dct_serialize_tables(const DctTables& tables);
 // Parses tables from a page file; malformed bytes give kCorrupt, never a crash.
 Expected<DctTablesPtr> dct_parse_tables(std::span<const uint8_t> bytes);
+// The channel count and page size the tables code: a decoder writes width * height * channels
+// bytes, so a reader checks them against the layer before trusting a file's tables.
+struct DctTablesShape {
+  int channels = 0, width = 0, height = 0;
+};
+DctTablesShape dct_tables_shape(const DctTables& tables);
 
 // Encodes one page of width*height texels, `channels` interleaved 8-bit channels, row-major.
 // Replaces the contents of `out`. Deterministic: the same texels and tables give the same bytes.

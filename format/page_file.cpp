@@ -45,32 +45,6 @@ const char* to_string(PageCodec v) {
   return "unknown";
 }
 
-const char* to_string(RuntimeFormat v) {
-  switch (v) {
-    case RuntimeFormat::kRgba8:
-      return "rgba8";
-    case RuntimeFormat::kBc1:
-      return "bc1";
-    case RuntimeFormat::kBc3:
-      return "bc3";
-    case RuntimeFormat::kBc4:
-      return "bc4";
-    case RuntimeFormat::kBc5:
-      return "bc5";
-    case RuntimeFormat::kBc7:
-      return "bc7";
-    case RuntimeFormat::kR8:
-      return "r8";
-    case RuntimeFormat::kRg8:
-      return "rg8";
-    case RuntimeFormat::kRgba16f:
-      return "rgba16f";
-    case RuntimeFormat::kRgba32f:
-      return "rgba32f";
-  }
-  return "unknown";
-}
-
 const char* to_string(ColorSpace v) {
   switch (v) {
     case ColorSpace::kLinear:

@@ -11,6 +11,7 @@
 
 #include "common/status.h"
 #include "format/page_geometry.h"
+#include "format/runtime_format.h"
 
 namespace vt {
 
@@ -33,26 +34,11 @@ enum class PageCodec : uint8_t {
   kBcZstd = 3,   // the layer's runtime BC format blocks for the whole page, zstd-compressed
 };
 
-// The GPU format a layer is transcoded to for the physical cache.
-enum class RuntimeFormat : uint8_t {
-  kRgba8 = 0,
-  kBc1 = 1,
-  kBc3 = 2,
-  kBc4 = 3,
-  kBc5 = 4,
-  kBc7 = 5,
-  kR8 = 6,
-  kRg8 = 7,
-  kRgba16f = 8,
-  kRgba32f = 9,
-};
-
 enum class ColorSpace : uint8_t { kLinear = 0, kSrgb = 1 };
 
 const char* to_string(LayerSemantic v);
 const char* to_string(TexelType v);
 const char* to_string(PageCodec v);
-const char* to_string(RuntimeFormat v);
 const char* to_string(ColorSpace v);
 const char* to_string(AddressMode v);
 uint32_t texel_type_bytes(TexelType type);
@@ -91,6 +77,8 @@ struct PageEntry {
   // Constant pages: the one texel value every texel of the page has (texel_bytes() bytes).
   uint8_t constant[16] = {};
 };
+
+class LayerCodec;  // format/layer_codec.h
 
 // Streams pages into a new page file. Pages may arrive in any order, from any number of
 // threads; pages not given are absent. The file appears under `path` only when finish()
@@ -150,8 +138,15 @@ class PageFileReader {
   virtual Status read_texels(const PageId& id, uint32_t layer, std::span<uint8_t> out) const = 0;
   // Bytes read_texels writes for this layer.
   virtual size_t decoded_page_bytes(uint32_t layer) const = 0;
-  // Checks the header, the index and every stored page's checksum.
-  virtual Status verify() const = 0;
+  // The codec read_texels decodes the layer's pages with (layer < layers()), made when the file
+  // opened: for callers that want a stored page's BC blocks as they are (runtime/page_source).
+  virtual const LayerCodec& layer_codec(uint32_t layer) const = 0;
+  // Checks a page's stored bytes against the index checksum whatever ReaderOptions say (Ok for
+  // constant and absent pages: open() checked their index entries).
+  virtual Status verify_page(const PageId& id, uint32_t layer) const = 0;
+  // Checks every stored page's checksum (open() has checked the header and the index): the first
+  // bad page's error. verify_pages (format/page_file_inspect.h) lists every bad page, threaded.
+  Status verify() const;
 };
 
 }  // namespace vt

@@ -2,64 +2,48 @@
 #include "format/page_file_c.h"
 
 #include <cstring>
-#include <exception>
 #include <memory>
 #include <string>
 
+#include "format/c_api_internal.h"
 #include "format/page_file.h"
 
 struct vtpf_file {
   std::unique_ptr<vt::PageFileReader> reader;
 };
 
+using vt::c_api::fail;
+using vt::c_api::fail_null;
+using vt::c_api::guard;
+
 namespace {
 
-std::string& last_error() {
-  thread_local std::string message;
-  return message;
-}
-
-int fail(const vt::Status& s) {
-  last_error() = s.message();
-  return int(s.code());
-}
-
-int fail_null(const char* what) {
-  last_error() = std::string(what) + " is NULL";
-  return VTPF_ERR_INVALID_ARGUMENT;
+int buffer_too_small(const vtpf_file* file, size_t capacity, const char* what, size_t needed) {
+  return fail(vt::Error(vt::ErrorCode::kInvalidArgument,
+                        file->reader->path() + ": buffer of " + std::to_string(capacity) +
+                            " bytes for " + what + " of " + std::to_string(needed)));
 }
 
 }  // namespace
 
 extern "C" {
 
-vtpf_file* vtpf_open(const char* path, int verify_checksums) {
-  last_error().clear();
-  if (!path) {
-    fail_null("path");
-    return nullptr;
-  }
-  try {
+int vtpf_open(const char* path, int verify_checksums, vtpf_file** out) {
+  if (!out) return fail_null("out");
+  *out = nullptr;
+  if (!path) return fail_null("path");
+  return guard([&] {
     vt::ReaderOptions options;
     options.verify_checksums = verify_checksums != 0;
     auto reader = vt::PageFileReader::open(path, options);
-    if (!reader.ok()) {
-      fail(reader.status());
-      return nullptr;
-    }
-    return new vtpf_file{std::move(reader).value()};
-  } catch (const std::exception& e) {  // std::bad_alloc must not cross into C
-    last_error() = std::string(path) + ": " + e.what();
-    return nullptr;
-  }
+    if (!reader.ok()) return fail(reader.status());
+    *out = new vtpf_file{std::move(reader).value()};
+    return int(VT_OK);
+  });
 }
 
 void vtpf_close(vtpf_file* file) {
   delete file;
-}
-
-const char* vtpf_last_error(void) {
-  return last_error().c_str();
 }
 
 int vtpf_get_geometry(const vtpf_file* file, vtpf_geometry* out) {
@@ -74,7 +58,7 @@ int vtpf_get_geometry(const vtpf_file* file, vtpf_geometry* out) {
   out->level_count = g.level_count();
   out->layer_count = uint32_t(file->reader->layers().size());
   out->version = file->reader->version();
-  return VTPF_OK;
+  return VT_OK;
 }
 
 uint32_t vtpf_pages_x(const vtpf_file* file, uint32_t level) {
@@ -105,7 +89,7 @@ int vtpf_get_layer(const vtpf_file* file, uint32_t layer, vtpf_layer_info* out) 
   out->texel_bytes = l.texel_bytes();
   out->name = l.name.c_str();
   out->decoded_page_bytes = file->reader->decoded_page_bytes(layer);
-  return VTPF_OK;
+  return VT_OK;
 }
 
 const char* vtpf_metadata(const vtpf_file* file, size_t* size) {
@@ -129,7 +113,7 @@ int vtpf_get_entry(const vtpf_file* file, uint32_t level, uint32_t x, uint32_t y
   out->size = e->size;
   out->checksum = e->checksum;
   std::memcpy(out->constant, e->constant, sizeof(out->constant));
-  return VTPF_OK;
+  return VT_OK;
 }
 
 int vtpf_read_stored(const vtpf_file* file, uint32_t level, uint32_t x, uint32_t y, uint32_t layer,
@@ -139,17 +123,13 @@ int vtpf_read_stored(const vtpf_file* file, uint32_t level, uint32_t x, uint32_t
   if (!e.ok()) return fail(e.status());
   if (size) *size = e->size;
   if (e->state == vt::PageState::kStored && (capacity < e->size || !buf))
-    return fail(vt::Error(vt::ErrorCode::kInvalidArgument,
-                          file->reader->path() + ": buffer of " + std::to_string(capacity) +
-                              " bytes for a page of " + std::to_string(e->size)));
-  try {
+    return buffer_too_small(file, capacity, "a page", e->size);
+  return guard([&] {
     auto bytes = file->reader->read_stored({level, x, y}, layer);
     if (!bytes.ok()) return fail(bytes.status());
     std::memcpy(buf, bytes->data(), bytes->size());
-  } catch (const std::exception& ex) {
-    return fail(vt::Error(vt::ErrorCode::kResourceLimit, ex.what()));
-  }
-  return VTPF_OK;
+    return int(VT_OK);
+  });
 }
 
 int vtpf_read_texels(const vtpf_file* file, uint32_t level, uint32_t x, uint32_t y, uint32_t layer,
@@ -158,22 +138,20 @@ int vtpf_read_texels(const vtpf_file* file, uint32_t level, uint32_t x, uint32_t
   if (!out) return fail_null("out");
   const size_t needed = file->reader->decoded_page_bytes(layer);
   if (layer < file->reader->layers().size() && capacity < needed)
-    return fail(vt::Error(vt::ErrorCode::kInvalidArgument,
-                          file->reader->path() + ": buffer of " + std::to_string(capacity) +
-                              " bytes for a decoded page of " + std::to_string(needed)));
-  try {
+    return buffer_too_small(file, capacity, "a decoded page", needed);
+  return guard([&] {
     vt::Status s = file->reader->read_texels(
         {level, x, y}, layer, std::span<uint8_t>(static_cast<uint8_t*>(out), needed));
-    return s.ok() ? VTPF_OK : fail(s);
-  } catch (const std::exception& ex) {
-    return fail(vt::Error(vt::ErrorCode::kResourceLimit, ex.what()));
-  }
+    return s.ok() ? int(VT_OK) : fail(s);
+  });
 }
 
 int vtpf_verify(const vtpf_file* file) {
   if (!file) return fail_null("file");
-  vt::Status s = file->reader->verify();
-  return s.ok() ? VTPF_OK : fail(s);
+  return guard([&] {
+    vt::Status s = file->reader->verify();
+    return s.ok() ? int(VT_OK) : fail(s);
+  });
 }
 
 }  // extern "C"

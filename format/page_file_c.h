@@ -1,29 +1,17 @@
 /* The page-file reader as a C API, for engines that do not take C++ (docs/FORMAT.md specifies
- * the bytes). Functions returning int give 0 (VTPF_OK) on success or a VTPF_ERR_* code; the
- * message of the calling thread's last error is vtpf_last_error(). A vtpf_file may be read from
- * several threads at once. */
+ * the bytes). Error codes, messages and naming follow format/vt_error_c.h. A vtpf_file may be
+ * read from several threads at once. */
 #ifndef VTBAKE_FORMAT_PAGE_FILE_C_H_
 #define VTBAKE_FORMAT_PAGE_FILE_C_H_
 
 #include <stddef.h>
 #include <stdint.h>
 
+#include "format/vt_error_c.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/* Same numbering as vt::ErrorCode. */
-enum {
-  VTPF_OK = 0,
-  VTPF_ERR_INVALID_ARGUMENT = 1,
-  VTPF_ERR_NOT_FOUND = 2,
-  VTPF_ERR_IO = 3,
-  VTPF_ERR_CORRUPT = 4,
-  VTPF_ERR_UNSUPPORTED = 5,
-  VTPF_ERR_RESOURCE_LIMIT = 6,
-  VTPF_ERR_CANCELLED = 7,
-  VTPF_ERR_INTERNAL = 8
-};
 
 /* Page states in the index. */
 enum { VTPF_PAGE_ABSENT = 0, VTPF_PAGE_CONSTANT = 1, VTPF_PAGE_STORED = 2 };
@@ -56,12 +44,10 @@ typedef struct vtpf_page_entry {
   uint8_t constant[16];
 } vtpf_page_entry;
 
-/* Opens and validates a page file; NULL on failure (see vtpf_last_error). verify_checksums != 0
- * checks every page's checksum when it is read. */
-vtpf_file* vtpf_open(const char* path, int verify_checksums);
+/* Opens and validates a page file into *out (NULL on failure). verify_checksums != 0 checks
+ * every page's checksum when it is read. */
+int vtpf_open(const char* path, int verify_checksums, vtpf_file** out);
 void vtpf_close(vtpf_file* file);
-/* The calling thread's last error message ("" when none); valid until its next vtpf_ call. */
-const char* vtpf_last_error(void);
 
 int vtpf_get_geometry(const vtpf_file* file, vtpf_geometry* out);
 /* Pages per row and column of a level (0 when the level does not exist). */
@@ -74,11 +60,11 @@ const char* vtpf_metadata(const vtpf_file* file, size_t* size);
 int vtpf_get_entry(const vtpf_file* file, uint32_t level, uint32_t x, uint32_t y, uint32_t layer,
                    vtpf_page_entry* out);
 /* Copies a stored page's bytes into buf (capacity bytes). *size receives the page's byte count
- * even when capacity is too small (then VTPF_ERR_INVALID_ARGUMENT, nothing copied). */
+ * even when capacity is too small (then VT_ERR_INVALID_ARGUMENT, nothing copied). */
 int vtpf_read_stored(const vtpf_file* file, uint32_t level, uint32_t x, uint32_t y, uint32_t layer,
                      void* buf, size_t capacity, size_t* size);
 /* Decodes a stored or constant page into out (capacity >= the layer's decoded_page_bytes). Absent
- * pages give VTPF_ERR_NOT_FOUND. */
+ * pages give VT_ERR_NOT_FOUND. */
 int vtpf_read_texels(const vtpf_file* file, uint32_t level, uint32_t x, uint32_t y, uint32_t layer,
                      void* out, size_t capacity);
 /* Checks every stored page's checksum. */

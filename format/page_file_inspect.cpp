@@ -4,14 +4,9 @@
 #include "common/parallel.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cstring>
 #include <map>
-#include <mutex>
-#include <thread>
 #include <tuple>
-
-#include <xxhash.h>
 
 namespace vt {
 
@@ -65,31 +60,20 @@ VerifyReport verify_pages(const PageFileReader& reader, int threads) {
           if (e.ok() && e->state == PageState::kStored) items.push_back({{level, x, y}, layer});
         }
 
-  // A reader opened without checksum verification still gets every page checked here.
   std::vector<Status> results(items.size());
-  parallel_for(items.size(), threads, [&](size_t i) {
-    auto e = reader.entry(items[i].id, items[i].layer);
-    if (!e.ok()) {
-      results[i] = e.status();
-      return;
-    }
-    auto bytes = reader.read_stored(items[i].id, items[i].layer);
-    if (!bytes.ok()) {
-      results[i] = bytes.status();
-    } else if (XXH3_64bits(bytes->data(), bytes->size()) != e->checksum) {
-      results[i] = Error(
-          ErrorCode::kCorrupt,
-          reader.path() + ": page (level " + std::to_string(items[i].id.level) + ", x " +
-              std::to_string(items[i].id.x) + ", y " + std::to_string(items[i].id.y) + ") layer " +
-              std::to_string(items[i].layer) + ": checksum mismatch in stored bytes");
-    }
-  });
+  parallel_for(items.size(), threads,
+               [&](size_t i) { results[i] = reader.verify_page(items[i].id, items[i].layer); });
 
   VerifyReport report;
   report.pages_checked = items.size();
   for (size_t i = 0; i < items.size(); ++i)
     if (!results[i].ok()) report.bad_pages.push_back({items[i].id, items[i].layer, results[i]});
   return report;
+}
+
+Status PageFileReader::verify() const {
+  const VerifyReport report = verify_pages(*this, 1);
+  return report.bad_pages.empty() ? Status::Ok() : report.bad_pages.front().status;
 }
 
 Expected<LevelImage> extract_level(const PageFileReader& reader, uint32_t level, uint32_t layer) {

@@ -103,7 +103,7 @@ inline std::string layer_problem(const LayerSpec& l) {
   if (l.channels < 1 || l.channels > 4) return "channels must be 1..4";
   if (uint8_t(l.texel_type) > uint8_t(TexelType::kF32)) return "unknown texel type";
   if (uint8_t(l.codec) > uint8_t(PageCodec::kBcZstd)) return "unknown codec";
-  if (uint8_t(l.runtime_format) > uint8_t(RuntimeFormat::kRgba32f)) return "unknown runtime format";
+  if (!runtime_format_info(l.runtime_format)) return "unknown runtime format";
   if (uint8_t(l.color_space) > uint8_t(ColorSpace::kSrgb)) return "unknown colour space";
   if (uint8_t(l.address_mode) > uint8_t(AddressMode::kWrap)) return "unknown address mode";
   if (l.name.size() > 255) return "name longer than 255 bytes";
@@ -112,8 +112,7 @@ inline std::string layer_problem(const LayerSpec& l) {
       l.texel_type != TexelType::kU8)
     return std::string(to_string(l.codec)) + " needs 8-bit texels";
   if (l.codec == PageCodec::kDct && l.codec_tables.empty()) return "dct layer without codec tables";
-  if (l.codec == PageCodec::kBcZstd &&
-      (l.runtime_format < RuntimeFormat::kBc1 || l.runtime_format > RuntimeFormat::kBc7))
+  if (l.codec == PageCodec::kBcZstd && !runtime_bc_format(l.runtime_format))
     return "bc+zstd layer needs a BC runtime format";
   return {};
 }

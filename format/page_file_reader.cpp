@@ -10,7 +10,7 @@
 #include <cerrno>
 #include <cstring>
 
-#include "format/page_decode.h"
+#include "format/layer_codec.h"
 #include "format/page_file.h"
 #include "format/page_file_layout.h"
 
@@ -19,11 +19,6 @@ namespace vt {
 namespace {
 
 using namespace pagefile;
-
-std::string page_name(const PageId& id, uint32_t layer) {
-  return "page (level " + std::to_string(id.level) + ", x " + std::to_string(id.x) + ", y " +
-         std::to_string(id.y) + ") layer " + std::to_string(layer);
-}
 
 class PageFileReaderImpl final : public PageFileReader {
  public:
@@ -89,9 +84,7 @@ class PageFileReaderImpl final : public PageFileReader {
       return Status::Ok();
     }
     VT_ASSIGN_OR_RETURN(std::span<const uint8_t> bytes, stored_bytes(id, layer));
-    Status s = decoders_[layer]->decode(e.codec, bytes, out);
-    if (!s.ok()) return s.with_context(path_ + ": " + page_name(id, layer));
-    return s;
+    return codecs_[layer].decode(bytes, out).with_context(path_ + ": " + page_name(id, layer));
   }
 
   size_t decoded_page_bytes(uint32_t layer) const override {
@@ -100,18 +93,12 @@ class PageFileReaderImpl final : public PageFileReader {
     return size * size * layers_[layer].texel_bytes();
   }
 
-  Status verify() const override {
-    const uint32_t layers = uint32_t(layers_.size());
-    for (uint32_t level = 0; level < geometry_.level_count(); ++level)
-      for (uint32_t y = 0; y < geometry_.pages_y(level); ++y)
-        for (uint32_t x = 0; x < geometry_.pages_x(level); ++x)
-          for (uint32_t layer = 0; layer < layers; ++layer) {
-            PageId id{level, x, y};
-            PageEntry e = parse_entry(*slot_of(id, layer));
-            if (e.state != PageState::kStored) continue;
-            VT_RETURN_IF_ERROR(check_stored(id, layer, e));
-          }
-    return Status::Ok();
+  const LayerCodec& layer_codec(uint32_t layer) const override { return codecs_[layer]; }
+
+  Status verify_page(const PageId& id, uint32_t layer) const override {
+    VT_ASSIGN_OR_RETURN(uint64_t slot, slot_of(id, layer));
+    PageEntry e = parse_entry(slot);
+    return e.state == PageState::kStored ? check_stored(id, layer, e) : Status::Ok();
   }
 
  private:
@@ -169,7 +156,7 @@ class PageFileReaderImpl final : public PageFileReader {
   uint32_t version_ = 0;
   PageGeometry geometry_;
   std::vector<LayerSpec> layers_;
-  std::vector<std::unique_ptr<LayerDecoder>> decoders_;
+  std::vector<LayerCodec> codecs_;
   std::string metadata_;
   std::vector<uint64_t> level_first_;
   bool align_4k_ = false;
@@ -287,12 +274,9 @@ Status PageFileReaderImpl::parse_layers(uint64_t pos, uint64_t end) {
   }
   if (pos != end) return corrupt("layer table does not end at the header checksum");
   for (size_t i = 0; i < layers_.size(); ++i) {
-    auto decoder = LayerDecoder::create(layers_[i], geometry_.page_size());
-    if (!decoder.ok()) {
-      Status s = decoder.status();
-      return Error(ErrorCode::kCorrupt, "layer " + std::to_string(i) + ": " + s.message());
-    }
-    decoders_.push_back(std::move(decoder).value());
+    auto codec = LayerCodec::create(layers_[i], geometry_.page_size());
+    if (!codec.ok()) return corrupt("layer " + std::to_string(i) + ": " + codec.status().message());
+    codecs_.push_back(std::move(codec).value());
   }
   return Status::Ok();
 }

@@ -111,4 +111,13 @@ void morton_decode(uint64_t code, uint32_t* x, uint32_t* y) {
   *y = compact_bits(code >> 1);
 }
 
+std::string page_name(const PageId& id) {
+  return "page (" + std::to_string(id.level) + ", " + std::to_string(id.x) + ", " +
+         std::to_string(id.y) + ")";
+}
+
+std::string page_name(const PageId& id, uint32_t layer) {
+  return page_name(id) + " layer " + std::to_string(layer);
+}
+
 }  // namespace vt

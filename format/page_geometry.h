@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "common/status.h"
 
@@ -18,6 +19,14 @@ struct PageId {
   uint32_t y = 0;
   friend bool operator==(const PageId&, const PageId&) = default;
 };
+
+// A page's key in maps and sets: level, y and x packed into 64 bits (x, y < 2^24 by validate()).
+inline uint64_t page_key(const PageId& id) {
+  return (uint64_t(id.level) << 48) | (uint64_t(id.y) << 24) | id.x;
+}
+// How every message names a page: "page (level, x, y)", and with a layer "... layer N".
+std::string page_name(const PageId& id);
+std::string page_name(const PageId& id, uint32_t layer);
 
 // Level 0 is width x height texels cut into pages of `payload` texels, each stored with
 // `border` extra texels on every side (page_size = payload + 2 * border, a multiple of 4).

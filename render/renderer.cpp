@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include "format/runtime_format.h"
 #include "render/shaders.h"
-#include "runtime/page_source.h"
 
 namespace vt::render {
 namespace {

@@ -7,6 +7,7 @@
 
 #include "codec/metrics.h"
 #include "format/page_file.h"
+#include "format/runtime_format.h"
 #include "render/report.h"
 #include "render/scene_draws.h"
 #include "runtime/page_source.h"
@@ -183,17 +184,9 @@ Expected<ViewMetrics> compare_view(const ReferenceFrame& reference_frame,
 
 Thresholds default_thresholds(RuntimeFormat cache_format) {
   Thresholds t;
-  switch (cache_format) {
-    case RuntimeFormat::kBc1:
-    case RuntimeFormat::kBc3:
-    case RuntimeFormat::kBc4:
-    case RuntimeFormat::kBc5:
-    case RuntimeFormat::kBc7:
-      t.min_psnr = 30.0;
-      t.min_tile_psnr = 30.0;
-      break;
-    default:
-      break;
+  if (runtime_bc_format(cache_format)) {  // block compression is lossy
+    t.min_psnr = 30.0;
+    t.min_tile_psnr = 30.0;
   }
   return t;
 }

@@ -12,10 +12,6 @@ namespace vt {
 
 namespace {
 
-uint64_t page_key(const PageId& id) {
-  return (uint64_t(id.level) << 48) | (uint64_t(id.y) << 24) | id.x;
-}
-
 enum class JobState : uint8_t { kQueued, kLoading, kCancelledWhileLoading, kDone };
 
 struct Job {

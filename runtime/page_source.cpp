@@ -1,55 +1,22 @@
 #include "runtime/page_source.h"
 
-#include <zstd.h>
-
 #include <cstring>
-#include <optional>
 #include <vector>
 
-#include "codec/dct.h"
+#include "format/layer_codec.h"
 #include "runtime/feedback.h"
 
 namespace vt {
 
 namespace {
 
-std::optional<BcFormat> bc_format_of(RuntimeFormat f) {
-  switch (f) {
-    case RuntimeFormat::kBc1:
-      return BcFormat::kBc1;
-    case RuntimeFormat::kBc3:
-      return BcFormat::kBc3;
-    case RuntimeFormat::kBc4:
-      return BcFormat::kBc4;
-    case RuntimeFormat::kBc5:
-      return BcFormat::kBc5;
-    case RuntimeFormat::kBc7:
-      return BcFormat::kBc7;
-    default:
-      return std::nullopt;
-  }
-}
-
-uint32_t uncompressed_channels(RuntimeFormat f) {
-  switch (f) {
-    case RuntimeFormat::kR8:
-      return 1;
-    case RuntimeFormat::kRg8:
-      return 2;
-    default:
-      return 4;
-  }
-}
-
 struct LayerPlan {
   RuntimeFormat upload = RuntimeFormat::kRgba8;
   size_t upload_bytes = 0;
   size_t decoded_bytes = 0;
-  uint32_t channels = 4;              // stored channels
-  bool passthrough = false;           // stored BC blocks are already the upload format
-  bool float_copy = false;            // float layers delivered as they are
-  std::optional<BcFormat> stored_bc;  // the layer's BC format (kBcZstd pages' blocks)
-  std::shared_ptr<DctTables> dct;     // parsed once from the layer's codec tables
+  uint32_t channels = 4;     // stored channels
+  bool passthrough = false;  // stored BC blocks are already the upload format
+  bool float_copy = false;   // float layers delivered as they are
 };
 
 class PageFileSource final : public PageSource {
@@ -81,58 +48,32 @@ class PageFileSource final : public PageSource {
     const LayerPlan& plan = plans_[layer];
     if (out.size() != plan.upload_bytes)
       return Error(ErrorCode::kInvalidArgument, reader_->path() + ": wrong upload buffer size");
-    const std::string where = reader_->path() + ": page (" + std::to_string(id.level) + ", " +
-                              std::to_string(id.x) + ", " + std::to_string(id.y) + ") layer " +
-                              std::to_string(layer);
+    const std::string where = reader_->path() + ": " + page_name(id, layer);
     auto entry = reader_->entry(id, layer);
     if (!entry.ok()) return entry.status().with_context(where);
-    std::vector<uint8_t> texels(plan.decoded_bytes);
-    const int ps = int(geometry().page_size());
-    if (entry->state == PageState::kStored &&
-        (entry->codec == PageCodec::kBcZstd || entry->codec == PageCodec::kDct)) {
-      // Decoded here rather than by the reader, so BC blocks can skip a decode/re-encode.
+    if (plan.passthrough && entry->state == PageState::kStored) {
+      // Stored BC blocks of the upload format skip a decode and re-encode.
       auto stored = reader_->read_stored(id, layer);
-      if (!stored.ok()) return stored.status().with_context(where);
-      if (entry->codec == PageCodec::kDct) {
-        if (!plan.dct) return Error(ErrorCode::kCorrupt, where + ": DCT page without tables");
-        VT_RETURN_IF_ERROR(
-            dct_decode_page(*plan.dct, *stored, ps, ps, texels.data()).with_context(where));
-      } else {
-        if (!plan.stored_bc)
-          return Error(ErrorCode::kCorrupt, where + ": BC page in a layer with no BC format");
-        std::vector<uint8_t> local;
-        std::span<uint8_t> blocks = out;
-        if (!plan.passthrough) {
-          local.resize(bc_image_bytes(*plan.stored_bc, ps, ps));
-          blocks = local;
-        }
-        const unsigned long long size = ZSTD_getFrameContentSize(stored->data(), stored->size());
-        if (size != blocks.size())
-          return Error(ErrorCode::kCorrupt, where + ": BC page decompresses to the wrong size");
-        const size_t got =
-            ZSTD_decompress(blocks.data(), blocks.size(), stored->data(), stored->size());
-        if (ZSTD_isError(got) || got != blocks.size())
-          return Error(ErrorCode::kCorrupt, where + ": zstd: " + ZSTD_getErrorName(got));
-        if (plan.passthrough) return Status::Ok();
-        VT_RETURN_IF_ERROR(bc_decode_image(*plan.stored_bc, blocks.data(), ps, ps,
-                                           int(plan.channels), texels.data())
-                               .with_context(where));
-      }
-    } else {
-      VT_RETURN_IF_ERROR(reader_->read_texels(id, layer, texels).with_context(where));
+      if (!stored.ok()) return stored.status();
+      return reader_->layer_codec(layer).bc_blocks(*stored, out).with_context(where);
     }
+    // Reader errors name the file and the page already.
+    std::vector<uint8_t> texels(plan.decoded_bytes);
+    VT_RETURN_IF_ERROR(reader_->read_texels(id, layer, texels));
+    const int ps = int(geometry().page_size());
     if (plan.float_copy) {
       std::memcpy(out.data(), texels.data(), out.size());
       return Status::Ok();
     }
-    if (auto bc = bc_format_of(plan.upload)) {
-      return bc_encode_image(*bc, options_.bc_quality, texels.data(), ps, ps, int(plan.channels),
-                             out.data())
+    const RuntimeFormatInfo& upload = *runtime_format_info(plan.upload);
+    if (upload.bc) {
+      return bc_encode_image(*upload.bc, options_.bc_quality, texels.data(), ps, ps,
+                             int(plan.channels), out.data())
           .with_context(where);
     }
     // Uncompressed 8-bit: channel i of the upload reads stored channel i, 0 when missing
     // (255 for a missing alpha of an RGBA upload).
-    const uint32_t oc = uncompressed_channels(plan.upload), ic = plan.channels;
+    const uint32_t oc = upload.channels, ic = plan.channels;
     const size_t n = size_t(ps) * ps;
     for (size_t t = 0; t < n; ++t)
       for (uint32_t c = 0; c < oc; ++c)
@@ -149,30 +90,6 @@ class PageFileSource final : public PageSource {
 };
 
 }  // namespace
-
-size_t runtime_format_page_bytes(RuntimeFormat format, uint32_t page_size) {
-  const size_t texels = size_t(page_size) * page_size;
-  switch (format) {
-    case RuntimeFormat::kBc1:
-    case RuntimeFormat::kBc4:
-      return texels / 2;
-    case RuntimeFormat::kBc3:
-    case RuntimeFormat::kBc5:
-    case RuntimeFormat::kBc7:
-      return texels;
-    case RuntimeFormat::kR8:
-      return texels;
-    case RuntimeFormat::kRg8:
-      return texels * 2;
-    case RuntimeFormat::kRgba8:
-      return texels * 4;
-    case RuntimeFormat::kRgba16f:
-      return texels * 8;
-    case RuntimeFormat::kRgba32f:
-      return texels * 16;
-  }
-  return 0;
-}
 
 Expected<std::unique_ptr<PageSource>> make_page_file_source(
     std::shared_ptr<const PageFileReader> reader, const PageFileSourceOptions& options) {
@@ -196,30 +113,20 @@ Expected<std::unique_ptr<PageSource>> make_page_file_source(
     plan.upload = spec.runtime_format;
     if (plan.upload == RuntimeFormat::kBc7 && options.bc7_as_rgba8)
       plan.upload = RuntimeFormat::kRgba8;
+    const RuntimeFormatInfo* upload = runtime_format_info(plan.upload);
+    if (!upload) return Error(ErrorCode::kCorrupt, where + ": unknown runtime format");
     if (spec.texel_type != TexelType::kU8) {
-      const bool ok =
-          spec.channels == 4 &&
-          ((spec.texel_type == TexelType::kF16 && plan.upload == RuntimeFormat::kRgba16f) ||
-           (spec.texel_type == TexelType::kF32 && plan.upload == RuntimeFormat::kRgba32f));
-      if (!ok)
+      // Float texels go to the cache as they are: a float format of the same channels and size.
+      if (!upload->is_float || upload->channels != spec.channels ||
+          upload->bits_per_texel != spec.texel_bytes() * 8)
         return Error(ErrorCode::kUnsupported,
                      where + ": float texels are only delivered as 4-channel float of their size");
       plan.float_copy = true;
-    } else if (plan.upload == RuntimeFormat::kRgba16f || plan.upload == RuntimeFormat::kRgba32f) {
+    } else if (upload->is_float) {
       return Error(ErrorCode::kUnsupported, where + ": 8-bit texels with a float runtime format");
     }
-    plan.stored_bc = bc_format_of(spec.runtime_format);
-    plan.passthrough = plan.stored_bc && plan.upload == spec.runtime_format;
-    if (spec.codec == PageCodec::kDct) {
-      if (spec.texel_type != TexelType::kU8)
-        return Error(ErrorCode::kCorrupt, where + ": DCT layer with float texels");
-      auto tables = dct_parse_tables(spec.codec_tables);
-      if (!tables.ok()) return tables.status().with_context(where + ": DCT tables");
-      plan.dct = std::shared_ptr<DctTables>(tables->release(), DctTablesDeleter());
-    }
+    plan.passthrough = spec.codec == PageCodec::kBcZstd && plan.upload == spec.runtime_format;
     plan.upload_bytes = runtime_format_page_bytes(plan.upload, g.page_size());
-    if (plan.float_copy && plan.decoded_bytes != plan.upload_bytes)
-      return Error(ErrorCode::kCorrupt, where + ": decoded page size does not match its format");
     plans.push_back(plan);
   }
   if (plans.empty()) return Error(ErrorCode::kCorrupt, path + ": no layers");

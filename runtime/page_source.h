@@ -43,9 +43,6 @@ inline size_t slot_bytes(const PageSource& source) {
   return total;
 }
 
-// Bytes of one page_size x page_size page in a runtime format (BC: 4x4 blocks).
-size_t runtime_format_page_bytes(RuntimeFormat format, uint32_t page_size);
-
 struct PageFileSourceOptions {
   BcQuality bc_quality = BcQuality::kRealtime;  // used when a page must be (re)encoded to BC
   // Lavapipe samples BC7 very slowly: optionally upload BC7 layers as RGBA8 instead.

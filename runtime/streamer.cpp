@@ -11,19 +11,6 @@
 
 namespace vt {
 
-namespace {
-
-uint64_t page_key(const PageId& id) {
-  return (uint64_t(id.level) << 48) | (uint64_t(id.y) << 24) | id.x;
-}
-
-std::string page_name(const PageId& id) {
-  return "page (" + std::to_string(id.level) + ", " + std::to_string(id.x) + ", " +
-         std::to_string(id.y) + ")";
-}
-
-}  // namespace
-
 struct Streamer::Impl {
   std::shared_ptr<const PageSource> source;
   StreamerOptions options;

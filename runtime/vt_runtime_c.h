@@ -1,30 +1,20 @@
 /* C API of the vtbake runtime (engine-facing): open a page file, feed one feedback buffer per
  * frame, copy the returned uploads into the physical cache textures and the page table into its
- * texture. Formats are those of runtime/feedback.h and runtime/page_table.h. Every function
- * returning int returns 0 on success and non-zero (a vtrt_error code) on failure; the message
- * is then available from vtrt_last_error(handle). Thread-safe per handle. */
+ * texture. Formats are those of runtime/feedback.h and runtime/page_table.h. Error codes,
+ * messages and naming follow format/vt_error_c.h. A handle may be used from several threads. */
 #ifndef VTBAKE_RUNTIME_VT_RUNTIME_C_H_
 #define VTBAKE_RUNTIME_VT_RUNTIME_C_H_
 
 #include <stddef.h>
 #include <stdint.h>
 
+#include "format/vt_error_c.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
 
 typedef struct vtrt_streamer vtrt_streamer;
-
-enum vtrt_error {
-  VTRT_OK = 0,
-  VTRT_INVALID_ARGUMENT = 1,
-  VTRT_NOT_FOUND = 2,
-  VTRT_IO = 3,
-  VTRT_CORRUPT = 4,
-  VTRT_UNSUPPORTED = 5,
-  VTRT_RESOURCE_LIMIT = 6,
-  VTRT_INTERNAL = 8
-};
 
 typedef struct vtrt_options {
   uint32_t slots_x, slots_y;    /* physical cache in slots (each <= 256) */
@@ -57,34 +47,33 @@ typedef struct vtrt_upload {
 
 /* Fills the defaults (32 x 32 slots, 2 threads, 64 in flight, 16 MiB per frame, bias <= 8). */
 void vtrt_default_options(vtrt_options* options);
-/* Opens `path` and creates a streamer; on failure *out is NULL and, when error_message is not
- * NULL, the message is copied there (at most message_capacity bytes, NUL-terminated). */
-int vtrt_open(const char* path, const vtrt_options* options, vtrt_streamer** out,
-              char* error_message, size_t message_capacity);
+/* Opens `path` and creates a streamer into *out (NULL on failure). options may be NULL (the
+ * defaults). */
+int vtrt_open(const char* path, const vtrt_options* options, vtrt_streamer** out);
 void vtrt_close(vtrt_streamer* streamer);
-const char* vtrt_last_error(const vtrt_streamer* streamer);
 
-int vtrt_geometry_get(const vtrt_streamer* streamer, vtrt_geometry* out);
-/* Runtime format (format/page_file.h RuntimeFormat value) and bytes per slot of a layer. */
-int vtrt_layer_upload_format(const vtrt_streamer* streamer, uint32_t layer, uint32_t* format,
-                             size_t* bytes);
+int vtrt_get_geometry(const vtrt_streamer* streamer, vtrt_geometry* out);
+/* Runtime format (format/runtime_format.h RuntimeFormat value) and bytes per slot of a layer. */
+int vtrt_get_upload_format(const vtrt_streamer* streamer, uint32_t layer, uint32_t* format,
+                           size_t* bytes);
 
 /* One frame. feedback: `count` uint32 values (may be NULL when count is 0). */
 int vtrt_update(vtrt_streamer* streamer, const uint32_t* feedback, size_t count,
                 vtrt_frame_stats* stats);
 /* The uploads of the last vtrt_update. */
 uint32_t vtrt_upload_count(const vtrt_streamer* streamer);
-int vtrt_upload_get(const vtrt_streamer* streamer, uint32_t index, uint32_t layer,
+int vtrt_get_upload(const vtrt_streamer* streamer, uint32_t index, uint32_t layer,
                     vtrt_upload* out);
 
 /* Page table level (RGBA8, width x height texels, see runtime/page_table.h). `data` points into
  * the streamer's copy taken at the last vtrt_update, valid until the next one. The dirty
  * rectangle is [x0, x1) x [y0, y1) (empty when x0 >= x1) since the previous vtrt_update. */
-int vtrt_page_table_level(const vtrt_streamer* streamer, uint32_t level, const uint8_t** data,
-                          uint32_t* width, uint32_t* height, uint32_t dirty[4]);
+int vtrt_get_page_table_level(const vtrt_streamer* streamer, uint32_t level, const uint8_t** data,
+                              uint32_t* width, uint32_t* height, uint32_t dirty[4]);
 
 /* Blocks until queued loads finish (tools and validation only). */
 void vtrt_wait_idle(vtrt_streamer* streamer);
+/* 1 when no load is queued or running, else 0. */
 int vtrt_idle(const vtrt_streamer* streamer);
 
 #ifdef __cplusplus

@@ -2,8 +2,8 @@
 #pragma once
 
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <unistd.h>
-#include <zstd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "format/page_file.h"
+#include "format/zstd_frame.h"
 
 namespace vt::testing {
 
@@ -113,10 +114,7 @@ inline GeneratedFile generate(PageFileDesc desc, uint32_t seed) {
             if (spec.codec == PageCodec::kRaw) {
               p.stored = p.texels;
             } else {
-              p.stored.resize(ZSTD_compressBound(p.texels.size()));
-              size_t n = ZSTD_compress(p.stored.data(), p.stored.size(), p.texels.data(),
-                                       p.texels.size(), 1);
-              p.stored.resize(n);
+              EXPECT_TRUE(zstd_compress(p.texels, 1, p.stored).ok());
             }
           }
           f.pages.push_back(std::move(p));

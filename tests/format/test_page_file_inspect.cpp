@@ -70,7 +70,18 @@ TEST(PageFileInspect, VerifyFindsEveryBadPage) {
       EXPECT_EQ(report.bad_pages[0].status.code(), ErrorCode::kCorrupt);
       EXPECT_NE(report.bad_pages[0].status.message().find(bad), std::string::npos);
     }
+    // verify() and verify_page check the bytes whatever the reader's options.
+    const VerifyReport report = verify_pages(**r, 1);
+    const BadPage& first = report.bad_pages[0];
+    EXPECT_EQ((*r)->verify().message(), first.status.message());
+    EXPECT_NE(first.status.message().find(page_name(first.id, first.layer) + ": checksum"),
+              std::string::npos)
+        << first.status.message();
+    EXPECT_EQ((*r)->verify_page(first.id, first.layer).code(), ErrorCode::kCorrupt);
   }
+  EXPECT_TRUE((*reader)->verify().ok());
+  for (auto& p : f.pages) EXPECT_TRUE((*reader)->verify_page(p.id, p.layer).ok());
+  EXPECT_EQ((*reader)->verify_page({0, 99, 0}, 0).code(), ErrorCode::kInvalidArgument);
 }
 
 TEST(PageFileInspect, ExtractReassemblesEveryLevelExactly) {
@@ -88,8 +99,8 @@ TEST(PageFileInspect, ExtractReassemblesEveryLevelExactly) {
       for (uint32_t y = 0; y < g.pages_y(l); ++y)
         for (uint32_t x = 0; x < g.pages_x(l); ++x) {
           auto a = cut_page(albedo[l], g.level_width(l), g.level_height(l), 3, g, {l, x, y});
-          std::vector<uint8_t> z(ZSTD_compressBound(a.size()));
-          z.resize(ZSTD_compress(z.data(), z.size(), a.data(), a.size(), 1));
+          std::vector<uint8_t> z;
+          ASSERT_TRUE(zstd_compress(a, 1, z).ok());
           ASSERT_TRUE((*w)->add_page({l, x, y}, 0, z).ok());
           auto h = cut_page(height[l], g.level_width(l), g.level_height(l), 4, g, {l, x, y});
           ASSERT_TRUE((*w)->add_page({l, x, y}, 1, h).ok());

@@ -103,6 +103,17 @@ TEST(PageGeometry, AddressTexel) {
   EXPECT_EQ(address_texel(12, 10, AddressMode::kWrap), 2);
 }
 
+TEST(PageId, KeyAndName) {
+  EXPECT_EQ(page_name({2, 3, 1}), "page (2, 3, 1)");
+  EXPECT_EQ(page_name({0, 4095, 17}, 3), "page (0, 4095, 17) layer 3");
+  // Keys are distinct for every page of the largest grids (x, y < 2^24, levels < 2^16).
+  const PageId ids[] = {
+      {0, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 0}, {0, (1u << 24) - 1, 0}, {0, 0, (1u << 24) - 1},
+      {24, 0, 0}};
+  for (const PageId& a : ids)
+    for (const PageId& b : ids) EXPECT_EQ(page_key(a) == page_key(b), a == b);
+}
+
 TEST(Morton, KnownCodes) {
   EXPECT_EQ(morton_encode(0, 0), 0u);
   EXPECT_EQ(morton_encode(1, 0), 1u);

@@ -1,0 +1,28 @@
+// Internal to the C APIs' implementations: how a Status, a NULL argument or an exception becomes
+// a vt_error code and the calling thread's vt_last_error() message (format/vt_error_c.h).
+#pragma once
+
+#include <exception>
+#include <string>
+
+#include "common/status.h"
+#include "format/vt_error_c.h"
+
+namespace vt::c_api {
+
+// Records the failure as the thread's last error; returns its code.
+int fail(const Status& status);
+// A NULL argument: VT_ERR_INVALID_ARGUMENT naming it.
+int fail_null(const char* what);
+
+// Runs `body` (returning int) so that no exception crosses into C.
+template <typename Fn>
+int guard(Fn&& body) {
+  try {
+    return body();
+  } catch (const std::exception& e) {  // std::bad_alloc above all
+    return fail(Error(ErrorCode::kResourceLimit, e.what()));
+  }
+}
+
+}  // namespace vt::c_api
