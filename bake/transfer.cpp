@@ -1,6 +1,7 @@
 // Material transfer (see transfer.h). Work is split into bands of atlas rows; each band walks
 // the triangles that overlap it in index order, so the result does not depend on threads.
 #include "bake/transfer.h"
+#include "bake/unwrap/atlas_raster.h"
 #include "common/parallel.h"
 
 #include <OpenImageIO/imagebufalgo.h>
@@ -28,6 +29,10 @@ constexpr float kOpaque = 1.0f - 0.5f / 255.0f;  // alpha at or above this is st
 using scene::Vec2;
 using scene::Vec3;
 using scene::Vec4;
+using unwrap::bin_by_rows;
+using unwrap::for_each_touched_texel;
+using unwrap::RasterTriangle;
+using unwrap::TexelRect;
 
 struct V3 {
   double x = 0, y = 0, z = 0;
@@ -54,95 +59,6 @@ V3 normalized(V3 a, V3 fallback) {
 }
 V3 v3(const Vec3& a) {
   return {a[0], a[1], a[2]};
-}
-
-// A triangle in atlas texel space, positively oriented (vertices reordered if needed), with its
-// edges in canonical form: an edge shared by two triangles is evaluated from the same endpoint
-// by both, so the two edge functions are exact negatives and no sample is claimed twice.
-struct RasterTri {
-  double x[3], y[3];
-  double area2 = 0;
-  struct Edge {
-    double ax, ay, dx, dy, sign;
-    bool include_zero;  // top-left rule
-  } e[3];               // e[k] is the edge opposite vertex k (from vertex k+1 to k+2)
-  int32_t chart = 0;
-  uint8_t order[3] = {0, 1, 2};  // original vertex index of each reordered vertex
-
-  double edge(int k, double px, double py) const {
-    const Edge& g = e[k];
-    return g.sign * (g.dx * (py - g.ay) - g.dy * (px - g.ax));
-  }
-  bool contains(double px, double py, double lambda[3]) const {
-    for (int k = 0; k < 3; ++k) {
-      double v = edge(k, px, py);
-      if (v < 0 || (v == 0 && !e[k].include_zero)) return false;
-      lambda[k] = v;
-    }
-    for (int k = 0; k < 3; ++k) lambda[k] /= area2;
-    return true;
-  }
-};
-
-RasterTri make_raster_tri(const std::array<double, 6>& p, int32_t chart) {
-  RasterTri t;
-  t.chart = chart;
-  for (int k = 0; k < 3; ++k) t.x[k] = p[2 * k], t.y[k] = p[2 * k + 1];
-  double a2 = (t.x[1] - t.x[0]) * (t.y[2] - t.y[0]) - (t.y[1] - t.y[0]) * (t.x[2] - t.x[0]);
-  if (a2 < 0) {
-    std::swap(t.x[1], t.x[2]);
-    std::swap(t.y[1], t.y[2]);
-    std::swap(t.order[1], t.order[2]);
-    a2 = -a2;
-  }
-  t.area2 = a2;
-  for (int k = 0; k < 3; ++k) {
-    int i = (k + 1) % 3, j = (k + 2) % 3;  // edge i -> j
-    bool forward = std::make_pair(t.x[i], t.y[i]) < std::make_pair(t.x[j], t.y[j]);
-    int a = forward ? i : j, b = forward ? j : i;
-    RasterTri::Edge& g = t.e[k];
-    g.ax = t.x[a], g.ay = t.y[a], g.dx = t.x[b] - t.x[a], g.dy = t.y[b] - t.y[a];
-    g.sign = forward ? 1.0 : -1.0;
-    double ex = t.x[j] - t.x[i], ey = t.y[j] - t.y[i];
-    g.include_zero = ey > 0 || (ey == 0 && ex < 0);
-  }
-  return t;
-}
-
-// Closest point of the (closed) triangle to p, as barycentrics of the reordered vertices.
-void closest_barycentrics(const RasterTri& t, double px, double py, double lambda[3]) {
-  double inside[3];
-  bool in = true;
-  for (int k = 0; k < 3; ++k) {
-    inside[k] = t.edge(k, px, py) / t.area2;
-    if (inside[k] < 0) in = false;
-  }
-  if (in) {
-    for (int k = 0; k < 3; ++k) lambda[k] = inside[k];
-    return;
-  }
-  double best = std::numeric_limits<double>::infinity();
-  for (int k = 0; k < 3; ++k) {
-    int i = (k + 1) % 3, j = (k + 2) % 3;
-    double ex = t.x[j] - t.x[i], ey = t.y[j] - t.y[i];
-    double len2 = ex * ex + ey * ey;
-    double s = len2 > 0 ? ((px - t.x[i]) * ex + (py - t.y[i]) * ey) / len2 : 0.0;
-    s = std::clamp(s, 0.0, 1.0);
-    double qx = t.x[i] + s * ex - px, qy = t.y[i] + s * ey - py;
-    double d = qx * qx + qy * qy;
-    if (d < best) {
-      best = d;
-      lambda[k] = 0, lambda[i] = 1 - s, lambda[j] = s;
-    }
-  }
-}
-
-double distance2_to(const RasterTri& t, double px, double py) {
-  double l[3];
-  closest_barycentrics(t, px, py, l);
-  double qx = l[0] * t.x[0] + l[1] * t.x[1] + l[2] * t.x[2] - px;
-  double qy = l[0] * t.y[0] + l[1] * t.y[1] + l[2] * t.y[2] - py;
-  return qx * qx + qy * qy;
 }
 
 // Runs `body(band)` for every band on `threads` threads; the calling thread reports progress.
@@ -176,69 +92,36 @@ struct BandRaster {
   }
 };
 
-// Rasterises `tri` (index t) into the band. on_sample(texel index in band, lambda) is called for
-// each sub-sample inside the triangle. Returns sub-samples claimed twice.
+// Rasterises `tri` (index t, chart `chart`) into the band. on_sample(texel index in band,
+// lambda) is called for each sub-sample inside the triangle. Returns sub-samples claimed twice.
 template <class OnSample>
-uint64_t raster_triangle(const RasterTri& tri, int32_t t, BandRaster& band,
+uint64_t raster_triangle(const RasterTriangle& tri, int32_t t, int32_t chart, BandRaster& band,
                          const std::vector<std::array<double, 2>>& pattern, uint32_t height,
                          OnSample&& on_sample) {
-  if (!(tri.area2 > 0) || !std::isfinite(tri.area2)) return 0;
-  double minx = std::min({tri.x[0], tri.x[1], tri.x[2]}),
-         maxx = std::max({tri.x[0], tri.x[1], tri.x[2]});
-  double miny = std::min({tri.y[0], tri.y[1], tri.y[2]}),
-         maxy = std::max({tri.y[0], tri.y[1], tri.y[2]});
-  // Texels whose open square meets the triangle: i in (min - 1, max).
-  int64_t xa = std::max<int64_t>(0, int64_t(std::floor(minx)));
-  int64_t xb = std::min<int64_t>(int64_t(band.width) - 1, int64_t(std::ceil(maxx)) - 1);
-  int64_t ya = std::max<int64_t>(band.y0, int64_t(std::floor(miny)));
-  int64_t yb =
-      std::min<int64_t>(std::min<int64_t>(band.y1, height) - 1, int64_t(std::ceil(maxy)) - 1);
   uint64_t twice = 0;
-  // Half extent of an edge function over a texel square, for the conservative test.
-  double reach[3];
-  for (int k = 0; k < 3; ++k) reach[k] = 0.5 * (std::abs(tri.e[k].dx) + std::abs(tri.e[k].dy));
-  for (int64_t y = ya; y <= yb; ++y) {
-    for (int64_t x = xa; x <= xb; ++x) {
-      double cx = x + 0.5, cy = y + 0.5;
-      bool touch = true;
-      for (int k = 0; k < 3 && touch; ++k) touch = tri.edge(k, cx, cy) + reach[k] > 0;
-      if (!touch) continue;
-      size_t i = size_t(y - band.y0) * band.width + size_t(x);
-      if (band.chart[i] < 0) {
-        band.chart[i] = tri.chart;
-      } else if (band.chart[i] != tri.chart) {
-        band.contested[i] = 1;
-      }
-      bool any = false;
-      for (size_t s = 0; s < pattern.size(); ++s) {
-        double lambda[3];
-        if (!tri.contains(x + pattern[s][0], y + pattern[s][1], lambda)) continue;
-        if (band.claimed[i] & (1u << s)) ++twice;
-        band.claimed[i] |= uint16_t(1u << s);
-        band.inside[i]++;
-        any = true;
-        on_sample(i, lambda);
-      }
-      double d = any ? 0.0 : distance2_to(tri, cx, cy);
-      if (d < band.best_dist[i]) band.best_dist[i] = d, band.best_tri[i] = t;
+  const TexelRect clip = {0, band.y0, int64_t(band.width) - 1,
+                          std::min<int64_t>(band.y1, height) - 1};
+  for_each_touched_texel(tri, 0.0, clip, [&](int64_t x, int64_t y) {
+    size_t i = size_t(y - band.y0) * band.width + size_t(x);
+    if (band.chart[i] < 0) {
+      band.chart[i] = chart;
+    } else if (band.chart[i] != chart) {
+      band.contested[i] = 1;
     }
-  }
+    bool any = false;
+    for (size_t s = 0; s < pattern.size(); ++s) {
+      double lambda[3];
+      if (!tri.contains(x + pattern[s][0], y + pattern[s][1], lambda)) continue;
+      if (band.claimed[i] & (1u << s)) ++twice;
+      band.claimed[i] |= uint16_t(1u << s);
+      band.inside[i]++;
+      any = true;
+      on_sample(i, lambda);
+    }
+    double d = any ? 0.0 : tri.distance2_to(x + 0.5, y + 0.5);
+    if (d < band.best_dist[i]) band.best_dist[i] = d, band.best_tri[i] = t;
+  });
   return twice;
-}
-
-std::vector<std::vector<uint32_t>> bin_triangles(const std::vector<RasterTri>& tris,
-                                                 uint32_t height, uint32_t bands) {
-  std::vector<std::vector<uint32_t>> bins(bands);
-  for (uint32_t t = 0; t < tris.size(); ++t) {
-    const RasterTri& r = tris[t];
-    double miny = std::min({r.y[0], r.y[1], r.y[2]}), maxy = std::max({r.y[0], r.y[1], r.y[2]});
-    if (!std::isfinite(miny) || !std::isfinite(maxy)) continue;
-    int64_t ya = std::max<int64_t>(0, int64_t(std::floor(miny)));
-    int64_t yb = std::min<int64_t>(int64_t(height) - 1, int64_t(std::ceil(maxy)) - 1);
-    if (yb < ya) continue;
-    for (int64_t b = ya / kBandRows; b <= yb / kBandRows; ++b) bins[b].push_back(t);
-  }
-  return bins;
 }
 
 // ---- Materials -------------------------------------------------------------------------------
@@ -371,7 +254,8 @@ class Transfer {
   std::vector<ImageSlot> images_;
   std::vector<std::string> temp_files_;
   std::vector<PrimInfo> prims_;
-  std::vector<RasterTri> tris_;
+  std::vector<RasterTriangle> tris_;
+  std::vector<int32_t> chart_;                          // per triangle
   std::vector<std::pair<uint32_t, uint32_t>> tri_src_;  // (prim info, face)
   scene::Material default_material_;
   bool want_[5] = {};  // by LayerSemantic
@@ -547,7 +431,8 @@ Status Transfer::setup_prims() {
         const Vec2& a = uv[p.indices[f + k]];
         q[2 * k] = double(a[0]) * W, q[2 * k + 1] = double(a[1]) * H;
       }
-      tris_.push_back(make_raster_tri(q, int32_t(chart_base + find(p.indices[f]))));
+      tris_.emplace_back(q);
+      chart_.push_back(int32_t(chart_base + find(p.indices[f])));
       tri_src_.push_back({pi, uint32_t(f / 3)});
     }
     chart_base += p.positions.size();
@@ -556,7 +441,7 @@ Status Transfer::setup_prims() {
 }
 
 void Transfer::make_eval(uint32_t t, TriEval& te) const {
-  const RasterTri& r = tris_[t];
+  const RasterTriangle& r = tris_[t];
   const PrimInfo& pi = prims_[tri_src_[t].first];
   const scene::Primitive& p = *pi.prim;
   size_t f = tri_src_[t].second;
@@ -731,7 +616,7 @@ Expected<TransferResult> Transfer::run() {
   auto coverage = std::make_shared<std::vector<uint8_t>>(N, 0);
   const auto pattern = supersample_pattern(opt_.supersample);
   const uint32_t bands = (H + kBandRows - 1) / kBandRows;
-  auto bins = bin_triangles(tris_, H, bands);
+  auto bins = bin_by_rows(tris_, H, kBandRows);
   std::atomic<uint64_t> sampled{0}, edge_only{0}, contested{0}, samples{0};
 
   auto store = [&](size_t texel, const Sample& s, float weight, bool add) {
@@ -755,11 +640,12 @@ Expected<TransferResult> Transfer::run() {
     const float weight = 1.0f / float(pattern.size());
     for (uint32_t t : bins[b]) {
       make_eval(t, te);
-      raster_triangle(tris_[t], int32_t(t), band, pattern, H, [&](size_t i, const double* l) {
-        evaluate(pt, te, l, s);
-        store(size_t(y0) * W + i, s, weight, true);
-        ++n_samples;
-      });
+      raster_triangle(tris_[t], int32_t(t), chart_[t], band, pattern, H,
+                      [&](size_t i, const double* l) {
+                        evaluate(pt, te, l, s);
+                        store(size_t(y0) * W + i, s, weight, true);
+                        ++n_samples;
+                      });
     }
     uint64_t n_sampled = 0, n_edge = 0, n_contested = 0;
     for (size_t i = 0; i < band.best_tri.size(); ++i) {
@@ -784,7 +670,7 @@ Expected<TransferResult> Transfer::run() {
       uint32_t t = uint32_t(band.best_tri[i]);
       make_eval(t, te);
       double l[3];
-      closest_barycentrics(tris_[t], (i % W) + 0.5, (y0 + i / W) + 0.5, l);
+      tris_[t].closest_barycentrics((i % W) + 0.5, (y0 + i / W) + 0.5, l);
       evaluate(pt, te, l, s);
       store(texel, s, 1.0f, false);
       ++n_samples;
@@ -878,20 +764,17 @@ AtlasRaster rasterize_atlas(const std::vector<std::array<double, 6>>& triangles,
   AtlasRaster out;
   out.owner.assign(size_t(width) * height, -1);
   out.inside.assign(size_t(width) * height, 0);
-  std::vector<RasterTri> tris;
-  for (size_t t = 0; t < triangles.size(); ++t) {
-    tris.push_back(make_raster_tri(triangles[t], t < chart.size() ? chart[t] : 0));
-  }
+  std::vector<RasterTriangle> tris(triangles.begin(), triangles.end());
   const auto pattern = supersample_pattern(supersample);
   const uint32_t bands = (height + kBandRows - 1) / kBandRows;
-  auto bins = bin_triangles(tris, height, bands);
+  auto bins = bin_by_rows(tris, height, kBandRows);
   BandRaster band;
   for (uint32_t b = 0; b < bands; ++b) {
     uint32_t y0 = b * kBandRows, y1 = std::min(height, y0 + kBandRows);
     band.reset(width, y0, y1);
     for (uint32_t t : bins[b]) {
-      out.double_sampled +=
-          raster_triangle(tris[t], int32_t(t), band, pattern, height, [](size_t, const double*) {});
+      out.double_sampled += raster_triangle(tris[t], int32_t(t), t < chart.size() ? chart[t] : 0,
+                                            band, pattern, height, [](size_t, const double*) {});
     }
     for (size_t i = 0; i < band.best_tri.size(); ++i) {
       out.owner[size_t(y0) * width + i] = band.best_tri[i];

@@ -933,8 +933,8 @@ Expected<UnwrapResult> unwrap_scene(const scene::Scene& in, const UnwrapOptions&
       for (int k = 0; k < 3; ++k) {
         const auto& uv = atlas_uv[new_index[3 * f + k]];
         p[k] = {static_cast<double>(uv[0]) * W, static_cast<double>(uv[1]) * H};
-        t.uv[2 * k] = static_cast<float>(p[k][0]);
-        t.uv[2 * k + 1] = static_cast<float>(p[k][1]);
+        t.uv[2 * k] = p[k][0];
+        t.uv[2 * k + 1] = p[k][1];
       }
       t.chart = face_chart[f];
       if (s.degenerate[f]) continue;
