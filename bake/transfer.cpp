@@ -3,6 +3,7 @@
 #include "bake/transfer.h"
 #include "bake/unwrap/atlas_raster.h"
 #include "common/parallel.h"
+#include "common/vec.h"
 
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
@@ -34,30 +35,7 @@ using unwrap::for_each_touched_texel;
 using unwrap::RasterTriangle;
 using unwrap::TexelRect;
 
-struct V3 {
-  double x = 0, y = 0, z = 0;
-};
-V3 operator+(V3 a, V3 b) {
-  return {a.x + b.x, a.y + b.y, a.z + b.z};
-}
-V3 operator-(V3 a, V3 b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-V3 operator*(V3 a, double s) {
-  return {a.x * s, a.y * s, a.z * s};
-}
-double dot(V3 a, V3 b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-V3 cross(V3 a, V3 b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-V3 normalized(V3 a, V3 fallback) {
-  double l = std::sqrt(dot(a, a));
-  if (!(l > 1e-30) || !std::isfinite(l)) return fallback;
-  return a * (1.0 / l);
-}
-V3 v3(const Vec3& a) {
+Vec3d v3(const Vec3& a) {
   return {a[0], a[1], a[2]};
 }
 
@@ -151,18 +129,49 @@ struct TriEval {
   const PrimInfo* p = nullptr;
   uint32_t v[3];                           // vertex indices in the raster triangle's order
   std::vector<std::array<double, 4>> duv;  // per UV set: ds/dx, dt/dx, ds/dy, dt/dy per texel
-  V3 dpdx, dpdy;                           // object-space position per atlas texel
-  V3 face_normal;
+  Vec3d dpdx, dpdy;                        // object-space position per atlas texel
+  Vec3d face_normal;
 };
+
+// The layers transfer fills. Accumulators, samples and want_ are indexed by a layer's slot,
+// never by LayerSemantic's value; the result lists layers in slot order, which must be
+// LayerSemantic order (transfer.h promises it; checked below).
+enum Slot { kAlbedoSlot, kNormalSlot, kOrmSlot, kEmissiveSlot, kSlots };
+struct SlotInfo {
+  LayerSemantic semantic;
+  uint32_t channels;  // accumulated (albedo keeps alpha until the texels show it is not needed)
+};
+constexpr SlotInfo kSlotInfo[kSlots] = {{LayerSemantic::kAlbedo, 4},
+                                        {LayerSemantic::kNormal, 3},
+                                        {LayerSemantic::kOrm, 3},
+                                        {LayerSemantic::kEmissive, 3}};
+constexpr bool slots_in_semantic_order() {
+  for (int l = 1; l < kSlots; ++l)
+    if (!(kSlotInfo[l - 1].semantic < kSlotInfo[l].semantic)) return false;
+  return true;
+}
+static_assert(slots_in_semantic_order(), "TransferResult::layers must be in LayerSemantic order");
 
 struct Sample {
   float albedo[4];
   float normal[3];
   float orm[3];
   float emissive[3];
+  const float* of(int slot) const {
+    switch (slot) {
+      case kAlbedoSlot:
+        return albedo;
+      case kNormalSlot:
+        return normal;
+      case kOrmSlot:
+        return orm;
+      default:
+        return emissive;
+    }
+  }
 };
 
-V3 lerp3(const std::vector<Vec3>& a, const uint32_t v[3], const double l[3]) {
+Vec3d lerp3(const std::vector<Vec3>& a, const uint32_t v[3], const double l[3]) {
   return v3(a[v[0]]) * l[0] + v3(a[v[1]]) * l[1] + v3(a[v[2]]) * l[2];
 }
 
@@ -172,28 +181,28 @@ V3 lerp3(const std::vector<Vec3>& a, const uint32_t v[3], const double l[3]) {
 std::vector<Vec4> compute_tangents(const scene::Primitive& p, const std::vector<Vec3>& normals,
                                    int set) {
   size_t n = p.positions.size();
-  std::vector<V3> tsum(n), bsum(n);
+  std::vector<Vec3d> tsum(n), bsum(n);
   const auto& uv = p.uvs[set];
   for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
     uint32_t i0 = p.indices[f], i1 = p.indices[f + 1], i2 = p.indices[f + 2];
-    V3 e1 = v3(p.positions[i1]) - v3(p.positions[i0]),
-       e2 = v3(p.positions[i2]) - v3(p.positions[i0]);
+    Vec3d e1 = v3(p.positions[i1]) - v3(p.positions[i0]),
+          e2 = v3(p.positions[i2]) - v3(p.positions[i0]);
     double du1 = uv[i1][0] - uv[i0][0], dv1 = uv[i1][1] - uv[i0][1];
     double du2 = uv[i2][0] - uv[i0][0], dv2 = uv[i2][1] - uv[i0][1];
     double det = du1 * dv2 - du2 * dv1;
     if (!(std::abs(det) > 1e-20)) continue;
-    V3 dpdu = (e1 * dv2 - e2 * dv1) * (1.0 / det);
-    V3 dpdv = (e2 * du1 - e1 * du2) * (1.0 / det);
+    Vec3d dpdu = (e1 * dv2 - e2 * dv1) * (1.0 / det);
+    Vec3d dpdv = (e2 * du1 - e1 * du2) * (1.0 / det);
     double area = std::sqrt(dot(cross(e1, e2), cross(e1, e2)));
-    V3 tu = normalized(dpdu, {}) * area, tv = normalized(dpdv, {}) * area;
+    Vec3d tu = normalized(dpdu, {}) * area, tv = normalized(dpdv, {}) * area;
     for (uint32_t i : {i0, i1, i2}) tsum[i] = tsum[i] + tu, bsum[i] = bsum[i] - tv;
   }
   std::vector<Vec4> out(n);
   for (size_t i = 0; i < n; ++i) {
-    V3 nn = normalized(v3(normals[i]), {0, 0, 1});
-    V3 t = normalized(tsum[i] - nn * dot(nn, tsum[i]), {});
+    Vec3d nn = normalized(v3(normals[i]), {0, 0, 1});
+    Vec3d t = normalized(tsum[i] - nn * dot(nn, tsum[i]), {});
     if (dot(t, t) == 0) {  // no UV gradient: any tangent perpendicular to the normal
-      t = normalized(cross(std::abs(nn.x) < 0.9 ? V3{1, 0, 0} : V3{0, 1, 0}, nn), {1, 0, 0});
+      t = normalized(cross(std::abs(nn.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0}, nn), {1, 0, 0});
     }
     double w = dot(cross(nn, t), bsum[i]) < 0 ? -1.0 : 1.0;
     out[i] = {float(t.x), float(t.y), float(t.z), float(w)};
@@ -202,16 +211,16 @@ std::vector<Vec4> compute_tangents(const scene::Primitive& p, const std::vector<
 }
 
 std::vector<Vec3> compute_normals(const scene::Primitive& p) {
-  std::vector<V3> sum(p.positions.size());
+  std::vector<Vec3d> sum(p.positions.size());
   for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
     uint32_t i0 = p.indices[f], i1 = p.indices[f + 1], i2 = p.indices[f + 2];
-    V3 n =
+    Vec3d n =
         cross(v3(p.positions[i1]) - v3(p.positions[i0]), v3(p.positions[i2]) - v3(p.positions[i0]));
     for (uint32_t i : {i0, i1, i2}) sum[i] = sum[i] + n;
   }
   std::vector<Vec3> out(sum.size());
   for (size_t i = 0; i < sum.size(); ++i) {
-    V3 n = normalized(sum[i], {0, 0, 1});
+    Vec3d n = normalized(sum[i], {0, 0, 1});
     out[i] = {float(n.x), float(n.y), float(n.z)};
   }
   return out;
@@ -258,7 +267,7 @@ class Transfer {
   std::vector<int32_t> chart_;                          // per triangle
   std::vector<std::pair<uint32_t, uint32_t>> tri_src_;  // (prim info, face)
   scene::Material default_material_;
-  bool want_[5] = {};  // by LayerSemantic
+  bool want_[kSlots] = {};  // by slot
   double sub_scale_ = 1.0;
   mutable std::atomic<bool> lookup_failed_{false};
   mutable std::mutex error_mutex_;
@@ -401,10 +410,10 @@ Status Transfer::setup_prims() {
       prims_.push_back(std::move(info));
     }
   }
-  want_[size_t(LayerSemantic::kAlbedo)] = true;
-  want_[size_t(LayerSemantic::kNormal)] = any_normal;
-  want_[size_t(LayerSemantic::kOrm)] = any_orm;
-  want_[size_t(LayerSemantic::kEmissive)] = any_emissive;
+  want_[kAlbedoSlot] = true;
+  want_[kNormalSlot] = any_normal;
+  want_[kOrmSlot] = any_orm;
+  want_[kEmissiveSlot] = any_emissive;
 
   const double W = opt_.width, H = opt_.height;
   int64_t chart_base = 0;  // chart ids: vertex-component roots, offset per primitive
@@ -464,7 +473,7 @@ void Transfer::make_eval(uint32_t t, TriEval& te) const {
     grad(uv[te.v[0]][1], uv[te.v[1]][1], uv[te.v[2]][1], d[1], d[3]);
     for (double& c : d) c = std::isfinite(c) ? c * sub_scale_ : 0.0;
   }
-  V3 P0 = v3(p.positions[te.v[0]]), P1 = v3(p.positions[te.v[1]]), P2 = v3(p.positions[te.v[2]]);
+  Vec3d P0 = v3(p.positions[te.v[0]]), P1 = v3(p.positions[te.v[1]]), P2 = v3(p.positions[te.v[2]]);
   grad(P0.x, P1.x, P2.x, te.dpdx.x, te.dpdy.x);
   grad(P0.y, P1.y, P2.y, te.dpdx.y, te.dpdy.y);
   grad(P0.z, P1.z, P2.z, te.dpdx.z, te.dpdy.z);
@@ -543,12 +552,12 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
     }
   }
   if (m.alpha_mode == scene::AlphaMode::kOpaque) s.albedo[3] = 1;
-  if (want_[size_t(LayerSemantic::kEmissive)]) {
+  if (want_[kEmissiveSlot]) {
     float e[4] = {1, 1, 1, 1};
     colour(m.emissive_texture, e);
     for (int c = 0; c < 3; ++c) s.emissive[c] = e[c] * m.emissive_factor[c];
   }
-  if (want_[size_t(LayerSemantic::kOrm)]) {
+  if (want_[kOrmSlot]) {
     float occ = 1, rough = m.roughness_factor, metal = m.metallic_factor;
     if (m.occlusion_texture.valid() && sample_texture(pt, m.occlusion_texture, te, l, tex)) {
       occ = 1.0f + m.occlusion_strength * (tex[0] - 1.0f);
@@ -559,19 +568,19 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
     }
     s.orm[0] = occ, s.orm[1] = rough, s.orm[2] = metal;
   }
-  if (want_[size_t(LayerSemantic::kNormal)]) {
-    V3 n = normalized(lerp3(te.p->normals, te.v, l), te.face_normal);
-    V3 world = n;
+  if (want_[kNormalSlot]) {
+    Vec3d n = normalized(lerp3(te.p->normals, te.v, l), te.face_normal);
+    Vec3d world = n;
     if (m.normal_texture.valid() && sample_texture(pt, m.normal_texture, te, l, tex)) {
       const auto& tg = te.p->tangents;
-      V3 t = {tg[te.v[0]][0] * l[0] + tg[te.v[1]][0] * l[1] + tg[te.v[2]][0] * l[2],
-              tg[te.v[0]][1] * l[0] + tg[te.v[1]][1] * l[1] + tg[te.v[2]][1] * l[2],
-              tg[te.v[0]][2] * l[0] + tg[te.v[1]][2] * l[1] + tg[te.v[2]][2] * l[2]};
+      Vec3d t = {tg[te.v[0]][0] * l[0] + tg[te.v[1]][0] * l[1] + tg[te.v[2]][0] * l[2],
+                 tg[te.v[0]][1] * l[0] + tg[te.v[1]][1] * l[1] + tg[te.v[2]][1] * l[2],
+                 tg[te.v[0]][2] * l[0] + tg[te.v[1]][2] * l[1] + tg[te.v[2]][2] * l[2]};
       t = normalized(
           t - n * dot(n, t),
-          normalized(cross(std::abs(n.x) < 0.9 ? V3{1, 0, 0} : V3{0, 1, 0}, n), {1, 0, 0}));
+          normalized(cross(std::abs(n.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0}, n), {1, 0, 0}));
       double w = tg[te.v[0]][3] < 0 ? -1.0 : 1.0;
-      V3 b = cross(n, t) * w;
+      Vec3d b = cross(n, t) * w;
       double x = (tex[0] * 2.0 - 1.0) * m.normal_scale, y = (tex[1] * 2.0 - 1.0) * m.normal_scale;
       double z = tex[2] * 2.0 - 1.0;
       if (images_[m.normal_texture.image].channels < 3)
@@ -579,11 +588,11 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
       world = normalized(t * x + b * y + n * z, n);
     }
     // The atlas frame: tangent along +x of the atlas, bitangent up the atlas image (glTF).
-    V3 ta = normalized(
+    Vec3d ta = normalized(
         te.dpdx - n * dot(n, te.dpdx),
-        normalized(cross(std::abs(n.x) < 0.9 ? V3{1, 0, 0} : V3{0, 1, 0}, n), {1, 0, 0}));
+        normalized(cross(std::abs(n.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0}, n), {1, 0, 0}));
     double wa = dot(cross(n, ta), te.dpdy) > 0 ? -1.0 : 1.0;
-    V3 ba = cross(n, ta) * wa;
+    Vec3d ba = cross(n, ta) * wa;
     s.normal[0] = float(dot(world, ta));
     s.normal[1] = float(dot(world, ba));
     s.normal[2] = float(dot(world, n));
@@ -608,11 +617,10 @@ Expected<TransferResult> Transfer::run() {
   TransferResult result;
   result.width = W, result.height = H;
   const size_t N = size_t(W) * H;
-  // Accumulators: albedo 4, normal 3, orm 3, emissive 3 channels.
-  static constexpr uint32_t kChannels[4] = {4, 3, 3, 3};
-  std::vector<float> acc[4];
-  for (int l = 0; l < 4; ++l)
-    if (want_[l]) acc[l].assign(N * kChannels[l], 0.0f);
+  // Accumulators, per slot.
+  std::vector<float> acc[kSlots];
+  for (int l = 0; l < kSlots; ++l)
+    if (want_[l]) acc[l].assign(N * kSlotInfo[l].channels, 0.0f);
   auto coverage = std::make_shared<std::vector<uint8_t>>(N, 0);
   const auto pattern = supersample_pattern(opt_.supersample);
   const uint32_t bands = (H + kBandRows - 1) / kBandRows;
@@ -620,12 +628,12 @@ Expected<TransferResult> Transfer::run() {
   std::atomic<uint64_t> sampled{0}, edge_only{0}, contested{0}, samples{0};
 
   auto store = [&](size_t texel, const Sample& s, float weight, bool add) {
-    const float* src[4] = {s.albedo, s.normal, s.orm, s.emissive};
-    for (int l = 0; l < 4; ++l) {
+    for (int l = 0; l < kSlots; ++l) {
       if (!want_[l]) continue;
-      float* d = &acc[l][texel * kChannels[l]];
-      for (uint32_t c = 0; c < kChannels[l]; ++c)
-        d[c] = add ? d[c] + src[l][c] * weight : src[l][c];
+      const uint32_t channels = kSlotInfo[l].channels;
+      const float* src = s.of(l);
+      float* d = &acc[l][texel * channels];
+      for (uint32_t c = 0; c < channels; ++c) d[c] = add ? d[c] + src[c] * weight : src[c];
     }
   };
 
@@ -658,9 +666,10 @@ Expected<TransferResult> Transfer::run() {
         // Partially covered texels average only the samples that fell inside.
         float scale = float(pattern.size()) / float(band.inside[i]);
         if (scale != 1.0f) {
-          for (int l = 0; l < 4; ++l) {
+          for (int l = 0; l < kSlots; ++l) {
             if (!want_[l]) continue;
-            for (uint32_t c = 0; c < kChannels[l]; ++c) acc[l][texel * kChannels[l] + c] *= scale;
+            const uint32_t channels = kSlotInfo[l].channels;
+            for (uint32_t c = 0; c < channels; ++c) acc[l][texel * channels + c] *= scale;
           }
         }
         continue;
@@ -680,12 +689,12 @@ Expected<TransferResult> Transfer::run() {
   if (lookup_failed_) return Error(ErrorCode::kIo, lookup_error_);
 
   // Layers: only those called for; alpha only if some covered texel is not opaque.
-  for (int l = 0; l < 4; ++l) {
+  for (int l = 0; l < kSlots; ++l) {
     if (!want_[l]) continue;
     TransferLayer layer;
-    layer.semantic = LayerSemantic(l);
-    layer.channels = kChannels[l];
-    if (l == int(LayerSemantic::kAlbedo)) {
+    layer.semantic = kSlotInfo[l].semantic;
+    layer.channels = kSlotInfo[l].channels;
+    if (l == kAlbedoSlot) {
       bool alpha = false;
       for (size_t i = 0; i < N && !alpha; ++i)
         alpha = (*coverage)[i] && acc[l][4 * i + 3] < kOpaque;
@@ -697,11 +706,11 @@ Expected<TransferResult> Transfer::run() {
         layer.channels = 3;
       }
     }
-    if (l == int(LayerSemantic::kNormal)) {
+    if (l == kNormalSlot) {
       for (size_t i = 0; i < N; ++i) {
         float* n = &acc[l][3 * i];
         if (!(*coverage)[i]) continue;
-        V3 v = normalized({n[0], n[1], n[2]}, {0, 0, 1});
+        Vec3d v = normalized(Vec3d{n[0], n[1], n[2]}, {0, 0, 1});
         n[0] = float(v.x), n[1] = float(v.y), n[2] = float(v.z);
       }
     } else {
