@@ -6,15 +6,16 @@
 #include <random>
 
 #include "bake/unwrap/atlas_raster.h"
+#include "tests/unwrap/grid_triangles.h"
 
 namespace vt::unwrap {
 namespace {
 
 using Corners = std::array<double, 6>;
 
-// Quads of an n x n lattice with spacing `cell`, split along alternating diagonals with
-// alternating winding. With `jitter` the interior vertices move by up to a quarter cell in
-// eighths of a texel, so the mesh stays valid and ties on texel centres stay exact.
+// An n x n lattice of quads with spacing `cell`, triangulated by grid_triangles. With `jitter` the
+// interior vertices move by up to a quarter cell in eighths of a texel, so the mesh stays valid and
+// ties on texel centres stay exact.
 std::vector<Corners> lattice(double x0, double y0, double cell, int n, bool jitter, uint32_t seed) {
   std::mt19937 rng(seed);
   const int steps = jitter ? int(cell * 8 / 4) : 0;
@@ -26,20 +27,7 @@ std::vector<Corners> lattice(double x0, double y0, double cell, int n, bool jitt
       if (i > 0 && i < n && j > 0 && j < n) x += d(rng) / 8.0, y += d(rng) / 8.0;
       v.push_back({x, y});
     }
-  std::vector<Corners> t;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      auto a = v[j * (n + 1) + i], b = v[j * (n + 1) + i + 1], c = v[(j + 1) * (n + 1) + i],
-           e = v[(j + 1) * (n + 1) + i + 1];
-      if ((i + j) % 2) {
-        t.push_back({a[0], a[1], b[0], b[1], e[0], e[1]});
-        t.push_back({a[0], a[1], c[0], c[1], e[0], e[1]});
-      } else {
-        t.push_back({a[0], a[1], c[0], c[1], b[0], b[1]});
-        t.push_back({b[0], b[1], e[0], e[1], c[0], c[1]});
-      }
-    }
-  return t;
+  return test::grid_triangles(v, n);
 }
 
 std::vector<int64_t> touched(const RasterTriangle& t, double margin, const TexelRect& clip) {
