@@ -1,8 +1,10 @@
 // Material transfer (see transfer.h). Work is split into bands of atlas rows; each band walks
 // the triangles that overlap it in index order, so the result does not depend on threads.
 #include "bake/transfer.h"
+#include "bake/unwrap/atlas_raster.h"
 #include "common/parallel.h"
 #include "common/srgb.h"
+#include "common/vec.h"
 
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
@@ -29,121 +31,13 @@ constexpr float kOpaque = 1.0f - 0.5f / 255.0f;  // alpha at or above this is st
 using scene::Vec2;
 using scene::Vec3;
 using scene::Vec4;
+using unwrap::bin_by_rows;
+using unwrap::for_each_touched_texel;
+using unwrap::RasterTriangle;
+using unwrap::TexelRect;
 
-struct V3 {
-  double x = 0, y = 0, z = 0;
-};
-V3 operator+(V3 a, V3 b) {
-  return {a.x + b.x, a.y + b.y, a.z + b.z};
-}
-V3 operator-(V3 a, V3 b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-V3 operator*(V3 a, double s) {
-  return {a.x * s, a.y * s, a.z * s};
-}
-double dot(V3 a, V3 b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-V3 cross(V3 a, V3 b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-V3 normalized(V3 a, V3 fallback) {
-  double l = std::sqrt(dot(a, a));
-  if (!(l > 1e-30) || !std::isfinite(l)) return fallback;
-  return a * (1.0 / l);
-}
-V3 v3(const Vec3& a) {
+Vec3d v3(const Vec3& a) {
   return {a[0], a[1], a[2]};
-}
-
-// A triangle in atlas texel space, positively oriented (vertices reordered if needed), with its
-// edges in canonical form: an edge shared by two triangles is evaluated from the same endpoint
-// by both, so the two edge functions are exact negatives and no sample is claimed twice.
-struct RasterTri {
-  double x[3], y[3];
-  double area2 = 0;
-  struct Edge {
-    double ax, ay, dx, dy, sign;
-    bool include_zero;  // top-left rule
-  } e[3];               // e[k] is the edge opposite vertex k (from vertex k+1 to k+2)
-  int32_t chart = 0;
-  uint8_t order[3] = {0, 1, 2};  // original vertex index of each reordered vertex
-
-  double edge(int k, double px, double py) const {
-    const Edge& g = e[k];
-    return g.sign * (g.dx * (py - g.ay) - g.dy * (px - g.ax));
-  }
-  bool contains(double px, double py, double lambda[3]) const {
-    for (int k = 0; k < 3; ++k) {
-      double v = edge(k, px, py);
-      if (v < 0 || (v == 0 && !e[k].include_zero)) return false;
-      lambda[k] = v;
-    }
-    for (int k = 0; k < 3; ++k) lambda[k] /= area2;
-    return true;
-  }
-};
-
-RasterTri make_raster_tri(const std::array<double, 6>& p, int32_t chart) {
-  RasterTri t;
-  t.chart = chart;
-  for (int k = 0; k < 3; ++k) t.x[k] = p[2 * k], t.y[k] = p[2 * k + 1];
-  double a2 = (t.x[1] - t.x[0]) * (t.y[2] - t.y[0]) - (t.y[1] - t.y[0]) * (t.x[2] - t.x[0]);
-  if (a2 < 0) {
-    std::swap(t.x[1], t.x[2]);
-    std::swap(t.y[1], t.y[2]);
-    std::swap(t.order[1], t.order[2]);
-    a2 = -a2;
-  }
-  t.area2 = a2;
-  for (int k = 0; k < 3; ++k) {
-    int i = (k + 1) % 3, j = (k + 2) % 3;  // edge i -> j
-    bool forward = std::make_pair(t.x[i], t.y[i]) < std::make_pair(t.x[j], t.y[j]);
-    int a = forward ? i : j, b = forward ? j : i;
-    RasterTri::Edge& g = t.e[k];
-    g.ax = t.x[a], g.ay = t.y[a], g.dx = t.x[b] - t.x[a], g.dy = t.y[b] - t.y[a];
-    g.sign = forward ? 1.0 : -1.0;
-    double ex = t.x[j] - t.x[i], ey = t.y[j] - t.y[i];
-    g.include_zero = ey > 0 || (ey == 0 && ex < 0);
-  }
-  return t;
-}
-
-// Closest point of the (closed) triangle to p, as barycentrics of the reordered vertices.
-void closest_barycentrics(const RasterTri& t, double px, double py, double lambda[3]) {
-  double inside[3];
-  bool in = true;
-  for (int k = 0; k < 3; ++k) {
-    inside[k] = t.edge(k, px, py) / t.area2;
-    if (inside[k] < 0) in = false;
-  }
-  if (in) {
-    for (int k = 0; k < 3; ++k) lambda[k] = inside[k];
-    return;
-  }
-  double best = std::numeric_limits<double>::infinity();
-  for (int k = 0; k < 3; ++k) {
-    int i = (k + 1) % 3, j = (k + 2) % 3;
-    double ex = t.x[j] - t.x[i], ey = t.y[j] - t.y[i];
-    double len2 = ex * ex + ey * ey;
-    double s = len2 > 0 ? ((px - t.x[i]) * ex + (py - t.y[i]) * ey) / len2 : 0.0;
-    s = std::clamp(s, 0.0, 1.0);
-    double qx = t.x[i] + s * ex - px, qy = t.y[i] + s * ey - py;
-    double d = qx * qx + qy * qy;
-    if (d < best) {
-      best = d;
-      lambda[k] = 0, lambda[i] = 1 - s, lambda[j] = s;
-    }
-  }
-}
-
-double distance2_to(const RasterTri& t, double px, double py) {
-  double l[3];
-  closest_barycentrics(t, px, py, l);
-  double qx = l[0] * t.x[0] + l[1] * t.x[1] + l[2] * t.x[2] - px;
-  double qy = l[0] * t.y[0] + l[1] * t.y[1] + l[2] * t.y[2] - py;
-  return qx * qx + qy * qy;
 }
 
 // Runs `body(band)` for every band on `threads` threads; the calling thread reports progress.
@@ -177,69 +71,36 @@ struct BandRaster {
   }
 };
 
-// Rasterises `tri` (index t) into the band. on_sample(texel index in band, lambda) is called for
-// each sub-sample inside the triangle. Returns sub-samples claimed twice.
+// Rasterises `tri` (index t, chart `chart`) into the band. on_sample(texel index in band,
+// lambda) is called for each sub-sample inside the triangle. Returns sub-samples claimed twice.
 template <class OnSample>
-uint64_t raster_triangle(const RasterTri& tri, int32_t t, BandRaster& band,
+uint64_t raster_triangle(const RasterTriangle& tri, int32_t t, int32_t chart, BandRaster& band,
                          const std::vector<std::array<double, 2>>& pattern, uint32_t height,
                          OnSample&& on_sample) {
-  if (!(tri.area2 > 0) || !std::isfinite(tri.area2)) return 0;
-  double minx = std::min({tri.x[0], tri.x[1], tri.x[2]}),
-         maxx = std::max({tri.x[0], tri.x[1], tri.x[2]});
-  double miny = std::min({tri.y[0], tri.y[1], tri.y[2]}),
-         maxy = std::max({tri.y[0], tri.y[1], tri.y[2]});
-  // Texels whose open square meets the triangle: i in (min - 1, max).
-  int64_t xa = std::max<int64_t>(0, int64_t(std::floor(minx)));
-  int64_t xb = std::min<int64_t>(int64_t(band.width) - 1, int64_t(std::ceil(maxx)) - 1);
-  int64_t ya = std::max<int64_t>(band.y0, int64_t(std::floor(miny)));
-  int64_t yb =
-      std::min<int64_t>(std::min<int64_t>(band.y1, height) - 1, int64_t(std::ceil(maxy)) - 1);
   uint64_t twice = 0;
-  // Half extent of an edge function over a texel square, for the conservative test.
-  double reach[3];
-  for (int k = 0; k < 3; ++k) reach[k] = 0.5 * (std::abs(tri.e[k].dx) + std::abs(tri.e[k].dy));
-  for (int64_t y = ya; y <= yb; ++y) {
-    for (int64_t x = xa; x <= xb; ++x) {
-      double cx = x + 0.5, cy = y + 0.5;
-      bool touch = true;
-      for (int k = 0; k < 3 && touch; ++k) touch = tri.edge(k, cx, cy) + reach[k] > 0;
-      if (!touch) continue;
-      size_t i = size_t(y - band.y0) * band.width + size_t(x);
-      if (band.chart[i] < 0) {
-        band.chart[i] = tri.chart;
-      } else if (band.chart[i] != tri.chart) {
-        band.contested[i] = 1;
-      }
-      bool any = false;
-      for (size_t s = 0; s < pattern.size(); ++s) {
-        double lambda[3];
-        if (!tri.contains(x + pattern[s][0], y + pattern[s][1], lambda)) continue;
-        if (band.claimed[i] & (1u << s)) ++twice;
-        band.claimed[i] |= uint16_t(1u << s);
-        band.inside[i]++;
-        any = true;
-        on_sample(i, lambda);
-      }
-      double d = any ? 0.0 : distance2_to(tri, cx, cy);
-      if (d < band.best_dist[i]) band.best_dist[i] = d, band.best_tri[i] = t;
+  const TexelRect clip = {0, band.y0, int64_t(band.width) - 1,
+                          std::min<int64_t>(band.y1, height) - 1};
+  for_each_touched_texel(tri, 0.0, clip, [&](int64_t x, int64_t y) {
+    size_t i = size_t(y - band.y0) * band.width + size_t(x);
+    if (band.chart[i] < 0) {
+      band.chart[i] = chart;
+    } else if (band.chart[i] != chart) {
+      band.contested[i] = 1;
     }
-  }
+    bool any = false;
+    for (size_t s = 0; s < pattern.size(); ++s) {
+      double lambda[3];
+      if (!tri.contains(x + pattern[s][0], y + pattern[s][1], lambda)) continue;
+      if (band.claimed[i] & (1u << s)) ++twice;
+      band.claimed[i] |= uint16_t(1u << s);
+      band.inside[i]++;
+      any = true;
+      on_sample(i, lambda);
+    }
+    double d = any ? 0.0 : tri.distance2_to(x + 0.5, y + 0.5);
+    if (d < band.best_dist[i]) band.best_dist[i] = d, band.best_tri[i] = t;
+  });
   return twice;
-}
-
-std::vector<std::vector<uint32_t>> bin_triangles(const std::vector<RasterTri>& tris,
-                                                 uint32_t height, uint32_t bands) {
-  std::vector<std::vector<uint32_t>> bins(bands);
-  for (uint32_t t = 0; t < tris.size(); ++t) {
-    const RasterTri& r = tris[t];
-    double miny = std::min({r.y[0], r.y[1], r.y[2]}), maxy = std::max({r.y[0], r.y[1], r.y[2]});
-    if (!std::isfinite(miny) || !std::isfinite(maxy)) continue;
-    int64_t ya = std::max<int64_t>(0, int64_t(std::floor(miny)));
-    int64_t yb = std::min<int64_t>(int64_t(height) - 1, int64_t(std::ceil(maxy)) - 1);
-    if (yb < ya) continue;
-    for (int64_t b = ya / kBandRows; b <= yb / kBandRows; ++b) bins[b].push_back(t);
-  }
-  return bins;
 }
 
 // ---- Materials -------------------------------------------------------------------------------
@@ -265,18 +126,49 @@ struct TriEval {
   const PrimInfo* p = nullptr;
   uint32_t v[3];                           // vertex indices in the raster triangle's order
   std::vector<std::array<double, 4>> duv;  // per UV set: ds/dx, dt/dx, ds/dy, dt/dy per texel
-  V3 dpdx, dpdy;                           // object-space position per atlas texel
-  V3 face_normal;
+  Vec3d dpdx, dpdy;                        // object-space position per atlas texel
+  Vec3d face_normal;
 };
+
+// The layers transfer fills. Accumulators, samples and want_ are indexed by a layer's slot,
+// never by LayerSemantic's value; the result lists layers in slot order, which must be
+// LayerSemantic order (transfer.h promises it; checked below).
+enum Slot { kAlbedoSlot, kNormalSlot, kOrmSlot, kEmissiveSlot, kSlots };
+struct SlotInfo {
+  LayerSemantic semantic;
+  uint32_t channels;  // accumulated (albedo keeps alpha until the texels show it is not needed)
+};
+constexpr SlotInfo kSlotInfo[kSlots] = {{LayerSemantic::kAlbedo, 4},
+                                        {LayerSemantic::kNormal, 3},
+                                        {LayerSemantic::kOrm, 3},
+                                        {LayerSemantic::kEmissive, 3}};
+constexpr bool slots_in_semantic_order() {
+  for (int l = 1; l < kSlots; ++l)
+    if (!(kSlotInfo[l - 1].semantic < kSlotInfo[l].semantic)) return false;
+  return true;
+}
+static_assert(slots_in_semantic_order(), "TransferResult::layers must be in LayerSemantic order");
 
 struct Sample {
   float albedo[4];
   float normal[3];
   float orm[3];
   float emissive[3];
+  const float* of(int slot) const {
+    switch (slot) {
+      case kAlbedoSlot:
+        return albedo;
+      case kNormalSlot:
+        return normal;
+      case kOrmSlot:
+        return orm;
+      default:
+        return emissive;
+    }
+  }
 };
 
-V3 lerp3(const std::vector<Vec3>& a, const uint32_t v[3], const double l[3]) {
+Vec3d lerp3(const std::vector<Vec3>& a, const uint32_t v[3], const double l[3]) {
   return v3(a[v[0]]) * l[0] + v3(a[v[1]]) * l[1] + v3(a[v[2]]) * l[2];
 }
 
@@ -286,28 +178,28 @@ V3 lerp3(const std::vector<Vec3>& a, const uint32_t v[3], const double l[3]) {
 std::vector<Vec4> compute_tangents(const scene::Primitive& p, const std::vector<Vec3>& normals,
                                    int set) {
   size_t n = p.positions.size();
-  std::vector<V3> tsum(n), bsum(n);
+  std::vector<Vec3d> tsum(n), bsum(n);
   const auto& uv = p.uvs[set];
   for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
     uint32_t i0 = p.indices[f], i1 = p.indices[f + 1], i2 = p.indices[f + 2];
-    V3 e1 = v3(p.positions[i1]) - v3(p.positions[i0]),
-       e2 = v3(p.positions[i2]) - v3(p.positions[i0]);
+    Vec3d e1 = v3(p.positions[i1]) - v3(p.positions[i0]),
+          e2 = v3(p.positions[i2]) - v3(p.positions[i0]);
     double du1 = uv[i1][0] - uv[i0][0], dv1 = uv[i1][1] - uv[i0][1];
     double du2 = uv[i2][0] - uv[i0][0], dv2 = uv[i2][1] - uv[i0][1];
     double det = du1 * dv2 - du2 * dv1;
     if (!(std::abs(det) > 1e-20)) continue;
-    V3 dpdu = (e1 * dv2 - e2 * dv1) * (1.0 / det);
-    V3 dpdv = (e2 * du1 - e1 * du2) * (1.0 / det);
+    Vec3d dpdu = (e1 * dv2 - e2 * dv1) * (1.0 / det);
+    Vec3d dpdv = (e2 * du1 - e1 * du2) * (1.0 / det);
     double area = std::sqrt(dot(cross(e1, e2), cross(e1, e2)));
-    V3 tu = normalized(dpdu, {}) * area, tv = normalized(dpdv, {}) * area;
+    Vec3d tu = normalized(dpdu, {}) * area, tv = normalized(dpdv, {}) * area;
     for (uint32_t i : {i0, i1, i2}) tsum[i] = tsum[i] + tu, bsum[i] = bsum[i] - tv;
   }
   std::vector<Vec4> out(n);
   for (size_t i = 0; i < n; ++i) {
-    V3 nn = normalized(v3(normals[i]), {0, 0, 1});
-    V3 t = normalized(tsum[i] - nn * dot(nn, tsum[i]), {});
+    Vec3d nn = normalized(v3(normals[i]), {0, 0, 1});
+    Vec3d t = normalized(tsum[i] - nn * dot(nn, tsum[i]), {});
     if (dot(t, t) == 0) {  // no UV gradient: any tangent perpendicular to the normal
-      t = normalized(cross(std::abs(nn.x) < 0.9 ? V3{1, 0, 0} : V3{0, 1, 0}, nn), {1, 0, 0});
+      t = normalized(cross(std::abs(nn.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0}, nn), {1, 0, 0});
     }
     double w = dot(cross(nn, t), bsum[i]) < 0 ? -1.0 : 1.0;
     out[i] = {float(t.x), float(t.y), float(t.z), float(w)};
@@ -316,16 +208,16 @@ std::vector<Vec4> compute_tangents(const scene::Primitive& p, const std::vector<
 }
 
 std::vector<Vec3> compute_normals(const scene::Primitive& p) {
-  std::vector<V3> sum(p.positions.size());
+  std::vector<Vec3d> sum(p.positions.size());
   for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
     uint32_t i0 = p.indices[f], i1 = p.indices[f + 1], i2 = p.indices[f + 2];
-    V3 n =
+    Vec3d n =
         cross(v3(p.positions[i1]) - v3(p.positions[i0]), v3(p.positions[i2]) - v3(p.positions[i0]));
     for (uint32_t i : {i0, i1, i2}) sum[i] = sum[i] + n;
   }
   std::vector<Vec3> out(sum.size());
   for (size_t i = 0; i < sum.size(); ++i) {
-    V3 n = normalized(sum[i], {0, 0, 1});
+    Vec3d n = normalized(sum[i], {0, 0, 1});
     out[i] = {float(n.x), float(n.y), float(n.z)};
   }
   return out;
@@ -368,10 +260,11 @@ class Transfer {
   std::vector<ImageSlot> images_;
   std::vector<std::string> temp_files_;
   std::vector<PrimInfo> prims_;
-  std::vector<RasterTri> tris_;
+  std::vector<RasterTriangle> tris_;
+  std::vector<int32_t> chart_;                          // per triangle
   std::vector<std::pair<uint32_t, uint32_t>> tri_src_;  // (prim info, face)
   scene::Material default_material_;
-  bool want_[5] = {};  // by LayerSemantic
+  bool want_[kSlots] = {};  // by slot
   double sub_scale_ = 1.0;
   mutable std::atomic<bool> lookup_failed_{false};
   mutable std::mutex error_mutex_;
@@ -514,10 +407,10 @@ Status Transfer::setup_prims() {
       prims_.push_back(std::move(info));
     }
   }
-  want_[size_t(LayerSemantic::kAlbedo)] = true;
-  want_[size_t(LayerSemantic::kNormal)] = any_normal;
-  want_[size_t(LayerSemantic::kOrm)] = any_orm;
-  want_[size_t(LayerSemantic::kEmissive)] = any_emissive;
+  want_[kAlbedoSlot] = true;
+  want_[kNormalSlot] = any_normal;
+  want_[kOrmSlot] = any_orm;
+  want_[kEmissiveSlot] = any_emissive;
 
   const double W = opt_.width, H = opt_.height;
   int64_t chart_base = 0;  // chart ids: vertex-component roots, offset per primitive
@@ -544,7 +437,8 @@ Status Transfer::setup_prims() {
         const Vec2& a = uv[p.indices[f + k]];
         q[2 * k] = double(a[0]) * W, q[2 * k + 1] = double(a[1]) * H;
       }
-      tris_.push_back(make_raster_tri(q, int32_t(chart_base + find(p.indices[f]))));
+      tris_.emplace_back(q);
+      chart_.push_back(int32_t(chart_base + find(p.indices[f])));
       tri_src_.push_back({pi, uint32_t(f / 3)});
     }
     chart_base += p.positions.size();
@@ -553,7 +447,7 @@ Status Transfer::setup_prims() {
 }
 
 void Transfer::make_eval(uint32_t t, TriEval& te) const {
-  const RasterTri& r = tris_[t];
+  const RasterTriangle& r = tris_[t];
   const PrimInfo& pi = prims_[tri_src_[t].first];
   const scene::Primitive& p = *pi.prim;
   size_t f = tri_src_[t].second;
@@ -576,7 +470,7 @@ void Transfer::make_eval(uint32_t t, TriEval& te) const {
     grad(uv[te.v[0]][1], uv[te.v[1]][1], uv[te.v[2]][1], d[1], d[3]);
     for (double& c : d) c = std::isfinite(c) ? c * sub_scale_ : 0.0;
   }
-  V3 P0 = v3(p.positions[te.v[0]]), P1 = v3(p.positions[te.v[1]]), P2 = v3(p.positions[te.v[2]]);
+  Vec3d P0 = v3(p.positions[te.v[0]]), P1 = v3(p.positions[te.v[1]]), P2 = v3(p.positions[te.v[2]]);
   grad(P0.x, P1.x, P2.x, te.dpdx.x, te.dpdy.x);
   grad(P0.y, P1.y, P2.y, te.dpdx.y, te.dpdy.y);
   grad(P0.z, P1.z, P2.z, te.dpdx.z, te.dpdy.z);
@@ -655,12 +549,12 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
     }
   }
   if (m.alpha_mode == scene::AlphaMode::kOpaque) s.albedo[3] = 1;
-  if (want_[size_t(LayerSemantic::kEmissive)]) {
+  if (want_[kEmissiveSlot]) {
     float e[4] = {1, 1, 1, 1};
     colour(m.emissive_texture, e);
     for (int c = 0; c < 3; ++c) s.emissive[c] = e[c] * m.emissive_factor[c];
   }
-  if (want_[size_t(LayerSemantic::kOrm)]) {
+  if (want_[kOrmSlot]) {
     float occ = 1, rough = m.roughness_factor, metal = m.metallic_factor;
     if (m.occlusion_texture.valid() && sample_texture(pt, m.occlusion_texture, te, l, tex)) {
       occ = 1.0f + m.occlusion_strength * (tex[0] - 1.0f);
@@ -671,19 +565,19 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
     }
     s.orm[0] = occ, s.orm[1] = rough, s.orm[2] = metal;
   }
-  if (want_[size_t(LayerSemantic::kNormal)]) {
-    V3 n = normalized(lerp3(te.p->normals, te.v, l), te.face_normal);
-    V3 world = n;
+  if (want_[kNormalSlot]) {
+    Vec3d n = normalized(lerp3(te.p->normals, te.v, l), te.face_normal);
+    Vec3d world = n;
     if (m.normal_texture.valid() && sample_texture(pt, m.normal_texture, te, l, tex)) {
       const auto& tg = te.p->tangents;
-      V3 t = {tg[te.v[0]][0] * l[0] + tg[te.v[1]][0] * l[1] + tg[te.v[2]][0] * l[2],
-              tg[te.v[0]][1] * l[0] + tg[te.v[1]][1] * l[1] + tg[te.v[2]][1] * l[2],
-              tg[te.v[0]][2] * l[0] + tg[te.v[1]][2] * l[1] + tg[te.v[2]][2] * l[2]};
+      Vec3d t = {tg[te.v[0]][0] * l[0] + tg[te.v[1]][0] * l[1] + tg[te.v[2]][0] * l[2],
+                 tg[te.v[0]][1] * l[0] + tg[te.v[1]][1] * l[1] + tg[te.v[2]][1] * l[2],
+                 tg[te.v[0]][2] * l[0] + tg[te.v[1]][2] * l[1] + tg[te.v[2]][2] * l[2]};
       t = normalized(
           t - n * dot(n, t),
-          normalized(cross(std::abs(n.x) < 0.9 ? V3{1, 0, 0} : V3{0, 1, 0}, n), {1, 0, 0}));
+          normalized(cross(std::abs(n.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0}, n), {1, 0, 0}));
       double w = tg[te.v[0]][3] < 0 ? -1.0 : 1.0;
-      V3 b = cross(n, t) * w;
+      Vec3d b = cross(n, t) * w;
       double x = (tex[0] * 2.0 - 1.0) * m.normal_scale, y = (tex[1] * 2.0 - 1.0) * m.normal_scale;
       double z = tex[2] * 2.0 - 1.0;
       if (images_[m.normal_texture.image].channels < 3)
@@ -691,11 +585,11 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
       world = normalized(t * x + b * y + n * z, n);
     }
     // The atlas frame: tangent along +x of the atlas, bitangent up the atlas image (glTF).
-    V3 ta = normalized(
+    Vec3d ta = normalized(
         te.dpdx - n * dot(n, te.dpdx),
-        normalized(cross(std::abs(n.x) < 0.9 ? V3{1, 0, 0} : V3{0, 1, 0}, n), {1, 0, 0}));
+        normalized(cross(std::abs(n.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0}, n), {1, 0, 0}));
     double wa = dot(cross(n, ta), te.dpdy) > 0 ? -1.0 : 1.0;
-    V3 ba = cross(n, ta) * wa;
+    Vec3d ba = cross(n, ta) * wa;
     s.normal[0] = float(dot(world, ta));
     s.normal[1] = float(dot(world, ba));
     s.normal[2] = float(dot(world, n));
@@ -720,24 +614,23 @@ Expected<TransferResult> Transfer::run() {
   TransferResult result;
   result.width = W, result.height = H;
   const size_t N = size_t(W) * H;
-  // Accumulators: albedo 4, normal 3, orm 3, emissive 3 channels.
-  static constexpr uint32_t kChannels[4] = {4, 3, 3, 3};
-  std::vector<float> acc[4];
-  for (int l = 0; l < 4; ++l)
-    if (want_[l]) acc[l].assign(N * kChannels[l], 0.0f);
+  // Accumulators, per slot.
+  std::vector<float> acc[kSlots];
+  for (int l = 0; l < kSlots; ++l)
+    if (want_[l]) acc[l].assign(N * kSlotInfo[l].channels, 0.0f);
   auto coverage = std::make_shared<std::vector<uint8_t>>(N, 0);
   const auto pattern = supersample_pattern(opt_.supersample);
   const uint32_t bands = (H + kBandRows - 1) / kBandRows;
-  auto bins = bin_triangles(tris_, H, bands);
+  auto bins = bin_by_rows(tris_, H, kBandRows);
   std::atomic<uint64_t> sampled{0}, edge_only{0}, contested{0}, samples{0};
 
   auto store = [&](size_t texel, const Sample& s, float weight, bool add) {
-    const float* src[4] = {s.albedo, s.normal, s.orm, s.emissive};
-    for (int l = 0; l < 4; ++l) {
+    for (int l = 0; l < kSlots; ++l) {
       if (!want_[l]) continue;
-      float* d = &acc[l][texel * kChannels[l]];
-      for (uint32_t c = 0; c < kChannels[l]; ++c)
-        d[c] = add ? d[c] + src[l][c] * weight : src[l][c];
+      const uint32_t channels = kSlotInfo[l].channels;
+      const float* src = s.of(l);
+      float* d = &acc[l][texel * channels];
+      for (uint32_t c = 0; c < channels; ++c) d[c] = add ? d[c] + src[c] * weight : src[c];
     }
   };
 
@@ -752,11 +645,12 @@ Expected<TransferResult> Transfer::run() {
     const float weight = 1.0f / float(pattern.size());
     for (uint32_t t : bins[b]) {
       make_eval(t, te);
-      raster_triangle(tris_[t], int32_t(t), band, pattern, H, [&](size_t i, const double* l) {
-        evaluate(pt, te, l, s);
-        store(size_t(y0) * W + i, s, weight, true);
-        ++n_samples;
-      });
+      raster_triangle(tris_[t], int32_t(t), chart_[t], band, pattern, H,
+                      [&](size_t i, const double* l) {
+                        evaluate(pt, te, l, s);
+                        store(size_t(y0) * W + i, s, weight, true);
+                        ++n_samples;
+                      });
     }
     uint64_t n_sampled = 0, n_edge = 0, n_contested = 0;
     for (size_t i = 0; i < band.best_tri.size(); ++i) {
@@ -769,9 +663,10 @@ Expected<TransferResult> Transfer::run() {
         // Partially covered texels average only the samples that fell inside.
         float scale = float(pattern.size()) / float(band.inside[i]);
         if (scale != 1.0f) {
-          for (int l = 0; l < 4; ++l) {
+          for (int l = 0; l < kSlots; ++l) {
             if (!want_[l]) continue;
-            for (uint32_t c = 0; c < kChannels[l]; ++c) acc[l][texel * kChannels[l] + c] *= scale;
+            const uint32_t channels = kSlotInfo[l].channels;
+            for (uint32_t c = 0; c < channels; ++c) acc[l][texel * channels + c] *= scale;
           }
         }
         continue;
@@ -781,7 +676,7 @@ Expected<TransferResult> Transfer::run() {
       uint32_t t = uint32_t(band.best_tri[i]);
       make_eval(t, te);
       double l[3];
-      closest_barycentrics(tris_[t], (i % W) + 0.5, (y0 + i / W) + 0.5, l);
+      tris_[t].closest_barycentrics((i % W) + 0.5, (y0 + i / W) + 0.5, l);
       evaluate(pt, te, l, s);
       store(texel, s, 1.0f, false);
       ++n_samples;
@@ -791,12 +686,12 @@ Expected<TransferResult> Transfer::run() {
   if (lookup_failed_) return Error(ErrorCode::kIo, lookup_error_);
 
   // Layers: only those called for; alpha only if some covered texel is not opaque.
-  for (int l = 0; l < 4; ++l) {
+  for (int l = 0; l < kSlots; ++l) {
     if (!want_[l]) continue;
     TransferLayer layer;
-    layer.semantic = LayerSemantic(l);
-    layer.channels = kChannels[l];
-    if (l == int(LayerSemantic::kAlbedo)) {
+    layer.semantic = kSlotInfo[l].semantic;
+    layer.channels = kSlotInfo[l].channels;
+    if (l == kAlbedoSlot) {
       bool alpha = false;
       for (size_t i = 0; i < N && !alpha; ++i)
         alpha = (*coverage)[i] && acc[l][4 * i + 3] < kOpaque;
@@ -808,11 +703,11 @@ Expected<TransferResult> Transfer::run() {
         layer.channels = 3;
       }
     }
-    if (l == int(LayerSemantic::kNormal)) {
+    if (l == kNormalSlot) {
       for (size_t i = 0; i < N; ++i) {
         float* n = &acc[l][3 * i];
         if (!(*coverage)[i]) continue;
-        V3 v = normalized({n[0], n[1], n[2]}, {0, 0, 1});
+        Vec3d v = normalized(Vec3d{n[0], n[1], n[2]}, {0, 0, 1});
         n[0] = float(v.x), n[1] = float(v.y), n[2] = float(v.z);
       }
     } else {
@@ -875,20 +770,17 @@ AtlasRaster rasterize_atlas(const std::vector<std::array<double, 6>>& triangles,
   AtlasRaster out;
   out.owner.assign(size_t(width) * height, -1);
   out.inside.assign(size_t(width) * height, 0);
-  std::vector<RasterTri> tris;
-  for (size_t t = 0; t < triangles.size(); ++t) {
-    tris.push_back(make_raster_tri(triangles[t], t < chart.size() ? chart[t] : 0));
-  }
+  std::vector<RasterTriangle> tris(triangles.begin(), triangles.end());
   const auto pattern = supersample_pattern(supersample);
   const uint32_t bands = (height + kBandRows - 1) / kBandRows;
-  auto bins = bin_triangles(tris, height, bands);
+  auto bins = bin_by_rows(tris, height, kBandRows);
   BandRaster band;
   for (uint32_t b = 0; b < bands; ++b) {
     uint32_t y0 = b * kBandRows, y1 = std::min(height, y0 + kBandRows);
     band.reset(width, y0, y1);
     for (uint32_t t : bins[b]) {
-      out.double_sampled +=
-          raster_triangle(tris[t], int32_t(t), band, pattern, height, [](size_t, const double*) {});
+      out.double_sampled += raster_triangle(tris[t], int32_t(t), t < chart.size() ? chart[t] : 0,
+                                            band, pattern, height, [](size_t, const double*) {});
     }
     for (size_t i = 0; i < band.best_tri.size(); ++i) {
       out.owner[size_t(y0) * width + i] = band.best_tri[i];

@@ -9,18 +9,11 @@
 namespace vt::render {
 namespace {
 
-Vec3 sub(Vec3 a, Vec3 b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-float dot(Vec3 a, Vec3 b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-Vec3 cross(Vec3 a, Vec3 b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-Vec3 normalize(Vec3 a) {
-  float l = std::sqrt(dot(a, a));
-  return l > 0 ? Vec3{a.x / l, a.y / l, a.z / l} : Vec3{0, 0, 1};
+// Unit length by division, +z for a zero vector (the renderer's own rule: common/vec.h's
+// normalized multiplies by the reciprocal).
+Vec3f normalize(Vec3f a) {
+  float l = length(a);
+  return l > 0 ? a / l : Vec3f{0, 0, 1};
 }
 
 }  // namespace
@@ -43,10 +36,10 @@ Mat4 Mat4::operator*(const Mat4& b) const {
   return r;
 }
 
-Mat4 look_at(Vec3 eye, Vec3 target, Vec3 up) {
-  Vec3 f = normalize(sub(target, eye));
-  Vec3 s = normalize(cross(f, up));
-  Vec3 u = cross(s, f);
+Mat4 look_at(Vec3f eye, Vec3f target, Vec3f up) {
+  Vec3f f = normalize(target - eye);
+  Vec3f s = normalize(cross(f, up));
+  Vec3f u = cross(s, f);
   Mat4 r = Mat4::identity();
   r.m[0] = s.x, r.m[4] = s.y, r.m[8] = s.z;
   r.m[1] = u.x, r.m[5] = u.y, r.m[9] = u.z;
@@ -80,9 +73,9 @@ Mat4 jitter(const Mat4& vp, float dx, float dy, int width, int height) {
   return r;
 }
 
-std::vector<Camera> orbit_views(Vec3 lo, Vec3 hi, int count, float aspect) {
-  Vec3 c{(lo.x + hi.x) * 0.5f, (lo.y + hi.y) * 0.5f, (lo.z + hi.z) * 0.5f};
-  Vec3 ext = sub(hi, lo);
+std::vector<Camera> orbit_views(Vec3f lo, Vec3f hi, int count, float aspect) {
+  Vec3f c{(lo.x + hi.x) * 0.5f, (lo.y + hi.y) * 0.5f, (lo.z + hi.z) * 0.5f};
+  Vec3f ext = hi - lo;
   float radius = std::max(0.5f * std::sqrt(dot(ext, ext)), 1e-3f);
   const float fov = 0.9f;
   std::vector<Camera> views;
@@ -93,8 +86,8 @@ std::vector<Camera> orbit_views(Vec3 lo, Vec3 hi, int count, float aspect) {
     static const float kElev[] = {0.6f, 0.9f, 0.5f, 0.12f};
     float d = radius * kDist[i % 4];
     float e = kElev[i % 4];
-    Vec3 eye{c.x + d * std::cos(e) * std::cos(azimuth), c.y + d * std::sin(e),
-             c.z + d * std::cos(e) * std::sin(azimuth)};
+    Vec3f eye{c.x + d * std::cos(e) * std::cos(azimuth), c.y + d * std::sin(e),
+              c.z + d * std::cos(e) * std::sin(azimuth)};
     Camera cam;
     cam.view_proj =
         perspective(fov, aspect, std::max(d - radius * 1.5f, d * 0.01f), d + radius * 2.0f) *
@@ -109,7 +102,7 @@ namespace {
 constexpr float kPi = 3.14159265358979f;
 constexpr size_t kMaxCameraFileBytes = 1 << 20;
 
-bool finite(Vec3 v) {
+bool finite(Vec3f v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
@@ -132,7 +125,7 @@ Status read_number(const nlohmann::json& j, const char* key, float* out) {
   return Status::Ok();
 }
 
-Status read_vec3(const nlohmann::json& j, const char* key, Vec3* out) {
+Status read_vec3(const nlohmann::json& j, const char* key, Vec3f* out) {
   if (!j.is_array() || j.size() != 3) {
     return Error(ErrorCode::kInvalidArgument, std::string(key) + ": expected [x, y, z]");
   }

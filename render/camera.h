@@ -8,12 +8,9 @@
 #include <vector>
 
 #include "common/status.h"
+#include "common/vec.h"
 
 namespace vt::render {
-
-struct Vec3 {
-  float x = 0, y = 0, z = 0;
-};
 
 // Column-major: m[column * 4 + row], as GLSL's mat4 reads it from push constants.
 struct Mat4 {
@@ -23,7 +20,7 @@ struct Mat4 {
 };
 
 // Right-handed view looking from `eye` towards `target`.
-Mat4 look_at(Vec3 eye, Vec3 target, Vec3 up);
+Mat4 look_at(Vec3f eye, Vec3f target, Vec3f up);
 // Right-handed perspective with Vulkan's y-down clip space and depth in [0, 1].
 Mat4 perspective(float fov_y_radians, float aspect, float z_near, float z_far);
 // Shifts the image by (dx, dy) pixels of a width x height target (sub-pixel jitter).
@@ -35,7 +32,7 @@ struct Camera {
 
 // Views around an axis-aligned box: a frontal view, close-ups (fine levels), grazing views
 // (anisotropic footprints) and a distant view (coarse levels). Deterministic.
-std::vector<Camera> orbit_views(Vec3 bounds_min, Vec3 bounds_max, int count, float aspect);
+std::vector<Camera> orbit_views(Vec3f bounds_min, Vec3f bounds_max, int count, float aspect);
 
 // Camera file (`vtbake validate --cameras FILE.json`), in the scene's world units:
 //
@@ -47,7 +44,7 @@ std::vector<Camera> orbit_views(Vec3 bounds_min, Vec3 bounds_max, int count, flo
 // distance. 1 to 256 cameras. Unknown keys are errors, so a misspelt key is not silently
 // replaced by its default. The aspect ratio comes from the render size.
 struct CameraSpec {
-  Vec3 eye, target, up{0, 1, 0};
+  Vec3f eye, target, up{0, 1, 0};
   float fov_y_deg = 50.0f;
   float z_near = 0, z_far = 0;  // 0 = derived from the eye-target distance
 };

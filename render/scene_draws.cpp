@@ -17,10 +17,10 @@ uint8_t linear_to_srgb8(float c) {
 }
 
 struct Bounds {
-  Vec3 lo{std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
-          std::numeric_limits<float>::max()};
-  Vec3 hi{-std::numeric_limits<float>::max(), -std::numeric_limits<float>::max(),
-          -std::numeric_limits<float>::max()};
+  Vec3f lo{std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
+           std::numeric_limits<float>::max()};
+  Vec3f hi{-std::numeric_limits<float>::max(), -std::numeric_limits<float>::max(),
+           -std::numeric_limits<float>::max()};
   void add(float x, float y, float z) {
     lo = {std::min(lo.x, x), std::min(lo.y, y), std::min(lo.z, z)};
     hi = {std::max(hi.x, x), std::max(hi.y, y), std::max(hi.z, z)};

@@ -6,17 +6,17 @@
 #include <cstdint>
 #include <vector>
 
-#include "scene/scene.h"
 #include "common/status.h"
 #include "render/camera.h"
 #include "render/renderer.h"
+#include "scene/scene.h"
 
 namespace vt::render {
 
 struct SceneDraws {
   std::vector<MeshData> meshes;
   std::vector<ReferenceTexture> textures;  // reference draws only
-  Vec3 bounds_min, bounds_max;             // world space; min > max when there is no geometry
+  Vec3f bounds_min, bounds_max;            // world space; min > max when there is no geometry
 };
 
 // The unwrapped scene for the virtual-texture pass: every primitive with its UV set `uv_set`

@@ -1,14 +1,16 @@
-// Chart packing: each chart's conservative texel footprint (every texel any triangle touches)
-// is dropped onto a skyline in each of four quarter-turn rotations, keeping the spot with the
-// lowest top, then the least wasted space under it. Quarter turns never mirror a chart.
-// The gutter is exact: a placed chart's footprint dilated by `padding` (Chebyshev) must lie
-// above the skyline of raw footprints, so any two charts have `padding` empty texels between.
+// Chart packing: each chart's conservative texel footprint (every texel a triangle touches with
+// the atlas rasteriser's footprint margin) is dropped onto a skyline in each of four quarter-turn
+// rotations, keeping the spot with the lowest top, then the least wasted space under it. Quarter
+// turns never mirror a chart. The gutter is exact: a placed chart's footprint dilated by `padding`
+// (Chebyshev) must lie above the skyline of raw footprints, so any two charts have `padding` empty
+// texels between.
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numeric>
 #include <thread>
 
+#include "bake/unwrap/atlas_raster.h"
 #include "bake/unwrap/unwrap_internal.h"
 #include "common/parallel.h"
 
@@ -24,54 +26,19 @@ Grid grid_of(const PackChart& c) {
           std::max(1, static_cast<int>(std::ceil(c.height)))};
 }
 
-// Conservative triangle / axis-aligned box overlap (separating axis test). The box is
-// inflated by 1/32 texel: atlas UVs are rounded to float afterwards (up to ~1e-3 texel in a
-// 16k atlas), and an edge through a texel corner must not slip into a neighbour's gutter.
-bool triangle_touches_box(const P2& a, const P2& b, const P2& c, double x0, double y0, double x1,
-                          double y1) {
-  const double eps = 1.0 / 32;
-  x0 -= eps, y0 -= eps, x1 += eps, y1 += eps;
-  if (std::max({a[0], b[0], c[0]}) < x0 || std::min({a[0], b[0], c[0]}) > x1) return false;
-  if (std::max({a[1], b[1], c[1]}) < y0 || std::min({a[1], b[1], c[1]}) > y1) return false;
-  const P2* v[3] = {&a, &b, &c};
-  for (int e = 0; e < 3; ++e) {
-    const P2& p = *v[e];
-    const P2& q = *v[(e + 1) % 3];
-    const P2& r = *v[(e + 2) % 3];
-    double nx = q[1] - p[1], ny = p[0] - q[0];  // edge normal
-    double tri_side = nx * (r[0] - p[0]) + ny * (r[1] - p[1]);
-    if (tri_side == 0) continue;  // degenerate edge direction: the other axes decide
-    double corners[4] = {nx * (x0 - p[0]) + ny * (y0 - p[1]), nx * (x1 - p[0]) + ny * (y0 - p[1]),
-                         nx * (x0 - p[0]) + ny * (y1 - p[1]), nx * (x1 - p[0]) + ny * (y1 - p[1])};
-    double lo = *std::min_element(corners, corners + 4);
-    double hi = *std::max_element(corners, corners + 4);
-    double tol = 1e-9 * (std::abs(nx) + std::abs(ny)) * std::max(1.0, std::abs(x1 - x0));
-    if (tri_side > 0 && hi < -tol) return false;
-    if (tri_side < 0 && lo > tol) return false;
-  }
-  return true;
-}
-
-// Footprint cells (i, j) of a chart in its unrotated grid.
+// Footprint cells (i, j) of a chart in its unrotated grid: every texel a triangle touches with
+// the footprint margin.
 std::vector<char> footprint(const PackChart& chart, const Grid& g) {
   std::vector<char> cells(static_cast<size_t>(g.gx) * g.gy, 0);
+  const TexelRect grid = {0, 0, g.gx - 1, g.gy - 1};
   for (const auto& t : chart.tris) {
     const P2& a = chart.points[t[0]];
     const P2& b = chart.points[t[1]];
     const P2& c = chart.points[t[2]];
-    int i0 =
-        std::clamp(static_cast<int>(std::floor(std::min({a[0], b[0], c[0]}))) - 1, 0, g.gx - 1);
-    int i1 =
-        std::clamp(static_cast<int>(std::floor(std::max({a[0], b[0], c[0]}))) + 1, 0, g.gx - 1);
-    int j0 =
-        std::clamp(static_cast<int>(std::floor(std::min({a[1], b[1], c[1]}))) - 1, 0, g.gy - 1);
-    int j1 =
-        std::clamp(static_cast<int>(std::floor(std::max({a[1], b[1], c[1]}))) + 1, 0, g.gy - 1);
-    for (int j = j0; j <= j1; ++j)
-      for (int i = i0; i <= i1; ++i) {
-        char& cell = cells[static_cast<size_t>(j) * g.gx + i];
-        if (!cell && triangle_touches_box(a, b, c, i, j, i + 1, j + 1)) cell = 1;
-      }
+    const RasterTriangle tri({a[0], a[1], b[0], b[1], c[0], c[1]});
+    for_each_touched_texel(tri, kFootprintMargin, grid, [&](int64_t i, int64_t j) {
+      cells[static_cast<size_t>(j) * g.gx + static_cast<size_t>(i)] = 1;
+    });
   }
   return cells;
 }

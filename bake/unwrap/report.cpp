@@ -5,6 +5,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "bake/unwrap/atlas_raster.h"
 #include "bake/unwrap/unwrap.h"
 
 namespace vt::unwrap {
@@ -75,32 +76,26 @@ Status write_atlas_picture(const UnwrapResult& result, const std::string& path, 
     }
   // Page grid lines in the chart panel, so the artist sees page boundaries.
   int page = result.stats.pages_x > 0 ? aw / result.stats.pages_x : 120;
+  const TexelRect picture = {0, 0, w - 1, h - 1};
   for (const AtlasTriangle& t : result.triangles) {
-    double x[3], y[3];
-    for (int k = 0; k < 3; ++k) x[k] = t.uv[2 * k] * scale, y[k] = t.uv[2 * k + 1] * scale;
-    int x0 = std::max(0, static_cast<int>(std::floor(std::min({x[0], x[1], x[2]}))));
-    int x1 = std::min(w - 1, static_cast<int>(std::floor(std::max({x[0], x[1], x[2]}))));
-    int y0 = std::max(0, static_cast<int>(std::floor(std::min({y[0], y[1], y[2]}))));
-    int y1 = std::min(h - 1, static_cast<int>(std::floor(std::max({y[0], y[1], y[2]}))));
-    double area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
+    std::array<double, 6> xy;
+    for (int k = 0; k < 6; ++k) xy[k] = t.uv[k] * scale;
+    const RasterTriangle tri(xy);
     auto cc = chart_colour(t.chart);
     auto sc = stretch_colour(t.stretch_l2);
-    for (int py = y0; py <= y1; ++py)
-      for (int px = x0; px <= x1; ++px) {
-        double cx = px + 0.5, cy = py + 0.5;
-        bool inside = true;
-        for (int e = 0; e < 3 && inside; ++e) {
-          int a = e, b = (e + 1) % 3;
-          double ef = (x[b] - x[a]) * (cy - y[a]) - (y[b] - y[a]) * (cx - x[a]);
-          inside = area >= 0 ? ef >= 0 : ef <= 0;
-        }
-        // Tiny triangles still show: always paint the pixel holding their first corner.
-        if (!inside && !(px == static_cast<int>(x[0]) && py == static_cast<int>(y[0]))) continue;
-        size_t o = (static_cast<size_t>(py) * pw + px) * 3;
-        std::copy(cc.begin(), cc.end(), pixels.begin() + o);
-        size_t o2 = (static_cast<size_t>(py) * pw + px + w + gap) * 3;
-        std::copy(sc.begin(), sc.end(), pixels.begin() + o2);
-      }
+    auto paint = [&](int64_t px, int64_t py) {
+      size_t o = (static_cast<size_t>(py) * pw + px) * 3;
+      std::copy(cc.begin(), cc.end(), pixels.begin() + o);
+      size_t o2 = (static_cast<size_t>(py) * pw + px + w + gap) * 3;
+      std::copy(sc.begin(), sc.end(), pixels.begin() + o2);
+    };
+    for_each_touched_texel(tri, 0.0, picture, [&](int64_t px, int64_t py) {
+      double lambda[3];
+      if (tri.contains(px + 0.5, py + 0.5, lambda)) paint(px, py);
+    });
+    // Tiny triangles still show: always paint the pixel holding their first corner.
+    const int64_t cx = static_cast<int64_t>(xy[0]), cy = static_cast<int64_t>(xy[1]);
+    if (cx >= 0 && cx < w && cy >= 0 && cy < h) paint(cx, cy);
   }
   for (int p = page; p < std::max(aw, ah); p += page) {
     int g = static_cast<int>(p * scale);

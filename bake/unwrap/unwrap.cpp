@@ -1,6 +1,8 @@
-// unwrap_scene: surfaces (one per primitive and instance) are welded, segmented into charts,
-// parameterised (parameterize.cpp), checked and split until every chart is a valid injective
-// map, scaled to one texel density, packed (pack.cpp) and written back as a new UV set.
+// unwrap_scene, as five stages (the functions at the end of this file, called in order):
+// collect surfaces (one per primitive and instance, welded), segment them into charts,
+// parameterise until valid (parameterize.cpp; charts are checked and split until every one is
+// an injective map), choose the texel density and pack (pack.cpp), write the atlas UVs back as
+// a new UV set. The atlas check (atlas_check.cpp) then measures the result.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -13,6 +15,7 @@
 #include <thread>
 #include <unordered_map>
 
+#include "bake/unwrap/atlas_raster.h"
 #include "bake/unwrap/unwrap.h"
 #include "bake/unwrap/unwrap_internal.h"
 #include "common/parallel.h"
@@ -46,13 +49,14 @@ double cross2(const P2& a, const P2& b, const P2& c) {
 
 // One primitive of one instance (or of one mesh with share_instances), in world space.
 struct Surface {
-  int out_mesh = 0, out_prim = 0;
-  std::vector<P3> pos;         // welded vertices, world space minus `origin`
-  std::vector<uint32_t> weld;  // source vertex -> welded vertex
-  std::vector<uint32_t> tri;   // welded corners, 3 per face
-  std::vector<int32_t> adj;    // per corner e: face across edge (e, e+1), or -1
-  std::vector<P3> normal;      // unit face normals
-  std::vector<double> area;    // face areas
+  int source_mesh = 0;             // in the input scene
+  int out_mesh = 0, out_prim = 0;  // in the output scene
+  std::vector<P3> pos;             // welded vertices, world space minus `origin`
+  std::vector<uint32_t> weld;      // source vertex -> welded vertex
+  std::vector<uint32_t> tri;       // welded corners, 3 per face
+  std::vector<int32_t> adj;        // per corner e: face across edge (e, e+1), or -1
+  std::vector<P3> normal;          // unit face normals
+  std::vector<double> area;        // face areas
   std::vector<char> degenerate;
 };
 
@@ -555,10 +559,9 @@ void fit_box(detail::PackChart* pc) {
     lo[0] = std::min(lo[0], p[0]), hi[0] = std::max(hi[0], p[0]), lo[1] = std::min(lo[1], p[1]),
     hi[1] = std::max(hi[1], p[1]);
   }
-  // Centre the box in whole texels with at least kMargin texel around it: a vertex on a texel
-  // line would conservatively touch the texel beyond the footprint grid, and float atlas UVs
-  // move vertices by up to ~1e-3 texel in a 16k atlas.
-  const double kMargin = 1.0 / 16;  // > pack.cpp's 1/32 texel inflation
+  // Centre the box in whole texels with at least kMargin texel around it, more than the
+  // footprint margin: no triangle then touches a texel beyond the footprint grid.
+  const double kMargin = 2 * kFootprintMargin;
   double w = hi[0] - lo[0], h = hi[1] - lo[1];
   double gx = std::max(1.0, std::ceil(w + 2 * kMargin)),
          gy = std::max(1.0, std::ceil(h + 2 * kMargin));
@@ -622,9 +625,9 @@ void repair_rounding(const Surface& s, const std::vector<uint32_t>& index, doubl
   }
 }
 
-}  // namespace
+// ---- the stages of unwrap_scene ----------------------------------------------------------
 
-Expected<UnwrapResult> unwrap_scene(const scene::Scene& in, const UnwrapOptions& opt) {
+Status check_options(const UnwrapOptions& opt) {
   if (opt.padding < 0 || opt.padding > 1024)
     return Error(ErrorCode::kInvalidArgument, "padding must be in [0, 1024]");
   if (opt.page_payload <= 0)
@@ -633,15 +636,13 @@ Expected<UnwrapResult> unwrap_scene(const scene::Scene& in, const UnwrapOptions&
     return Error(ErrorCode::kInvalidArgument, "texels per unit must be a finite positive number");
   if (opt.texels_per_unit == 0 && opt.size_pages <= 0)
     return Error(ErrorCode::kInvalidArgument, "give texels per unit or a positive size in pages");
-  VT_RETURN_IF_ERROR(scene::validate_geometry(in));
-  const int threads = thread_count(opt.threads);
+  return Status::Ok();
+}
 
-  UnwrapResult result;
-  UnwrapStats& st = result.stats;
-  scene::Scene& out = result.scene;
-  out = in;
-  auto t0 = Clock::now();
-
+// Stage 1: one welded surface per primitive and instance (per mesh with share_instances), in
+// world space. Makes `out`'s meshes match the surfaces' out_mesh numbering.
+Expected<std::vector<Surface>> collect_surfaces(const scene::Scene& in, const UnwrapOptions& opt,
+                                                int threads, scene::Scene* out) {
   // Which meshes to unwrap, with which world matrix.
   std::vector<std::pair<int, scene::Mat4>> jobs;  // output mesh -> (source mesh, world)
   std::vector<scene::Instance> instances = in.instances();
@@ -656,11 +657,11 @@ Expected<UnwrapResult> unwrap_scene(const scene::Scene& in, const UnwrapOptions&
       jobs.push_back({static_cast<int>(m), world});
     }
   } else {
-    out.meshes.clear();
-    for (auto& node : out.nodes) node.mesh = -1;  // nodes outside the scene keep no mesh
+    out->meshes.clear();
+    for (auto& node : out->nodes) node.mesh = -1;  // nodes outside the scene keep no mesh
     for (const auto& inst : instances) {
-      out.nodes[inst.node].mesh = static_cast<int>(out.meshes.size());
-      out.meshes.push_back(in.meshes[inst.mesh]);
+      out->nodes[inst.node].mesh = static_cast<int>(out->meshes.size());
+      out->meshes.push_back(in.meshes[inst.mesh]);
       jobs.push_back({inst.mesh, inst.world});
     }
   }
@@ -670,6 +671,7 @@ Expected<UnwrapResult> unwrap_scene(const scene::Scene& in, const UnwrapOptions&
     for (size_t p = 0; p < mesh.primitives.size(); ++p) {
       if (mesh.primitives[p].indices.empty()) continue;
       Surface s;
+      s.source_mesh = jobs[j].first;
       s.out_mesh = static_cast<int>(j);
       s.out_prim = static_cast<int>(p);
       surfaces.push_back(std::move(s));
@@ -677,45 +679,43 @@ Expected<UnwrapResult> unwrap_scene(const scene::Scene& in, const UnwrapOptions&
   }
   for (const auto& s : surfaces) {
     // World matrices can still overflow a finite mesh into inf: name the instance.
-    const auto& world = jobs[s.out_mesh].second;
-    for (double v : world)
+    for (double v : jobs[s.out_mesh].second)
       if (!std::isfinite(v))
-        return Error(
-            ErrorCode::kInvalidArgument,
-            "mesh '" + in.meshes[jobs[s.out_mesh].first].name + "': non-finite node transform");
+        return Error(ErrorCode::kInvalidArgument,
+                     "mesh '" + in.meshes[s.source_mesh].name + "': non-finite node transform");
   }
   parallel_for(surfaces.size(), threads, [&](size_t i) {
     Surface& s = surfaces[i];
-    weld(in.meshes[jobs[s.out_mesh].first].primitives[s.out_prim], &s, jobs[s.out_mesh].second);
+    weld(in.meshes[s.source_mesh].primitives[s.out_prim], &s, jobs[s.out_mesh].second);
     build_topology(&s);
   });
   for (const auto& s : surfaces)
     for (const P3& p : s.pos)
       if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-        return Error(ErrorCode::kInvalidArgument, "mesh '" +
-                                                      in.meshes[jobs[s.out_mesh].first].name +
+        return Error(ErrorCode::kInvalidArgument, "mesh '" + in.meshes[s.source_mesh].name +
                                                       "': world position overflows double");
-  std::vector<Chart> charts;
-  {
-    std::vector<std::vector<Chart>> per(surfaces.size());
-    parallel_for(surfaces.size(), threads, [&](size_t i) {
-      segment(surfaces[i], static_cast<uint32_t>(i), opt.max_chart_angle_deg, &per[i]);
-    });
-    for (auto& v : per)
-      for (auto& c : v) charts.push_back(std::move(c));
-  }
-  for (const auto& s : surfaces) {
-    st.faces += static_cast<int64_t>(s.tri.size() / 3);
-    for (char d : s.degenerate) st.degenerate_faces += d;
-  }
-  if (st.faces == 0) return Error(ErrorCode::kInvalidArgument, "scene has no triangles to unwrap");
-  st.seconds.segment = seconds_since(t0);
+  return surfaces;
+}
 
-  // Parameterise; charts that fail are split and redone until every chart is valid. A
-  // one-face chart always succeeds, so this terminates.
-  t0 = Clock::now();
+// Stage 2: charts grown on every surface, in surface order.
+std::vector<Chart> segment_surfaces(const std::vector<Surface>& surfaces, const UnwrapOptions& opt,
+                                    int threads) {
+  std::vector<std::vector<Chart>> per(surfaces.size());
+  parallel_for(surfaces.size(), threads, [&](size_t i) {
+    segment(surfaces[i], static_cast<uint32_t>(i), opt.max_chart_angle_deg, &per[i]);
+  });
+  std::vector<Chart> charts;
+  for (auto& v : per)
+    for (auto& c : v) charts.push_back(std::move(c));
+  return charts;
+}
+
+// Stage 3: parameterises the charts; charts that fail are split and redone until every chart
+// is valid. A one-face chart always succeeds, so this terminates. Deterministic chart order.
+std::vector<Chart> parameterize_until_valid(const std::vector<Surface>& surfaces,
+                                            std::vector<Chart> pending, const UnwrapOptions& opt,
+                                            int threads, UnwrapStats* st) {
   std::vector<Chart> done;
-  std::vector<Chart> pending = std::move(charts);
   while (!pending.empty()) {
     std::vector<ChartVerdict> verdict(pending.size());
     parallel_for(pending.size(), threads, [&](size_t i) {
@@ -735,235 +735,301 @@ Expected<UnwrapResult> unwrap_scene(const scene::Scene& in, const UnwrapOptions&
         stretch_round = true;
         ++c.round;
       }
-      ++st.charts_split;
+      ++st->charts_split;
       auto halves = split_chart(surfaces[c.surface], c);
       next.push_back(std::move(halves.first));
       next.push_back(std::move(halves.second));
     }
-    st.split_rounds += stretch_round;
+    st->split_rounds += stretch_round;
     pending = std::move(next);
   }
-  // Deterministic chart order: by surface, then by first face.
+  // By surface, then by first face.
   std::stable_sort(done.begin(), done.end(), [](const Chart& a, const Chart& b) {
     return a.surface != b.surface ? a.surface < b.surface : a.faces[0] < b.faces[0];
   });
-  charts = std::move(done);
-  st.charts = static_cast<int64_t>(charts.size());
-  st.seconds.parameterize = seconds_since(t0);
+  return done;
+}
 
-  // Scale to the texel density, fit boxes, pack. With a target size the density is searched
-  // so that the packed atlas fits size_pages × size_pages pages.
-  t0 = Clock::now();
+// Charts scaled to `tpu` texels per world unit, rotated and boxed for packing.
+std::vector<detail::PackChart> make_pack_charts(const std::vector<Chart>& charts, double tpu,
+                                                int threads) {
+  std::vector<detail::PackChart> pcs(charts.size());
+  parallel_for(charts.size(), threads, [&](size_t i) {
+    const Chart& c = charts[i];
+    double k = (c.degenerate || !(c.area3d > 0) || !(c.area_uv > 0))
+                   ? (c.degenerate ? 0.5 : tpu)
+                   : std::sqrt(c.area3d / c.area_uv) * tpu;
+    if (!std::isfinite(k)) k = 0.5;
+    detail::PackChart& pc = pcs[i];
+    pc.points.resize(c.uv.size());
+    for (size_t v = 0; v < c.uv.size(); ++v) pc.points[v] = {c.uv[v][0] * k, c.uv[v][1] * k};
+    for (size_t f = 0; f < c.faces.size(); ++f)
+      pc.tris.push_back(
+          {c.corner_local[3 * f], c.corner_local[3 * f + 1], c.corner_local[3 * f + 2]});
+    fit_box(&pc);
+  });
+  return pcs;
+}
+
+// The atlas width (whole pages) that the boxes of `pcs` with their gutters could fill.
+int atlas_width_for(const std::vector<detail::PackChart>& pcs, const UnwrapOptions& opt) {
+  double box = 0, need = 1;
+  for (const auto& pc : pcs) {
+    box += (std::ceil(pc.width) + opt.padding) * (std::ceil(pc.height) + opt.padding);
+    need = std::max(need, std::ceil(std::min(pc.width, pc.height)) + 1);
+  }
+  double side = std::max(need, std::sqrt(box));
+  return static_cast<int>(std::ceil(side / opt.page_payload) * opt.page_payload);
+}
+
+// A packed atlas: the charts as packed and where they went.
+struct PackedAtlas {
+  double texels_per_unit = 0;
+  int width = 0;
+  std::vector<detail::PackChart> charts;
+  detail::PackResult packed;
+};
+
+// The starting density for a square atlas `width` texels wide: an optimistic fill, bounded so
+// that no chart is longer than the atlas (a chart's bounding-box diagonal at one texel per unit
+// bounds every rotation's extent).
+double first_density_guess(const std::vector<Chart>& charts, int width) {
   double area3d = 0;
   for (const auto& c : charts) area3d += c.area3d;
-  const int page = opt.page_payload;
-  auto make_pack_charts = [&](double tpu) {
-    std::vector<detail::PackChart> pcs(charts.size());
-    parallel_for(charts.size(), threads, [&](size_t i) {
-      const Chart& c = charts[i];
-      double k = (c.degenerate || !(c.area3d > 0) || !(c.area_uv > 0))
-                     ? (c.degenerate ? 0.5 : tpu)
-                     : std::sqrt(c.area3d / c.area_uv) * tpu;
-      if (!std::isfinite(k)) k = 0.5;
-      detail::PackChart& pc = pcs[i];
-      pc.points.resize(c.uv.size());
-      for (size_t v = 0; v < c.uv.size(); ++v) pc.points[v] = {c.uv[v][0] * k, c.uv[v][1] * k};
-      for (size_t f = 0; f < c.faces.size(); ++f)
-        pc.tris.push_back(
-            {c.corner_local[3 * f], c.corner_local[3 * f + 1], c.corner_local[3 * f + 2]});
-      fit_box(&pc);
-    });
-    return pcs;
-  };
-  auto choose_width = [&](const std::vector<detail::PackChart>& pcs) {
-    double box = 0, need = 1;
-    for (const auto& pc : pcs) {
-      box += (std::ceil(pc.width) + opt.padding) * (std::ceil(pc.height) + opt.padding);
-      need = std::max(need, std::ceil(std::min(pc.width, pc.height)) + 1);
-    }
-    double side = std::max(need, std::sqrt(box));
-    return static_cast<int>(std::ceil(side / page) * page);
-  };
-  double tpu = opt.texels_per_unit;
-  std::vector<detail::PackChart> pcs;
-  detail::PackResult packed;
-  int width = 0;
-  if (tpu > 0) {
-    pcs = make_pack_charts(tpu);
-    width = choose_width(pcs);
-    if (static_cast<int64_t>(width) * width > opt.max_atlas_texels)
-      return Error(ErrorCode::kResourceLimit, "atlas of " + std::to_string(width) +
-                                                  " texels wide at " + std::to_string(tpu) +
-                                                  " texels per unit exceeds the atlas limit");
-    packed = detail::pack_charts(pcs, width, opt.padding, threads);
-  } else {
-    width = opt.size_pages * page;
-    if (static_cast<int64_t>(width) * width > opt.max_atlas_texels)
-      return Error(ErrorCode::kResourceLimit,
-                   "atlas of " + std::to_string(opt.size_pages) + " pages exceeds the atlas limit");
-    // Start from an optimistic fill and search the density (bisection on the scale).
-    double lo = 0, hi = 0;
-    tpu = std::sqrt(0.7 * static_cast<double>(width) * width / std::max(area3d, 1e-300));
-    if (!(area3d > 0)) tpu = 1;
-    // No chart may be longer than the atlas: bound the start by the longest chart (its
-    // bounding-box diagonal at one texel per unit bounds every rotation's extent).
-    double longest = 0;
-    for (const auto& c : charts) {
-      if (c.degenerate || !(c.area3d > 0) || !(c.area_uv > 0)) continue;
-      double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
-      for (const P2& p : c.uv)
-        for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-      longest = std::max(
-          longest, std::hypot(hi[0] - lo[0], hi[1] - lo[1]) * std::sqrt(c.area3d / c.area_uv));
-    }
-    if (longest > 0) tpu = std::min(tpu, (width - 2.0) / longest);
-    bool have_fit = false;
-    std::vector<detail::PackChart> best_pcs;
-    detail::PackResult best_pack;
-    double best_tpu = 0;
-    for (int iter = 0; iter < 16; ++iter) {
-      auto trial = make_pack_charts(tpu);
-      int w = choose_width(trial);
-      bool fits = false;
-      detail::PackResult pr;
-      if (w <= 2 * width) {  // hopeless widths are skipped: their charts cannot fit
-        pr = detail::pack_charts(trial, width, opt.padding, threads);
-        double max_w = 0;
-        for (const auto& pc : trial) max_w = std::max(max_w, std::min(pc.width, pc.height));
-        fits = !pr.overflow && pr.height <= width && max_w < width;
-      }
-      if (fits) {
-        if (!have_fit || tpu > best_tpu)
-          best_tpu = tpu, best_pcs = trial, best_pack = pr, have_fit = true;
-        lo = tpu;
-      } else {
-        hi = tpu;
-      }
-      double next = hi > 0 ? (lo > 0 ? std::sqrt(lo * hi) : tpu * 0.7) : tpu * 1.3;
-      if (lo > 0 && hi > 0 && hi / lo < 1.02) break;
-      tpu = next;
-    }
-    if (!have_fit)
-      return Error(ErrorCode::kResourceLimit,
-                   "charts do not fit in " + std::to_string(opt.size_pages) + " pages");
-    tpu = best_tpu;
-    pcs = std::move(best_pcs);
-    packed = std::move(best_pack);
+  double tpu = std::sqrt(0.7 * static_cast<double>(width) * width / std::max(area3d, 1e-300));
+  if (!(area3d > 0)) tpu = 1;
+  double longest = 0;
+  for (const auto& c : charts) {
+    if (c.degenerate || !(c.area3d > 0) || !(c.area_uv > 0)) continue;
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    for (const P2& p : c.uv)
+      for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+    longest = std::max(longest,
+                       std::hypot(hi[0] - lo[0], hi[1] - lo[1]) * std::sqrt(c.area3d / c.area_uv));
   }
-  st.texels_per_unit = tpu;
-  st.atlas_width = width;
-  st.atlas_height = std::max(page, (packed.height + page - 1) / page * page);
-  if (opt.texels_per_unit == 0) st.atlas_height = width;  // a requested size is a square
-  st.pages_x = st.atlas_width / page;
-  st.pages_y = st.atlas_height / page;
-  st.seconds.pack = seconds_since(t0);
+  if (longest > 0) tpu = std::min(tpu, (width - 2.0) / longest);
+  return tpu;
+}
 
-  // Output: every chart-local vertex becomes a vertex per source vertex it came from.
-  t0 = Clock::now();
+// Stage 4: chooses the texel density and packs. With texels_per_unit given the atlas width
+// follows from it; otherwise the density is searched (bisection on the scale) so that the
+// packed atlas fits size_pages × size_pages pages.
+Expected<PackedAtlas> choose_density_and_pack(const std::vector<Chart>& charts,
+                                              const UnwrapOptions& opt, int threads) {
+  PackedAtlas best;
+  if (opt.texels_per_unit > 0) {
+    best.texels_per_unit = opt.texels_per_unit;
+    best.charts = make_pack_charts(charts, opt.texels_per_unit, threads);
+    best.width = atlas_width_for(best.charts, opt);
+    if (static_cast<int64_t>(best.width) * best.width > opt.max_atlas_texels)
+      return Error(ErrorCode::kResourceLimit, "atlas of " + std::to_string(best.width) +
+                                                  " texels wide at " +
+                                                  std::to_string(opt.texels_per_unit) +
+                                                  " texels per unit exceeds the atlas limit");
+    best.packed = detail::pack_charts(best.charts, best.width, opt.padding, threads);
+    return best;
+  }
+  const int width = opt.size_pages * opt.page_payload;
+  if (static_cast<int64_t>(width) * width > opt.max_atlas_texels)
+    return Error(ErrorCode::kResourceLimit,
+                 "atlas of " + std::to_string(opt.size_pages) + " pages exceeds the atlas limit");
+  best.width = width;
+  double lo = 0, hi = 0;
+  double tpu = first_density_guess(charts, width);
+  bool have_fit = false;
+  for (int iter = 0; iter < 16; ++iter) {
+    auto trial = make_pack_charts(charts, tpu, threads);
+    int w = atlas_width_for(trial, opt);
+    bool fits = false;
+    detail::PackResult pr;
+    if (w <= 2 * width) {  // hopeless widths are skipped: their charts cannot fit
+      pr = detail::pack_charts(trial, width, opt.padding, threads);
+      double max_w = 0;
+      for (const auto& pc : trial) max_w = std::max(max_w, std::min(pc.width, pc.height));
+      fits = !pr.overflow && pr.height <= width && max_w < width;
+    }
+    if (fits) {
+      if (!have_fit || tpu > best.texels_per_unit) {
+        best.texels_per_unit = tpu, best.charts = trial, best.packed = pr, have_fit = true;
+      }
+      lo = tpu;
+    } else {
+      hi = tpu;
+    }
+    double next = hi > 0 ? (lo > 0 ? std::sqrt(lo * hi) : tpu * 0.7) : tpu * 1.3;
+    if (lo > 0 && hi > 0 && hi / lo < 1.02) break;
+    tpu = next;
+  }
+  if (!have_fit)
+    return Error(ErrorCode::kResourceLimit,
+                 "charts do not fit in " + std::to_string(opt.size_pages) + " pages");
+  return best;
+}
+
+// Per-surface sums for the stretch statistics.
+struct StretchSums {
+  double l2_num = 0, area3d = 0, area_uv = 0, linf = 0;
+};
+
+// Stage 5 for one surface: every chart-local vertex becomes a vertex per source vertex it came
+// from; the primitive gets the atlas UVs as a new last UV set. Fills `tris` (one per face, from
+// the float UVs actually written) and the surface's stretch sums.
+void write_surface_uvs(const Surface& s, const std::vector<Chart>& charts,
+                       const std::vector<uint32_t>& chart_ids, const PackedAtlas& atlas, double W,
+                       double H, const scene::Primitive& src, scene::Primitive* dst,
+                       std::vector<AtlasTriangle>* tris, StretchSums* sums) {
+  size_t faces = s.tri.size() / 3;
+  std::vector<uint32_t> new_index(s.tri.size());
+  std::vector<scene::Vec2> atlas_uv;
+  std::vector<uint32_t> source_of;
+  std::vector<int32_t> face_chart(faces, -1);
+  for (uint32_t ci : chart_ids) {
+    const Chart& c = charts[ci];
+    const auto& pc = atlas.charts[ci];
+    const auto& pl = atlas.packed.placements[ci];
+    std::vector<scene::Vec2> local_uv(c.uv.size());
+    for (size_t v = 0; v < c.uv.size(); ++v) {
+      P2 p = detail::place_point(pc, pl, pc.points[v]);
+      local_uv[v] = {static_cast<float>(p[0] / W), static_cast<float>(1.0 - p[1] / H)};
+    }
+    std::unordered_map<uint64_t, uint32_t> made;  // (local vertex, source vertex) -> new
+    for (size_t i = 0; i < c.faces.size(); ++i) {
+      uint32_t f = c.faces[i];
+      face_chart[f] = static_cast<int32_t>(ci);
+      for (int k = 0; k < 3; ++k) {
+        uint32_t local = c.corner_local[3 * i + k];
+        uint32_t source = src.indices[3 * f + k];
+        uint64_t key = (static_cast<uint64_t>(local) << 32) | source;
+        auto [it, inserted] = made.try_emplace(key, static_cast<uint32_t>(source_of.size()));
+        if (inserted) {
+          source_of.push_back(source);
+          atlas_uv.push_back(local_uv[local]);
+        }
+        new_index[3 * f + k] = it->second;
+      }
+    }
+  }
+  // Float rounding of atlas UVs can flip or flatten a triangle that is a sliver in UV. Such
+  // a triangle is repaired by moving its corners a few float ulps (far below the 1/16 texel
+  // chart margin) in the direction that restores its orientation, keeping every triangle
+  // around the moved corner correctly oriented.
+  repair_rounding(s, new_index, W, H, &atlas_uv);
+  // Rebuild the primitive's vertex arrays from source_of.
+  auto gather = [&](const auto& from, auto& to) {
+    if (from.empty()) return;
+    std::remove_reference_t<decltype(to)> v(source_of.size());
+    for (size_t i = 0; i < source_of.size(); ++i) v[i] = from[source_of[i]];
+    to = std::move(v);
+  };
+  gather(src.positions, dst->positions);
+  gather(src.normals, dst->normals);
+  gather(src.tangents, dst->tangents);
+  gather(src.colors, dst->colors);
+  dst->uvs.resize(src.uvs.size());
+  for (size_t n = 0; n < src.uvs.size(); ++n) gather(src.uvs[n], dst->uvs[n]);
+  dst->uvs.push_back(atlas_uv);
+  dst->indices = new_index;
+  // Atlas triangles and stretch against world space.
+  tris->resize(faces);
+  for (size_t f = 0; f < faces; ++f) {
+    AtlasTriangle& t = (*tris)[f];
+    P2 p[3];
+    for (int k = 0; k < 3; ++k) {
+      const auto& uv = atlas_uv[new_index[3 * f + k]];
+      p[k] = {static_cast<double>(uv[0]) * W, static_cast<double>(uv[1]) * H};
+      t.uv[2 * k] = p[k][0];
+      t.uv[2 * k + 1] = p[k][1];
+    }
+    t.chart = face_chart[f];
+    if (s.degenerate[f]) continue;
+    // y down in the atlas: flip y so front faces are positive for the stretch formula.
+    P2 q[3] = {{p[0][0], -p[0][1]}, {p[1][0], -p[1][1]}, {p[2][0], -p[2][1]}};
+    auto [l2sq, li] = triangle_stretch(s.pos[s.tri[3 * f]], s.pos[s.tri[3 * f + 1]],
+                                       s.pos[s.tri[3 * f + 2]], q[0], q[1], q[2]);
+    double a_uv = std::abs(cross2(q[0], q[1], q[2])) / 2;
+    sums->l2_num += l2sq * s.area[f];
+    sums->area3d += s.area[f];
+    sums->area_uv += a_uv;
+    if (std::isfinite(li)) sums->linf = std::max(sums->linf, li);
+    t.stretch_l2 = static_cast<float>(std::sqrt(l2sq) * std::sqrt(a_uv / s.area[f]));
+  }
+}
+
+// Stage 5: writes the atlas UVs of every surface into `result` and the stretch statistics.
+void write_atlas_uvs(const scene::Scene& in, const std::vector<Surface>& surfaces,
+                     const std::vector<Chart>& charts, const PackedAtlas& atlas,
+                     UnwrapResult* result, int threads) {
+  UnwrapStats& st = result->stats;
   const double W = st.atlas_width, H = st.atlas_height;
   std::vector<std::vector<uint32_t>> charts_of(surfaces.size());
   for (size_t c = 0; c < charts.size(); ++c)
     charts_of[charts[c].surface].push_back(static_cast<uint32_t>(c));
-  result.triangles.resize(0);
   std::vector<std::vector<AtlasTriangle>> tri_out(surfaces.size());
-  std::vector<double> l2_num(surfaces.size(), 0), a3_sum(surfaces.size(), 0),
-      auv_sum(surfaces.size(), 0), linf(surfaces.size(), 0);
+  std::vector<StretchSums> sums(surfaces.size());
   parallel_for(surfaces.size(), threads, [&](size_t si) {
     const Surface& s = surfaces[si];
-    const scene::Primitive& src = in.meshes[jobs[s.out_mesh].first].primitives[s.out_prim];
-    scene::Primitive& dst = out.meshes[s.out_mesh].primitives[s.out_prim];
-    size_t faces = s.tri.size() / 3;
-    std::vector<uint32_t> new_index(s.tri.size());
-    std::vector<scene::Vec2> atlas_uv;
-    std::vector<uint32_t> source_of;
-    std::vector<int32_t> face_chart(faces, -1);
-    for (uint32_t ci : charts_of[si]) {
-      const Chart& c = charts[ci];
-      const auto& pc = pcs[ci];
-      const auto& pl = packed.placements[ci];
-      std::vector<scene::Vec2> local_uv(c.uv.size());
-      for (size_t v = 0; v < c.uv.size(); ++v) {
-        P2 p = detail::place_point(pc, pl, pc.points[v]);
-        local_uv[v] = {static_cast<float>(p[0] / W), static_cast<float>(1.0 - p[1] / H)};
-      }
-      std::unordered_map<uint64_t, uint32_t> made;  // (local vertex, source vertex) -> new
-      for (size_t i = 0; i < c.faces.size(); ++i) {
-        uint32_t f = c.faces[i];
-        face_chart[f] = static_cast<int32_t>(ci);
-        for (int k = 0; k < 3; ++k) {
-          uint32_t local = c.corner_local[3 * i + k];
-          uint32_t source = src.indices[3 * f + k];
-          uint64_t key = (static_cast<uint64_t>(local) << 32) | source;
-          auto [it, inserted] = made.try_emplace(key, static_cast<uint32_t>(source_of.size()));
-          if (inserted) {
-            source_of.push_back(source);
-            atlas_uv.push_back(local_uv[local]);
-          }
-          uint32_t id = it->second;
-          new_index[3 * f + k] = id;
-        }
-      }
-    }
-    // Float rounding of atlas UVs can flip or flatten a triangle that is a sliver in UV. Such
-    // a triangle is repaired by moving its corners a few float ulps (far below the 1/16 texel
-    // chart margin) in the direction that restores its orientation, keeping every triangle
-    // around the moved corner correctly oriented.
-    repair_rounding(s, new_index, W, H, &atlas_uv);
-    // Rebuild the primitive's vertex arrays from source_of.
-    auto gather = [&](const auto& from, auto& to) {
-      if (from.empty()) return;
-      std::remove_reference_t<decltype(to)> v(source_of.size());
-      for (size_t i = 0; i < source_of.size(); ++i) v[i] = from[source_of[i]];
-      to = std::move(v);
-    };
-    gather(src.positions, dst.positions);
-    gather(src.normals, dst.normals);
-    gather(src.tangents, dst.tangents);
-    gather(src.colors, dst.colors);
-    dst.uvs.resize(src.uvs.size());
-    for (size_t n = 0; n < src.uvs.size(); ++n) gather(src.uvs[n], dst.uvs[n]);
-    dst.uvs.push_back(atlas_uv);
-    dst.indices = new_index;
-    // Atlas triangles (from the float UVs actually written) and stretch against world space.
-    auto& tris = tri_out[si];
-    tris.resize(faces);
-    for (size_t f = 0; f < faces; ++f) {
-      AtlasTriangle& t = tris[f];
-      P2 p[3];
-      for (int k = 0; k < 3; ++k) {
-        const auto& uv = atlas_uv[new_index[3 * f + k]];
-        p[k] = {static_cast<double>(uv[0]) * W, static_cast<double>(uv[1]) * H};
-        t.uv[2 * k] = static_cast<float>(p[k][0]);
-        t.uv[2 * k + 1] = static_cast<float>(p[k][1]);
-      }
-      t.chart = face_chart[f];
-      if (s.degenerate[f]) continue;
-      // y down in the atlas: flip y so front faces are positive for the stretch formula.
-      P2 q[3] = {{p[0][0], -p[0][1]}, {p[1][0], -p[1][1]}, {p[2][0], -p[2][1]}};
-      auto [l2sq, li] = triangle_stretch(s.pos[s.tri[3 * f]], s.pos[s.tri[3 * f + 1]],
-                                         s.pos[s.tri[3 * f + 2]], q[0], q[1], q[2]);
-      double a_uv = std::abs(cross2(q[0], q[1], q[2])) / 2;
-      l2_num[si] += l2sq * s.area[f];
-      a3_sum[si] += s.area[f];
-      auv_sum[si] += a_uv;
-      if (std::isfinite(li)) linf[si] = std::max(linf[si], li);
-      t.stretch_l2 = static_cast<float>(std::sqrt(l2sq) * std::sqrt(a_uv / s.area[f]));
-    }
+    write_surface_uvs(
+        s, charts, charts_of[si], atlas, W, H, in.meshes[s.source_mesh].primitives[s.out_prim],
+        &result->scene.meshes[s.out_mesh].primitives[s.out_prim], &tri_out[si], &sums[si]);
   });
+  result->triangles.resize(0);
   double num = 0, a3 = 0, auv = 0, li = 0;
   for (size_t si = 0; si < surfaces.size(); ++si) {
-    num += l2_num[si], a3 += a3_sum[si], auv += auv_sum[si], li = std::max(li, linf[si]);
-    for (auto& t : tri_out[si]) result.triangles.push_back(t);
+    num += sums[si].l2_num, a3 += sums[si].area3d, auv += sums[si].area_uv,
+        li = std::max(li, sums[si].linf);
+    for (auto& t : tri_out[si]) result->triangles.push_back(t);
   }
   double normalise = a3 > 0 ? std::sqrt(auv / a3) : 1.0;
   st.stretch_l2 = a3 > 0 ? std::sqrt(num / a3) * normalise : 1.0;
   st.stretch_linf = li * normalise;
-  for (const auto& t : result.triangles)
-    for (float v : t.uv)
+  for (const auto& t : result->triangles)
+    for (double v : t.uv)
       if (!std::isfinite(v)) {
         ++st.unmapped_faces;
         break;
       }
+}
+
+}  // namespace
+
+Expected<UnwrapResult> unwrap_scene(const scene::Scene& in, const UnwrapOptions& opt) {
+  VT_RETURN_IF_ERROR(check_options(opt));
+  VT_RETURN_IF_ERROR(scene::validate_geometry(in));
+  const int threads = thread_count(opt.threads);
+  UnwrapResult result;
+  UnwrapStats& st = result.stats;
+  result.scene = in;
+
+  auto t0 = Clock::now();
+  auto surfaces = collect_surfaces(in, opt, threads, &result.scene);
+  if (!surfaces.ok()) return surfaces.status();
+  std::vector<Chart> charts = segment_surfaces(*surfaces, opt, threads);
+  for (const auto& s : *surfaces) {
+    st.faces += static_cast<int64_t>(s.tri.size() / 3);
+    for (char d : s.degenerate) st.degenerate_faces += d;
+  }
+  if (st.faces == 0) return Error(ErrorCode::kInvalidArgument, "scene has no triangles to unwrap");
+  st.seconds.segment = seconds_since(t0);
+
+  t0 = Clock::now();
+  charts = parameterize_until_valid(*surfaces, std::move(charts), opt, threads, &st);
+  st.charts = static_cast<int64_t>(charts.size());
+  st.seconds.parameterize = seconds_since(t0);
+
+  t0 = Clock::now();
+  auto atlas = choose_density_and_pack(charts, opt, threads);
+  if (!atlas.ok()) return atlas.status();
+  const int page = opt.page_payload;
+  st.texels_per_unit = atlas->texels_per_unit;
+  st.atlas_width = atlas->width;
+  st.atlas_height = std::max(page, (atlas->packed.height + page - 1) / page * page);
+  if (opt.texels_per_unit == 0) st.atlas_height = atlas->width;  // a requested size is a square
+  st.pages_x = st.atlas_width / page;
+  st.pages_y = st.atlas_height / page;
+  st.seconds.pack = seconds_since(t0);
+
+  t0 = Clock::now();
+  write_atlas_uvs(in, *surfaces, charts, *atlas, &result, threads);
   st.seconds.output = seconds_since(t0);
 
   t0 = Clock::now();

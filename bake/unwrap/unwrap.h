@@ -5,12 +5,13 @@
 // with rotation and a gutter into an atlas that is a whole number of pages.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include "scene/scene.h"
 #include "common/status.h"
+#include "scene/scene.h"
 
 namespace vt::unwrap {
 
@@ -57,7 +58,9 @@ struct UnwrapStats {
 
 // One triangle as laid out in the atlas, for pictures and checks.
 struct AtlasTriangle {
-  std::array<float, 6> uv;  // atlas texel coordinates (x right, y down) of its three corners
+  // Atlas texel coordinates (x right, y down) of its three corners, exactly as transfer reads
+  // them: the float atlas UVs times the atlas size, in double.
+  std::array<double, 6> uv;
   int32_t chart = 0;
   float stretch_l2 = 1.0f;  // this triangle's Sander L2 stretch (normalised)
 };
@@ -73,9 +76,10 @@ struct UnwrapResult {
 // and vertex), an atlas over max_atlas_texels, an invalid option.
 Expected<UnwrapResult> unwrap_scene(const scene::Scene& scene, const UnwrapOptions& options);
 
-// Exact texel-space checks of a laid-out atlas (used by unwrap_scene; exposed for tests):
-// utilisation, overlapping triangles (texel centres covered twice, top-left fill rule on a
-// fixed-point grid) and overlapping texels (texels any part of two charts touches).
+// Texel-space checks of a laid-out atlas with the atlas rasteriser (atlas_raster.h; used by
+// unwrap_scene, exposed for tests): utilisation (texel centres covered), overlapping triangles
+// (texel centres two triangles own by the fill rule) and overlapping texels (texels two charts
+// touch: what transfer counts as contested).
 struct AtlasCheck {
   double utilisation = 0;
   int64_t covered_texels = 0;

@@ -11,6 +11,7 @@
 #include "bake/build_summary_json.h"
 #include "bake/scene_bake.h"
 #include "bake/transfer.h"
+#include "common/vec.h"
 #include "format/page_file.h"
 #include "samples/sample_scene.h"
 #include "tests/transfer/transfer_test_util.h"
@@ -176,24 +177,7 @@ void ridge_normal(double u, double v, float* t) {
   t[0] = float(x / l * 0.5 + 0.5), t[1] = float(y / l * 0.5 + 0.5), t[2] = float(z / l * 0.5 + 0.5);
 }
 
-struct V {
-  double x, y, z;
-};
-V operator+(V a, V b) {
-  return {a.x + b.x, a.y + b.y, a.z + b.z};
-}
-V operator-(V a, V b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-V operator*(V a, double s) {
-  return {a.x * s, a.y * s, a.z * s};
-}
-double dot(V a, V b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-V cross(V a, V b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
+using V = Vec3d;
 V unit(V a) {
   return a * (1.0 / std::sqrt(dot(a, a)));
 }

@@ -17,7 +17,7 @@ namespace {
 constexpr float kAspect = 16.0f / 9.0f;
 
 // Clip-space position of a world point.
-std::array<float, 4> project(const Mat4& m, Vec3 p) {
+std::array<float, 4> project(const Mat4& m, Vec3f p) {
   std::array<float, 4> r{};
   for (int row = 0; row < 4; ++row) {
     r[row] =

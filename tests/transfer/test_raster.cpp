@@ -4,6 +4,8 @@
 
 #include <random>
 
+#include "tests/unwrap/grid_triangles.h"
+
 #include "bake/transfer.h"
 
 namespace vt {
@@ -25,22 +27,7 @@ Tris jittered_grid(double x0, double y0, double cell, int n, double jitter, uint
       v.push_back({x, y});
     }
   }
-  Tris t;
-  for (int j = 0; j < n; ++j) {
-    for (int i = 0; i < n; ++i) {
-      auto a = v[j * (n + 1) + i], b = v[j * (n + 1) + i + 1], c = v[(j + 1) * (n + 1) + i],
-           e = v[(j + 1) * (n + 1) + i + 1];
-      // Alternate the diagonal and the winding so both orientations are exercised.
-      if ((i + j) % 2) {
-        t.push_back({a[0], a[1], b[0], b[1], e[0], e[1]});
-        t.push_back({a[0], a[1], c[0], c[1], e[0], e[1]});
-      } else {
-        t.push_back({a[0], a[1], c[0], c[1], b[0], b[1]});
-        t.push_back({b[0], b[1], c[0], c[1], e[0], e[1]});
-      }
-    }
-  }
-  return t;
+  return test::grid_triangles(v, n);
 }
 
 bool inside_closed(const std::array<double, 6>& t, double px, double py, bool strict) {
