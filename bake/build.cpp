@@ -219,9 +219,7 @@ class LayerRun {
     LevelSummary& lsum = sum_.levels[level_];
     for (uint32_t x = 0; x < px; ++x) {
       const PageId id{level_, x, row};
-      VT_RETURN_IF_ERROR(errors[x].with_context(layer_.spec.name + " page (" +
-                                                std::to_string(level_) + ", " + std::to_string(x) +
-                                                ", " + std::to_string(row) + ")"));
+      VT_RETURN_IF_ERROR(errors[x].with_context(layer_.spec.name + " " + page_name(id)));
       if (!present[x]) {
         ++lsum.absent;
         continue;

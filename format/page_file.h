@@ -98,10 +98,6 @@ class PageFileWriter {
   // Adds a page whose every texel equals `texel` (texel_bytes() bytes). Thread-safe.
   virtual Status add_constant_page(const PageId& id, uint32_t layer,
                                    std::span<const uint8_t> texel) = 0;
-  // Replaces a dct layer's codec tables (a builder that trains them on the layer's first pages
-  // sets them here). Only before any stored page of that layer is added: those pages must have
-  // been coded with the tables the file holds. Constant pages do not depend on them.
-  virtual Status set_codec_tables(uint32_t layer, std::span<const uint8_t> tables) = 0;
   // Writes the index and header, fsyncs and renames into place. No add_* after it.
   virtual Status finish() = 0;
 };

@@ -139,7 +139,6 @@ class PageFileWriterImpl final : public PageFileWriter {
                    path_ + ": " + std::to_string(entries) + " index entries is too many");
     entries_.resize(size_t(entries));
     claimed_.resize(size_t(entries));
-    layer_has_stored_.assign(layer_count_, 0);
     level_first_.resize(g.level_count());
     for (uint32_t l = 0; l < g.level_count(); ++l) level_first_[l] = level_first_page(g, l);
 
@@ -167,7 +166,7 @@ class PageFileWriterImpl final : public PageFileWriter {
       return bad(id, layer,
                  "raw page of " + std::to_string(data.size()) + " bytes, expected " +
                      std::to_string(raw_page_bytes(spec)));
-    VT_RETURN_IF_ERROR(claim(id, layer, slot, /*stored=*/true));
+    VT_RETURN_IF_ERROR(claim(id, layer, slot));
     uint64_t offset = spill_end_.fetch_add(data.size());
     Status s = pwrite_all(spill_fd_, data.data(), data.size(), offset, path_);
     SpillEntry e;
@@ -193,7 +192,7 @@ class PageFileWriterImpl final : public PageFileWriter {
       return bad(id, layer,
                  "constant value of " + std::to_string(texel.size()) + " bytes, expected " +
                      std::to_string(spec.texel_bytes()));
-    VT_RETURN_IF_ERROR(claim(id, layer, slot, /*stored=*/false));
+    VT_RETURN_IF_ERROR(claim(id, layer, slot));
     SpillEntry e;
     e.state = PageState::kConstant;
     std::memcpy(e.constant, texel.data(), texel.size());
@@ -201,24 +200,6 @@ class PageFileWriterImpl final : public PageFileWriter {
     std::lock_guard lock(mutex_);
     release();
     entries_[slot] = e;
-    return Status::Ok();
-  }
-
-  Status set_codec_tables(uint32_t layer, std::span<const uint8_t> tables) override {
-    auto refuse = [&](const std::string& what) {
-      return Error(ErrorCode::kInvalidArgument,
-                   path_ + ": codec tables of layer " + std::to_string(layer) + ": " + what);
-    };
-    std::lock_guard lock(mutex_);
-    if (layer >= layer_count_) return refuse("layer out of range");
-    LayerSpec& spec = desc_.layers[layer];
-    if (finished_) return refuse("set after finish()");
-    if (spec.codec != PageCodec::kDct) return refuse("only dct layers have codec tables");
-    if (layer_has_stored_[layer]) return refuse("set after a stored page of the layer");
-    LayerSpec changed = spec;
-    changed.codec_tables.assign(tables.begin(), tables.end());
-    if (std::string why = layer_problem(changed); !why.empty()) return refuse(why);
-    spec = std::move(changed);
     return Status::Ok();
   }
 
@@ -242,10 +223,7 @@ class PageFileWriterImpl final : public PageFileWriter {
   }
 
   Status bad(const PageId& id, uint32_t layer, const std::string& what) const {
-    return Error(ErrorCode::kInvalidArgument, path_ + ": page (level " + std::to_string(id.level) +
-                                                  ", x " + std::to_string(id.x) + ", y " +
-                                                  std::to_string(id.y) + ") layer " +
-                                                  std::to_string(layer) + ": " + what);
+    return Error(ErrorCode::kInvalidArgument, path_ + ": " + page_name(id, layer) + ": " + what);
   }
 
   Expected<size_t> check_page(const PageId& id, uint32_t layer) const {
@@ -258,12 +236,11 @@ class PageFileWriterImpl final : public PageFileWriter {
   }
 
   // Reserves the slot so that a second add of the same page fails whatever the thread timing.
-  Status claim(const PageId& id, uint32_t layer, size_t slot, bool stored) {
+  Status claim(const PageId& id, uint32_t layer, size_t slot) {
     std::lock_guard lock(mutex_);
     if (finished_) return bad(id, layer, "page added after finish()");
     if (claimed_[slot]) return bad(id, layer, "page added twice");
     claimed_[slot] = 1;
-    if (stored) layer_has_stored_[layer] = 1;
     ++in_flight_;
     return Status::Ok();
   }
@@ -281,7 +258,6 @@ class PageFileWriterImpl final : public PageFileWriter {
   std::vector<uint64_t> level_first_;
   std::vector<SpillEntry> entries_;
   std::vector<uint8_t> claimed_;
-  std::vector<uint8_t> layer_has_stored_;  // per layer: a stored page was added
   std::mutex mutex_;
   std::condition_variable idle_;
   uint64_t in_flight_ = 0;

@@ -155,9 +155,11 @@ TEST(BuildTasks, CoverageLevelsWaitForTheWholeLevelBefore) {
     ASSERT_NE(it, tasks.end()) << "level " << l;
     EXPECT_EQ(it->deps.size(), g.pages_y(l - 1));
     const uint32_t whole = uint32_t(it - tasks.begin());
-    for (const BuildTask& t : tasks)
-      if (t.kind == BuildTask::Kind::kBand && t.level == l)
+    for (const BuildTask& t : tasks) {
+      if (t.kind == BuildTask::Kind::kBand && t.level == l) {
         EXPECT_EQ(t.deps, std::vector<uint32_t>{whole});
+      }
+    }
   }
 }
 

@@ -243,43 +243,6 @@ TEST(PageFileWriter, RejectsBadPages) {
   EXPECT_EQ((*reader)->read_texels({0, 5, 3}, 0, small).code(), ErrorCode::kInvalidArgument);
 }
 
-TEST(PageFileWriter, CodecTablesCanBeReplacedUntilAStoredPageOfTheLayer) {
-  const std::string path = temp_path("tables.vtpf");
-  PageFileDesc desc;
-  desc.geometry = {16, 16, 12, 2};  // one 16x16 page
-  desc.layers = {layer("a", 3, TexelType::kU8, PageCodec::kDct),
-                 layer("b", 3, TexelType::kU8, PageCodec::kDct),
-                 layer("c", 3, TexelType::kU8, PageCodec::kRaw)};
-  // The reader parses dct tables, so these are real ones (two qualities tell them apart).
-  auto tables = [](int quality) {
-    DctSettings s;
-    s.quality = quality;
-    return dct_serialize_tables(*dct_make_tables(s, 16, 16).value());
-  };
-  desc.layers[0].codec_tables = tables(50);
-  desc.layers[1].codec_tables = tables(50);
-  auto w = PageFileWriter::create(path, desc);
-  ASSERT_TRUE(w.ok());
-  PageFileWriter& writer = **w;
-  const std::vector<uint8_t> texel(3, 9), stored(40, 5), trained = tables(80);
-  // A constant page does not depend on the tables; a stored one fixes them.
-  ASSERT_TRUE(writer.add_constant_page({0, 0, 0}, 0, texel).ok());
-  EXPECT_TRUE(writer.set_codec_tables(0, trained).ok());
-  ASSERT_TRUE(writer.add_page({0, 0, 0}, 1, stored).ok());
-  const Status late = writer.set_codec_tables(1, trained);
-  EXPECT_EQ(late.code(), ErrorCode::kInvalidArgument);
-  EXPECT_NE(late.message().find("after a stored page"), std::string::npos) << late.message();
-  EXPECT_FALSE(writer.set_codec_tables(2, trained).ok());  // raw layers have none
-  EXPECT_FALSE(writer.set_codec_tables(3, trained).ok());  // no layer 3
-  EXPECT_FALSE(writer.set_codec_tables(0, {}).ok());       // dct needs tables
-  ASSERT_TRUE(writer.finish().ok());
-  EXPECT_FALSE(writer.set_codec_tables(0, trained).ok());
-  auto reader = PageFileReader::open(path);
-  ASSERT_TRUE(reader.ok()) << reader.status().message();
-  EXPECT_EQ((*reader)->layers()[0].codec_tables, trained);
-  EXPECT_EQ((*reader)->layers()[1].codec_tables, tables(50));
-}
-
 TEST(PageFileWriter, AbandonedWriterLeavesNoFiles) {
   const std::string path = temp_path("abandoned.vtpf");
   const auto dir = std::filesystem::path(path).parent_path();
