@@ -203,29 +203,18 @@ Status write_texture(const std::string& path, uint32_t width, uint32_t height, u
   return write_image_file(source, path);
 }
 
-Status write_sample_scene(const std::string& dir, const SampleSceneOptions& o) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) return Error(ErrorCode::kIo, dir + ": cannot create folder (" + ec.message() + ")");
-  const uint32_t S = std::max(16u, o.texture_size);
-  scene::Scene sc;
-  auto image = [&](const std::string& file) {
-    scene::Image im;
-    im.name = fs::path(file).stem().string();
-    im.uri = file;
-    im.path = (fs::path(dir) / file).string();
-    if (file.ends_with(".png")) im.mime_type = "image/png";
-    sc.images.push_back(im);
-    return int(sc.images.size() - 1);
-  };
-  auto ref = [](int image) {
-    scene::TextureRef r;
-    r.image = image;
-    return r;
-  };
-  auto file = [&](const std::string& name) { return (fs::path(dir) / name).string(); };
+namespace {
 
+// Albedo of a material made of cells: per-channel base + range * cell, lit by `light`, darkened
+// by `mask` (grout, mortar), in that order of operations.
+void cell_albedo(float* t, const double (&base)[3], const double (&range)[3], double cell,
+                 double light, double mask) {
+  for (int c = 0; c < 3; ++c) t[c] = float((base[c] + range[c] * cell) * light * mask);
+}
+
+// The textures, procedural, written under `dir` at `S` texels a side (some at 1/2 or 1/4).
+Status write_sample_textures(const std::string& dir, uint32_t S) {
+  auto file = [&](const std::string& name) { return (std::filesystem::path(dir) / name).string(); };
   // Ground: tiles with grout, grain and a bump map; roughness/metal varying per tile.
   auto tile_h = [](double u, double v) {
     double fu = u * 8 - std::floor(u * 8), fv = v * 8 - std::floor(v * 8);
@@ -236,9 +225,7 @@ Status write_sample_scene(const std::string& dir, const SampleSceneOptions& o) {
       write_texture(file("ground_albedo.png"), S, S, 3, [&](double u, double v, float* t) {
         double cell = hash2(int64_t(u * 8), int64_t(v * 8), 1), g = fbm(u, v, 64, 3);
         double grout = tile_h(u, v) < 0.45 ? 0.35 : 1.0;
-        t[0] = float((0.45 + 0.35 * cell) * (0.7 + 0.3 * g) * grout);
-        t[1] = float((0.40 + 0.20 * cell) * (0.7 + 0.3 * g) * grout);
-        t[2] = float((0.30 + 0.15 * cell) * (0.7 + 0.3 * g) * grout);
+        cell_albedo(t, {0.45, 0.40, 0.30}, {0.35, 0.20, 0.15}, cell, 0.7 + 0.3 * g, grout);
       }));
   VT_RETURN_IF_ERROR(write_texture(
       file("ground_normal.png"), S, S, 3,
@@ -259,9 +246,7 @@ Status write_sample_scene(const std::string& dir, const SampleSceneOptions& o) {
         double row = std::floor(v * 8), bu = u * 4 + (int64_t(row) % 2) * 0.5;
         double c = hash2(int64_t(std::floor(bu)), int64_t(row), 4), g = fbm(u, v, 128, 11);
         double m = brick(u, v) > 0.5 ? 1.0 : 0.5;
-        t[0] = float((0.55 + 0.25 * c) * (0.8 + 0.2 * g) * m);
-        t[1] = float((0.22 + 0.10 * c) * (0.8 + 0.2 * g) * m);
-        t[2] = float((0.15 + 0.05 * c) * (0.8 + 0.2 * g) * m);
+        cell_albedo(t, {0.55, 0.22, 0.15}, {0.25, 0.10, 0.05}, c, 0.8 + 0.2 * g, m);
       }));
   VT_RETURN_IF_ERROR(write_texture(
       file("brick_normal.png"), S, S, 3,
@@ -286,55 +271,72 @@ Status write_sample_scene(const std::string& dir, const SampleSceneOptions& o) {
         t[0] = float(line), t[1] = float(0.6 * line), t[2] = float(0.2 * line);
       }));
   // Card: a leaf with an alpha mask.
-  VT_RETURN_IF_ERROR(
-      write_texture(file("leaf_albedo.png"), S / 2, S / 2, 4, [&](double u, double v, float* t) {
-        double x = (u - 0.5) * 2, y = (v - 0.5) * 2;
-        double inside = x * x / 0.5 + y * y < 1 - 0.15 * std::sin(std::atan2(y, x) * 12) ? 1 : 0;
-        double vein = std::abs(x) < 0.02 ? 0.6 : 1.0;
-        t[0] = float(0.15 * vein), t[1] = float((0.45 + 0.2 * fbm(u, v, 32, 8)) * vein),
-        t[2] = float(0.1 * vein);
-        t[3] = float(inside);
-      }));
+  return write_texture(file("leaf_albedo.png"), S / 2, S / 2, 4, [&](double u, double v, float* t) {
+    double x = (u - 0.5) * 2, y = (v - 0.5) * 2;
+    double inside = x * x / 0.5 + y * y < 1 - 0.15 * std::sin(std::atan2(y, x) * 12) ? 1 : 0;
+    double vein = std::abs(x) < 0.02 ? 0.6 : 1.0;
+    t[0] = float(0.15 * vein), t[1] = float((0.45 + 0.2 * fbm(u, v, 32, 8)) * vein),
+    t[2] = float(0.1 * vein);
+    t[3] = float(inside);
+  });
+}
 
-  int ground_albedo = image("ground_albedo.png"), ground_normal = image("ground_normal.png");
-  int ground_mr = image("ground_mr.png"), brick_albedo = image("brick_albedo.png");
-  int brick_normal = image("brick_normal.png"), brick_ao = image("brick_ao.png");
-  int sphere_albedo = image("sphere_albedo.exr"), torus_emissive = image("torus_emissive.png");
-  int leaf_albedo = image("leaf_albedo.png");
+// The images the textures became and the five materials over them (sc.images, sc.materials).
+void add_sample_materials(scene::Scene& sc, const std::string& dir) {
+  namespace fs = std::filesystem;
+  auto image = [&](const std::string& file) {
+    scene::Image im;
+    im.name = fs::path(file).stem().string();
+    im.uri = file;
+    im.path = (fs::path(dir) / file).string();
+    if (file.ends_with(".png")) im.mime_type = "image/png";
+    sc.images.push_back(im);
+    scene::TextureRef r;
+    r.image = int(sc.images.size() - 1);
+    return r;
+  };
+  auto ground_albedo = image("ground_albedo.png"), ground_normal = image("ground_normal.png");
+  auto ground_mr = image("ground_mr.png"), brick_albedo = image("brick_albedo.png");
+  auto brick_normal = image("brick_normal.png"), brick_ao = image("brick_ao.png");
+  auto sphere_albedo = image("sphere_albedo.exr"), torus_emissive = image("torus_emissive.png");
+  auto leaf_albedo = image("leaf_albedo.png");
 
   scene::Material ground;
   ground.name = "ground";
-  ground.base_color_texture = ref(ground_albedo);
-  ground.normal_texture = ref(ground_normal);
-  ground.metallic_roughness_texture = ref(ground_mr);
+  ground.base_color_texture = ground_albedo;
+  ground.normal_texture = ground_normal;
+  ground.metallic_roughness_texture = ground_mr;
   scene::Material bricks;
   bricks.name = "bricks";
-  bricks.base_color_texture = ref(brick_albedo);
-  bricks.normal_texture = ref(brick_normal);
-  bricks.occlusion_texture = ref(brick_ao);
+  bricks.base_color_texture = brick_albedo;
+  bricks.normal_texture = brick_normal;
+  bricks.occlusion_texture = brick_ao;
   bricks.metallic_factor = 0.0f;
   bricks.roughness_factor = 0.8f;
   scene::Material sphere;
   sphere.name = "sphere (linear EXR)";
-  sphere.base_color_texture = ref(sphere_albedo);
+  sphere.base_color_texture = sphere_albedo;
   sphere.metallic_factor = 0.6f;
   sphere.roughness_factor = 0.3f;
   scene::Material torus;
   torus.name = "glowing torus";
   torus.base_color_factor = {0.1f, 0.1f, 0.12f, 1.0f};
-  torus.emissive_texture = ref(torus_emissive);
+  torus.emissive_texture = torus_emissive;
   torus.emissive_factor = {1.0f, 1.0f, 1.0f};
   torus.metallic_factor = 0.0f;
   torus.roughness_factor = 0.5f;
   scene::Material leaf;
   leaf.name = "leaf (alpha mask)";
-  leaf.base_color_texture = ref(leaf_albedo);
+  leaf.base_color_texture = leaf_albedo;
   leaf.alpha_mode = scene::AlphaMode::kMask;
   leaf.double_sided = true;
   leaf.metallic_factor = 0.0f;
   leaf.roughness_factor = 0.6f;
   sc.materials = {ground, bricks, sphere, torus, leaf};
+}
 
+// The meshes (material i of add_sample_materials) and the nodes placing them.
+void add_sample_meshes(scene::Scene& sc, const SampleSceneOptions& o) {
   auto mesh = [&](const std::string& name, scene::Primitive p, int material) {
     p.material = material;
     scene::Mesh m;
@@ -365,6 +367,19 @@ Status write_sample_scene(const std::string& dir, const SampleSceneOptions& o) {
   node("sphere", sphere_mesh, translate_scale(1.5, 1.0, -1.0, 1.0));
   node("torus", torus_mesh, translate_scale(-1.0, 0.3, 2.0, 1.0, 0.5));
   node("leaf card", card_mesh, translate_scale(3.0, 0.0, 2.0, 1.0, -0.6));
+}
+
+}  // namespace
+
+Status write_sample_scene(const std::string& dir, const SampleSceneOptions& o) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) return Error(ErrorCode::kIo, dir + ": cannot create folder (" + ec.message() + ")");
+  VT_RETURN_IF_ERROR(write_sample_textures(dir, std::max(16u, o.texture_size)));
+  scene::Scene sc;
+  add_sample_materials(sc, dir);
+  add_sample_meshes(sc, o);
   sc.source_path = (fs::path(dir) / "scene.gltf").string();
   return scene::save_gltf(sc, sc.source_path, kSampleSceneGltf);
 }
