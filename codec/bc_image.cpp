@@ -1,5 +1,6 @@
 // Whole-image BC encode/decode: gathers 4x4 blocks and calls the per-format block codecs.
 #include <cstring>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,23 @@ Status check_image(BcFormat format, const void* a, const void* b, int width, int
   }
   return Status::Ok();
 }
+
+// One block to RGBA; the channels a format does not store read 0 (colour) and 255 (alpha).
+using BlockDecoder = void (*)(const uint8_t* block, uint8_t* rgba);
+
+void bc1_decode_rgba(const uint8_t* block, uint8_t* rgba) {
+  bc1_decode_block(block, rgba);
+}
+
+void bc4_decode_rgba(const uint8_t* block, uint8_t* rgba) {
+  bc4_decode_block(block, rgba, 4);
+  for (int i = 0; i < 16; ++i) rgba[4 * i + 1] = rgba[4 * i + 2] = 0, rgba[4 * i + 3] = 255;
+}
+
+// Indexed by BcFormat (check_image rejects any other value).
+constexpr BlockDecoder kBlockDecoders[] = {bc1_decode_rgba, bc3_decode_block, bc4_decode_rgba,
+                                           bc5_decode_block, bc7_decode_block};
+static_assert(std::size(kBlockDecoders) == size_t(BcFormat::kBc7) + 1);
 
 }  // namespace
 
@@ -122,28 +140,12 @@ Status bc_decode_image(BcFormat format, const uint8_t* blocks, int width, int he
   VT_RETURN_IF_ERROR(check_image(format, blocks, texels, width, height, channels));
   const size_t block_bytes = bc_block_bytes(format);
   const size_t row_stride = size_t(width) * size_t(channels);
+  const BlockDecoder decode_block = kBlockDecoders[int(format)];
   uint8_t rgba[64];
   for (int by = 0; by < height / 4; ++by) {
     for (int bx = 0; bx < width / 4; ++bx) {
       const uint8_t* block = blocks + (size_t(by) * size_t(width / 4) + size_t(bx)) * block_bytes;
-      switch (format) {
-        case BcFormat::kBc1:
-          bc1_decode_block(block, rgba);
-          break;
-        case BcFormat::kBc3:
-          bc3_decode_block(block, rgba);
-          break;
-        case BcFormat::kBc4:
-          bc4_decode_block(block, rgba, 4);
-          for (int i = 0; i < 16; ++i) rgba[4 * i + 1] = rgba[4 * i + 2] = 0, rgba[4 * i + 3] = 255;
-          break;
-        case BcFormat::kBc5:
-          bc5_decode_block(block, rgba);
-          break;
-        case BcFormat::kBc7:
-          bc7_decode_block(block, rgba);
-          break;
-      }
+      decode_block(block, rgba);
       for (int y = 0; y < 4; ++y) {
         uint8_t* dst =
             texels + (size_t(by) * 4 + size_t(y)) * row_stride + size_t(bx) * 4 * size_t(channels);

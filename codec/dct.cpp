@@ -20,6 +20,7 @@
 
 #include "codec/dct_rans.h"
 #include "codec/dct_transform.h"
+#include "common/hash.h"
 
 namespace vt {
 
@@ -596,16 +597,8 @@ using TokenCounts = std::vector<std::array<uint32_t, kTokens>>;  // [plane * kHi
 // channels, whose fine detail fades in and out across the page so that busy, smooth and flat
 // areas all occur, plus a hard edge. The last page is a flat field with a gentle gradient.
 std::vector<uint8_t> synthetic_page(int size, int channels, uint32_t seed, bool flat) {
-  auto hash = [](uint32_t x) {
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
-  };
   auto lattice = [&](int x, int y, uint32_t salt) {
-    return float(hash(uint32_t(x) * 73856093u ^ uint32_t(y) * 19349663u ^ salt) >> 8) /
+    return float(hash32(uint32_t(x) * 73856093u ^ uint32_t(y) * 19349663u ^ salt) >> 8) /
                float(1 << 24) -
            0.5f;
   };
@@ -618,8 +611,9 @@ std::vector<uint8_t> synthetic_page(int size, int channels, uint32_t seed, bool 
     return (a + (b - a) * sx) * (1 - sy) + (c + (d - c) * sx) * sy;
   };
   std::vector<uint8_t> page(size_t(size) * size * channels);
-  const float edge_a = float(int(hash(seed) % 7) - 3), edge_b = float(int(hash(seed + 1) % 5) - 2);
-  const float edge_c = float(int(hash(seed + 2) % uint32_t(size)));
+  const float edge_a = float(int(hash32(seed) % 7) - 3),
+              edge_b = float(int(hash32(seed + 1) % 5) - 2);
+  const float edge_c = float(int(hash32(seed + 2) % uint32_t(size)));
   for (int y = 0; y < size; y++) {
     for (int x = 0; x < size; x++) {
       const float detail = std::clamp(noise(x, y, 48, seed * 7) * 5.0f + 0.6f, 0.0f, 1.0f);

@@ -9,7 +9,7 @@
 //        tmp[y][u] = clamp((sum_v B[y][v] * F[v][u] + 256) >> 9, -32768, 32767)
 //      pass 2 (horizontal) is unchanged:
 //        out[y][x] = clamp((sum_u B[x][u] * tmp[y][u] + 2048) >> 12, -4095, 4095)
-//      with B = kIdctBasis (12-bit orthonormal basis, dct_transform.cpp) and >> arithmetic.
+//      with B = kIdctBasis (12-bit orthonormal basis, below) and >> arithmetic.
 //      Pass 1 can only saturate when a column holds several coefficients near +-2047 with
 //      matching signs; blocks of 8-bit content (|F| <= 1024 plus half a quantiser step) never do.
 //   2. 4:2:0 chroma samples (Co, Cg) are clamped to [-2047, 2047] before the 9-3-3-1 filter
@@ -29,6 +29,19 @@
 #include <span>
 
 namespace vt::dct_detail {
+
+// Orthonormal 8-point DCT basis B[x][u] = c(u) cos((2x + 1) u pi / 16) in 1/4096, rounded once
+// (c(0) = sqrt(1/8), else 1/2). Part of the format: the decoder's integer IDCT is defined on it.
+inline constexpr int16_t kIdctBasis[8][8] = {
+    {1448, 2009, 1892, 1703, 1448, 1138, 784, 400},
+    {1448, 1703, 784, -400, -1448, -2009, -1892, -1138},
+    {1448, 1138, -784, -2009, -1448, 400, 1892, 1703},
+    {1448, 400, -1892, -1138, 1448, 1703, -784, -2009},
+    {1448, -400, -1892, 1138, 1448, -1703, -784, 2009},
+    {1448, -1138, -784, 2009, -1448, -400, 1892, -1703},
+    {1448, -1703, 784, 400, -1448, 2009, -1892, 1138},
+    {1448, -2009, 1892, -1703, 1448, -1138, 784, -400},
+};
 
 // f: dequantised coefficients in natural (row-major v*8+u) order, each in [-2047, 2047], zero
 // outside rows < nv and columns < nu (1..8); nv, nu only pick a fast path, the result is that

@@ -6,20 +6,12 @@
 #include <array>
 #include <utility>
 
+#include "common/hash.h"
 #include "runtime/feedback.h"
 
 namespace vt {
 
 namespace {
-
-inline uint32_t hash32(uint32_t x) {
-  x ^= x >> 16;
-  x *= 0x7feb352dU;
-  x ^= x >> 15;
-  x *= 0x846ca68bU;
-  x ^= x >> 16;
-  return x;
-}
 
 // Flat open-addressing map uint32 -> count. A slot holds key + 1 (0 = empty) and the index of
 // the entry in dense arrays (keys, counts, slots), so iterating and clearing cost O(entries)

@@ -5,18 +5,10 @@
 
 #include <xxhash.h>
 
+#include "common/hash.h"
+
 namespace vt {
 namespace {
-
-inline uint32_t hash(uint32_t x, uint32_t y, uint32_t s) {
-  uint32_t h = x * 0x8da6b343u ^ y * 0xd8163841u ^ s * 0xcb1ab31fu;
-  h ^= h >> 15;
-  h *= 0x2c1b3c6du;
-  h ^= h >> 12;
-  h *= 0x297a2d39u;
-  h ^= h >> 15;
-  return h;
-}
 
 inline float unorm8(int v) {
   return float(std::clamp(v, 0, 255)) / 255.0f;
@@ -56,8 +48,8 @@ Status ProceduralImageSource::read_rows(uint32_t y0, uint32_t y1, float* out) {
           v[0] = 200, v[1] = 120, v[2] = 40;
         } else {
           int gx = int(uint64_t(x) * 160 / w), gy = int(uint64_t(y) * 160 / h);
-          uint32_t cell = hash(x / 37, y / 37, seed_);
-          int noise = int(hash(x, y, seed_ + 1) & 31) - 16;
+          uint32_t cell = hash2d(x / 37, y / 37, seed_);
+          int noise = int(hash2d(x, y, seed_ + 1) & 31) - 16;
           bool line = (x % 16) == 0 || (y % 16) == 0;
           v[0] = gx + int(cell & 63) + noise;
           v[1] = gy + int((cell >> 8) & 63) + noise;

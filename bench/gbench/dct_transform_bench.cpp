@@ -17,21 +17,14 @@
 #include <vector>
 
 #include "codec/dct_transform.h"
+#include "common/hash.h"
 
 namespace {
 
+using vt::Lcg64;
 using vt::dct_detail::TransformImpl;
 
 constexpr int kPage = 128;
-
-struct Rng {
-  uint64_t s;
-  uint32_t next() {
-    s = s * 6364136223846793005ull + 1442695040888963407ull;
-    return uint32_t(s >> 33);
-  }
-  int range(int lo, int hi) { return lo + int(next() % uint32_t(hi - lo + 1)); }
-};
 
 struct Block {
   int16_t f[64];
@@ -43,7 +36,7 @@ struct Block {
 struct PageBlocks {
   std::vector<Block> blocks;
   PageBlocks() {
-    Rng rng{2024};
+    Lcg64 rng{2024};
     auto add_plane = [&](int plane, int bw, int bh) {
       for (int by = 0; by < bh; by++)
         for (int bx = 0; bx < bw; bx++) {
@@ -93,13 +86,19 @@ void idct_page(const TransformImpl& impl, PagePlanes& out) {
   }
 }
 
-void BM_IdctPage(benchmark::State& state, const TransformImpl* impl) {
-  PagePlanes planes;
+// Times `step`, which writes to `out`, keeping the compiler from dropping the writes.
+template <class Step>
+void time_steps(benchmark::State& state, const void* out, Step step) {
   for (auto _ : state) {
-    idct_page(*impl, planes);
-    benchmark::DoNotOptimize(planes.y.data());
+    step();
+    benchmark::DoNotOptimize(out);
     benchmark::ClobberMemory();
   }
+}
+
+void BM_IdctPage(benchmark::State& state, const TransformImpl* impl) {
+  PagePlanes planes;
+  time_steps(state, planes.y.data(), [&] { idct_page(*impl, planes); });
   state.counters["blocks/page"] = double(page_blocks().blocks.size());
 }
 
@@ -111,55 +110,49 @@ std::vector<int16_t> full_res(const std::vector<int16_t>& c) {
   return f;
 }
 
-void BM_Colour420Page(benchmark::State& state, const TransformImpl* impl) {
-  const int ch = int(state.range(0));
-  PagePlanes planes;
-  idct_page(vt::dct_detail::scalar_transform(), planes);
-  std::vector<uint8_t> texels(size_t(kPage) * kPage * ch, 255);
-  for (auto _ : state) {
-    impl->ycocg420_to_rgb(planes.y.data(), kPage, planes.co.data(), planes.cg.data(), kPage / 2,
-                          kPage, kPage, ch, texels.data());
-    benchmark::DoNotOptimize(texels.data());
-    benchmark::ClobberMemory();
+// Input and output of the colour benchmarks: the page's planes (scalar IDCT) and a page of
+// `ch`-channel texels, the channels not written left at 255.
+struct ColourCase {
+  explicit ColourCase(int channels) : ch(channels), texels(size_t(kPage) * kPage * ch, 255) {
+    idct_page(vt::dct_detail::scalar_transform(), planes);
   }
+  int ch;
+  PagePlanes planes;
+  std::vector<uint8_t> texels;
+};
+
+void BM_Colour420Page(benchmark::State& state, const TransformImpl* impl) {
+  ColourCase c(int(state.range(0)));
+  time_steps(state, c.texels.data(), [&] {
+    impl->ycocg420_to_rgb(c.planes.y.data(), kPage, c.planes.co.data(), c.planes.cg.data(),
+                          kPage / 2, kPage, kPage, c.ch, c.texels.data());
+  });
 }
 
 void BM_Colour444Page(benchmark::State& state, const TransformImpl* impl) {
-  const int ch = int(state.range(0));
-  PagePlanes planes;
-  idct_page(vt::dct_detail::scalar_transform(), planes);
-  const std::vector<int16_t> co = full_res(planes.co), cg = full_res(planes.cg);
-  std::vector<uint8_t> texels(size_t(kPage) * kPage * ch, 255);
-  for (auto _ : state) {
-    impl->ycocg_to_rgb(planes.y.data(), kPage, co.data(), cg.data(), kPage, kPage, kPage, ch,
-                       texels.data());
-    benchmark::DoNotOptimize(texels.data());
-    benchmark::ClobberMemory();
-  }
+  ColourCase c(int(state.range(0)));
+  const std::vector<int16_t> co = full_res(c.planes.co), cg = full_res(c.planes.cg);
+  time_steps(state, c.texels.data(), [&] {
+    impl->ycocg_to_rgb(c.planes.y.data(), kPage, co.data(), cg.data(), kPage, kPage, kPage, c.ch,
+                       c.texels.data());
+  });
 }
 
 void BM_PlaneToChannel(benchmark::State& state, const TransformImpl* impl) {
-  const int ch = int(state.range(0));
-  PagePlanes planes;
-  idct_page(vt::dct_detail::scalar_transform(), planes);
-  std::vector<uint8_t> texels(size_t(kPage) * kPage * ch, 255);
-  for (auto _ : state) {
-    impl->plane_to_channel(planes.y.data(), kPage, kPage, kPage, ch, ch - 1, texels.data());
-    benchmark::DoNotOptimize(texels.data());
-    benchmark::ClobberMemory();
-  }
+  ColourCase c(int(state.range(0)));
+  time_steps(state, c.texels.data(), [&] {
+    impl->plane_to_channel(c.planes.y.data(), kPage, kPage, kPage, c.ch, c.ch - 1, c.texels.data());
+  });
 }
 
 void BM_BackEndPage(benchmark::State& state, const TransformImpl* impl) {
   PagePlanes planes;
   std::vector<uint8_t> texels(size_t(kPage) * kPage * 3);
-  for (auto _ : state) {
+  time_steps(state, texels.data(), [&] {
     idct_page(*impl, planes);
     impl->ycocg420_to_rgb(planes.y.data(), kPage, planes.co.data(), planes.cg.data(), kPage / 2,
                           kPage, kPage, 3, texels.data());
-    benchmark::DoNotOptimize(texels.data());
-    benchmark::ClobberMemory();
-  }
+  });
 }
 
 }  // namespace

@@ -39,14 +39,20 @@ int expand6(int v) {
 
 // ---- decoder rounding rules ----
 
+// The RGBA texels of a BC1 block with endpoints c0, c1 (RGB565) and index byte `indices` for
+// texels 0-3 (the other texels index 0).
+std::array<uint8_t, 64> bc1_decode_indices(uint16_t c0, uint16_t c1, uint8_t indices) {
+  const uint8_t block[8] = {
+      uint8_t(c0), uint8_t(c0 >> 8), uint8_t(c1), uint8_t(c1 >> 8), indices, 0, 0, 0};
+  std::array<uint8_t, 64> rgba;
+  bc1_decode_block(block, rgba.data());
+  return rgba;
+}
+
 TEST(Bc1Decode, FourColourPaletteTruncates) {
   // c0 = (31, 0, 1), c1 = (0, 0, 0): red 255 and 0, blue 8 and 0.
   const uint16_t c0 = (31 << 11) | 1, c1 = 0;
-  // indices 0,1,2,3 in the first four texels
-  const uint8_t block[8] = {
-      uint8_t(c0), uint8_t(c0 >> 8), uint8_t(c1), uint8_t(c1 >> 8), 0xE4, 0, 0, 0};
-  uint8_t rgba[64];
-  bc1_decode_block(block, rgba);
+  const auto rgba = bc1_decode_indices(c0, c1, 0xE4);  // indices 0,1,2,3 in texels 0-3
   EXPECT_EQ(rgba[0], 255);
   EXPECT_EQ(rgba[4], 0);
   EXPECT_EQ(rgba[8], 170);  // (2*255 + 0) / 3 = 170
@@ -60,10 +66,7 @@ TEST(Bc1Decode, FourColourPaletteTruncates) {
 TEST(Bc1Decode, ThreeColourMidpointRoundsUpAndIndexThreeIsBlack) {
   // c0 = (r0, g1, b0) <= c1 = (r1, g2, b0): red 0 and 8, green 4 and 8.
   const uint16_t c0 = 1 << 5, c1 = (1 << 11) | (2 << 5);
-  const uint8_t block[8] = {
-      uint8_t(c0), uint8_t(c0 >> 8), uint8_t(c1), uint8_t(c1 >> 8), 0xE4, 0, 0, 0};
-  uint8_t rgba[64];
-  bc1_decode_block(block, rgba);
+  const auto rgba = bc1_decode_indices(c0, c1, 0xE4);
   EXPECT_EQ(rgba[0], 0);
   EXPECT_EQ(rgba[1], 4);
   EXPECT_EQ(rgba[4], 8);
@@ -80,12 +83,7 @@ TEST(Bc1Decode, ThreeColourMidpointRoundsUpAndIndexThreeIsBlack) {
 TEST(Bc1Decode, ThreeColourOddSumRoundsUp) {
   // An odd sum: green 0 -> 0 and 16 -> 65 give (0 + 65 + 1) / 2 = 33 (32.5 rounds up).
   const uint16_t c0 = 0, c1 = 16 << 5;
-  const uint8_t block[8] = {uint8_t(c0), uint8_t(c0 >> 8),
-                            uint8_t(c1), uint8_t(c1 >> 8),
-                            0x02,        0,
-                            0,           0};  // texel 0 -> index 2
-  uint8_t rgba[64];
-  bc1_decode_block(block, rgba);
+  const auto rgba = bc1_decode_indices(c0, c1, 0x02);  // texel 0 -> index 2
   EXPECT_EQ(expand6(16), 65);
   EXPECT_EQ(rgba[1], 33);
 }
@@ -105,14 +103,20 @@ TEST(Bc3Decode, ColourHalfIsAlwaysFourColour) {
   EXPECT_EQ(rgba[3], 255);
 }
 
-TEST(Bc4Decode, EightValueModeTruncates) {
-  // e0 = 200 > e1 = 10; indices 0..7 in texels 0..7.
+// The 16 texels of a BC4 block with endpoints e0, e1 and index i in texel i for i < 8 (index 0
+// in texels 8-15), so texels 0-7 show the whole palette.
+std::array<uint8_t, 16> bc4_decode_palette_block(uint8_t e0, uint8_t e1) {
   uint64_t bits = 0;
   for (int i = 0; i < 8; ++i) bits |= uint64_t(i) << (3 * i);
-  uint8_t block[8] = {200, 10};
+  uint8_t block[8] = {e0, e1};
   for (int i = 0; i < 6; ++i) block[2 + i] = uint8_t(bits >> (8 * i));
-  uint8_t v[16];
-  bc4_decode_block(block, v, 1);
+  std::array<uint8_t, 16> v;
+  bc4_decode_block(block, v.data(), 1);
+  return v;
+}
+
+TEST(Bc4Decode, EightValueModeTruncates) {
+  const auto v = bc4_decode_palette_block(200, 10);  // e0 > e1
   EXPECT_EQ(v[0], 200);
   EXPECT_EQ(v[1], 10);
   for (int k = 2; k < 8; ++k) EXPECT_EQ(v[k], ((8 - k) * 200 + (k - 1) * 10) / 7) << k;
@@ -120,12 +124,7 @@ TEST(Bc4Decode, EightValueModeTruncates) {
 }
 
 TEST(Bc4Decode, SixValueModeHasZeroAnd255) {
-  uint64_t bits = 0;
-  for (int i = 0; i < 8; ++i) bits |= uint64_t(i) << (3 * i);
-  uint8_t block[8] = {10, 200};
-  for (int i = 0; i < 6; ++i) block[2 + i] = uint8_t(bits >> (8 * i));
-  uint8_t v[16];
-  bc4_decode_block(block, v, 1);
+  const auto v = bc4_decode_palette_block(10, 200);  // e0 <= e1
   EXPECT_EQ(v[0], 10);
   EXPECT_EQ(v[1], 200);
   EXPECT_EQ(v[2], (4 * 10 + 1 * 200) / 5);

@@ -9,37 +9,18 @@
 #include <vector>
 
 #include "codec/dct.h"
+#include "common/hash.h"
 
 namespace vt::dct_test {
 
 enum class Pattern { kGradient, kNoise, kEdges, kText, kMixed };
 
 inline const char* pattern_name(Pattern p) {
-  switch (p) {
-    case Pattern::kGradient:
-      return "gradient";
-    case Pattern::kNoise:
-      return "noise";
-    case Pattern::kEdges:
-      return "edges";
-    case Pattern::kText:
-      return "text";
-    case Pattern::kMixed:
-      return "mixed";
-  }
-  return "?";
+  static constexpr const char* kNames[] = {"gradient", "noise", "edges", "text", "mixed"};
+  return kNames[int(p)];
 }
 
-struct Rng {
-  uint64_t s;
-  uint32_t next() {
-    s = s * 6364136223846793005ull + 1442695040888963407ull;
-    return uint32_t(s >> 33);
-  }
-  int range(int n) { return int(next() % uint32_t(n)); }
-};
-
-inline uint8_t pattern_value(Pattern p, int x, int y, int c, int w, int h, Rng& rng,
+inline uint8_t pattern_value(Pattern p, int x, int y, int c, int w, int h, Lcg64& rng,
                              const std::vector<uint8_t>& glyphs) {
   switch (p) {
     case Pattern::kGradient: {
@@ -71,14 +52,15 @@ inline uint8_t pattern_value(Pattern p, int x, int y, int c, int w, int h, Rng& 
 
 // A width x height page of `channels` interleaved 8-bit channels.
 inline std::vector<uint8_t> make_page(Pattern p, int w, int h, int channels, uint64_t seed = 1) {
-  Rng rng{seed};
+  Lcg64 rng{seed};
   // Text-like: short horizontal and vertical strokes on a grid of 6x8 character cells.
   std::vector<uint8_t> glyphs(size_t(w) * h, 0);
   for (int cy = 0; cy + 8 <= h; cy += 9) {
     for (int cx = 0; cx + 6 <= w; cx += 7) {
       for (int s = 0; s < 3; s++) {
-        const bool horizontal = rng.range(2) == 0;
-        const int x0 = cx + rng.range(horizontal ? 2 : 6), y0 = cy + rng.range(horizontal ? 8 : 3);
+        const bool horizontal = rng.below(2) == 0;
+        const int x0 = cx + int(rng.below(horizontal ? 2 : 6)),
+                  y0 = cy + int(rng.below(horizontal ? 8 : 3));
         for (int i = 0; i < (horizontal ? 4 : 6); i++) {
           const int x = horizontal ? x0 + i : x0, y = horizontal ? y0 : y0 + i;
           if (x < w && y < h) glyphs[size_t(y) * w + x] = 1;
@@ -217,13 +199,13 @@ TEST(Dct, HigherQualityGivesHigherPsnrAndMoreBytes) {
 }
 
 TEST(Dct, ConstantPagesDecodeExactlyAndCostAFewBytes) {
-  dct_test::Rng rng{99};
+  Lcg64 rng{99};
   for (Layout l : kLayouts) {
     for (int q : {1, 50, 100}) {
       auto t = tables_for(q, l);
       for (int trial = 0; trial < 4; trial++) {
         std::vector<uint8_t> texel(size_t(l.channels));
-        for (auto& v : texel) v = uint8_t(trial == 0 ? 0 : trial == 1 ? 255 : rng.range(256));
+        for (auto& v : texel) v = uint8_t(trial == 0 ? 0 : trial == 1 ? 255 : int(rng.below(256)));
         std::vector<uint8_t> page;
         for (int i = 0; i < 128 * 128; i++) page.insert(page.end(), texel.begin(), texel.end());
         const RoundTrip r = round_trip(*t, page, 128, 128);
@@ -470,10 +452,10 @@ TEST(Dct, TruncatedAndCorruptPagesGiveErrorsNotCrashes) {
     }
     EXPECT_EQ(corrupt, total) << "layout " << int(l.layout);
     // Flipped bits decode to something or fail cleanly; the sanitizers check the rest.
-    dct_test::Rng rng{17};
+    Lcg64 rng{17};
     for (int i = 0; i < 50; i++) {
       auto bad = coded;
-      bad[size_t(rng.range(int(bad.size())))] ^= uint8_t(1u << rng.range(8));
+      bad[rng.below(bad.size())] ^= uint8_t(1u << rng.below(8));
       const Status s = dct_decode_page(*t, bad, 128, 128, out.data());
       EXPECT_TRUE(s.ok() || s.code() == ErrorCode::kCorrupt);
     }

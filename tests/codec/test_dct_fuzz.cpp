@@ -6,19 +6,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "common/hash.h"
 #include "fuzz_dct.cpp"
 
 namespace vt {
 namespace {
-
-struct Rng {
-  uint64_t s;
-  uint32_t next() {
-    s = s * 6364136223846793005ull + 1442695040888963407ull;
-    return uint32_t(s >> 33);
-  }
-  size_t below(size_t n) { return n == 0 ? 0 : size_t(next()) % n; }
-};
 
 // Stops a loop after `iterations` or `seconds`, whichever comes first, so the test stays
 // bounded on a slow sanitizer build.
@@ -32,7 +24,7 @@ struct Budget {
   bool more() { return iterations-- > 0 && std::chrono::steady_clock::now() < end; }
 };
 
-void mutate(std::vector<uint8_t>& v, Rng& rng) {
+void mutate(std::vector<uint8_t>& v, Lcg64& rng) {
   const int edits = 1 + int(rng.below(4));
   for (int e = 0; e < edits; e++) {
     const size_t at = dct_fuzz::kHeaderBytes + rng.below(v.size() - dct_fuzz::kHeaderBytes + 1);
@@ -57,7 +49,16 @@ void mutate(std::vector<uint8_t>& v, Rng& rng) {
   }
 }
 
-std::vector<uint8_t> valid_page_input(uint8_t mode, uint8_t quality, uint8_t size, Rng& rng) {
+// Runs the target on `count` independently mutated copies of `input`.
+void run_mutated(const std::vector<uint8_t>& input, int count, Lcg64& rng) {
+  for (int m = 0; m < count; m++) {
+    auto bad = input;
+    mutate(bad, rng);
+    LLVMFuzzerTestOneInput(bad.data(), bad.size());
+  }
+}
+
+std::vector<uint8_t> valid_page_input(uint8_t mode, uint8_t quality, uint8_t size, Lcg64& rng) {
   std::vector<uint8_t> input = {mode, quality, size};
   const dct_fuzz::Setup setup = dct_fuzz::setup_from(input.data());
   const DctTablesPtr tables = dct_fuzz::tables_for(setup);
@@ -73,7 +74,7 @@ std::vector<uint8_t> valid_page_input(uint8_t mode, uint8_t quality, uint8_t siz
 }
 
 TEST(DctFuzz, RandomInputs) {
-  Rng rng{1};
+  Lcg64 rng{1};
   Budget budget(3000, 8.0);
   while (budget.more()) {
     std::vector<uint8_t> input(rng.below(2048));
@@ -83,22 +84,18 @@ TEST(DctFuzz, RandomInputs) {
 }
 
 TEST(DctFuzz, MutatedValidPages) {
-  Rng rng{2};
+  Lcg64 rng{2};
   Budget budget(3000, 10.0);
   while (budget.more()) {
     const uint8_t mode = uint8_t((rng.next() & 0x1E));  // a page, any layout, trained or not
     auto input = valid_page_input(mode, uint8_t(rng.next()), uint8_t(rng.next()), rng);
     LLVMFuzzerTestOneInput(input.data(), input.size());  // unmutated: must decode
-    for (int m = 0; m < 8; m++) {
-      auto bad = input;
-      mutate(bad, rng);
-      LLVMFuzzerTestOneInput(bad.data(), bad.size());
-    }
+    run_mutated(input, 8, rng);
   }
 }
 
 TEST(DctFuzz, MutatedTables) {
-  Rng rng{3};
+  Lcg64 rng{3};
   Budget budget(300, 8.0);
   while (budget.more()) {
     const dct_fuzz::Setup setup = dct_fuzz::setup_from(
@@ -106,17 +103,13 @@ TEST(DctFuzz, MutatedTables) {
     const auto bytes = dct_serialize_tables(*dct_fuzz::tables_for(setup));
     std::vector<uint8_t> input = {1, 0, 0};
     input.insert(input.end(), bytes.begin(), bytes.end());
-    for (int m = 0; m < 8; m++) {
-      auto bad = input;
-      mutate(bad, rng);
-      LLVMFuzzerTestOneInput(bad.data(), bad.size());
-    }
+    run_mutated(input, 8, rng);
   }
 }
 
 TEST(DctFuzz, ValidPagesDecode) {
   // The target itself is checked: valid input goes through the decode-twice comparison.
-  Rng rng{4};
+  Lcg64 rng{4};
   for (int i = 0; i < 32; i++) {
     auto input = valid_page_input(uint8_t(i & 0x1E), uint8_t(rng.next()), uint8_t(rng.next()), rng);
     const dct_fuzz::Setup setup = dct_fuzz::setup_from(input.data());

@@ -8,18 +8,10 @@
 #include <functional>
 #include <thread>
 
+#include "common/hash.h"
 #include "runtime/page_source.h"
 
 namespace vt::testing {
-
-inline uint32_t mix32(uint32_t x) {
-  x ^= x >> 16;
-  x *= 0x7feb352dU;
-  x ^= x >> 15;
-  x *= 0x846ca68bU;
-  x ^= x >> 16;
-  return x;
-}
 
 class FakeSource final : public PageSource {
  public:
@@ -45,9 +37,9 @@ class FakeSource final : public PageSource {
   }
   // Content only depends on the page and layer (the first word names them, for quick checks).
   static void fill(const PageId& id, uint32_t layer, std::span<uint8_t> out) {
-    const uint32_t seed = mix32(id.level * 0x9E3779B9u ^ mix32(id.x * 65537u + id.y) ^ layer);
+    const uint32_t seed = hash32(id.level * 0x9E3779B9u ^ hash32(id.x * 65537u + id.y) ^ layer);
     for (size_t i = 0; i < out.size(); i += 4) {
-      const uint32_t v = mix32(seed + uint32_t(i));
+      const uint32_t v = hash32(seed + uint32_t(i));
       std::memcpy(&out[i], &v, std::min<size_t>(4, out.size() - i));
     }
   }

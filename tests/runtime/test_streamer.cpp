@@ -56,7 +56,7 @@ struct CpuCache {
 TEST(Streamer, PropertyRandomRequestsAndEvictions) {
   // Absent pages exercise the "nearest present ancestor" rule throughout.
   auto src = std::make_shared<FakeSource>(small_geometry(13, 9), 2, [](const PageId& id) {
-    return id.level < 2 && testing::mix32(id.x * 31 + id.y * 7 + id.level) % 7 == 0;
+    return id.level < 2 && hash32(id.x * 31 + id.y * 7 + id.level) % 7 == 0;
   });
   const uint64_t slot = slot_bytes(*src);
   const uint64_t budget = (12 + 16) * slot + slot / 2;  // 12 slots + staging for 16
