@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 #include <functional>
+#include <utility>
 
 #include "format/runtime_format.h"
 #include "render/shaders.h"
@@ -68,26 +69,19 @@ std::vector<std::vector<uint8_t>> box_mip_chain(const uint8_t* rgba, uint32_t wi
 }
 
 VkFormat cache_vk_format(RuntimeFormat f) {
-  switch (f) {
-    case RuntimeFormat::kRgba8:
-      return VK_FORMAT_R8G8B8A8_UNORM;
-    case RuntimeFormat::kR8:
-      return VK_FORMAT_R8_UNORM;
-    case RuntimeFormat::kRg8:
-      return VK_FORMAT_R8G8_UNORM;
-    case RuntimeFormat::kBc1:
-      return VK_FORMAT_BC1_RGB_UNORM_BLOCK;
-    case RuntimeFormat::kBc3:
-      return VK_FORMAT_BC3_UNORM_BLOCK;
-    case RuntimeFormat::kBc4:
-      return VK_FORMAT_BC4_UNORM_BLOCK;
-    case RuntimeFormat::kBc5:
-      return VK_FORMAT_BC5_UNORM_BLOCK;
-    case RuntimeFormat::kBc7:
-      return VK_FORMAT_BC7_UNORM_BLOCK;
-    default:
-      return VK_FORMAT_UNDEFINED;
+  static constexpr std::pair<RuntimeFormat, VkFormat> kFormats[] = {
+      {RuntimeFormat::kRgba8, VK_FORMAT_R8G8B8A8_UNORM},
+      {RuntimeFormat::kR8, VK_FORMAT_R8_UNORM},
+      {RuntimeFormat::kRg8, VK_FORMAT_R8G8_UNORM},
+      {RuntimeFormat::kBc1, VK_FORMAT_BC1_RGB_UNORM_BLOCK},
+      {RuntimeFormat::kBc3, VK_FORMAT_BC3_UNORM_BLOCK},
+      {RuntimeFormat::kBc4, VK_FORMAT_BC4_UNORM_BLOCK},
+      {RuntimeFormat::kBc5, VK_FORMAT_BC5_UNORM_BLOCK},
+      {RuntimeFormat::kBc7, VK_FORMAT_BC7_UNORM_BLOCK}};
+  for (const auto& [runtime, vk] : kFormats) {
+    if (runtime == f) return vk;
   }
+  return VK_FORMAT_UNDEFINED;
 }
 
 size_t cache_page_bytes(RuntimeFormat f, uint32_t page_size) {
