@@ -546,7 +546,9 @@ TEST_P(ValidateFault, EveryViewFails) {
   print_runs(c.name, runs);
   EXPECT_EQ(failing_views(runs, c.runtime), 4);
   // A dropped alpha channel shows as surface where the reference has holes.
-  if (c.fault == Fault::kOpaqueAlpha) EXPECT_GT(runs[1].metrics.coverage_mismatch_share, 0.05);
+  if (c.fault == Fault::kOpaqueAlpha) {
+    EXPECT_GT(runs[1].metrics.coverage_mismatch_share, 0.05);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Validate, ValidateFault, testing::ValuesIn(kFaultCases),
