@@ -27,7 +27,8 @@ inline LayerSpec test_layer(const std::string& name, uint8_t channels, PageCodec
                    .name = name,
                    .channels = channels,
                    .codec = codec,
-                   .runtime_format = runtime};
+                   .runtime_format = runtime,
+                   .codec_tables = {}};
 }
 
 }  // namespace vt::runtime_test
