@@ -6,6 +6,7 @@
 #include <string>
 
 #include "common/status.h"
+#include "format/page_geometry.h"
 #include "format/vt_error_c.h"
 
 namespace vt::c_api {
@@ -23,6 +24,17 @@ int guard(Fn&& body) {
   } catch (const std::exception& e) {  // std::bad_alloc above all
     return fail(Error(ErrorCode::kResourceLimit, e.what()));
   }
+}
+
+// Fills the geometry fields that vtpf_geometry and vtrt_geometry share.
+template <typename CGeometry>
+void fill_geometry(const PageGeometry& g, CGeometry* out) {
+  out->width = g.width;
+  out->height = g.height;
+  out->payload = g.payload;
+  out->border = g.border;
+  out->page_size = g.page_size();
+  out->level_count = g.level_count();
 }
 
 }  // namespace vt::c_api

@@ -49,13 +49,7 @@ void vtpf_close(vtpf_file* file) {
 int vtpf_get_geometry(const vtpf_file* file, vtpf_geometry* out) {
   if (!file) return fail_null("file");
   if (!out) return fail_null("out");
-  const vt::PageGeometry& g = file->reader->geometry();
-  out->width = g.width;
-  out->height = g.height;
-  out->payload = g.payload;
-  out->border = g.border;
-  out->page_size = g.page_size();
-  out->level_count = g.level_count();
+  vt::c_api::fill_geometry(file->reader->geometry(), out);
   out->layer_count = uint32_t(file->reader->layers().size());
   out->version = file->reader->version();
   return VT_OK;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cstring>
+#include <functional>
+#include <utility>
 
 #include "format/runtime_format.h"
 #include "render/shaders.h"
@@ -67,26 +69,19 @@ std::vector<std::vector<uint8_t>> box_mip_chain(const uint8_t* rgba, uint32_t wi
 }
 
 VkFormat cache_vk_format(RuntimeFormat f) {
-  switch (f) {
-    case RuntimeFormat::kRgba8:
-      return VK_FORMAT_R8G8B8A8_UNORM;
-    case RuntimeFormat::kR8:
-      return VK_FORMAT_R8_UNORM;
-    case RuntimeFormat::kRg8:
-      return VK_FORMAT_R8G8_UNORM;
-    case RuntimeFormat::kBc1:
-      return VK_FORMAT_BC1_RGB_UNORM_BLOCK;
-    case RuntimeFormat::kBc3:
-      return VK_FORMAT_BC3_UNORM_BLOCK;
-    case RuntimeFormat::kBc4:
-      return VK_FORMAT_BC4_UNORM_BLOCK;
-    case RuntimeFormat::kBc5:
-      return VK_FORMAT_BC5_UNORM_BLOCK;
-    case RuntimeFormat::kBc7:
-      return VK_FORMAT_BC7_UNORM_BLOCK;
-    default:
-      return VK_FORMAT_UNDEFINED;
+  static constexpr std::pair<RuntimeFormat, VkFormat> kFormats[] = {
+      {RuntimeFormat::kRgba8, VK_FORMAT_R8G8B8A8_UNORM},
+      {RuntimeFormat::kR8, VK_FORMAT_R8_UNORM},
+      {RuntimeFormat::kRg8, VK_FORMAT_R8G8_UNORM},
+      {RuntimeFormat::kBc1, VK_FORMAT_BC1_RGB_UNORM_BLOCK},
+      {RuntimeFormat::kBc3, VK_FORMAT_BC3_UNORM_BLOCK},
+      {RuntimeFormat::kBc4, VK_FORMAT_BC4_UNORM_BLOCK},
+      {RuntimeFormat::kBc5, VK_FORMAT_BC5_UNORM_BLOCK},
+      {RuntimeFormat::kBc7, VK_FORMAT_BC7_UNORM_BLOCK}};
+  for (const auto& [runtime, vk] : kFormats) {
+    if (runtime == f) return vk;
   }
+  return VK_FORMAT_UNDEFINED;
 }
 
 size_t cache_page_bytes(RuntimeFormat f, uint32_t page_size) {
@@ -155,6 +150,29 @@ struct Renderer::Impl {
                   uint32_t w, uint32_t h, std::span<const VkClearColorValue> clears);
   void end_pass(VkCommandBuffer cmd, std::span<const Image* const> targets,
                 std::span<const Buffer* const> readbacks, uint32_t w, uint32_t h);
+
+  // One render pass: clear the targets, bind `pipe`, draw, copy each target to its readback.
+  struct PassTargets {
+    std::span<const Image* const> targets;
+    std::span<const Buffer* const> readbacks;
+    const Image* depth;
+    uint32_t width, height;
+    std::span<const VkClearColorValue> clears;
+  };
+  Status run_pass(const PassTargets& pass, VkPipeline pipe,
+                  const std::function<void(VkCommandBuffer)>& draw);
+  // The reference and virtual passes share the colour and status targets.
+  Status run_color_pass(uint32_t w, uint32_t h, VkPipeline pipe,
+                        const std::function<void(VkCommandBuffer)>& draw);
+  Rgba8Image read_color(uint32_t w, uint32_t h) const;
+
+  // Stages `bytes` and copies them into `image`, which is in `from` before and shader-readable
+  // after.
+  Status upload_image(Image& image, std::span<const uint8_t> bytes,
+                      std::span<const ImageCopy> copies, VkImageLayout from);
+  // A pool of `sets` descriptor sets of `descriptors` combined image samplers in all.
+  Expected<VkDescriptorPool> make_pool(uint32_t sets, uint32_t descriptors);
+  Expected<VkDescriptorSet> allocate_set(VkDescriptorPool pool, VkDescriptorSetLayout layout);
 };
 
 Renderer::Impl::~Impl() {
@@ -409,6 +427,39 @@ void Renderer::Impl::end_pass(VkCommandBuffer cmd, std::span<const Image* const>
   vkCmdPipelineBarrier2(cmd, &dep);
 }
 
+Status Renderer::Impl::upload_image(Image& image, std::span<const uint8_t> bytes,
+                                    std::span<const ImageCopy> copies, VkImageLayout from) {
+  VT_ASSIGN_OR_RETURN(Buffer buf, ctx.create_buffer_with(bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT));
+  return ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    VulkanContext::transition(cmd, image, from, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    VulkanContext::copy_buffer_to_image(cmd, buf, image, copies);
+    VulkanContext::transition(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  });
+}
+
+Expected<VkDescriptorPool> Renderer::Impl::make_pool(uint32_t sets, uint32_t descriptors) {
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, descriptors};
+  VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pci.maxSets = sets;
+  pci.poolSizeCount = 1;
+  pci.pPoolSizes = &size;
+  VkDescriptorPool pool;
+  VT_VK(vkCreateDescriptorPool(dev, &pci, nullptr, &pool));
+  return pool;
+}
+
+Expected<VkDescriptorSet> Renderer::Impl::allocate_set(VkDescriptorPool pool,
+                                                       VkDescriptorSetLayout layout) {
+  VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  ai.descriptorPool = pool;
+  ai.descriptorSetCount = 1;
+  ai.pSetLayouts = &layout;
+  VkDescriptorSet set;
+  VT_VK(vkAllocateDescriptorSets(dev, &ai, &set));
+  return set;
+}
+
 Renderer::Renderer(std::unique_ptr<Impl> impl, const RenderOptions& options)
     : impl_(std::move(impl)), options_(options) {}
 Renderer::~Renderer() = default;
@@ -483,12 +534,8 @@ Status Renderer::set_reference_textures(std::span<const ReferenceTexture> textur
   s.ref_pool = VK_NULL_HANDLE;
   if (textures.empty()) return Status::Ok();
 
-  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, uint32_t(textures.size())};
-  VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  pci.maxSets = uint32_t(textures.size());
-  pci.poolSizeCount = 1;
-  pci.pPoolSizes = &size;
-  VT_VK(vkCreateDescriptorPool(s.dev, &pci, nullptr, &s.ref_pool));
+  const uint32_t count = uint32_t(textures.size());
+  VT_ASSIGN_OR_RETURN(s.ref_pool, s.make_pool(count, count));
 
   for (size_t t = 0; t < textures.size(); ++t) {
     const ReferenceTexture& tex = textures[t];
@@ -519,20 +566,8 @@ Status Renderer::set_reference_textures(std::span<const ReferenceTexture> textur
     d.height = tex.height;
     d.mip_levels = levels;
     VT_ASSIGN_OR_RETURN(g.image, s.ctx.create_image(d));
-    VT_ASSIGN_OR_RETURN(Buffer buf,
-                        s.ctx.create_buffer_with(staging, VK_BUFFER_USAGE_TRANSFER_SRC_BIT));
-    VT_RETURN_IF_ERROR(s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-      VulkanContext::transition(cmd, g.image, VK_IMAGE_LAYOUT_UNDEFINED,
-                                VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-      VulkanContext::copy_buffer_to_image(cmd, buf, g.image, copies);
-      VulkanContext::transition(cmd, g.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                                VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-    }));
-    VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-    ai.descriptorPool = s.ref_pool;
-    ai.descriptorSetCount = 1;
-    ai.pSetLayouts = &s.ref_set_layout;
-    VT_VK(vkAllocateDescriptorSets(s.dev, &ai, &g.set));
+    VT_RETURN_IF_ERROR(s.upload_image(g.image, staging, copies, VK_IMAGE_LAYOUT_UNDEFINED));
+    VT_ASSIGN_OR_RETURN(g.set, s.allocate_set(s.ref_pool, s.ref_set_layout));
     VkDescriptorImageInfo ii{g.mode == AddressMode::kWrap ? s.trilinear_repeat : s.trilinear_clamp,
                              g.image.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
@@ -592,32 +627,18 @@ Status Renderer::set_virtual_texture(const VirtualTextureSetup& setup) {
   VT_ASSIGN_OR_RETURN(s.table, s.ctx.create_image(td));
   // Zero the table (no page valid) so a frame before the first upload reads defined data.
   std::vector<uint8_t> zeros(size_t(td.width) * td.height * 4, 0);
-  VT_ASSIGN_OR_RETURN(Buffer zb, s.ctx.create_buffer_with(zeros, VK_BUFFER_USAGE_TRANSFER_SRC_BIT));
   VT_RETURN_IF_ERROR(s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
     VulkanContext::transition(cmd, s.cache, VK_IMAGE_LAYOUT_UNDEFINED,
                               VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-    VulkanContext::transition(cmd, s.table, VK_IMAGE_LAYOUT_UNDEFINED,
-                              VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-    std::vector<ImageCopy> copies;
-    for (uint32_t l = 0; l < td.mip_levels; ++l) {
-      copies.push_back({0, l, 0, 0, std::max(1u, td.width >> l), std::max(1u, td.height >> l)});
-    }
-    VulkanContext::copy_buffer_to_image(cmd, zb, s.table, copies);
-    VulkanContext::transition(cmd, s.table, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   }));
+  std::vector<ImageCopy> copies;
+  for (uint32_t l = 0; l < td.mip_levels; ++l) {
+    copies.push_back({0, l, 0, 0, std::max(1u, td.width >> l), std::max(1u, td.height >> l)});
+  }
+  VT_RETURN_IF_ERROR(s.upload_image(s.table, zeros, copies, VK_IMAGE_LAYOUT_UNDEFINED));
 
-  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2};
-  VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  pci.maxSets = 1;
-  pci.poolSizeCount = 1;
-  pci.pPoolSizes = &size;
-  VT_VK(vkCreateDescriptorPool(s.dev, &pci, nullptr, &s.vt_pool));
-  VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  ai.descriptorPool = s.vt_pool;
-  ai.descriptorSetCount = 1;
-  ai.pSetLayouts = &s.vt_set_layout;
-  VT_VK(vkAllocateDescriptorSets(s.dev, &ai, &s.vt_set));
+  VT_ASSIGN_OR_RETURN(s.vt_pool, s.make_pool(1, 2));
+  VT_ASSIGN_OR_RETURN(s.vt_set, s.allocate_set(s.vt_pool, s.vt_set_layout));
   VkDescriptorImageInfo infos[2] = {
       {s.cache_sampler, s.cache.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
       {s.table_sampler, s.table.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
@@ -656,15 +677,7 @@ Status Renderer::upload_slots(std::span<const SlotUpload> pages) {
     copies.push_back({staging.size(), 0, int32_t(p.slot_x * ps), int32_t(p.slot_y * ps), ps, ps});
     staging.insert(staging.end(), p.bytes.begin(), p.bytes.end());
   }
-  VT_ASSIGN_OR_RETURN(Buffer buf,
-                      s.ctx.create_buffer_with(staging, VK_BUFFER_USAGE_TRANSFER_SRC_BIT));
-  return s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    VulkanContext::transition(cmd, s.cache, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                              VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-    VulkanContext::copy_buffer_to_image(cmd, buf, s.cache, copies);
-    VulkanContext::transition(cmd, s.cache, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-  });
+  return s.upload_image(s.cache, staging, copies, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
 }
 
 Status Renderer::upload_page_table(const PageTableLevels& table) {
@@ -686,15 +699,7 @@ Status Renderer::upload_page_table(const PageTableLevels& table) {
     copies.push_back({staging.size(), l, 0, 0, g.pages_x(l), g.pages_y(l)});
     staging.insert(staging.end(), table.levels[l].begin(), table.levels[l].end());
   }
-  VT_ASSIGN_OR_RETURN(Buffer buf,
-                      s.ctx.create_buffer_with(staging, VK_BUFFER_USAGE_TRANSFER_SRC_BIT));
-  return s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    VulkanContext::transition(cmd, s.table, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                              VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-    VulkanContext::copy_buffer_to_image(cmd, buf, s.table, copies);
-    VulkanContext::transition(cmd, s.table, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-  });
+  return s.upload_image(s.table, staging, copies, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
 }
 
 namespace {
@@ -713,48 +718,13 @@ void draw_mesh(VkCommandBuffer cmd, VkPipelineLayout layout, const Push& p, cons
 
 }  // namespace
 
-Expected<ReferenceFrame> Renderer::render_reference(const Camera& camera) {
-  Impl& s = *impl_;
-  for (const auto& m : s.reference_meshes()) {
-    if (m.texture >= s.textures.size()) {
-      return Error(ErrorCode::kInvalidArgument, "render: a mesh names reference texture " +
-                                                    std::to_string(m.texture) + " but only " +
-                                                    std::to_string(s.textures.size()) + " are set");
-    }
-  }
-  const uint32_t w = options_.width, h = options_.height;
-  const Image* targets[] = {&s.color, &s.status};
-  const Buffer* readbacks[] = {&s.color_rb, &s.status_rb};
-  const VkClearColorValue clears[] = {{{0.0f, 0.0f, 0.0f, 0.0f}}, {}};
-  VT_RETURN_IF_ERROR(s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    s.begin_pass(cmd, targets, s.depth, w, h, clears);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.ref_pipe);
-    for (const auto& m : s.reference_meshes()) {
-      const auto& t = s.textures[m.texture];
-      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.ref_layout, 0, 1, &t.set, 0,
-                              nullptr);
-      Push p{};
-      std::memcpy(p.mvp, camera.view_proj.m.data(), sizeof(p.mvp));
-      p.tex[0] = float(t.width);
-      p.tex[1] = float(t.height);
-      p.tex[2] = 1.0f;
-      p.tex[3] = m.alpha_cutoff;
-      p.misc[1] = t.mode == AddressMode::kWrap ? 1 : 0;
-      p.misc[2] = int32_t(t.max_level);
-      draw_mesh(cmd, s.ref_layout, p, m);
-    }
-    s.end_pass(cmd, targets, readbacks, w, h);
-  }));
-  ReferenceFrame out;
-  out.color.width = w;
-  out.color.height = h;
-  out.color.texels.assign(s.color_rb.mapped(), s.color_rb.mapped() + size_t(w) * h * 4);
-  out.covered.resize(size_t(w) * h);
-  std::memcpy(out.covered.data(), s.status_rb.mapped(), out.covered.size() * 4);
+namespace {
+
+std::vector<uint32_t> read_u32(const Buffer& readback, size_t count) {
+  std::vector<uint32_t> out(count);
+  std::memcpy(out.data(), readback.mapped(), count * 4);
   return out;
 }
-
-namespace {
 
 // Fills the virtual-texture fields of the push constants.
 void fill_vt_push(Push& p, const VirtualTextureSetup& vt) {
@@ -771,6 +741,64 @@ void fill_vt_push(Push& p, const VirtualTextureSetup& vt) {
 
 }  // namespace
 
+Status Renderer::Impl::run_pass(const PassTargets& pass, VkPipeline pipe,
+                                const std::function<void(VkCommandBuffer)>& draw) {
+  return ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    begin_pass(cmd, pass.targets, *pass.depth, pass.width, pass.height, pass.clears);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
+    draw(cmd);
+    end_pass(cmd, pass.targets, pass.readbacks, pass.width, pass.height);
+  });
+}
+
+Status Renderer::Impl::run_color_pass(uint32_t w, uint32_t h, VkPipeline pipe,
+                                      const std::function<void(VkCommandBuffer)>& draw) {
+  const Image* targets[] = {&color, &status};
+  const Buffer* readbacks[] = {&color_rb, &status_rb};
+  const VkClearColorValue clears[] = {{{0.0f, 0.0f, 0.0f, 0.0f}}, {}};
+  return run_pass({targets, readbacks, &depth, w, h, clears}, pipe, draw);
+}
+
+Rgba8Image Renderer::Impl::read_color(uint32_t w, uint32_t h) const {
+  Rgba8Image out;
+  out.width = w;
+  out.height = h;
+  out.texels.assign(color_rb.mapped(), color_rb.mapped() + size_t(w) * h * 4);
+  return out;
+}
+
+Expected<ReferenceFrame> Renderer::render_reference(const Camera& camera) {
+  Impl& s = *impl_;
+  for (const auto& m : s.reference_meshes()) {
+    if (m.texture >= s.textures.size()) {
+      return Error(ErrorCode::kInvalidArgument, "render: a mesh names reference texture " +
+                                                    std::to_string(m.texture) + " but only " +
+                                                    std::to_string(s.textures.size()) + " are set");
+    }
+  }
+  const uint32_t w = options_.width, h = options_.height;
+  VT_RETURN_IF_ERROR(s.run_color_pass(w, h, s.ref_pipe, [&](VkCommandBuffer cmd) {
+    for (const auto& m : s.reference_meshes()) {
+      const auto& t = s.textures[m.texture];
+      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.ref_layout, 0, 1, &t.set, 0,
+                              nullptr);
+      Push p{};
+      std::memcpy(p.mvp, camera.view_proj.m.data(), sizeof(p.mvp));
+      p.tex[0] = float(t.width);
+      p.tex[1] = float(t.height);
+      p.tex[2] = 1.0f;
+      p.tex[3] = m.alpha_cutoff;
+      p.misc[1] = t.mode == AddressMode::kWrap ? 1 : 0;
+      p.misc[2] = int32_t(t.max_level);
+      draw_mesh(cmd, s.ref_layout, p, m);
+    }
+  }));
+  ReferenceFrame out;
+  out.color = s.read_color(w, h);
+  out.covered = read_u32(s.status_rb, size_t(w) * h);
+  return out;
+}
+
 Expected<FeedbackImage> Renderer::render_feedback(const Camera& camera, uint32_t frame) {
   Impl& s = *impl_;
   if (!s.has_vt) return Error(ErrorCode::kInvalidArgument, "render: no virtual texture set");
@@ -785,25 +813,22 @@ Expected<FeedbackImage> Renderer::render_feedback(const Camera& camera, uint32_t
   VkClearColorValue clear{};
   clear.uint32[0] = 0xFFFFFFFFu;
   const VkClearColorValue clears[] = {clear};
-  VT_RETURN_IF_ERROR(s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    s.begin_pass(cmd, targets, s.fb_depth, w, h, clears);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.fb_pipe);
-    for (const auto& m : s.meshes) {
-      Push p{};
-      std::memcpy(p.mvp, mvp.m.data(), sizeof(p.mvp));
-      fill_vt_push(p, s.vt);
-      p.tex[2] = float(w) / float(options_.width);
-      p.tex[3] = -1.0f;
-      p.misc[0] = int32_t(frame & 3);
-      draw_mesh(cmd, s.fb_layout, p, m);
-    }
-    s.end_pass(cmd, targets, readbacks, w, h);
-  }));
+  VT_RETURN_IF_ERROR(s.run_pass({targets, readbacks, &s.fb_depth, w, h, clears}, s.fb_pipe,
+                                [&](VkCommandBuffer cmd) {
+                                  for (const auto& m : s.meshes) {
+                                    Push p{};
+                                    std::memcpy(p.mvp, mvp.m.data(), sizeof(p.mvp));
+                                    fill_vt_push(p, s.vt);
+                                    p.tex[2] = float(w) / float(options_.width);
+                                    p.tex[3] = -1.0f;
+                                    p.misc[0] = int32_t(frame & 3);
+                                    draw_mesh(cmd, s.fb_layout, p, m);
+                                  }
+                                }));
   FeedbackImage out;
   out.width = w;
   out.height = h;
-  out.requests.resize(size_t(w) * h);
-  std::memcpy(out.requests.data(), s.fb_rb.mapped(), out.requests.size() * 4);
+  out.requests = read_u32(s.fb_rb, size_t(w) * h);
   return out;
 }
 
@@ -811,12 +836,7 @@ Expected<VirtualFrame> Renderer::render_virtual(const Camera& camera) {
   Impl& s = *impl_;
   if (!s.has_vt) return Error(ErrorCode::kInvalidArgument, "render: no virtual texture set");
   const uint32_t w = options_.width, h = options_.height;
-  const Image* targets[] = {&s.color, &s.status};
-  const Buffer* readbacks[] = {&s.color_rb, &s.status_rb};
-  const VkClearColorValue clears[] = {{{0.0f, 0.0f, 0.0f, 0.0f}}, {}};
-  VT_RETURN_IF_ERROR(s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    s.begin_pass(cmd, targets, s.depth, w, h, clears);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.vt_pipe);
+  VT_RETURN_IF_ERROR(s.run_color_pass(w, h, s.vt_pipe, [&](VkCommandBuffer cmd) {
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.vt_layout, 0, 1, &s.vt_set, 0,
                             nullptr);
     for (const auto& m : s.meshes) {
@@ -827,14 +847,10 @@ Expected<VirtualFrame> Renderer::render_virtual(const Camera& camera) {
       p.tex[3] = m.alpha_cutoff;
       draw_mesh(cmd, s.vt_layout, p, m);
     }
-    s.end_pass(cmd, targets, readbacks, w, h);
   }));
   VirtualFrame out;
-  out.color.width = w;
-  out.color.height = h;
-  out.color.texels.assign(s.color_rb.mapped(), s.color_rb.mapped() + size_t(w) * h * 4);
-  out.status.resize(size_t(w) * h);
-  std::memcpy(out.status.data(), s.status_rb.mapped(), out.status.size() * 4);
+  out.color = s.read_color(w, h);
+  out.status = read_u32(s.status_rb, size_t(w) * h);
   return out;
 }
 

@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 namespace vt::render {
@@ -89,24 +90,19 @@ Buffer& Buffer::operator=(Buffer&& o) noexcept {
   if (this != &o) {
     reset();
     device_ = o.device_;
-    buffer_ = o.buffer_;
-    memory_ = o.memory_;
-    size_ = o.size_;
-    mapped_ = o.mapped_;
-    o.buffer_ = VK_NULL_HANDLE;
-    o.memory_ = VK_NULL_HANDLE;
-    o.mapped_ = nullptr;
-    o.size_ = 0;
+    buffer_ = std::exchange(o.buffer_, VK_NULL_HANDLE);
+    memory_ = std::exchange(o.memory_, VK_NULL_HANDLE);
+    size_ = std::exchange(o.size_, 0);
+    mapped_ = std::exchange(o.mapped_, nullptr);
   }
   return *this;
 }
 
 void Buffer::reset() {
   if (device_ == VK_NULL_HANDLE) return;
-  if (buffer_) vkDestroyBuffer(device_, buffer_, nullptr);
-  if (memory_) vkFreeMemory(device_, memory_, nullptr);  // unmaps implicitly
-  buffer_ = VK_NULL_HANDLE;
-  memory_ = VK_NULL_HANDLE;
+  if (VkBuffer b = std::exchange(buffer_, VK_NULL_HANDLE)) vkDestroyBuffer(device_, b, nullptr);
+  // Freeing the memory unmaps it.
+  if (VkDeviceMemory m = std::exchange(memory_, VK_NULL_HANDLE)) vkFreeMemory(device_, m, nullptr);
   mapped_ = nullptr;
   size_ = 0;
 }
@@ -115,25 +111,19 @@ Image& Image::operator=(Image&& o) noexcept {
   if (this != &o) {
     reset();
     device_ = o.device_;
-    image_ = o.image_;
-    memory_ = o.memory_;
-    view_ = o.view_;
     desc_ = o.desc_;
-    o.image_ = VK_NULL_HANDLE;
-    o.memory_ = VK_NULL_HANDLE;
-    o.view_ = VK_NULL_HANDLE;
+    image_ = std::exchange(o.image_, VK_NULL_HANDLE);
+    memory_ = std::exchange(o.memory_, VK_NULL_HANDLE);
+    view_ = std::exchange(o.view_, VK_NULL_HANDLE);
   }
   return *this;
 }
 
 void Image::reset() {
   if (device_ == VK_NULL_HANDLE) return;
-  if (view_) vkDestroyImageView(device_, view_, nullptr);
-  if (image_) vkDestroyImage(device_, image_, nullptr);
-  if (memory_) vkFreeMemory(device_, memory_, nullptr);
-  view_ = VK_NULL_HANDLE;
-  image_ = VK_NULL_HANDLE;
-  memory_ = VK_NULL_HANDLE;
+  if (VkImageView v = std::exchange(view_, VK_NULL_HANDLE)) vkDestroyImageView(device_, v, nullptr);
+  if (VkImage i = std::exchange(image_, VK_NULL_HANDLE)) vkDestroyImage(device_, i, nullptr);
+  if (VkDeviceMemory m = std::exchange(memory_, VK_NULL_HANDLE)) vkFreeMemory(device_, m, nullptr);
 }
 
 Expected<std::unique_ptr<VulkanContext>> VulkanContext::create(const VulkanOptions& options) {

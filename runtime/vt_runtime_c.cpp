@@ -32,15 +32,22 @@ int out_of_range(const char* what) {
   return fail(vt::Error(vt::ErrorCode::kInvalidArgument, std::string(what) + " out of range"));
 }
 
+// vtrt_options mirrors StreamerOptions field by field: one list of the shared fields serves both
+// directions.
+template <typename From, typename To>
+void copy_streamer_fields(const From& from, To& to) {
+  to.slots_x = from.slots_x;
+  to.slots_y = from.slots_y;
+  to.memory_budget_bytes = from.memory_budget_bytes;
+  to.threads = from.threads;
+  to.max_in_flight = from.max_in_flight;
+  to.upload_byte_limit = from.upload_byte_limit;
+  to.max_lod_bias = from.max_lod_bias;
+}
+
 vt::StreamerOptions streamer_options(const vtrt_options& o) {
   vt::StreamerOptions so;
-  so.slots_x = o.slots_x;
-  so.slots_y = o.slots_y;
-  so.memory_budget_bytes = o.memory_budget_bytes;
-  so.threads = o.threads;
-  so.max_in_flight = o.max_in_flight;
-  so.upload_byte_limit = o.upload_byte_limit;
-  so.max_lod_bias = o.max_lod_bias;
+  copy_streamer_fields(o, so);
   return so;
 }
 
@@ -50,14 +57,7 @@ extern "C" {
 
 void vtrt_default_options(vtrt_options* o) {
   if (!o) return;
-  const vt::StreamerOptions d;
-  o->slots_x = d.slots_x;
-  o->slots_y = d.slots_y;
-  o->memory_budget_bytes = d.memory_budget_bytes;
-  o->threads = d.threads;
-  o->max_in_flight = d.max_in_flight;
-  o->upload_byte_limit = d.upload_byte_limit;
-  o->max_lod_bias = d.max_lod_bias;
+  copy_streamer_fields(vt::StreamerOptions{}, *o);
   o->bc7_as_rgba8 = 0;
 }
 
@@ -104,13 +104,7 @@ void vtrt_close(vtrt_streamer* h) {
 int vtrt_get_geometry(const vtrt_streamer* h, vtrt_geometry* out) {
   if (!h) return fail_null("streamer");
   if (!out) return fail_null("out");
-  const vt::PageGeometry& g = h->source->geometry();
-  out->width = g.width;
-  out->height = g.height;
-  out->payload = g.payload;
-  out->border = g.border;
-  out->page_size = g.page_size();
-  out->level_count = g.level_count();
+  vt::c_api::fill_geometry(h->source->geometry(), out);
   out->layer_count = h->source->layer_count();
   return VT_OK;
 }

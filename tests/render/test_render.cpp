@@ -18,7 +18,6 @@
 #include <string>
 #include <vector>
 
-#include "scene/scene.h"
 #include "format/page_file.h"
 #include "render/renderer.h"
 #include "render/report.h"
@@ -27,6 +26,7 @@
 #include "render/vulkan_context.h"
 #include "runtime/page_source.h"
 #include "runtime/streamer.h"
+#include "scene/scene.h"
 
 namespace vt::render {
 namespace {
@@ -233,25 +233,30 @@ std::unique_ptr<Renderer> make_renderer(const Look& look = {}) {
 }
 
 struct Bake {
-  std::shared_ptr<const PageFileReader> reader;
   std::shared_ptr<const PageSource> source;
   std::unique_ptr<Streamer> streamer;
 };
 
-Bake open_bake(const std::string& path) {
-  Bake b;
+std::shared_ptr<const PageSource> open_source(const std::string& path) {
   auto reader = PageFileReader::open(path);
   EXPECT_TRUE(reader.ok()) << reader.status().message();
-  b.reader = std::shared_ptr<const PageFileReader>(std::move(*reader));
-  auto source = make_page_file_source(b.reader);
+  if (!reader.ok()) return nullptr;
+  auto source = make_page_file_source(std::shared_ptr<const PageFileReader>(std::move(*reader)));
   EXPECT_TRUE(source.ok()) << source.status().message();
-  b.source = std::shared_ptr<const PageSource>(std::move(*source));
+  if (!source.ok()) return nullptr;
+  return std::shared_ptr<const PageSource>(std::move(*source));
+}
+
+Bake open_bake(const std::string& path) {
+  Bake b;
+  b.source = open_source(path);
+  if (!b.source) return b;
   StreamerOptions so;
   so.slots_x = 16;
   so.slots_y = 16;
   auto streamer = Streamer::create(b.source, so);
   EXPECT_TRUE(streamer.ok()) << streamer.status().message();
-  b.streamer = std::move(*streamer);
+  if (streamer.ok()) b.streamer = std::move(*streamer);
   return b;
 }
 
@@ -451,18 +456,6 @@ TEST(Validate, AlphaTestedMaterialMatchesReference) {
   }
 }
 
-TEST(Validate, DroppedAlphaFails) {
-  REQUIRE_VULKAN();
-  Look look;
-  look.alpha_holes = true;
-  auto runs = run_views(
-      write_bake("alpha_dropped", RuntimeFormat::kRgba8, Fault::kOpaqueAlpha, look), nullptr, look);
-  ASSERT_EQ(runs.size(), 4u);
-  print_runs("alpha-dropped", runs);
-  EXPECT_EQ(failing_views(runs, RuntimeFormat::kRgba8), 4);
-  EXPECT_GT(runs[1].metrics.coverage_mismatch_share, 0.05);
-}
-
 // Wrapped addressing: the ground repeats the texture across its seams, where the borders hold
 // the texels of the opposite edge.
 TEST(Validate, WrappedLayerMatchesReference) {
@@ -508,38 +501,6 @@ TEST(Validate, RendersAreBitIdentical) {
   }
 }
 
-TEST(Validate, ZeroedBordersFail) {
-  REQUIRE_VULKAN();
-  auto runs = run_views(write_bake("zero_borders", RuntimeFormat::kRgba8, Fault::kZeroBorders));
-  ASSERT_EQ(runs.size(), 4u);
-  print_runs("zero-borders", runs);
-  EXPECT_EQ(failing_views(runs, RuntimeFormat::kRgba8), 4);
-}
-
-TEST(Validate, ZeroedBordersFailWithBc1Cache) {
-  REQUIRE_VULKAN();
-  auto runs = run_views(write_bake("zero_borders_bc1", RuntimeFormat::kBc1, Fault::kZeroBorders));
-  ASSERT_EQ(runs.size(), 4u);
-  print_runs("zero-borders-bc1", runs);
-  EXPECT_EQ(failing_views(runs, RuntimeFormat::kBc1), 4);
-}
-
-TEST(Validate, WrongPageInIndexFails) {
-  REQUIRE_VULKAN();
-  auto runs = run_views(write_bake("wrong_page", RuntimeFormat::kRgba8, Fault::kSwappedPages));
-  ASSERT_EQ(runs.size(), 4u);
-  print_runs("wrong-page", runs);
-  EXPECT_EQ(failing_views(runs, RuntimeFormat::kRgba8), 4);
-}
-
-TEST(Validate, SwappedBcChannelsFail) {
-  REQUIRE_VULKAN();
-  auto runs = run_views(write_bake("swapped_bc1", RuntimeFormat::kBc1, Fault::kSwappedChannels));
-  ASSERT_EQ(runs.size(), 4u);
-  print_runs("swapped-bc1", runs);
-  EXPECT_EQ(failing_views(runs, RuntimeFormat::kBc1), 4);
-}
-
 // The page table claims each entry's page is one level coarser than the one in its slot.
 void off_by_one_level(Renderer& renderer, const Streamer& streamer) {
   PageTable table = streamer.page_table();
@@ -555,40 +516,67 @@ void off_by_one_level(Renderer& renderer, const Streamer& streamer) {
   EXPECT_TRUE(renderer.upload_page_table(levels).ok());
 }
 
-TEST(Validate, OffByOnePageTableLevelFails) {
+// A faulty bake, cache or page table: every view must fail the thresholds of its cache format.
+struct FaultCase {
+  const char* name;
+  RuntimeFormat runtime;
+  Fault fault;
+  void (*tamper)(Renderer&, const Streamer&) = nullptr;
+  bool alpha_holes = false;
+};
+
+const FaultCase kFaultCases[] = {
+    {"zero_borders", RuntimeFormat::kRgba8, Fault::kZeroBorders},
+    {"zero_borders_bc1", RuntimeFormat::kBc1, Fault::kZeroBorders},
+    {"wrong_page", RuntimeFormat::kRgba8, Fault::kSwappedPages},
+    {"swapped_bc1", RuntimeFormat::kBc1, Fault::kSwappedChannels},
+    {"off_by_one", RuntimeFormat::kRgba8, Fault::kNone, off_by_one_level},
+    {"alpha_dropped", RuntimeFormat::kRgba8, Fault::kOpaqueAlpha, nullptr, true},
+};
+
+class ValidateFault : public testing::TestWithParam<FaultCase> {};
+
+TEST_P(ValidateFault, EveryViewFails) {
   REQUIRE_VULKAN();
-  auto runs =
-      run_views(write_bake("off_by_one", RuntimeFormat::kRgba8, Fault::kNone), off_by_one_level);
+  const FaultCase& c = GetParam();
+  Look look;
+  look.alpha_holes = c.alpha_holes;
+  auto runs = run_views(write_bake(c.name, c.runtime, c.fault, look), c.tamper, look);
   ASSERT_EQ(runs.size(), 4u);
-  print_runs("off-by-one", runs);
-  EXPECT_EQ(failing_views(runs, RuntimeFormat::kRgba8), 4);
+  print_runs(c.name, runs);
+  EXPECT_EQ(failing_views(runs, c.runtime), 4);
+  // A dropped alpha channel shows as surface where the reference has holes.
+  if (c.fault == Fault::kOpaqueAlpha) {
+    EXPECT_GT(runs[1].metrics.coverage_mismatch_share, 0.05);
+  }
 }
 
-std::shared_ptr<const PageSource> open_source(const std::string& path) {
-  auto reader = PageFileReader::open(path);
-  EXPECT_TRUE(reader.ok()) << reader.status().message();
-  if (!reader.ok()) return nullptr;
-  auto source = make_page_file_source(std::shared_ptr<const PageFileReader>(std::move(*reader)));
-  EXPECT_TRUE(source.ok()) << source.status().message();
-  if (!source.ok()) return nullptr;
-  return std::shared_ptr<const PageSource>(std::move(*source));
+INSTANTIATE_TEST_SUITE_P(Validate, ValidateFault, testing::ValuesIn(kFaultCases),
+                         [](const testing::TestParamInfo<FaultCase>& info) {
+                           return std::string(info.param.name);
+                         });
+
+// validate_views over the first `view_count` views of the synthetic bake `name` (RGBA8 cache).
+Expected<ValidationReport> validate_bake(Renderer& renderer, const std::string& name, Fault fault,
+                                         size_t view_count, const std::string& out_dir = "") {
+  auto source = open_source(write_bake(name, RuntimeFormat::kRgba8, fault));
+  if (!source) return Error(ErrorCode::kInternal, "cannot open " + name);
+  ValidateOptions options;
+  options.streamer.slots_x = options.streamer.slots_y = 16;
+  options.out_dir = out_dir;
+  std::vector<Camera> cams = views();
+  return validate_views(renderer, source, std::span(cams).first(view_count), options);
 }
 
 TEST(Validate, WritesImagesAndReport) {
   REQUIRE_VULKAN();
   std::unique_ptr<Renderer> renderer = make_renderer();
   ASSERT_TRUE(renderer);
-  auto source = open_source(write_bake("report", RuntimeFormat::kRgba8, Fault::kNone));
-  ASSERT_TRUE(source);
   const char* keep = std::getenv("VT_RENDER_KEEP_IMAGES");  // a folder to inspect the images
   const std::string dir =
       keep ? keep : (std::filesystem::path(testing::TempDir()) / "vt_render_report").string();
   std::filesystem::create_directories(dir);
-  ValidateOptions options;
-  options.streamer.slots_x = options.streamer.slots_y = 16;
-  options.out_dir = dir;
-  std::vector<Camera> cams = views();
-  auto report = validate_views(*renderer, source, std::span(cams).first(2), options);
+  auto report = validate_bake(*renderer, "report", Fault::kNone, 2, dir);
   ASSERT_TRUE(report.ok()) << report.status().message();
   EXPECT_TRUE(report->passed());
   ASSERT_EQ(report->views.size(), 2u);
@@ -610,7 +598,7 @@ TEST(Validate, WritesImagesAndReport) {
     ASSERT_TRUE(in);
     std::vector<uint8_t> rgb(size_t(kWidth) * kHeight * 3);
     ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, rgb.data()));
-    auto ref = renderer->render_reference(cams[0]);
+    auto ref = renderer->render_reference(views()[0]);
     ASSERT_TRUE(ref.ok());
     for (size_t i = 0; i < size_t(kWidth) * kHeight; ++i) {
       for (int c = 0; c < 3; ++c) ASSERT_EQ(rgb[i * 3 + c], ref->color.texels[i * 4 + c]) << i;
@@ -631,12 +619,7 @@ TEST(Validate, ReportFailsABrokenBake) {
   REQUIRE_VULKAN();
   std::unique_ptr<Renderer> renderer = make_renderer();
   ASSERT_TRUE(renderer);
-  auto source = open_source(write_bake("report_bad", RuntimeFormat::kRgba8, Fault::kZeroBorders));
-  ASSERT_TRUE(source);
-  ValidateOptions options;
-  options.streamer.slots_x = options.streamer.slots_y = 16;
-  std::vector<Camera> cams = views();
-  auto report = validate_views(*renderer, source, std::span(cams).first(1), options);
+  auto report = validate_bake(*renderer, "report_bad", Fault::kZeroBorders, 1);
   ASSERT_TRUE(report.ok()) << report.status().message();
   EXPECT_FALSE(report->passed());
   bool tile = false;

@@ -12,16 +12,12 @@
 #include "format/page_file.h"
 #include "format/zstd_frame.h"
 #include "runtime/page_source.h"
+#include "runtime_test_util.h"
 
 namespace vt {
 namespace {
 
-std::string temp_file(const std::string& name) {
-  auto dir =
-      std::filesystem::temp_directory_path() / ("vtbake_runtime_src_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return (dir / name).string();
-}
+using namespace vt::runtime_test;
 
 // Smooth procedural RGBA content, different per page.
 std::vector<uint8_t> page_texels(const PageId& id, uint32_t size, uint32_t channels) {
@@ -66,30 +62,14 @@ TEST(PageFileSource, EveryCodecToItsRuntimeFormat) {
 
   PageFileDesc desc;
   desc.geometry = g;
-  LayerSpec albedo;
-  albedo.name = "albedo";
-  albedo.channels = 3;
-  albedo.codec = PageCodec::kDct;
-  albedo.runtime_format = RuntimeFormat::kBc1;
+  LayerSpec albedo = test_layer("albedo", 3, PageCodec::kDct, RuntimeFormat::kBc1);
   albedo.codec_tables = dct_serialize_tables(**tables);
-  LayerSpec normal;
-  normal.semantic = LayerSemantic::kNormal;
-  normal.name = "normal";
-  normal.channels = 2;
-  normal.codec = PageCodec::kBcZstd;
-  normal.runtime_format = RuntimeFormat::kBc5;
-  LayerSpec custom;
-  custom.semantic = LayerSemantic::kCustom;
-  custom.name = "custom";
-  custom.channels = 4;
-  custom.codec = PageCodec::kBcZstd;
-  custom.runtime_format = RuntimeFormat::kBc7;
-  LayerSpec mask;
-  mask.semantic = LayerSemantic::kCustom;
-  mask.name = "mask";
-  mask.channels = 1;
-  mask.codec = PageCodec::kRawZstd;
-  mask.runtime_format = RuntimeFormat::kBc4;
+  const LayerSpec normal =
+      test_layer("normal", 2, PageCodec::kBcZstd, RuntimeFormat::kBc5, LayerSemantic::kNormal);
+  const LayerSpec custom =
+      test_layer("custom", 4, PageCodec::kBcZstd, RuntimeFormat::kBc7, LayerSemantic::kCustom);
+  const LayerSpec mask =
+      test_layer("mask", 1, PageCodec::kRawZstd, RuntimeFormat::kBc4, LayerSemantic::kCustom);
   desc.layers = {albedo, normal, custom, mask};
   const std::string path = temp_file("codecs.vtpf");
   auto writer = PageFileWriter::create(path, desc);

@@ -13,17 +13,12 @@
 #include "format/page_file.h"
 #include "runtime/reference_sampler.h"
 #include "runtime/streamer.h"
+#include "runtime_test_util.h"
 
 namespace vt {
 namespace {
 
-std::string temp_file(const std::string& name) {
-  static int counter = 0;
-  auto dir = std::filesystem::temp_directory_path() /
-             ("vtbake_runtime_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-  std::filesystem::create_directories(dir);
-  return (dir / name).string();
-}
+using namespace vt::runtime_test;
 
 struct Level {
   uint32_t w, h;
@@ -69,11 +64,7 @@ std::string write_file(const PageGeometry& g, AddressMode mode, const std::vecto
                        bool (*absent)(const PageId&)) {
   PageFileDesc desc;
   desc.geometry = g;
-  LayerSpec layer;
-  layer.name = "albedo";
-  layer.channels = 4;
-  layer.codec = PageCodec::kRaw;
-  layer.runtime_format = RuntimeFormat::kRgba8;
+  LayerSpec layer = test_layer("albedo", 4, PageCodec::kRaw, RuntimeFormat::kRgba8);
   layer.address_mode = mode;
   desc.layers.push_back(layer);
   const std::string path = temp_file("sampler.vtpf");
