@@ -36,25 +36,23 @@ class MemorySink final : public PageSink {
  public:
   using Key = std::tuple<uint32_t, uint32_t, uint32_t, uint32_t>;  // layer, level, y, x
   Status add_page(const PageId& id, uint32_t layer, std::span<const uint8_t> data) override {
-    std::lock_guard<std::mutex> lock(mu_);
-    auto& p = pages[{layer, id.level, id.y, id.x}];
-    if (p.state != PageState::kAbsent) return Error(ErrorCode::kInternal, "page given twice");
-    p.state = PageState::kStored;
-    p.bytes.assign(data.begin(), data.end());
-    return Status::Ok();
+    return put(id, layer, PageState::kStored, data);
   }
   Status add_constant_page(const PageId& id, uint32_t layer,
                            std::span<const uint8_t> texel) override {
-    std::lock_guard<std::mutex> lock(mu_);
-    auto& p = pages[{layer, id.level, id.y, id.x}];
-    if (p.state != PageState::kAbsent) return Error(ErrorCode::kInternal, "page given twice");
-    p.state = PageState::kConstant;
-    p.bytes.assign(texel.begin(), texel.end());
-    return Status::Ok();
+    return put(id, layer, PageState::kConstant, texel);
   }
   std::map<Key, StoredPage> pages;
 
  private:
+  Status put(const PageId& id, uint32_t layer, PageState state, std::span<const uint8_t> bytes) {
+    std::lock_guard<std::mutex> lock(mu_);
+    auto& p = pages[{layer, id.level, id.y, id.x}];
+    if (p.state != PageState::kAbsent) return Error(ErrorCode::kInternal, "page given twice");
+    p.state = state;
+    p.bytes.assign(bytes.begin(), bytes.end());
+    return Status::Ok();
+  }
   std::mutex mu_;
 };
 
