@@ -27,6 +27,15 @@ void write_bytes(const std::string& path, const void* data, size_t size) {
       .write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
 }
 
+// A PLY header: `vertices` float x, y, z vertices, then one list element ("face 2",
+// "tristrips 1") of vertex_indices lists with `list_types` ("uchar int": count, index).
+std::string ply_header(const std::string& format, int vertices, const std::string& list_element,
+                       const std::string& list_types) {
+  return "ply\nformat " + format + " 1.0\nelement vertex " + std::to_string(vertices) +
+         "\nproperty float x\nproperty float y\nproperty float z\nelement " + list_element +
+         "\nproperty list " + list_types + " vertex_indices\nend_header\n";
+}
+
 TEST(SceneIo, ObjWithMtlQuadsNegativeIndicesAndMaterials) {
   write_text(
       temp("a.mtl"),
@@ -73,11 +82,8 @@ TEST(SceneIo, ObjErrorsNameFileAndLine) {
 }
 
 TEST(SceneIo, PlyAsciiAndBinary) {
-  write_text(temp("a.ply"),
-             "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float "
-             "y\nproperty float z\n"
-             "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
-             "0 0 0\n1 0 0\n1 1 0\n0 1 0.5\n3 0 1 2\n3 0 2 3\n");
+  write_text(temp("a.ply"), ply_header("ascii", 4, "face 2", "uchar int") +
+                                "0 0 0\n1 0 0\n1 1 0\n0 1 0.5\n3 0 1 2\n3 0 2 3\n");
   auto a = scene::load_scene(temp("a.ply"));
   ASSERT_TRUE(a.ok()) << a.status().message();
   const auto& pa = a->meshes[0].primitives[0];
@@ -85,10 +91,7 @@ TEST(SceneIo, PlyAsciiAndBinary) {
   ASSERT_EQ(pa.positions.size(), 4u);
   EXPECT_FLOAT_EQ(pa.positions[pa.indices[5]][2], 0.5f);
 
-  std::string header =
-      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
-  std::string body = header;
+  std::string body = ply_header("binary_little_endian", 3, "face 1", "uchar int");
   float v[9] = {0, 0, 0, 2, 0, 0, 0, 3, 0};
   body.append(reinterpret_cast<const char*>(v), sizeof(v));
   unsigned char count = 3;
@@ -114,11 +117,8 @@ TEST(SceneIo, PlyAsciiAndBinary) {
 TEST(SceneIo, PlyTristripsWithRestart) {
   // Draco's reader has no tristrips element; the fallback reader turns strips into triangles
   // with alternating winding, restarting at -1.
-  write_text(temp("s.ply"),
-             "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float "
-             "y\nproperty float z\n"
-             "element tristrips 1\nproperty list int int vertex_indices\nend_header\n"
-             "0 0 0\n1 0 0\n0 1 0\n1 1 0\n5 0 0\n6 0 0\n8 0 1 2 3 -1 4 5 2\n");
+  write_text(temp("s.ply"), ply_header("ascii", 6, "tristrips 1", "int int") +
+                                "0 0 0\n1 0 0\n0 1 0\n1 1 0\n5 0 0\n6 0 0\n8 0 1 2 3 -1 4 5 2\n");
   auto s = scene::load_scene(temp("s.ply"));
   ASSERT_TRUE(s.ok()) << s.status().message();
   const auto& p = s->meshes[0].primitives[0];
@@ -132,9 +132,7 @@ TEST(SceneIo, PlyTristripsWithRestart) {
   }
   // A truncated strip list is an error naming the file.
   write_text(temp("s2.ply"),
-             "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty "
-             "float y\nproperty float z\n"
-             "element tristrips 1\nproperty list int int vertex_indices\nend_header\n\x01\x02");
+             ply_header("binary_little_endian", 1, "tristrips 1", "int int") + "\x01\x02");
   auto bad = scene::load_scene(temp("s2.ply"));
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.status().message().find("s2.ply"), std::string::npos);

@@ -13,9 +13,11 @@
 #include <string>
 #include <vector>
 
+#include "bake/transfer.h"
+#include "bake/unwrap/unwrap.h"
+#include "format/page_file.h"
 #include "samples/sample_scene.h"
 #include "scene/scene.h"
-#include "format/page_file.h"
 
 namespace vt::test {
 
@@ -65,6 +67,21 @@ inline int add_image(scene::Scene& s, const std::string& path) {
   im.uri = std::filesystem::path(path).filename().string();
   s.images.push_back(im);
   return int(s.images.size() - 1);
+}
+
+// single_mesh_scene whose material takes its base colour from the image at `path`.
+inline scene::Scene textured_scene(scene::Primitive prim, const std::string& path,
+                                   scene::Material mat = {}) {
+  scene::Scene s = single_mesh_scene(std::move(prim), std::move(mat));
+  s.materials[0].base_color_texture.image = add_image(s, path);
+  return s;
+}
+
+// Transfer options at the unwrapped atlas's size, the others at their defaults.
+inline TransferOptions atlas_transfer_options(const unwrap::UnwrapStats& stats) {
+  TransferOptions o;
+  o.width = uint32_t(stats.atlas_width), o.height = uint32_t(stats.atlas_height);
+  return o;
 }
 
 // Level 0 of one layer as floats in [0, 1] (8-bit) or as stored (float), payload texels only;
