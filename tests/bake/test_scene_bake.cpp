@@ -14,6 +14,7 @@
 #include "common/vec.h"
 #include "format/page_file.h"
 #include "samples/sample_scene.h"
+#include "tests/transfer/atlas_reference.h"
 #include "tests/transfer/transfer_test_util.h"
 
 namespace vt {
@@ -275,7 +276,14 @@ TEST(SceneBake, SupersamplingImprovesAccuracyMonotonically) {
   scene::Scene s = test::textured_scene(make_grid(1.0f, 1, 1), dir.file("stripes.exr"));
   auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 32});
   ASSERT_TRUE(un.ok());
-  const scene::Primitive& p = un->scene.meshes[0].primitives[0];
+  // Reference over texels whose square lies inside the quad's atlas footprint.
+  const std::vector<double> reference =
+      test::atlas_reference(un->scene.meshes[0].primitives[0], uint32_t(un->stats.atlas_width),
+                            uint32_t(un->stats.atlas_height), 32, [&](double u, double v) {
+                              float val[3];
+                              stripes(u, v, val);
+                              return double(val[0]);
+                            });
   double rmse[3];
   int k = 0;
   for (int ss : {1, 4, 16}) {
@@ -284,41 +292,12 @@ TEST(SceneBake, SupersamplingImprovesAccuracyMonotonically) {
     auto t = transfer_materials(un->scene, to);
     ASSERT_TRUE(t.ok()) << t.status().message();
     const auto& texels = t->layers[0].texels;
-    // Reference over texels whose square lies inside the quad's atlas footprint.
     double se = 0;
     uint64_t n = 0;
-    const auto& atlas = p.uvs.back();
-    for (uint32_t y = 0; y < to.height; ++y) {
-      for (uint32_t x = 0; x < to.width; ++x) {
-        double sum = 0;
-        bool all_in = true;
-        for (int j = 0; j < 32 && all_in; ++j) {
-          for (int i = 0; i < 32 && all_in; ++i) {
-            double px = (x + (i + 0.5) / 32) / to.width, py = (y + (j + 0.5) / 32) / to.height;
-            all_in = false;
-            for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
-              const auto &a = atlas[p.indices[f]], &b = atlas[p.indices[f + 1]],
-                         &c = atlas[p.indices[f + 2]];
-              double d = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-              double l1 = ((px - a[0]) * (c[1] - a[1]) - (py - a[1]) * (c[0] - a[0])) / d;
-              double l2 = ((b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0])) / d;
-              if (l1 < 0 || l2 < 0 || l1 + l2 > 1) continue;
-              const auto &ua = p.uvs[0][p.indices[f]], &ub = p.uvs[0][p.indices[f + 1]],
-                         &uc = p.uvs[0][p.indices[f + 2]];
-              double u = ua[0] + l1 * (ub[0] - ua[0]) + l2 * (uc[0] - ua[0]);
-              double v = ua[1] + l1 * (ub[1] - ua[1]) + l2 * (uc[1] - ua[1]);
-              float val[3];
-              stripes(u, v, val);
-              sum += val[0];
-              all_in = true;
-              break;
-            }
-          }
-        }
-        if (!all_in) continue;
-        double d = texels[(size_t(y) * to.width + x) * 3] - sum / 1024;
-        se += d * d, ++n;
-      }
+    for (size_t i = 0; i < reference.size(); ++i) {
+      if (std::isnan(reference[i])) continue;
+      double d = texels[i * 3] - reference[i];
+      se += d * d, ++n;
     }
     ASSERT_GT(n, 500u);
     rmse[k++] = std::sqrt(se / n);
