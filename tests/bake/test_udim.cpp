@@ -74,21 +74,7 @@ TEST(Udim, GridAssembledExactlyWithMissingTilesBlack) {
   auto sum = build_page_file(o);
   ASSERT_TRUE(sum.ok()) << sum.status().message();
 
-  auto reader = PageFileReader::open(o.output);
-  ASSERT_TRUE(reader.ok()) << reader.status().message();
-  auto level = extract_level(**reader, 0, 0);
-  ASSERT_TRUE(level.ok()) << level.status().message();
-  ASSERT_EQ(level->width, w);
-  ASSERT_EQ(level->height, h);
-  ASSERT_EQ(level->channels, 3u);
-  for (uint32_t gy = 0; gy < h; ++gy) {
-    for (uint32_t gx = 0; gx < w; ++gx) {
-      for (uint32_t c = 0; c < 3; ++c) {
-        ASSERT_EQ(level->texels[(size_t(gy) * w + gx) * 3 + c], expected(gx, gy, c))
-            << gx << "," << gy << " c" << c;
-      }
-    }
-  }
+  test::expect_level0_rgb(o.output, w, h, expected);
   fs::remove_all(dir);
 }
 
