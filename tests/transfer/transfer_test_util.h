@@ -1,9 +1,8 @@
-// Helpers for the transfer tests: scratch folders, procedural textured scenes, level-0 read-back
+// Helpers for the transfer tests: procedural textured scenes, level-0 read-back
 // from page files and resampling through the atlas UVs.
 #pragma once
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -18,30 +17,11 @@
 #include "format/page_file.h"
 #include "samples/sample_scene.h"
 #include "scene/scene.h"
+#include "tests/transfer/scratch_dir.h"
 
 namespace vt::test {
 
 constexpr double kPi = 3.14159265358979323846;
-
-// A folder removed when the test ends.
-class ScratchDir {
- public:
-  ScratchDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = std::filesystem::temp_directory_path() /
-            ("vt_transfer_" + std::to_string(getpid()) + "_" + info->name());
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
-  }
-  ~ScratchDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  std::filesystem::path path_;
-};
 
 // One-mesh scene at the origin with a material of its own.
 inline scene::Scene single_mesh_scene(scene::Primitive prim, scene::Material mat) {
