@@ -139,6 +139,52 @@ TEST(SceneIo, PlyTristripsWithRestart) {
   EXPECT_NE(bad.status().message().find("s2.ply"), std::string::npos);
 }
 
+// Every PLY scalar type under both its names, big endian: tristrips send the file to the
+// fallback reader, which must read (or skip) each property at its own size.
+TEST(SceneIo, PlyFallbackReadsEveryScalarTypeBigEndian) {
+  std::string body =
+      "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty double x\n"
+      "property int16 y\nproperty float32 z\nproperty uchar a\nproperty int8 b\n"
+      "property ushort c\nproperty uint32 d\nproperty float64 e\n"
+      "element tristrips 1\nproperty list uint8 int vertex_indices\nend_header\n";
+  auto put = [&](const void* v, size_t n) {  // big endian
+    const char* b = static_cast<const char*>(v);
+    for (size_t i = n; i-- > 0;) body.push_back(b[i]);
+  };
+  const double xs[3] = {0.5, 2.25, -1.0};
+  const int16_t ys[3] = {-3, 7, 300};
+  const float zs[3] = {1.5f, -2.0f, 4.0f};
+  for (int k = 0; k < 3; ++k) {
+    const uint8_t a = 200;
+    const int8_t b = -5;
+    const uint16_t c = 60000;
+    const uint32_t d = 4000000000u;
+    const double e = 1e300;
+    put(&xs[k], 8), put(&ys[k], 2), put(&zs[k], 4), put(&a, 1), put(&b, 1), put(&c, 2), put(&d, 4),
+        put(&e, 8);
+  }
+  const uint8_t count = 3;
+  const int32_t strip[3] = {0, 1, 2};
+  put(&count, 1);
+  for (int32_t i : strip) put(&i, 4);
+  auto s = write_and_load("types.ply", body);
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  const auto& p = s->meshes[0].primitives[0];
+  ASSERT_EQ(p.positions.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(p.positions[k][0], float(xs[k])) << k;
+    EXPECT_EQ(p.positions[k][1], float(ys[k])) << k;
+    EXPECT_EQ(p.positions[k][2], zs[k]) << k;
+  }
+  EXPECT_EQ(p.indices, (std::vector<uint32_t>{0, 1, 2}));
+  // An unknown type is no size at all: the data cannot be read.
+  auto bad = write_and_load(
+      "types2.ply",
+      "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty quad x\n"
+      "element tristrips 0\nproperty list uchar int vertex_indices\nend_header\n0123456789abcdef");
+  EXPECT_FALSE(bad.ok());
+}
+
 // A glTF with an external .bin: two nodes (TRS parent, child with a matrix) instancing one
 // mesh, a textured material with a sampler, uint16 indices and a normalised uint8 colour.
 TEST(SceneIo, GltfWithExternalBufferNodesAndMaterials) {
