@@ -36,9 +36,15 @@ PackChart random_chart(std::mt19937& rng) {
 
 TEST(Bounds, HoldEveryPointAndAreInvertedWhenEmpty) {
   const auto [lo, hi] = bounds_of(std::vector<Vec2d>{{1, -2}, {-3, 4}, {0.5, 0}});
-  EXPECT_EQ(lo.x, -3), EXPECT_EQ(lo.y, -2), EXPECT_EQ(hi.x, 1), EXPECT_EQ(hi.y, 4);
+  EXPECT_EQ(lo.x, -3);
+  EXPECT_EQ(lo.y, -2);
+  EXPECT_EQ(hi.x, 1);
+  EXPECT_EQ(hi.y, 4);
   const auto b = bounds_of(std::vector<Vec3d>{{1, 2, 3}, {-1, 5, -7}});
-  EXPECT_EQ(b.lo.z, -7), EXPECT_EQ(b.hi.z, 3), EXPECT_EQ(b.lo.x, -1), EXPECT_EQ(b.hi.y, 5);
+  EXPECT_EQ(b.lo.z, -7);
+  EXPECT_EQ(b.hi.z, 3);
+  EXPECT_EQ(b.lo.x, -1);
+  EXPECT_EQ(b.hi.y, 5);
   const auto none = bounds_of(std::vector<Vec2d>{});
   EXPECT_GT(none.lo.x, none.hi.x);
 }
