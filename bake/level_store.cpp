@@ -9,6 +9,28 @@
 #include "bake/pyramid.h"
 
 namespace vt {
+namespace {
+
+// pread and pwrite may move fewer bytes than asked, or be interrupted: repeat until all moved.
+template <class Io, class Byte>
+Status move_all(Io io, int fd, Byte* p, size_t left, off_t off, const std::string& path,
+                const char* verb) {
+  while (left > 0) {
+    ssize_t n = io(fd, p, left, off);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      return Error(ErrorCode::kIo, path + ": scratch " + verb + " failed: " + std::strerror(errno));
+    }
+    p += n, left -= size_t(n), off += n;
+  }
+  return Status::Ok();
+}
+
+off_t row_offset(uint32_t y, size_t row_floats) {
+  return off_t(uint64_t(y) * row_floats * sizeof(float));
+}
+
+}  // namespace
 
 Expected<std::unique_ptr<LevelStore>> LevelStore::create(uint32_t width, uint32_t height,
                                                          uint32_t channels, bool in_memory,
@@ -60,45 +82,24 @@ LevelStore::~LevelStore() {
 
 Status LevelStore::write_rows(uint32_t y0, uint32_t rows, const float* data) {
   if (uint64_t(y0) + rows > height_) return Error(ErrorCode::kInternal, "level rows past end");
+  const size_t bytes = size_t(rows) * row_floats() * sizeof(float);
   if (in_memory()) {
-    std::memcpy(memory_.data() + size_t(y0) * row_floats(), data,
-                size_t(rows) * row_floats() * sizeof(float));
+    std::memcpy(memory_.data() + size_t(y0) * row_floats(), data, bytes);
     return Status::Ok();
   }
-  const char* p = reinterpret_cast<const char*>(data);
-  size_t left = size_t(rows) * row_floats() * sizeof(float);
-  off_t off = off_t(uint64_t(y0) * row_floats() * sizeof(float));
-  while (left > 0) {
-    ssize_t n = pwrite(fd_, p, left, off);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      return Error(ErrorCode::kIo, path_ + ": scratch write failed: " + std::strerror(errno));
-    }
-    p += n, left -= size_t(n), off += n;
-  }
-  return Status::Ok();
+  return move_all(::pwrite, fd_, reinterpret_cast<const char*>(data), bytes,
+                  row_offset(y0, row_floats()), path_, "write");
 }
 
 Status LevelStore::read(uint32_t y0, uint32_t y1, float* out) {
   if (y0 > y1 || y1 > height_) return Error(ErrorCode::kInternal, "level rows past end");
-  const uint32_t rows = y1 - y0;
+  const size_t bytes = size_t(y1 - y0) * row_floats() * sizeof(float);
   if (in_memory()) {
-    std::memcpy(out, memory_.data() + size_t(y0) * row_floats(),
-                size_t(rows) * row_floats() * sizeof(float));
+    std::memcpy(out, memory_.data() + size_t(y0) * row_floats(), bytes);
     return Status::Ok();
   }
-  char* p = reinterpret_cast<char*>(out);
-  size_t left = size_t(rows) * row_floats() * sizeof(float);
-  off_t off = off_t(uint64_t(y0) * row_floats() * sizeof(float));
-  while (left > 0) {
-    ssize_t n = pread(fd_, p, left, off);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      return Error(ErrorCode::kIo, path_ + ": scratch read failed: " + std::strerror(errno));
-    }
-    p += n, left -= size_t(n), off += n;
-  }
-  return Status::Ok();
+  return move_all(::pread, fd_, reinterpret_cast<char*>(out), bytes, row_offset(y0, row_floats()),
+                  path_, "read");
 }
 
 }  // namespace vt

@@ -78,25 +78,30 @@ void filter_row(const DownsampleKernel& k, AddressMode mode, const float* src, u
   }
 }
 
+// The filters' names, written once for to_string and parse_mip_filter.
+struct MipFilterName {
+  MipFilter filter;
+  const char* name;
+};
+constexpr MipFilterName kMipFilterNames[] = {
+    {MipFilter::kBox, "box"},
+    {MipFilter::kKaiser, "kaiser"},
+    {MipFilter::kLanczos3, "lanczos3"},
+};
+
 }  // namespace
 
 const char* to_string(MipFilter f) {
-  switch (f) {
-    case MipFilter::kBox:
-      return "box";
-    case MipFilter::kKaiser:
-      return "kaiser";
-    case MipFilter::kLanczos3:
-      return "lanczos3";
-  }
+  for (const MipFilterName& n : kMipFilterNames)
+    if (n.filter == f) return n.name;
   return "?";
 }
 
 Expected<MipFilter> parse_mip_filter(const char* name) {
   std::string n = name ? name : "";
-  if (n == "box") return MipFilter::kBox;
-  if (n == "kaiser") return MipFilter::kKaiser;
-  if (n == "lanczos3" || n == "lanczos") return MipFilter::kLanczos3;
+  if (n == "lanczos") return MipFilter::kLanczos3;  // the alias users write
+  for (const MipFilterName& f : kMipFilterNames)
+    if (n == f.name) return f.filter;
   return Status(ErrorCode::kInvalidArgument,
                 "unknown filter '" + n + "' (expected box, kaiser or lanczos3)");
 }

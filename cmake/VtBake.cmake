@@ -36,3 +36,16 @@ function(vt_drop_missing_include_dirs target)
   endforeach()
   set_target_properties(${target} PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${kept}")
 endfunction()
+
+# vt_add_areas(FOLDERS... TOOLS FOLDERS...): adds the runtime side's folders, and the TOOLS
+# folders unless VTBAKE_RUNTIME_ONLY, for the sources and the tests alike.
+function(vt_add_areas)
+  cmake_parse_arguments(ARG "" "" "TOOLS" ${ARGN})
+  set(areas ${ARG_UNPARSED_ARGUMENTS})
+  if(NOT VTBAKE_RUNTIME_ONLY)
+    list(APPEND areas ${ARG_TOOLS})
+  endif()
+  foreach(area IN LISTS areas)
+    add_subdirectory(${area})
+  endforeach()
+endfunction()

@@ -20,13 +20,31 @@ struct Element {
   std::vector<Property> props;
 };
 
-size_t type_size(const std::string& t) {
-  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
-  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-  if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32")
-    return 4;
-  if (t == "double" || t == "float64") return 8;
-  return 0;
+template <class T>
+double load(const uint8_t* b) {
+  T v;
+  std::memcpy(&v, b, sizeof(T));
+  return static_cast<double>(v);
+}
+
+// PLY's scalar types under both spellings (PLY 1.0 and the sized names).
+struct ScalarType {
+  const char* name;
+  const char* sized_name;
+  size_t size;
+  double (*load)(const uint8_t*);
+};
+constexpr ScalarType kScalarTypes[] = {
+    {"char", "int8", 1, load<int8_t>},    {"uchar", "uint8", 1, load<uint8_t>},
+    {"short", "int16", 2, load<int16_t>}, {"ushort", "uint16", 2, load<uint16_t>},
+    {"int", "int32", 4, load<int32_t>},   {"uint", "uint32", 4, load<uint32_t>},
+    {"float", "float32", 4, load<float>}, {"double", "float64", 8, load<double>},
+};
+
+const ScalarType* scalar_type(const std::string& t) {
+  for (const ScalarType& s : kScalarTypes)
+    if (t == s.name || t == s.sized_name) return &s;
+  return nullptr;
 }
 
 struct Reader {
@@ -36,45 +54,16 @@ struct Reader {
   bool ok = true;
 
   double binary(const std::string& t) {
-    size_t n = type_size(t);
-    if (n == 0 || static_cast<size_t>(end - p) < n) {
+    const ScalarType* type = scalar_type(t);
+    if (!type || static_cast<size_t>(end - p) < type->size) {
       ok = false;
       return 0;
     }
     uint8_t b[8];
-    std::memcpy(b, p, n);
-    p += n;
-    if (format == 2) std::reverse(b, b + n);
-    if (t == "char" || t == "int8") return static_cast<int8_t>(b[0]);
-    if (t == "uchar" || t == "uint8") return b[0];
-    if (t == "short" || t == "int16") {
-      int16_t v;
-      std::memcpy(&v, b, 2);
-      return v;
-    }
-    if (t == "ushort" || t == "uint16") {
-      uint16_t v;
-      std::memcpy(&v, b, 2);
-      return v;
-    }
-    if (t == "int" || t == "int32") {
-      int32_t v;
-      std::memcpy(&v, b, 4);
-      return v;
-    }
-    if (t == "uint" || t == "uint32") {
-      uint32_t v;
-      std::memcpy(&v, b, 4);
-      return v;
-    }
-    if (t == "float" || t == "float32") {
-      float v;
-      std::memcpy(&v, b, 4);
-      return v;
-    }
-    double v;
-    std::memcpy(&v, b, 8);
-    return v;
+    std::memcpy(b, p, type->size);
+    p += type->size;
+    if (format == 2) std::reverse(b, b + type->size);
+    return type->load(b);
   }
   double ascii() {
     while (p < end && std::isspace(*p)) ++p;

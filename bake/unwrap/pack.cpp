@@ -32,10 +32,10 @@ std::vector<char> footprint(const PackChart& chart, const Grid& g) {
   std::vector<char> cells(static_cast<size_t>(g.gx) * g.gy, 0);
   const TexelRect grid = {0, 0, g.gx - 1, g.gy - 1};
   for (const auto& t : chart.tris) {
-    const P2& a = chart.points[t[0]];
-    const P2& b = chart.points[t[1]];
-    const P2& c = chart.points[t[2]];
-    const RasterTriangle tri({a[0], a[1], b[0], b[1], c[0], c[1]});
+    const Vec2d& a = chart.points[t[0]];
+    const Vec2d& b = chart.points[t[1]];
+    const Vec2d& c = chart.points[t[2]];
+    const RasterTriangle tri({a.x, a.y, b.x, b.y, c.x, c.y});
     for_each_touched_texel(tri, kFootprintMargin, grid, [&](int64_t i, int64_t j) {
       cells[static_cast<size_t>(j) * g.gx + static_cast<size_t>(i)] = 1;
     });
@@ -94,24 +94,24 @@ Profile profile(const std::vector<char>& cells, const Grid& g, int rotation, int
 
 }  // namespace
 
-P2 place_point(const PackChart& chart, const Placement& pl, const P2& p) {
+Vec2d place_point(const PackChart& chart, const Placement& pl, const Vec2d& p) {
   Grid g = grid_of(chart);
-  P2 r;
+  Vec2d r;
   switch (pl.rotation) {
     case 0:
       r = p;
       break;
     case 1:
-      r = {g.gy - p[1], p[0]};
+      r = {g.gy - p.y, p.x};
       break;
     case 2:
-      r = {g.gx - p[0], g.gy - p[1]};
+      r = {g.gx - p.x, g.gy - p.y};
       break;
     default:
-      r = {p[1], g.gx - p[0]};
+      r = {p.y, g.gx - p.x};
       break;
   }
-  return {r[0] + pl.x, r[1] + pl.y};
+  return {r.x + pl.x, r.y + pl.y};
 }
 
 PackResult pack_charts(const std::vector<PackChart>& charts, int width, int padding, int threads) {

@@ -23,12 +23,12 @@ namespace SMP = CGAL::Surface_mesh_parameterization;
 
 }  // namespace
 
-ParamStatus parameterize_chart(const std::vector<P3>& vertices,
+ParamStatus parameterize_chart(const std::vector<Vec3d>& vertices,
                                const std::vector<std::array<uint32_t, 3>>& faces, Method method,
-                               std::vector<P2>* uv) {
+                               std::vector<Vec2d>* uv) {
   SurfaceMesh mesh;
   mesh.reserve(vertices.size(), faces.size() * 3 / 2 + 3, faces.size());
-  for (const P3& p : vertices) mesh.add_vertex(Kernel::Point_3(p[0], p[1], p[2]));
+  for (const Vec3d& p : vertices) mesh.add_vertex(Kernel::Point_3(p.x, p.y, p.z));
   for (const auto& f : faces) {
     if (mesh.add_face(VertexIndex(f[0]), VertexIndex(f[1]), VertexIndex(f[2])) ==
         SurfaceMesh::null_face())

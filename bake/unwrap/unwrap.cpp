@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <compare>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -23,39 +24,28 @@
 namespace vt::unwrap {
 namespace {
 
-using detail::P2;
-using detail::P3;
 using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-P3 sub(const P3& a, const P3& b) {
-  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
-}
-P3 cross(const P3& a, const P3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const P3& a, const P3& b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-double norm(const P3& a) {
-  return std::sqrt(dot(a, a));
-}
-double cross2(const P2& a, const P2& b, const P2& c) {
-  return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+using detail::bounds_of;
+
+// Twice the signed area of the triangle abc.
+double cross2(Vec2d a, Vec2d b, Vec2d c) {
+  return cross(b - a, c - a);
 }
 
 // One primitive of one instance (or of one mesh with share_instances), in world space.
 struct Surface {
   int source_mesh = 0;             // in the input scene
   int out_mesh = 0, out_prim = 0;  // in the output scene
-  std::vector<P3> pos;             // welded vertices, world space minus `origin`
+  std::vector<Vec3d> pos;          // welded vertices, world space minus `origin`
   std::vector<uint32_t> weld;      // source vertex -> welded vertex
   std::vector<uint32_t> tri;       // welded corners, 3 per face
   std::vector<int32_t> adj;        // per corner e: face across edge (e, e+1), or -1
-  std::vector<P3> normal;          // unit face normals
+  std::vector<Vec3d> normal;       // unit face normals
   std::vector<double> area;        // face areas
   std::vector<char> degenerate;
 };
@@ -67,8 +57,8 @@ struct Chart {
   int round = 0;  // stretch split rounds this chart descends from
   // Filled by parameterisation:
   std::vector<uint32_t> corner_local;  // per face corner: local vertex
-  std::vector<P3> local_pos;
-  std::vector<P2> uv;
+  std::vector<Vec3d> local_pos;
+  std::vector<Vec2d> uv;
   double area3d = 0, area_uv = 0, l2 = 1;
 };
 
@@ -111,16 +101,16 @@ void weld(const scene::Primitive& p, Surface* s, const scene::Mat4& world) {
   std::sort(ids.begin(), ids.end(), [&](uint32_t a, uint32_t b) { return first[a] < first[b]; });
   for (size_t k = 0; k < ids.size(); ++k) remap[ids[k]] = static_cast<uint32_t>(k);
   for (auto& w : s->weld) w = remap[w];
-  std::vector<P3> world_pos(rep.size());
-  for (size_t k = 0; k < rep.size(); ++k)
-    world_pos[remap[k]] = scene::transform_point(world, p.positions[rep[k]]);
+  std::vector<Vec3d> world_pos(rep.size());
+  for (size_t k = 0; k < rep.size(); ++k) {
+    const auto q = scene::transform_point(world, p.positions[rep[k]]);
+    world_pos[remap[k]] = {q[0], q[1], q[2]};
+  }
   // Work relative to the surface's bounding-box centre so large offsets cost no precision.
-  P3 lo = {1e300, 1e300, 1e300}, hi = {-1e300, -1e300, -1e300};
-  for (const P3& q : world_pos)
-    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], q[k]), hi[k] = std::max(hi[k], q[k]);
-  P3 centre = {(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2};
+  const auto [lo, hi] = bounds_of(world_pos);
+  const Vec3d centre = (lo + hi) / 2.0;
   s->pos.resize(world_pos.size());
-  for (size_t k = 0; k < world_pos.size(); ++k) s->pos[k] = sub(world_pos[k], centre);
+  for (size_t k = 0; k < world_pos.size(); ++k) s->pos[k] = world_pos[k] - centre;
   s->tri.resize(p.indices.size());
   for (size_t i = 0; i < p.indices.size(); ++i) s->tri[i] = s->weld[p.indices[i]];
 }
@@ -131,13 +121,12 @@ void build_topology(Surface* s) {
   s->area.resize(faces);
   s->degenerate.assign(faces, 0);
   for (size_t f = 0; f < faces; ++f) {
-    const P3& a = s->pos[s->tri[3 * f]];
-    const P3& b = s->pos[s->tri[3 * f + 1]];
-    const P3& c = s->pos[s->tri[3 * f + 2]];
-    P3 n = cross(sub(b, a), sub(c, a));
-    double len = norm(n);
-    double longest =
-        std::max({dot(sub(b, a), sub(b, a)), dot(sub(c, b), sub(c, b)), dot(sub(a, c), sub(a, c))});
+    const Vec3d& a = s->pos[s->tri[3 * f]];
+    const Vec3d& b = s->pos[s->tri[3 * f + 1]];
+    const Vec3d& c = s->pos[s->tri[3 * f + 2]];
+    Vec3d n = cross(b - a, c - a);
+    double len = length(n);
+    double longest = std::max({dot(b - a, b - a), dot(c - b, c - b), dot(a - c, a - c)});
     s->area[f] = len / 2;
     bool same = s->tri[3 * f] == s->tri[3 * f + 1] || s->tri[3 * f + 1] == s->tri[3 * f + 2] ||
                 s->tri[3 * f] == s->tri[3 * f + 2];
@@ -145,7 +134,7 @@ void build_topology(Surface* s) {
       s->degenerate[f] = 1;
       s->normal[f] = {0, 0, 0};
     } else {
-      s->normal[f] = {n[0] / len, n[1] / len, n[2] / len};
+      s->normal[f] = n / len;
     }
   }
   // Faces are neighbours across an edge used by exactly two faces in opposite directions
@@ -187,12 +176,12 @@ void segment(const Surface& s, uint32_t surface_index, double max_angle_deg,
   size_t faces = s.tri.size() / 3;
   const double cos_max = std::cos(max_angle_deg * M_PI / 180.0);
   std::vector<int32_t> chart_of(faces, -1);
-  std::vector<P3> centroid(faces);
+  std::vector<Vec3d> centroid(faces);
   for (size_t f = 0; f < faces; ++f) {
-    const P3& a = s.pos[s.tri[3 * f]];
-    const P3& b = s.pos[s.tri[3 * f + 1]];
-    const P3& c = s.pos[s.tri[3 * f + 2]];
-    centroid[f] = {(a[0] + b[0] + c[0]) / 3, (a[1] + b[1] + c[1]) / 3, (a[2] + b[2] + c[2]) / 3};
+    const Vec3d& a = s.pos[s.tri[3 * f]];
+    const Vec3d& b = s.pos[s.tri[3 * f + 1]];
+    const Vec3d& c = s.pos[s.tri[3 * f + 2]];
+    centroid[f] = (a + b + c) / 3.0;
   }
   using Item = std::pair<double, uint32_t>;
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
@@ -208,19 +197,18 @@ void segment(const Surface& s, uint32_t surface_index, double max_angle_deg,
       charts->push_back(std::move(chart));
       continue;
     }
-    P3 nsum = {s.normal[seed][0] * s.area[seed], s.normal[seed][1] * s.area[seed],
-               s.normal[seed][2] * s.area[seed]};
+    Vec3d nsum = s.normal[seed] * s.area[seed];
     double area = s.area[seed];
-    P3 seed_c = centroid[seed];
+    Vec3d seed_c = centroid[seed];
     auto push_neighbours = [&](uint32_t f) {
-      P3 n = nsum;
-      double len = norm(n);
-      if (len > 0) n = {n[0] / len, n[1] / len, n[2] / len};
+      Vec3d n = nsum;
+      double len = length(n);
+      if (len > 0) n = n / len;
       double radius = std::sqrt(area / M_PI) + 1e-300;
       for (int e = 0; e < 3; ++e) {
         int32_t g = s.adj[3 * f + e];
         if (g < 0 || chart_of[g] >= 0) continue;
-        double cost = (1.0 - dot(s.normal[g], n)) + 0.05 * norm(sub(centroid[g], seed_c)) / radius;
+        double cost = (1.0 - dot(s.normal[g], n)) + 0.05 * length(centroid[g] - seed_c) / radius;
         heap.push({cost, static_cast<uint32_t>(g)});
       }
     };
@@ -229,13 +217,13 @@ void segment(const Surface& s, uint32_t surface_index, double max_angle_deg,
       uint32_t f = heap.top().second;
       heap.pop();
       if (chart_of[f] >= 0) continue;
-      P3 n = nsum;
-      double len = norm(n);
-      if (len > 0) n = {n[0] / len, n[1] / len, n[2] / len};
+      Vec3d n = nsum;
+      double len = length(n);
+      if (len > 0) n = n / len;
       if (dot(s.normal[f], n) < cos_max || dot(s.normal[f], s.normal[seed]) < cos_max) continue;
       chart_of[f] = id;
       chart.faces.push_back(f);
-      for (int k = 0; k < 3; ++k) nsum[k] += s.normal[f][k] * s.area[f];
+      nsum = nsum + s.normal[f] * s.area[f];
       area += s.area[f];
       push_neighbours(f);
     }
@@ -351,13 +339,13 @@ void build_local(const Surface& s, Chart* c) {
   }
 }
 
-bool segments_cross(const P2& a, const P2& b, const P2& c, const P2& d) {
+bool segments_cross(const Vec2d& a, const Vec2d& b, const Vec2d& c, const Vec2d& d) {
   double o1 = cross2(a, b, c), o2 = cross2(a, b, d), o3 = cross2(c, d, a), o4 = cross2(c, d, b);
   if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0)))
     return true;
-  auto on = [](const P2& p, const P2& q, const P2& r, double o) {  // r on segment pq
-    return o == 0 && std::min(p[0], q[0]) <= r[0] && r[0] <= std::max(p[0], q[0]) &&
-           std::min(p[1], q[1]) <= r[1] && r[1] <= std::max(p[1], q[1]);
+  auto on = [](const Vec2d& p, const Vec2d& q, const Vec2d& r, double o) {  // r on segment pq
+    return o == 0 && std::min(p.x, q.x) <= r.x && r.x <= std::max(p.x, q.x) &&
+           std::min(p.y, q.y) <= r.y && r.y <= std::max(p.y, q.y);
   };
   return on(a, b, c, o1) || on(a, b, d, o2) || on(c, d, a, o3) || on(c, d, b, o4);
 }
@@ -380,20 +368,18 @@ bool boundary_self_intersects(const Chart& c) {
       seg.push_back({a, b});
   }
   if (seg.size() < 3) return false;
-  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
-  for (const P2& p : c.uv)
-    for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  const auto [lo, hi] = bounds_of(c.uv);
   int g = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(seg.size()))));
-  double cw = std::max(hi[0] - lo[0], 1e-300) / g, ch = std::max(hi[1] - lo[1], 1e-300) / g;
+  double cw = std::max(hi.x - lo.x, 1e-300) / g, ch = std::max(hi.y - lo.y, 1e-300) / g;
   std::vector<std::vector<uint32_t>> cells(static_cast<size_t>(g) * g);
   auto cell = [&](double v, double l, double w) {
     return std::clamp(static_cast<int>((v - l) / w), 0, g - 1);
   };
   for (size_t k = 0; k < seg.size(); ++k) {
-    const P2& a = c.uv[seg[k][0]];
-    const P2& b = c.uv[seg[k][1]];
-    int x0 = cell(std::min(a[0], b[0]), lo[0], cw), x1 = cell(std::max(a[0], b[0]), lo[0], cw);
-    int y0 = cell(std::min(a[1], b[1]), lo[1], ch), y1 = cell(std::max(a[1], b[1]), lo[1], ch);
+    const Vec2d& a = c.uv[seg[k][0]];
+    const Vec2d& b = c.uv[seg[k][1]];
+    int x0 = cell(std::min(a.x, b.x), lo.x, cw), x1 = cell(std::max(a.x, b.x), lo.x, cw);
+    int y0 = cell(std::min(a.y, b.y), lo.y, ch), y1 = cell(std::max(a.y, b.y), lo.y, ch);
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x)
         cells[static_cast<size_t>(y) * g + x].push_back(static_cast<uint32_t>(k));
@@ -410,16 +396,13 @@ bool boundary_self_intersects(const Chart& c) {
 }
 
 // Sander et al. stretch of one triangle: returns {L2^2, Linf} for 3D q and 2D p.
-std::pair<double, double> triangle_stretch(const P3& q1, const P3& q2, const P3& q3, const P2& p1,
-                                           const P2& p2, const P2& p3) {
+std::pair<double, double> triangle_stretch(const Vec3d& q1, const Vec3d& q2, const Vec3d& q3,
+                                           const Vec2d& p1, const Vec2d& p2, const Vec2d& p3) {
   double a2 = cross2(p1, p2, p3);  // twice the signed UV area
   if (!(std::abs(a2) > 0))
     return {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-  P3 ss, st;
-  for (int k = 0; k < 3; ++k) {
-    ss[k] = (q1[k] * (p2[1] - p3[1]) + q2[k] * (p3[1] - p1[1]) + q3[k] * (p1[1] - p2[1])) / a2;
-    st[k] = (q1[k] * (p3[0] - p2[0]) + q2[k] * (p1[0] - p3[0]) + q3[k] * (p2[0] - p1[0])) / a2;
-  }
+  Vec3d ss = (q1 * (p2.y - p3.y) + q2 * (p3.y - p1.y) + q3 * (p1.y - p2.y)) / a2;
+  Vec3d st = (q1 * (p3.x - p2.x) + q2 * (p1.x - p3.x) + q3 * (p2.x - p1.x)) / a2;
   double a = dot(ss, ss), b = dot(ss, st), c = dot(st, st);
   double root = std::sqrt((a - c) * (a - c) + 4 * b * b);
   return {(a + c) / 2, std::sqrt(std::max(0.0, (a + c + root) / 2))};
@@ -441,39 +424,36 @@ ChartVerdict parameterize(const Surface& s, Chart* c, const UnwrapOptions& opt) 
   }
   if (n == 1) {
     // One face: an exact isometric placement, longest edge first for accuracy.
-    const P3* q[3] = {&c->local_pos[c->corner_local[0]], &c->local_pos[c->corner_local[1]],
-                      &c->local_pos[c->corner_local[2]]};
+    const Vec3d* q[3] = {&c->local_pos[c->corner_local[0]], &c->local_pos[c->corner_local[1]],
+                         &c->local_pos[c->corner_local[2]]};
     int e = 0;
     double best = -1;
     for (int k = 0; k < 3; ++k) {
-      double l = norm(sub(*q[(k + 1) % 3], *q[k]));
+      double l = length(*q[(k + 1) % 3] - *q[k]);
       if (l > best) best = l, e = k;
     }
-    P3 ab = sub(*q[(e + 1) % 3], *q[e]), ac = sub(*q[(e + 2) % 3], *q[e]);
-    double len = norm(ab);
-    double x = dot(ac, ab) / len, y = norm(cross(ab, ac)) / len;
+    Vec3d ab = *q[(e + 1) % 3] - *q[e], ac = *q[(e + 2) % 3] - *q[e];
+    double len = length(ab);
+    double x = dot(ac, ab) / len, y = length(cross(ab, ac)) / len;
     c->uv.assign(3, {0, 0});
     c->uv[c->corner_local[e]] = {0, 0};
     c->uv[c->corner_local[(e + 1) % 3]] = {len, 0};
     c->uv[c->corner_local[(e + 2) % 3]] = {x, y};
   } else {
     // Normalise the chart to unit size for the solver; scale back afterwards.
-    P3 lo = {1e300, 1e300, 1e300}, hi = {-1e300, -1e300, -1e300};
-    for (const P3& p : c->local_pos)
-      for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-    double scale = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+    const auto [lo, hi] = bounds_of(c->local_pos);
+    double scale = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
     if (!(scale > 0)) return ChartVerdict::kSplit;
-    std::vector<P3> unit(c->local_pos.size());
-    for (size_t v = 0; v < unit.size(); ++v)
-      for (int k = 0; k < 3; ++k) unit[v][k] = (c->local_pos[v][k] - lo[k]) / scale;
+    std::vector<Vec3d> unit(c->local_pos.size());
+    for (size_t v = 0; v < unit.size(); ++v) unit[v] = (c->local_pos[v] - lo) / scale;
     std::vector<std::array<uint32_t, 3>> faces(n);
     for (size_t i = 0; i < n; ++i)
       faces[i] = {c->corner_local[3 * i], c->corner_local[3 * i + 1], c->corner_local[3 * i + 2]};
     auto status = detail::parameterize_chart(unit, faces, opt.method, &c->uv);
     if (status != detail::ParamStatus::kOk) return ChartVerdict::kSplit;
-    for (P2& p : c->uv) {
-      if (!std::isfinite(p[0]) || !std::isfinite(p[1])) return ChartVerdict::kSplit;
-      p[0] *= scale, p[1] *= scale;
+    for (Vec2d& p : c->uv) {
+      if (!std::isfinite(p.x) || !std::isfinite(p.y)) return ChartVerdict::kSplit;
+      p.x *= scale, p.y *= scale;
     }
   }
   // Orientation: the chart's total signed area is made positive (never mirrored later), and
@@ -483,18 +463,16 @@ ChartVerdict parameterize(const Surface& s, Chart* c, const UnwrapOptions& opt) 
     total += cross2(c->uv[c->corner_local[3 * i]], c->uv[c->corner_local[3 * i + 1]],
                     c->uv[c->corner_local[3 * i + 2]]);
   if (total < 0)
-    for (P2& p : c->uv) p[0] = -p[0];
-  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
-  for (const P2& p : c->uv)
-    for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-  double extent2 = std::max(hi[0] - lo[0], hi[1] - lo[1]);
+    for (Vec2d& p : c->uv) p.x = -p.x;
+  const auto [lo, hi] = bounds_of(c->uv);
+  double extent2 = std::max(hi.x - lo.x, hi.y - lo.y);
   extent2 *= extent2;
   c->area_uv = 0;
   double l2sum = 0;
   for (size_t i = 0; i < n; ++i) {
-    const P2& a = c->uv[c->corner_local[3 * i]];
-    const P2& b = c->uv[c->corner_local[3 * i + 1]];
-    const P2& d = c->uv[c->corner_local[3 * i + 2]];
+    const Vec2d& a = c->uv[c->corner_local[3 * i]];
+    const Vec2d& b = c->uv[c->corner_local[3 * i + 1]];
+    const Vec2d& d = c->uv[c->corner_local[3 * i + 2]];
     double a2 = cross2(a, b, d);
     // Strictly positive with margin: the map must survive rounding to float atlas UVs.
     if (!(a2 > 1e-12 * extent2)) return n > 1 ? ChartVerdict::kSplit : ChartVerdict::kOk;
@@ -517,12 +495,18 @@ ChartVerdict parameterize(const Surface& s, Chart* c, const UnwrapOptions& opt) 
 // Rotates chart-local points to the smallest-area bounding box (hull edge directions), then
 // moves the box's corner to the origin.
 void fit_box(detail::PackChart* pc) {
-  std::vector<P2> pts = pc->points;
-  std::sort(pts.begin(), pts.end());
-  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
-  std::vector<P2> hull;
+  std::vector<Vec2d> pts = pc->points;
+  // Lexicographic, as std::array's operator< orders.
+  std::sort(pts.begin(), pts.end(), [](Vec2d a, Vec2d b) {
+    const auto c = a.x <=> b.x;
+    return c != 0 ? c < 0 : a.y < b.y;
+  });
+  pts.erase(std::unique(pts.begin(), pts.end(),
+                        [](Vec2d a, Vec2d b) { return a.x == b.x && a.y == b.y; }),
+            pts.end());
+  std::vector<Vec2d> hull;
   if (pts.size() >= 3) {
-    std::vector<P2> h(2 * pts.size());
+    std::vector<Vec2d> h(2 * pts.size());
     size_t k = 0;
     for (size_t i = 0; i < pts.size(); ++i) {
       while (k >= 2 && cross2(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
@@ -539,34 +523,30 @@ void fit_box(detail::PackChart* pc) {
   }
   double best_area = std::numeric_limits<double>::infinity(), best_c = 1, best_s = 0;
   for (size_t i = 0; i < hull.size(); ++i) {
-    const P2& a = hull[i];
-    const P2& b = hull[(i + 1) % hull.size()];
-    double dx = b[0] - a[0], dy = b[1] - a[1], len = std::hypot(dx, dy);
+    const Vec2d& a = hull[i];
+    const Vec2d& b = hull[(i + 1) % hull.size()];
+    double dx = b.x - a.x, dy = b.y - a.y, len = std::hypot(dx, dy);
     if (!(len > 0)) continue;
     double cs = dx / len, sn = dy / len;
     double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
-    for (const P2& p : hull) {
-      double x = p[0] * cs + p[1] * sn, y = -p[0] * sn + p[1] * cs;
+    for (const Vec2d& p : hull) {
+      double x = p.x * cs + p.y * sn, y = -p.x * sn + p.y * cs;
       lo[0] = std::min(lo[0], x), hi[0] = std::max(hi[0], x), lo[1] = std::min(lo[1], y),
       hi[1] = std::max(hi[1], y);
     }
     double area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
     if (area < best_area * (1 - 1e-9)) best_area = area, best_c = cs, best_s = sn;
   }
-  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
-  for (P2& p : pc->points) {
-    p = {p[0] * best_c + p[1] * best_s, -p[0] * best_s + p[1] * best_c};
-    lo[0] = std::min(lo[0], p[0]), hi[0] = std::max(hi[0], p[0]), lo[1] = std::min(lo[1], p[1]),
-    hi[1] = std::max(hi[1], p[1]);
-  }
+  for (Vec2d& p : pc->points) p = {p.x * best_c + p.y * best_s, -p.x * best_s + p.y * best_c};
+  const auto [lo, hi] = bounds_of(pc->points);
   // Centre the box in whole texels with at least kMargin texel around it, more than the
   // footprint margin: no triangle then touches a texel beyond the footprint grid.
   const double kMargin = 2 * kFootprintMargin;
-  double w = hi[0] - lo[0], h = hi[1] - lo[1];
+  double w = hi.x - lo.x, h = hi.y - lo.y;
   double gx = std::max(1.0, std::ceil(w + 2 * kMargin)),
          gy = std::max(1.0, std::ceil(h + 2 * kMargin));
-  double ox = (gx - w) / 2 - lo[0], oy = (gy - h) / 2 - lo[1];
-  for (P2& p : pc->points) p = {p[0] + ox, p[1] + oy};
+  double ox = (gx - w) / 2 - lo.x, oy = (gy - h) / 2 - lo.y;
+  for (Vec2d& p : pc->points) p = {p.x + ox, p.y + oy};
   pc->width = gx;
   pc->height = gy;
 }
@@ -690,8 +670,8 @@ Expected<std::vector<Surface>> collect_surfaces(const scene::Scene& in, const Un
     build_topology(&s);
   });
   for (const auto& s : surfaces)
-    for (const P3& p : s.pos)
-      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+    for (const Vec3d& p : s.pos)
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
         return Error(ErrorCode::kInvalidArgument, "mesh '" + in.meshes[s.source_mesh].name +
                                                       "': world position overflows double");
   return surfaces;
@@ -762,7 +742,7 @@ std::vector<detail::PackChart> make_pack_charts(const std::vector<Chart>& charts
     if (!std::isfinite(k)) k = 0.5;
     detail::PackChart& pc = pcs[i];
     pc.points.resize(c.uv.size());
-    for (size_t v = 0; v < c.uv.size(); ++v) pc.points[v] = {c.uv[v][0] * k, c.uv[v][1] * k};
+    for (size_t v = 0; v < c.uv.size(); ++v) pc.points[v] = c.uv[v] * k;
     for (size_t f = 0; f < c.faces.size(); ++f)
       pc.tris.push_back(
           {c.corner_local[3 * f], c.corner_local[3 * f + 1], c.corner_local[3 * f + 2]});
@@ -801,11 +781,9 @@ double first_density_guess(const std::vector<Chart>& charts, int width) {
   double longest = 0;
   for (const auto& c : charts) {
     if (c.degenerate || !(c.area3d > 0) || !(c.area_uv > 0)) continue;
-    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
-    for (const P2& p : c.uv)
-      for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
-    longest = std::max(longest,
-                       std::hypot(hi[0] - lo[0], hi[1] - lo[1]) * std::sqrt(c.area3d / c.area_uv));
+    const auto [lo, hi] = bounds_of(c.uv);
+    longest =
+        std::max(longest, std::hypot(hi.x - lo.x, hi.y - lo.y) * std::sqrt(c.area3d / c.area_uv));
   }
   if (longest > 0) tpu = std::min(tpu, (width - 2.0) / longest);
   return tpu;
@@ -889,8 +867,8 @@ void write_surface_uvs(const Surface& s, const std::vector<Chart>& charts,
     const auto& pl = atlas.packed.placements[ci];
     std::vector<scene::Vec2> local_uv(c.uv.size());
     for (size_t v = 0; v < c.uv.size(); ++v) {
-      P2 p = detail::place_point(pc, pl, pc.points[v]);
-      local_uv[v] = {static_cast<float>(p[0] / W), static_cast<float>(1.0 - p[1] / H)};
+      Vec2d p = detail::place_point(pc, pl, pc.points[v]);
+      local_uv[v] = {static_cast<float>(p.x / W), static_cast<float>(1.0 - p.y / H)};
     }
     std::unordered_map<uint64_t, uint32_t> made;  // (local vertex, source vertex) -> new
     for (size_t i = 0; i < c.faces.size(); ++i) {
@@ -933,17 +911,17 @@ void write_surface_uvs(const Surface& s, const std::vector<Chart>& charts,
   tris->resize(faces);
   for (size_t f = 0; f < faces; ++f) {
     AtlasTriangle& t = (*tris)[f];
-    P2 p[3];
+    Vec2d p[3];
     for (int k = 0; k < 3; ++k) {
       const auto& uv = atlas_uv[new_index[3 * f + k]];
       p[k] = {static_cast<double>(uv[0]) * W, static_cast<double>(uv[1]) * H};
-      t.uv[2 * k] = p[k][0];
-      t.uv[2 * k + 1] = p[k][1];
+      t.uv[2 * k] = p[k].x;
+      t.uv[2 * k + 1] = p[k].y;
     }
     t.chart = face_chart[f];
     if (s.degenerate[f]) continue;
     // y down in the atlas: flip y so front faces are positive for the stretch formula.
-    P2 q[3] = {{p[0][0], -p[0][1]}, {p[1][0], -p[1][1]}, {p[2][0], -p[2][1]}};
+    Vec2d q[3] = {{p[0].x, -p[0].y}, {p[1].x, -p[1].y}, {p[2].x, -p[2].y}};
     auto [l2sq, li] = triangle_stretch(s.pos[s.tri[3 * f]], s.pos[s.tri[3 * f + 1]],
                                        s.pos[s.tri[3 * f + 2]], q[0], q[1], q[2]);
     double a_uv = std::abs(cross2(q[0], q[1], q[2])) / 2;

@@ -1,16 +1,37 @@
 // Internal pieces of vt_unwrap shared between its source files (not installed, not for callers).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
 
 #include "bake/unwrap/unwrap.h"
+#include "common/vec.h"
 
 namespace vt::unwrap::detail {
 
-using P2 = std::array<double, 2>;
-using P3 = std::array<double, 3>;
+// The smallest axis-aligned box holding some points; lo > hi on every axis when there are none.
+template <class V>
+struct Bounds {
+  V lo, hi;
+};
+inline Bounds<Vec2d> bounds_of(const std::vector<Vec2d>& points) {
+  Bounds<Vec2d> b{{1e300, 1e300}, {-1e300, -1e300}};
+  for (const Vec2d& p : points) {
+    b.lo = {std::min(b.lo.x, p.x), std::min(b.lo.y, p.y)};
+    b.hi = {std::max(b.hi.x, p.x), std::max(b.hi.y, p.y)};
+  }
+  return b;
+}
+inline Bounds<Vec3d> bounds_of(const std::vector<Vec3d>& points) {
+  Bounds<Vec3d> b{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
+  for (const Vec3d& p : points) {
+    b.lo = {std::min(b.lo.x, p.x), std::min(b.lo.y, p.y), std::min(b.lo.z, p.z)};
+    b.hi = {std::max(b.hi.x, p.x), std::max(b.hi.y, p.y), std::max(b.hi.z, p.z)};
+  }
+  return b;
+}
 
 enum class ParamStatus { kOk, kNotDisk, kFailed };
 
@@ -18,14 +39,14 @@ enum class ParamStatus { kOk, kNotDisk, kFailed };
 // Returns kNotDisk when the faces do not form one disk, kFailed when the solver fails; on kOk
 // `uv` holds one point per vertex (not yet checked for flips: the caller does that).
 // This is the only function that touches CGAL, so CGAL is compiled once.
-ParamStatus parameterize_chart(const std::vector<P3>& vertices,
+ParamStatus parameterize_chart(const std::vector<Vec3d>& vertices,
                                const std::vector<std::array<uint32_t, 3>>& faces, Method method,
-                               std::vector<P2>* uv);
+                               std::vector<Vec2d>* uv);
 
 // A chart ready to pack: triangles in chart-local texel coordinates (already scaled to the
 // texel density and rotated to a small bounding box), origin at the box's minimum corner.
 struct PackChart {
-  std::vector<P2> points;                     // local texel coordinates
+  std::vector<Vec2d> points;                  // local texel coordinates
   std::vector<std::array<uint32_t, 3>> tris;  // into points
   double width = 0, height = 0;               // bounding box
 };
@@ -48,6 +69,6 @@ struct PackResult {
 PackResult pack_charts(const std::vector<PackChart>& charts, int width, int padding, int threads);
 
 // Applies a placement to a local point (the inverse of nothing: used to write atlas UVs).
-P2 place_point(const PackChart& chart, const Placement& placement, const P2& p);
+Vec2d place_point(const PackChart& chart, const Placement& placement, const Vec2d& p);
 
 }  // namespace vt::unwrap::detail

@@ -1,10 +1,11 @@
-// Helpers for the bake tests: a page sink that keeps pages in memory, and reassembly of level
-// images from the pages' payloads.
+// Helpers for the bake tests: a level-0 check of a raw page file, a page sink that keeps pages in
+// memory, and reassembly of level images from the pages' payloads.
 #pragma once
 
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <tuple>
@@ -14,6 +15,8 @@
 #include "bake/build_plan.h"
 #include "bake/page_encoder.h"
 #include "bake/paging.h"
+#include "format/page_file.h"
+#include "format/page_file_inspect.h"
 
 namespace vt::test {
 
@@ -27,6 +30,28 @@ inline LayerInput layer_input(LayerSemantic semantic, std::shared_ptr<ImageSourc
   return layer;
 }
 
+// Checks that level 0 of layer 0 of the page file at `path` holds w x h RGB texels and that
+// texel (x, y) channel c is want(x, y, c) (raw codec: the stored payload exactly).
+inline void expect_level0_rgb(
+    const std::string& path, uint32_t w, uint32_t h,
+    const std::function<uint8_t(uint32_t x, uint32_t y, uint32_t c)>& want) {
+  auto reader = PageFileReader::open(path);
+  ASSERT_TRUE(reader.ok()) << reader.status().message();
+  auto level = extract_level(**reader, 0, 0);
+  ASSERT_TRUE(level.ok()) << level.status().message();
+  ASSERT_EQ(level->width, w);
+  ASSERT_EQ(level->height, h);
+  ASSERT_EQ(level->channels, 3u);
+  for (uint32_t y = 0; y < h; ++y) {
+    for (uint32_t x = 0; x < w; ++x) {
+      for (uint32_t c = 0; c < 3; ++c) {
+        ASSERT_EQ(level->texels[(size_t(y) * w + x) * 3 + c], want(x, y, c))
+            << x << "," << y << " c" << c;
+      }
+    }
+  }
+}
+
 struct StoredPage {
   PageState state = PageState::kAbsent;
   std::vector<uint8_t> bytes;  // stored bytes, or the constant texel
@@ -36,25 +61,23 @@ class MemorySink final : public PageSink {
  public:
   using Key = std::tuple<uint32_t, uint32_t, uint32_t, uint32_t>;  // layer, level, y, x
   Status add_page(const PageId& id, uint32_t layer, std::span<const uint8_t> data) override {
-    std::lock_guard<std::mutex> lock(mu_);
-    auto& p = pages[{layer, id.level, id.y, id.x}];
-    if (p.state != PageState::kAbsent) return Error(ErrorCode::kInternal, "page given twice");
-    p.state = PageState::kStored;
-    p.bytes.assign(data.begin(), data.end());
-    return Status::Ok();
+    return put(id, layer, PageState::kStored, data);
   }
   Status add_constant_page(const PageId& id, uint32_t layer,
                            std::span<const uint8_t> texel) override {
-    std::lock_guard<std::mutex> lock(mu_);
-    auto& p = pages[{layer, id.level, id.y, id.x}];
-    if (p.state != PageState::kAbsent) return Error(ErrorCode::kInternal, "page given twice");
-    p.state = PageState::kConstant;
-    p.bytes.assign(texel.begin(), texel.end());
-    return Status::Ok();
+    return put(id, layer, PageState::kConstant, texel);
   }
   std::map<Key, StoredPage> pages;
 
  private:
+  Status put(const PageId& id, uint32_t layer, PageState state, std::span<const uint8_t> bytes) {
+    std::lock_guard<std::mutex> lock(mu_);
+    auto& p = pages[{layer, id.level, id.y, id.x}];
+    if (p.state != PageState::kAbsent) return Error(ErrorCode::kInternal, "page given twice");
+    p.state = state;
+    p.bytes.assign(bytes.begin(), bytes.end());
+    return Status::Ok();
+  }
   std::mutex mu_;
 };
 

@@ -32,6 +32,18 @@ TEST(Kernel, NormalisedAndSymmetric) {
   EXPECT_EQ(*parse_mip_filter("kaiser"), MipFilter::kKaiser);
 }
 
+TEST(Filters, NamesReadBackAndLanczosIsAnAlias) {
+  for (MipFilter f : kFilters) {
+    auto back = parse_mip_filter(to_string(f));
+    ASSERT_TRUE(back.ok()) << to_string(f);
+    EXPECT_EQ(*back, f);
+  }
+  EXPECT_STREQ(to_string(MipFilter::kLanczos3), "lanczos3");
+  EXPECT_EQ(*parse_mip_filter("lanczos"), MipFilter::kLanczos3);
+  EXPECT_FALSE(parse_mip_filter(nullptr).ok());
+  EXPECT_FALSE(parse_mip_filter("Box").ok());
+}
+
 TEST(Filters, ConstantStaysConstantAtEveryLevel) {
   const float kValues[] = {0.3f, 1.0f, std::numeric_limits<float>::max()};
   for (MipFilter f : kFilters) {

@@ -14,6 +14,7 @@
 #include "common/vec.h"
 #include "format/page_file.h"
 #include "samples/sample_scene.h"
+#include "tests/transfer/atlas_reference.h"
 #include "tests/transfer/transfer_test_util.h"
 
 namespace vt {
@@ -27,6 +28,14 @@ void smooth_colour(double u, double v, float* t) {
   t[1] = float(std::round((0.5 + 0.35 * std::cos(2 * kPi * (u - 3 * v))) * 255) / 255);
   t[2] = float(
       std::round((0.5 + 0.3 * std::sin(2 * kPi * 4 * u) * std::cos(2 * kPi * 2 * v)) * 255) / 255);
+}
+
+// The transfer's private copies of images (embedded bytes, .tx levels) still in `dir`.
+size_t transfer_copies_left(const test::ScratchDir& dir) {
+  size_t left = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir.file("")))
+    left += e.path().filename().string().rfind("vtbake-transfer-", 0) == 0;
+  return left;
 }
 
 struct RoundTrip {
@@ -84,8 +93,7 @@ TEST(SceneBake, TexturedQuadRoundTripsAbove40dB) {
   ASSERT_TRUE(write_texture(dir.file("quad.png"), 256, 256, 3, smooth_colour).ok());
   scene::Material m;
   m.name = "quad";
-  scene::Scene s = test::single_mesh_scene(make_grid(1.0f, 1, 1), m);
-  s.materials[0].base_color_texture.image = test::add_image(s, dir.file("quad.png"));
+  scene::Scene s = test::textured_scene(make_grid(1.0f, 1, 1), dir.file("quad.png"), m);
   RoundTrip r = bake_and_compare(s, dir, 256, 256, 256);
   ASSERT_TRUE(r.reader);
   EXPECT_GT(r.samples, 3u * 250 * 250);
@@ -105,8 +113,7 @@ TEST(SceneBake, TexturedCubeRoundTripsAbove40dB) {
   m.name = "cube";
   m.metallic_factor = 0.0f;  // non-default factors: the scene calls for an ORM layer
   m.roughness_factor = 0.25f;
-  scene::Scene s = test::single_mesh_scene(make_box(1, 1, 1), m);
-  s.materials[0].base_color_texture.image = test::add_image(s, dir.file("cube.png"));
+  scene::Scene s = test::textured_scene(make_box(1, 1, 1), dir.file("cube.png"), m);
   RoundTrip r = bake_and_compare(s, dir, 128, 128, 128);
   ASSERT_TRUE(r.reader);
   EXPECT_GT(r.samples, 3u * 6 * 120 * 120);
@@ -141,12 +148,10 @@ TEST(SceneBake, AlphaOnlyWhereSomeTexelIsNotOpaque) {
   for (auto mode : {scene::AlphaMode::kMask, scene::AlphaMode::kOpaque}) {
     scene::Material m;
     m.alpha_mode = mode;
-    scene::Scene s = test::single_mesh_scene(make_grid(1.0f, 1, 1), m);
-    s.materials[0].base_color_texture.image = test::add_image(s, dir.file("card.png"));
+    scene::Scene s = test::textured_scene(make_grid(1.0f, 1, 1), dir.file("card.png"), m);
     auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 64});
     ASSERT_TRUE(un.ok()) << un.status().message();
-    TransferOptions to;
-    to.width = uint32_t(un->stats.atlas_width), to.height = uint32_t(un->stats.atlas_height);
+    TransferOptions to = test::atlas_transfer_options(un->stats);
     auto t = transfer_materials(un->scene, to);
     ASSERT_TRUE(t.ok()) << t.status().message();
     ASSERT_EQ(t->layers.size(), 1u);
@@ -268,56 +273,31 @@ TEST(SceneBake, SupersamplingImprovesAccuracyMonotonically) {
     t[0] = t[1] = t[2] = float(s);
   };
   ASSERT_TRUE(write_texture(dir.file("stripes.exr"), 512, 512, 3, stripes).ok());
-  scene::Material m;
-  scene::Scene s = test::single_mesh_scene(make_grid(1.0f, 1, 1), m);
-  s.materials[0].base_color_texture.image = test::add_image(s, dir.file("stripes.exr"));
+  scene::Scene s = test::textured_scene(make_grid(1.0f, 1, 1), dir.file("stripes.exr"));
   auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 32});
   ASSERT_TRUE(un.ok());
-  const scene::Primitive& p = un->scene.meshes[0].primitives[0];
+  // Reference over texels whose square lies inside the quad's atlas footprint.
+  const std::vector<double> reference =
+      test::atlas_reference(un->scene.meshes[0].primitives[0], uint32_t(un->stats.atlas_width),
+                            uint32_t(un->stats.atlas_height), 32, [&](double u, double v) {
+                              float val[3];
+                              stripes(u, v, val);
+                              return double(val[0]);
+                            });
   double rmse[3];
   int k = 0;
   for (int ss : {1, 4, 16}) {
-    TransferOptions to;
-    to.width = uint32_t(un->stats.atlas_width), to.height = uint32_t(un->stats.atlas_height);
+    TransferOptions to = test::atlas_transfer_options(un->stats);
     to.supersample = ss;
     auto t = transfer_materials(un->scene, to);
     ASSERT_TRUE(t.ok()) << t.status().message();
     const auto& texels = t->layers[0].texels;
-    // Reference over texels whose square lies inside the quad's atlas footprint.
     double se = 0;
     uint64_t n = 0;
-    const auto& atlas = p.uvs.back();
-    for (uint32_t y = 0; y < to.height; ++y) {
-      for (uint32_t x = 0; x < to.width; ++x) {
-        double sum = 0;
-        bool all_in = true;
-        for (int j = 0; j < 32 && all_in; ++j) {
-          for (int i = 0; i < 32 && all_in; ++i) {
-            double px = (x + (i + 0.5) / 32) / to.width, py = (y + (j + 0.5) / 32) / to.height;
-            all_in = false;
-            for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
-              const auto &a = atlas[p.indices[f]], &b = atlas[p.indices[f + 1]],
-                         &c = atlas[p.indices[f + 2]];
-              double d = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-              double l1 = ((px - a[0]) * (c[1] - a[1]) - (py - a[1]) * (c[0] - a[0])) / d;
-              double l2 = ((b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0])) / d;
-              if (l1 < 0 || l2 < 0 || l1 + l2 > 1) continue;
-              const auto &ua = p.uvs[0][p.indices[f]], &ub = p.uvs[0][p.indices[f + 1]],
-                         &uc = p.uvs[0][p.indices[f + 2]];
-              double u = ua[0] + l1 * (ub[0] - ua[0]) + l2 * (uc[0] - ua[0]);
-              double v = ua[1] + l1 * (ub[1] - ua[1]) + l2 * (uc[1] - ua[1]);
-              float val[3];
-              stripes(u, v, val);
-              sum += val[0];
-              all_in = true;
-              break;
-            }
-          }
-        }
-        if (!all_in) continue;
-        double d = texels[(size_t(y) * to.width + x) * 3] - sum / 1024;
-        se += d * d, ++n;
-      }
+    for (size_t i = 0; i < reference.size(); ++i) {
+      if (std::isnan(reference[i])) continue;
+      double d = texels[i * 3] - reference[i];
+      se += d * d, ++n;
     }
     ASSERT_GT(n, 500u);
     rmse[k++] = std::sqrt(se / n);
@@ -331,15 +311,12 @@ TEST(SceneBake, SupersamplingImprovesAccuracyMonotonically) {
 TEST(SceneBake, SameTexelsWhateverTheThreadCount) {
   test::ScratchDir dir;
   ASSERT_TRUE(write_texture(dir.file("c.png"), 64, 64, 3, smooth_colour).ok());
-  scene::Material m;
-  scene::Scene s = test::single_mesh_scene(make_uv_sphere(1.0f, 24), m);
-  s.materials[0].base_color_texture.image = test::add_image(s, dir.file("c.png"));
+  scene::Scene s = test::textured_scene(make_uv_sphere(1.0f, 24), dir.file("c.png"));
   auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 40});
   ASSERT_TRUE(un.ok());
   std::vector<float> first;
   for (int threads : {1, 2, 3}) {
-    TransferOptions to;
-    to.width = uint32_t(un->stats.atlas_width), to.height = uint32_t(un->stats.atlas_height);
+    TransferOptions to = test::atlas_transfer_options(un->stats);
     to.threads = threads;
     to.supersample = 4;
     auto t = transfer_materials(un->scene, to);
@@ -354,13 +331,10 @@ TEST(SceneBake, SameTexelsWhateverTheThreadCount) {
 }
 
 TEST(SceneBake, MissingImageIsAnErrorNamingTheFile) {
-  scene::Material m;
-  scene::Scene s = test::single_mesh_scene(make_grid(1, 1, 1), m);
-  s.materials[0].base_color_texture.image = test::add_image(s, "/nonexistent/dir/albedo.png");
+  scene::Scene s = test::textured_scene(make_grid(1, 1, 1), "/nonexistent/dir/albedo.png");
   auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 16});
   ASSERT_TRUE(un.ok());
-  TransferOptions to;
-  to.width = uint32_t(un->stats.atlas_width), to.height = uint32_t(un->stats.atlas_height);
+  TransferOptions to = test::atlas_transfer_options(un->stats);
   auto t = transfer_materials(un->scene, to);
   ASSERT_FALSE(t.ok());
   EXPECT_NE(t.status().message().find("/nonexistent/dir/albedo.png"), std::string::npos)
@@ -408,12 +382,6 @@ TEST(SceneBake, SampleSceneBakesWithEveryLayer) {
   EXPECT_EQ(un->instances().size(), 7u);
 }
 
-}  // namespace
-}  // namespace vt
-
-namespace vt {
-namespace {
-
 TEST(SceneBake, FactorsTimesVertexColoursAreExact) {
   scene::Material m;
   m.base_color_factor = {0.5f, 1.0f, 1.0f, 1.0f};
@@ -424,8 +392,7 @@ TEST(SceneBake, FactorsTimesVertexColoursAreExact) {
   scene::Scene s = test::single_mesh_scene(p, m);
   auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 40});
   ASSERT_TRUE(un.ok());
-  TransferOptions to;
-  to.width = uint32_t(un->stats.atlas_width), to.height = uint32_t(un->stats.atlas_height);
+  TransferOptions to = test::atlas_transfer_options(un->stats);
   auto t = transfer_materials(un->scene, to);
   ASSERT_TRUE(t.ok()) << t.status().message();
   ASSERT_EQ(t->layers.size(), 2u);  // albedo (opaque) and emissive
@@ -453,22 +420,13 @@ TEST(SceneBake, FactorsTimesVertexColoursAreExact) {
   EXPECT_GT(rmax, 0.48f);
 }
 
-}  // namespace
-}  // namespace vt
-
-namespace vt {
-namespace {
-
 TEST(SceneBake, EmbeddedImagesGiveTheSameTexelsAsFiles) {
   test::ScratchDir dir;
   ASSERT_TRUE(write_texture(dir.file("e.png"), 64, 64, 3, smooth_colour).ok());
-  scene::Material m;
-  scene::Scene s = test::single_mesh_scene(make_grid(1.0f, 1, 1), m);
-  s.materials[0].base_color_texture.image = test::add_image(s, dir.file("e.png"));
+  scene::Scene s = test::textured_scene(make_grid(1.0f, 1, 1), dir.file("e.png"));
   auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 32});
   ASSERT_TRUE(un.ok());
-  TransferOptions to;
-  to.width = uint32_t(un->stats.atlas_width), to.height = uint32_t(un->stats.atlas_height);
+  TransferOptions to = test::atlas_transfer_options(un->stats);
   to.scratch_dir = dir.file("");
   auto from_file = transfer_materials(un->scene, to);
   ASSERT_TRUE(from_file.ok()) << from_file.status().message();
@@ -481,28 +439,16 @@ TEST(SceneBake, EmbeddedImagesGiveTheSameTexelsAsFiles) {
   ASSERT_TRUE(embedded.ok()) << embedded.status().message();
   EXPECT_TRUE(from_file->layers[0].texels == embedded->layers[0].texels);
   // The private copy is gone afterwards.
-  size_t left = 0;
-  for (const auto& e : std::filesystem::directory_iterator(dir.file("")))
-    left += e.path().filename().string().rfind("vtbake-transfer-", 0) == 0;
-  EXPECT_EQ(left, 0u);
+  EXPECT_EQ(transfer_copies_left(dir), 0u);
 }
-
-}  // namespace
-}  // namespace vt
-
-namespace vt {
-namespace {
 
 TEST(SceneBake, FilteredMipLevelsOptionIsUsedAndAgreesOnSmoothTextures) {
   test::ScratchDir dir;
   ASSERT_TRUE(write_texture(dir.file("m.png"), 64, 64, 3, smooth_colour).ok());
-  scene::Material m;
-  scene::Scene s = test::single_mesh_scene(make_grid(1.0f, 1, 1), m);
-  s.materials[0].base_color_texture.image = test::add_image(s, dir.file("m.png"));
+  scene::Scene s = test::textured_scene(make_grid(1.0f, 1, 1), dir.file("m.png"));
   auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 16});  // reads MIP level 2
   ASSERT_TRUE(un.ok());
-  TransferOptions to;
-  to.width = uint32_t(un->stats.atlas_width), to.height = uint32_t(un->stats.atlas_height);
+  TransferOptions to = test::atlas_transfer_options(un->stats);
   to.scratch_dir = dir.file("");
   auto box = transfer_materials(un->scene, to);
   to.mip_filter = "lanczos3";
@@ -517,10 +463,7 @@ TEST(SceneBake, FilteredMipLevelsOptionIsUsedAndAgreesOnSmoothTextures) {
   }
   EXPECT_GT(test::psnr(se, n), 35.0);
   EXPECT_FALSE(box->layers[0].texels == lanczos->layers[0].texels);  // the .tx was used
-  size_t left = 0;
-  for (const auto& e : std::filesystem::directory_iterator(dir.file("")))
-    left += e.path().filename().string().rfind("vtbake-transfer-", 0) == 0;
-  EXPECT_EQ(left, 0u);
+  EXPECT_EQ(transfer_copies_left(dir), 0u);
 }
 
 // The nested BuildOptions reach the build as `vtbake build` would set them, except what the
@@ -528,8 +471,7 @@ TEST(SceneBake, FilteredMipLevelsOptionIsUsedAndAgreesOnSmoothTextures) {
 TEST(SceneBake, NestedBuildOptionsReachTheBuild) {
   test::ScratchDir dir;
   ASSERT_TRUE(write_texture(dir.file("cube.png"), 64, 64, 3, smooth_colour).ok());
-  scene::Scene s = test::single_mesh_scene(make_box(1, 1, 1), scene::Material{});
-  s.materials[0].base_color_texture.image = test::add_image(s, dir.file("cube.png"));
+  scene::Scene s = test::textured_scene(make_box(1, 1, 1), dir.file("cube.png"));
   SceneBakeOptions o;
   EXPECT_EQ(o.build.memory_limit, uint64_t(8) << 30);  // the transfer's buffers count too
   o.build.output = dir.file("box.vtpf");

@@ -2,8 +2,6 @@
 // clear error naming the file.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <cmath>
 #include <filesystem>
 
@@ -12,19 +10,12 @@
 #include "format/page_file.h"
 #include "format/page_file_inspect.h"
 #include "tests/bake/bake_test_util.h"
+#include "tests/transfer/scratch_dir.h"
 
 namespace vt {
 namespace {
 
 namespace fs = std::filesystem;
-
-fs::path temp_dir() {
-  fs::path d =
-      fs::temp_directory_path() / ("vt_udim_tests_" + std::to_string(getpid()) + "_" +
-                                   testing::UnitTest::GetInstance()->current_test_info()->name());
-  fs::create_directories(d);
-  return d;
-}
 
 // An 8-bit tile whose texels depend on the tile number, so misplaced tiles are caught.
 std::vector<float> tile_texels(uint32_t w, uint32_t h, uint32_t ch, uint32_t udim) {
@@ -44,15 +35,15 @@ Status write_tile(const fs::path& path, uint32_t w, uint32_t h, uint32_t ch, uin
 }
 
 TEST(Udim, GridAssembledExactlyWithMissingTilesBlack) {
-  fs::path dir = temp_dir();
+  test::ScratchDir dir;
   const uint32_t tw = 20, th = 14;
   // u 0..2 on row v = 0, u 0 on row v = 1; (1, 1) and (2, 1) are missing. A decoy file with
   // another prefix must be ignored.
   for (uint32_t n : {1001u, 1002u, 1003u, 1011u})
-    ASSERT_TRUE(write_tile(dir / ("tex." + std::to_string(n) + ".png"), tw, th, 3, n).ok());
-  ASSERT_TRUE(write_tile(dir / "other.1004.png", tw, th, 3, 1004).ok());
+    ASSERT_TRUE(write_tile(dir.file("tex." + std::to_string(n) + ".png"), tw, th, 3, n).ok());
+  ASSERT_TRUE(write_tile(dir.file("other.1004.png"), tw, th, 3, 1004).ok());
 
-  auto src = open_udim_image((dir / "tex.<UDIM>.png").string());
+  auto src = open_udim_image(dir.file("tex.<UDIM>.png"));
   ASSERT_TRUE(src.ok()) << src.status().message();
   ASSERT_EQ((*src)->info().width, 3 * tw);
   ASSERT_EQ((*src)->info().height, 2 * th);
@@ -70,46 +61,30 @@ TEST(Udim, GridAssembledExactlyWithMissingTilesBlack) {
       test::layer_input(LayerSemantic::kAlbedo, std::shared_ptr<ImageSource>(std::move(*src))));
   o.payload = 24;  // pages straddle tile edges
   o.codec.codec = CodecKind::kRaw;
-  o.output = (dir / "grid.vtpf").string();
+  o.output = dir.file("grid.vtpf");
   auto sum = build_page_file(o);
   ASSERT_TRUE(sum.ok()) << sum.status().message();
 
-  auto reader = PageFileReader::open(o.output);
-  ASSERT_TRUE(reader.ok()) << reader.status().message();
-  auto level = extract_level(**reader, 0, 0);
-  ASSERT_TRUE(level.ok()) << level.status().message();
-  ASSERT_EQ(level->width, w);
-  ASSERT_EQ(level->height, h);
-  ASSERT_EQ(level->channels, 3u);
-  for (uint32_t gy = 0; gy < h; ++gy) {
-    for (uint32_t gx = 0; gx < w; ++gx) {
-      for (uint32_t c = 0; c < 3; ++c) {
-        ASSERT_EQ(level->texels[(size_t(gy) * w + gx) * 3 + c], expected(gx, gy, c))
-            << gx << "," << gy << " c" << c;
-      }
-    }
-  }
-  fs::remove_all(dir);
+  test::expect_level0_rgb(o.output, w, h, expected);
 }
 
 TEST(Udim, MismatchedOrMissingTilesAreClearErrors) {
-  fs::path dir = temp_dir();
-  ASSERT_TRUE(write_tile(dir / "t.1001.png", 16, 16, 3, 1001).ok());
-  ASSERT_TRUE(write_tile(dir / "t.1002.png", 16, 8, 3, 1002).ok());
-  auto src = open_udim_image((dir / "t.<UDIM>.png").string());
+  test::ScratchDir dir;
+  ASSERT_TRUE(write_tile(dir.file("t.1001.png"), 16, 16, 3, 1001).ok());
+  ASSERT_TRUE(write_tile(dir.file("t.1002.png"), 16, 8, 3, 1002).ok());
+  auto src = open_udim_image(dir.file("t.<UDIM>.png"));
   ASSERT_FALSE(src.ok());
   EXPECT_NE(src.status().message().find("t.1002.png"), std::string::npos) << src.status().message();
 
-  ASSERT_TRUE(write_tile(dir / "c.1001.png", 16, 16, 3, 1001).ok());
-  ASSERT_TRUE(write_tile(dir / "c.1002.png", 16, 16, 4, 1002).ok());
-  src = open_udim_image((dir / "c.<UDIM>.png").string());
+  ASSERT_TRUE(write_tile(dir.file("c.1001.png"), 16, 16, 3, 1001).ok());
+  ASSERT_TRUE(write_tile(dir.file("c.1002.png"), 16, 16, 4, 1002).ok());
+  src = open_udim_image(dir.file("c.<UDIM>.png"));
   ASSERT_FALSE(src.ok());
   EXPECT_NE(src.status().message().find("c.1002.png"), std::string::npos);
 
-  src = open_udim_image((dir / "none.<UDIM>.png").string());
+  src = open_udim_image(dir.file("none.<UDIM>.png"));
   ASSERT_FALSE(src.ok());
   EXPECT_NE(src.status().message().find("none.<UDIM>.png"), std::string::npos);
-  fs::remove_all(dir);
 }
 
 }  // namespace

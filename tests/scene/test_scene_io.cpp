@@ -22,21 +22,36 @@ void write_text(const std::string& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
 }
 
+// Writes `text` to the temporary file `name` and loads it.
+Expected<scene::Scene> write_and_load(const std::string& name, const std::string& text) {
+  write_text(temp(name), text);
+  return scene::load_scene(temp(name));
+}
+
 void write_bytes(const std::string& path, const void* data, size_t size) {
   std::ofstream(path, std::ios::binary)
       .write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
+}
+
+// A PLY header: `vertices` float x, y, z vertices, then one list element ("face 2",
+// "tristrips 1") of vertex_indices lists with `list_types` ("uchar int": count, index).
+std::string ply_header(const std::string& format, int vertices, const std::string& list_element,
+                       const std::string& list_types) {
+  return "ply\nformat " + format + " 1.0\nelement vertex " + std::to_string(vertices) +
+         "\nproperty float x\nproperty float y\nproperty float z\nelement " + list_element +
+         "\nproperty list " + list_types + " vertex_indices\nend_header\n";
 }
 
 TEST(SceneIo, ObjWithMtlQuadsNegativeIndicesAndMaterials) {
   write_text(
       temp("a.mtl"),
       "newmtl red\nKd 1 0 0\nmap_Kd -bm 1 tex/red.png\nnewmtl glass\nKd 0.5 0.5 0.5\nd 0.25\n");
-  write_text(temp("a.obj"),
-             "# quad and triangle\nmtllib vt_unwrap_io_a.mtl\n"
-             "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
-             "usemtl red\nf 1/1/1 2/2/1 3/3/1 4/4/1\n"
-             "usemtl glass\nf -4/-4/-1 -2/-2/-1 -1/-1/-1\n");
-  auto s = scene::load_scene(temp("a.obj"));
+  auto s = write_and_load(
+      "a.obj",
+      "# quad and triangle\nmtllib vt_unwrap_io_a.mtl\n"
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
+      "usemtl red\nf 1/1/1 2/2/1 3/3/1 4/4/1\n"
+      "usemtl glass\nf -4/-4/-1 -2/-2/-1 -1/-1/-1\n");
   ASSERT_TRUE(s.ok()) << s.status().message();
   ASSERT_EQ(s->materials.size(), 2u);
   EXPECT_EQ(s->materials[0].name, "red");
@@ -61,8 +76,7 @@ TEST(SceneIo, ObjWithMtlQuadsNegativeIndicesAndMaterials) {
 }
 
 TEST(SceneIo, ObjErrorsNameFileAndLine) {
-  write_text(temp("bad.obj"), "v 0 0 0\nv 1 0 0\nf 1 2 7\n");
-  auto s = scene::load_scene(temp("bad.obj"));
+  auto s = write_and_load("bad.obj", "v 0 0 0\nv 1 0 0\nf 1 2 7\n");
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.status().message().find("bad.obj:3"), std::string::npos) << s.status().message();
   auto missing = scene::load_scene(temp("does_not_exist.obj"));
@@ -73,30 +87,22 @@ TEST(SceneIo, ObjErrorsNameFileAndLine) {
 }
 
 TEST(SceneIo, PlyAsciiAndBinary) {
-  write_text(temp("a.ply"),
-             "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float "
-             "y\nproperty float z\n"
-             "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
-             "0 0 0\n1 0 0\n1 1 0\n0 1 0.5\n3 0 1 2\n3 0 2 3\n");
-  auto a = scene::load_scene(temp("a.ply"));
+  auto a = write_and_load("a.ply", ply_header("ascii", 4, "face 2", "uchar int") +
+                                       "0 0 0\n1 0 0\n1 1 0\n0 1 0.5\n3 0 1 2\n3 0 2 3\n");
   ASSERT_TRUE(a.ok()) << a.status().message();
   const auto& pa = a->meshes[0].primitives[0];
   ASSERT_EQ(pa.triangle_count(), 2u);
   ASSERT_EQ(pa.positions.size(), 4u);
   EXPECT_FLOAT_EQ(pa.positions[pa.indices[5]][2], 0.5f);
 
-  std::string header =
-      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
-  std::string body = header;
+  std::string body = ply_header("binary_little_endian", 3, "face 1", "uchar int");
   float v[9] = {0, 0, 0, 2, 0, 0, 0, 3, 0};
   body.append(reinterpret_cast<const char*>(v), sizeof(v));
   unsigned char count = 3;
   int idx[3] = {0, 1, 2};
   body.push_back(static_cast<char>(count));
   body.append(reinterpret_cast<const char*>(idx), sizeof(idx));
-  write_text(temp("b.ply"), body);
-  auto b = scene::load_scene(temp("b.ply"));
+  auto b = write_and_load("b.ply", body);
   ASSERT_TRUE(b.ok()) << b.status().message();
   const auto& pb = b->meshes[0].primitives[0];
   ASSERT_EQ(pb.triangle_count(), 1u);
@@ -104,9 +110,8 @@ TEST(SceneIo, PlyAsciiAndBinary) {
   for (const auto& p : pb.positions) ys = std::max(ys, p[1]);
   EXPECT_FLOAT_EQ(ys, 3.0f);
 
-  write_text(temp("c.ply"),
-             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n");
-  auto c = scene::load_scene(temp("c.ply"));
+  auto c = write_and_load(
+      "c.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n");
   ASSERT_FALSE(c.ok());
   EXPECT_NE(c.status().message().find("c.ply"), std::string::npos);
 }
@@ -114,12 +119,9 @@ TEST(SceneIo, PlyAsciiAndBinary) {
 TEST(SceneIo, PlyTristripsWithRestart) {
   // Draco's reader has no tristrips element; the fallback reader turns strips into triangles
   // with alternating winding, restarting at -1.
-  write_text(temp("s.ply"),
-             "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float "
-             "y\nproperty float z\n"
-             "element tristrips 1\nproperty list int int vertex_indices\nend_header\n"
-             "0 0 0\n1 0 0\n0 1 0\n1 1 0\n5 0 0\n6 0 0\n8 0 1 2 3 -1 4 5 2\n");
-  auto s = scene::load_scene(temp("s.ply"));
+  auto s =
+      write_and_load("s.ply", ply_header("ascii", 6, "tristrips 1", "int int") +
+                                  "0 0 0\n1 0 0\n0 1 0\n1 1 0\n5 0 0\n6 0 0\n8 0 1 2 3 -1 4 5 2\n");
   ASSERT_TRUE(s.ok()) << s.status().message();
   const auto& p = s->meshes[0].primitives[0];
   EXPECT_EQ(p.indices, (std::vector<uint32_t>{0, 1, 2, 2, 1, 3, 4, 5, 2}));
@@ -131,13 +133,56 @@ TEST(SceneIo, PlyTristripsWithRestart) {
     EXPECT_GT((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]), 0) << t;
   }
   // A truncated strip list is an error naming the file.
-  write_text(temp("s2.ply"),
-             "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty "
-             "float y\nproperty float z\n"
-             "element tristrips 1\nproperty list int int vertex_indices\nend_header\n\x01\x02");
-  auto bad = scene::load_scene(temp("s2.ply"));
+  auto bad = write_and_load(
+      "s2.ply", ply_header("binary_little_endian", 1, "tristrips 1", "int int") + "\x01\x02");
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.status().message().find("s2.ply"), std::string::npos);
+}
+
+// Every PLY scalar type under both its names, big endian: tristrips send the file to the
+// fallback reader, which must read (or skip) each property at its own size.
+TEST(SceneIo, PlyFallbackReadsEveryScalarTypeBigEndian) {
+  std::string body =
+      "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty double x\n"
+      "property int16 y\nproperty float32 z\nproperty uchar a\nproperty int8 b\n"
+      "property ushort c\nproperty uint32 d\nproperty float64 e\n"
+      "element tristrips 1\nproperty list uint8 int vertex_indices\nend_header\n";
+  auto put = [&](const void* v, size_t n) {  // big endian
+    const char* b = static_cast<const char*>(v);
+    for (size_t i = n; i-- > 0;) body.push_back(b[i]);
+  };
+  const double xs[3] = {0.5, 2.25, -1.0};
+  const int16_t ys[3] = {-3, 7, 300};
+  const float zs[3] = {1.5f, -2.0f, 4.0f};
+  for (int k = 0; k < 3; ++k) {
+    const uint8_t a = 200;
+    const int8_t b = -5;
+    const uint16_t c = 60000;
+    const uint32_t d = 4000000000u;
+    const double e = 1e300;
+    put(&xs[k], 8), put(&ys[k], 2), put(&zs[k], 4), put(&a, 1), put(&b, 1), put(&c, 2), put(&d, 4),
+        put(&e, 8);
+  }
+  const uint8_t count = 3;
+  const int32_t strip[3] = {0, 1, 2};
+  put(&count, 1);
+  for (int32_t i : strip) put(&i, 4);
+  auto s = write_and_load("types.ply", body);
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  const auto& p = s->meshes[0].primitives[0];
+  ASSERT_EQ(p.positions.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(p.positions[k][0], float(xs[k])) << k;
+    EXPECT_EQ(p.positions[k][1], float(ys[k])) << k;
+    EXPECT_EQ(p.positions[k][2], zs[k]) << k;
+  }
+  EXPECT_EQ(p.indices, (std::vector<uint32_t>{0, 1, 2}));
+  // An unknown type is no size at all: the data cannot be read.
+  auto bad = write_and_load(
+      "types2.ply",
+      "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty quad x\n"
+      "element tristrips 0\nproperty list uchar int vertex_indices\nend_header\n0123456789abcdef");
+  EXPECT_FALSE(bad.ok());
 }
 
 // A glTF with an external .bin: two nodes (TRS parent, child with a matrix) instancing one
@@ -182,8 +227,7 @@ TEST(SceneIo, GltfWithExternalBufferNodesAndMaterials) {
               {"name": "child", "matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,5,1], "mesh": 0}],
     "scenes": [{"nodes": [0]}], "scene": 0
   })"_json;
-  write_text(temp("g.gltf"), doc.dump());
-  auto s = scene::load_scene(temp("g.gltf"));
+  auto s = write_and_load("g.gltf", doc.dump());
   ASSERT_TRUE(s.ok()) << s.status().message();
   ASSERT_EQ(s->meshes.size(), 1u);
   const auto& p = s->meshes[0].primitives[0];
@@ -206,8 +250,7 @@ TEST(SceneIo, GltfWithExternalBufferNodesAndMaterials) {
 
   // Out-of-bounds accessor: a clear error naming the file.
   doc["accessors"][0]["count"] = 1000;
-  write_text(temp("h.gltf"), doc.dump());
-  auto bad = scene::load_scene(temp("h.gltf"));
+  auto bad = write_and_load("h.gltf", doc.dump());
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.status().message().find("h.gltf"), std::string::npos);
   EXPECT_NE(bad.status().message().find("accessor 0"), std::string::npos) << bad.status().message();
@@ -257,8 +300,7 @@ TEST(SceneIo, GlbRoundTripThroughExporter) {
   std::ifstream in(path, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   for (size_t cut : {size_t{10}, size_t{30}, bytes.size() / 2, bytes.size() - 4}) {
-    write_text(temp("t.glb"), bytes.substr(0, cut));
-    auto t = scene::load_scene(temp("t.glb"));
+    auto t = write_and_load("t.glb", bytes.substr(0, cut));
     ASSERT_FALSE(t.ok()) << cut;
     EXPECT_NE(t.status().message().find("t.glb"), std::string::npos) << t.status().message();
   }
@@ -338,8 +380,7 @@ TEST(SceneIo, DracoFileAndKhrDracoPrimitive) {
                 {"attributes", {{"POSITION", pos_id}, {"TEXCOORD_0", uv_id}}}}}}}}}}}}},
       {"nodes", {{{"mesh", 0}}}},
       {"scenes", {{{"nodes", {0}}}}}};
-  write_text(temp("k.gltf"), doc.dump());
-  auto k = scene::load_scene(temp("k.gltf"));
+  auto k = write_and_load("k.gltf", doc.dump());
   ASSERT_TRUE(k.ok()) << k.status().message();
   const auto& q = k->meshes[0].primitives[0];
   EXPECT_EQ(q.triangle_count(), 2u);

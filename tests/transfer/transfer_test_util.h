@@ -1,9 +1,8 @@
-// Helpers for the transfer tests: scratch folders, procedural textured scenes, level-0 read-back
+// Helpers for the transfer tests: procedural textured scenes, level-0 read-back
 // from page files and resampling through the atlas UVs.
 #pragma once
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -13,33 +12,16 @@
 #include <string>
 #include <vector>
 
+#include "bake/transfer.h"
+#include "bake/unwrap/unwrap.h"
+#include "format/page_file.h"
 #include "samples/sample_scene.h"
 #include "scene/scene.h"
-#include "format/page_file.h"
+#include "tests/transfer/scratch_dir.h"
 
 namespace vt::test {
 
 constexpr double kPi = 3.14159265358979323846;
-
-// A folder removed when the test ends.
-class ScratchDir {
- public:
-  ScratchDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = std::filesystem::temp_directory_path() /
-            ("vt_transfer_" + std::to_string(getpid()) + "_" + info->name());
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
-  }
-  ~ScratchDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  std::filesystem::path path_;
-};
 
 // One-mesh scene at the origin with a material of its own.
 inline scene::Scene single_mesh_scene(scene::Primitive prim, scene::Material mat) {
@@ -65,6 +47,21 @@ inline int add_image(scene::Scene& s, const std::string& path) {
   im.uri = std::filesystem::path(path).filename().string();
   s.images.push_back(im);
   return int(s.images.size() - 1);
+}
+
+// single_mesh_scene whose material takes its base colour from the image at `path`.
+inline scene::Scene textured_scene(scene::Primitive prim, const std::string& path,
+                                   scene::Material mat = {}) {
+  scene::Scene s = single_mesh_scene(std::move(prim), std::move(mat));
+  s.materials[0].base_color_texture.image = add_image(s, path);
+  return s;
+}
+
+// Transfer options at the unwrapped atlas's size, the others at their defaults.
+inline TransferOptions atlas_transfer_options(const unwrap::UnwrapStats& stats) {
+  TransferOptions o;
+  o.width = uint32_t(stats.atlas_width), o.height = uint32_t(stats.atlas_height);
+  return o;
 }
 
 // Level 0 of one layer as floats in [0, 1] (8-bit) or as stored (float), payload texels only;

@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <random>
 
-#include "scene/scene.h"
 #include "bake/unwrap/unwrap.h"
+#include "scene/scene.h"
 
 namespace vt::test {
 
@@ -79,6 +79,14 @@ inline Scene scene_of(Primitive p, std::string name = "test") {
   std::vector<Primitive> v;
   v.push_back(std::move(p));
   return scene_of(std::move(v), std::move(name));
+}
+
+// The tests' unwrap options: a small atlas target and two threads.
+inline unwrap::UnwrapOptions small_options(int size_pages = 4) {
+  unwrap::UnwrapOptions o;
+  o.size_pages = size_pages;
+  o.threads = 2;
+  return o;
 }
 
 // Every output triangle keeps its source corners' positions; the new UV set is last, finite

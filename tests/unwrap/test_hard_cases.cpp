@@ -9,14 +9,8 @@
 namespace vt::test {
 namespace {
 
-unwrap::UnwrapOptions options() {
-  unwrap::UnwrapOptions o;
-  o.size_pages = 4;
-  o.threads = 2;
-  return o;
-}
-
-void expect_unwraps(const Scene& s, unwrap::UnwrapOptions o = options(), int padding_check = 4) {
+void expect_unwraps(const Scene& s, unwrap::UnwrapOptions o = small_options(),
+                    int padding_check = 4) {
   auto r = unwrap::unwrap_scene(s, o);
   ASSERT_TRUE(r.ok()) << r.status().message();
   expect_valid(s, *r, padding_check);
@@ -34,7 +28,7 @@ TEST(HardCases, DegenerateTriangles) {
   p.positions.push_back({5, 5, 5});
   p.indices.insert(p.indices.end(), {n, n + 1, n + 2, 0, 0, 1, n + 3, n + 4, n + 5});
   Scene s = scene_of(p);
-  auto r = unwrap::unwrap_scene(s, options());
+  auto r = unwrap::unwrap_scene(s, small_options());
   ASSERT_TRUE(r.ok()) << r.status().message();
   expect_valid(s, *r, 4);
   EXPECT_EQ(r->stats.degenerate_faces, 3);
@@ -66,7 +60,7 @@ TEST(HardCases, SliverThinnerThanFloatUvPrecision) {
   p.positions = {{0, 0, 0}, {1000, 0, 0}, {500, 1e-5f, 0}, {0, 0, 5}, {1, 0, 5}, {0, 1, 5}};
   p.indices = {0, 1, 2, 3, 4, 5};
   Scene s = scene_of(p);
-  auto r = unwrap::unwrap_scene(s, options());
+  auto r = unwrap::unwrap_scene(s, small_options());
   ASSERT_TRUE(r.ok()) << r.status().message();
   expect_valid(s, *r, 4);
   EXPECT_EQ(r->stats.degenerate_faces, 0);
@@ -80,8 +74,8 @@ TEST(HardCases, DuplicateVerticesWeld) {
     soup.indices.push_back(static_cast<uint32_t>(soup.positions.size()));
     soup.positions.push_back(indexed.positions[i]);
   }
-  auto a = unwrap::unwrap_scene(scene_of(indexed), options());
-  auto b = unwrap::unwrap_scene(scene_of(soup), options());
+  auto a = unwrap::unwrap_scene(scene_of(indexed), small_options());
+  auto b = unwrap::unwrap_scene(scene_of(soup), small_options());
   ASSERT_TRUE(a.ok() && b.ok());
   expect_valid(scene_of(soup), *b, 4);
   EXPECT_EQ(a->stats.charts, b->stats.charts);
@@ -114,9 +108,7 @@ TEST(HardCases, TenThousandComponents) {
     p.indices.insert(p.indices.end(), {b, b + 1, b + 2});
   }
   Scene s = scene_of(p);
-  auto o = options();
-  o.size_pages = 8;
-  auto r = unwrap::unwrap_scene(s, o);
+  auto r = unwrap::unwrap_scene(s, small_options(8));
   ASSERT_TRUE(r.ok()) << r.status().message();
   expect_valid(s, *r, 0);
   EXPECT_EQ(r->stats.charts, 10000);
@@ -145,7 +137,7 @@ TEST(HardCases, HighGenusPlateWithHoles) {
                      full.indices.begin() + 3 * t + 3);
   }
   Scene s = scene_of(p);
-  auto r = unwrap::unwrap_scene(s, options());
+  auto r = unwrap::unwrap_scene(s, small_options());
   ASSERT_TRUE(r.ok());
   expect_valid(s, *r, 4);
   EXPECT_GT(r->stats.charts, 1);
@@ -164,7 +156,7 @@ TEST(HardCases, LargeOffsetAndTinyScale) {
   Scene offset = scene_of(p);
   offset.nodes[0].local[12] = 1e7;
   offset.nodes[0].local[13] = -1e7;
-  auto a = unwrap::unwrap_scene(offset, options());
+  auto a = unwrap::unwrap_scene(offset, small_options());
   ASSERT_TRUE(a.ok());
   expect_valid(offset, *a, 4);
   // Offset stored in the float positions themselves (a 1e4-sized mesh at 1e7).
@@ -173,12 +165,12 @@ TEST(HardCases, LargeOffsetAndTinyScale) {
   expect_unwraps(scene_of(q));
   // Scaled by 1e-6.
   Primitive tiny = sphere(24, 12, 1e-6);
-  auto c = unwrap::unwrap_scene(scene_of(tiny), options());
+  auto c = unwrap::unwrap_scene(scene_of(tiny), small_options());
   ASSERT_TRUE(c.ok());
   expect_valid(scene_of(tiny), *c, 4);
   EXPECT_EQ(c->stats.degenerate_faces, 0);
   // Same charts and stretch as the unit sphere: the result does not depend on scale.
-  auto unit = unwrap::unwrap_scene(scene_of(p), options());
+  auto unit = unwrap::unwrap_scene(scene_of(p), small_options());
   ASSERT_TRUE(unit.ok());
   EXPECT_EQ(unit->stats.charts, c->stats.charts);
   EXPECT_NEAR(unit->stats.stretch_l2, c->stats.stretch_l2, 1e-3);
@@ -189,7 +181,7 @@ TEST(HardCases, NonFinitePositionsAreAClearError) {
   for (float bad : {std::nanf(""), std::numeric_limits<float>::infinity()}) {
     Primitive p = flat_grid(2, 2);
     p.positions[4][1] = bad;
-    auto r = unwrap::unwrap_scene(scene_of(p, "Body"), options());
+    auto r = unwrap::unwrap_scene(scene_of(p, "Body"), small_options());
     ASSERT_FALSE(r.ok());
     EXPECT_NE(r.status().message().find("'Body'"), std::string::npos) << r.status().message();
     EXPECT_NE(r.status().message().find("vertex 4"), std::string::npos) << r.status().message();
@@ -198,7 +190,7 @@ TEST(HardCases, NonFinitePositionsAreAClearError) {
 
 TEST(HardCases, EmptyMeshAndOneTriangle) {
   Primitive empty;
-  auto r = unwrap::unwrap_scene(scene_of(empty), options());
+  auto r = unwrap::unwrap_scene(scene_of(empty), small_options());
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), ErrorCode::kInvalidArgument);
   EXPECT_NE(r.status().message().find("no triangles"), std::string::npos);
@@ -208,7 +200,7 @@ TEST(HardCases, EmptyMeshAndOneTriangle) {
   one.indices = {0, 1, 2};
   std::vector<Primitive> both = {empty, one};
   Scene s = scene_of(both);
-  auto r2 = unwrap::unwrap_scene(s, options());
+  auto r2 = unwrap::unwrap_scene(s, small_options());
   ASSERT_TRUE(r2.ok()) << r2.status().message();
   EXPECT_EQ(r2->stats.faces, 1);
   EXPECT_EQ(r2->stats.charts, 1);
@@ -219,7 +211,7 @@ TEST(HardCases, EmptyMeshAndOneTriangle) {
 TEST(HardCases, BadIndicesAreAClearError) {
   Primitive p = flat_grid(1, 1);
   p.indices[2] = 99;
-  auto r = unwrap::unwrap_scene(scene_of(p, "Broken"), options());
+  auto r = unwrap::unwrap_scene(scene_of(p, "Broken"), small_options());
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.status().message().find("uses vertex 99"), std::string::npos) << r.status().message();
 }
@@ -233,9 +225,7 @@ TEST(HardCases, BigMesh200k) {
   }
   ASSERT_GT(p.triangle_count(), 195000u);
   Scene s = scene_of(p);
-  auto o = options();
-  o.size_pages = 16;
-  auto r = unwrap::unwrap_scene(s, o);
+  auto r = unwrap::unwrap_scene(s, small_options(16));
   ASSERT_TRUE(r.ok()) << r.status().message();
   expect_valid(s, *r, 0);
   EXPECT_LT(r->stats.stretch_l2, 1.05);

@@ -25,16 +25,28 @@ PackChart random_chart(std::mt19937& rng) {
     c.points.push_back({r * stretch * std::cos(a) * jitter(rng), r * std::sin(a) * jitter(rng)});
   }
   for (int k = 0; k < n; ++k) c.tris.push_back({0, uint32_t(1 + k), uint32_t(1 + (k + 1) % n)});
-  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
-  for (const P2& p : c.points)
-    for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  const auto [lo, hi] = bounds_of(c.points);
   const double m = 2 * kFootprintMargin;
-  c.width = std::max(1.0, std::ceil(hi[0] - lo[0] + 2 * m));
-  c.height = std::max(1.0, std::ceil(hi[1] - lo[1] + 2 * m));
-  for (P2& p : c.points)
-    p = {p[0] - lo[0] + (c.width - (hi[0] - lo[0])) / 2,
-         p[1] - lo[1] + (c.height - (hi[1] - lo[1])) / 2};
+  c.width = std::max(1.0, std::ceil(hi.x - lo.x + 2 * m));
+  c.height = std::max(1.0, std::ceil(hi.y - lo.y + 2 * m));
+  for (Vec2d& p : c.points)
+    p = {p.x - lo.x + (c.width - (hi.x - lo.x)) / 2, p.y - lo.y + (c.height - (hi.y - lo.y)) / 2};
   return c;
+}
+
+TEST(Bounds, HoldEveryPointAndAreInvertedWhenEmpty) {
+  const auto [lo, hi] = bounds_of(std::vector<Vec2d>{{1, -2}, {-3, 4}, {0.5, 0}});
+  EXPECT_EQ(lo.x, -3);
+  EXPECT_EQ(lo.y, -2);
+  EXPECT_EQ(hi.x, 1);
+  EXPECT_EQ(hi.y, 4);
+  const auto b = bounds_of(std::vector<Vec3d>{{1, 2, 3}, {-1, 5, -7}});
+  EXPECT_EQ(b.lo.z, -7);
+  EXPECT_EQ(b.hi.z, 3);
+  EXPECT_EQ(b.lo.x, -1);
+  EXPECT_EQ(b.hi.y, 5);
+  const auto none = bounds_of(std::vector<Vec2d>{});
+  EXPECT_GT(none.lo.x, none.hi.x);
 }
 
 // Owner chart of every texel the placed charts touch with `margin`; counts texels two charts
@@ -49,10 +61,10 @@ Layout measure(const std::vector<PackChart>& charts, const PackResult& r, int wi
   Layout out;
   for (size_t c = 0; c < charts.size(); ++c) {
     for (const auto& t : charts[c].tris) {
-      P2 a = place_point(charts[c], r.placements[c], charts[c].points[t[0]]);
-      P2 b = place_point(charts[c], r.placements[c], charts[c].points[t[1]]);
-      P2 d = place_point(charts[c], r.placements[c], charts[c].points[t[2]]);
-      RasterTriangle tri({a[0], a[1], b[0], b[1], d[0], d[1]});
+      Vec2d a = place_point(charts[c], r.placements[c], charts[c].points[t[0]]);
+      Vec2d b = place_point(charts[c], r.placements[c], charts[c].points[t[1]]);
+      Vec2d d = place_point(charts[c], r.placements[c], charts[c].points[t[2]]);
+      RasterTriangle tri({a.x, a.y, b.x, b.y, d.x, d.y});
       TexelRect all = tri.bounds(margin);
       if (all.x0 < 0 || all.y0 < 0 || all.x1 >= width) ++out.outside;
       for_each_touched_texel(tri, margin, {0, 0, width - 1, height - 1}, [&](int64_t x, int64_t y) {

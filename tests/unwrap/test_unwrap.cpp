@@ -9,13 +9,6 @@
 namespace vt::test {
 namespace {
 
-unwrap::UnwrapOptions small_options() {
-  unwrap::UnwrapOptions o;
-  o.size_pages = 4;
-  o.threads = 2;
-  return o;
-}
-
 TEST(Unwrap, FlatGridIsOneIsometricChart) {
   Scene s = scene_of(flat_grid(20, 10, 2.0, 1.0));
   auto r = unwrap::unwrap_scene(s, small_options());
