@@ -10,9 +10,10 @@
 #include <cmath>
 #include <filesystem>
 
-#include "samples/sample_scene.h"
 #include "bake/transfer.h"
 #include "bake/unwrap/unwrap.h"
+#include "samples/sample_scene.h"
+#include "tests/transfer/atlas_reference.h"
 
 namespace {
 
@@ -58,36 +59,8 @@ Fixture& fixture() {
     uo.texels_per_unit = 64;
     f.unwrapped = std::move(vt::unwrap::unwrap_scene(s, uo)).value();
     const auto& p = f.unwrapped.scene.meshes[0].primitives[0];
-    const auto& atlas = p.uvs.back();
     uint32_t W = f.unwrapped.stats.atlas_width, H = f.unwrapped.stats.atlas_height;
-    f.reference.assign(size_t(W) * H, NAN);
-    for (uint32_t y = 0; y < H; ++y) {
-      for (uint32_t x = 0; x < W; ++x) {
-        double sum = 0;
-        bool all_in = true;
-        for (int j = 0; j < 16 && all_in; ++j) {
-          for (int i = 0; i < 16 && all_in; ++i) {
-            double px = (x + (i + 0.5) / 16) / W, py = (y + (j + 0.5) / 16) / H;
-            all_in = false;
-            for (size_t t = 0; t + 2 < p.indices.size(); t += 3) {
-              const auto &a = atlas[p.indices[t]], &b = atlas[p.indices[t + 1]],
-                         &c = atlas[p.indices[t + 2]];
-              double d = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-              double l1 = ((px - a[0]) * (c[1] - a[1]) - (py - a[1]) * (c[0] - a[0])) / d;
-              double l2 = ((b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0])) / d;
-              if (l1 < 0 || l2 < 0 || l1 + l2 > 1) continue;
-              const auto &ua = p.uvs[0][p.indices[t]], &ub = p.uvs[0][p.indices[t + 1]],
-                         &uc = p.uvs[0][p.indices[t + 2]];
-              sum += stripes(ua[0] + l1 * (ub[0] - ua[0]) + l2 * (uc[0] - ua[0]),
-                             ua[1] + l1 * (ub[1] - ua[1]) + l2 * (uc[1] - ua[1]));
-              all_in = true;
-              break;
-            }
-          }
-        }
-        if (all_in) f.reference[size_t(y) * W + x] = sum / 256;
-      }
-    }
+    f.reference = vt::test::atlas_reference(p, W, H, 16, stripes);
     return f;
   }();
   return f;
