@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "scene/scene.h"
 #include "common/status.h"
 #include "format/page_file.h"
+#include "scene/scene.h"
 
 namespace vt {
 
