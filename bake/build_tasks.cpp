@@ -20,15 +20,16 @@ std::vector<BuildTask> make_build_tasks(const BuildPlan& plan) {
     std::vector<uint32_t> previous;  // band tasks of the level before, by row
     for (uint32_t l = 0; l < g.level_count(); ++l) {
       std::vector<uint32_t> bands;
+      const bool needs_whole = level_needs_whole(plan, li, l);
       uint32_t whole = 0;
-      if (level_needs_whole(plan, li, l)) {
+      if (needs_whole) {
         whole = uint32_t(tasks.size());
         tasks.push_back({BuildTask::Kind::kLevel, li, l, 0, previous});
       }
       const int64_t h = g.level_height(l);
       for (uint32_t r = 0; r < g.pages_y(l); ++r) {
         BuildTask t{BuildTask::Kind::kBand, li, l, r, {}};
-        if (l > 0 && level_needs_whole(plan, li, l)) {
+        if (needs_whole) {
           t.deps = {whole};
         } else if (l > 0) {
           // The rows this band reads, addressed as the row window reads them, and the bands

@@ -16,27 +16,45 @@ namespace {
 
 constexpr float kFloatMax = std::numeric_limits<float>::max();
 
+// What converting a layer's source rows needs, copied out of its LayerPlan: a streamed level 0
+// lives as long as the plan that owns it, and must not point into that plan's storage.
+struct Conversion {
+  explicit Conversion(const LayerPlan& p)
+      : source_channels(p.source_channels),
+        work_channels(p.work_channels),
+        alpha(p.alpha),
+        normal(p.normal),
+        decode_unorm_normal(p.decode_unorm_normal),
+        colour(p.colour),
+        to_linear(p.to_linear) {}
+  uint32_t source_channels, work_channels;
+  int alpha;
+  bool normal, decode_unorm_normal, colour;
+  std::shared_ptr<const ColorConverter> to_linear;
+};
+
 // Source rows to the layer's working form: non-finite values fixed by policy (and counted once
 // per texel), colour converted to linear, alpha premultiplied, normals decoded and renormalised.
 class Level0Converter {
  public:
   Level0Converter(const LayerPlan& plan, uint32_t width, uint32_t height, NonFinitePolicy policy,
                   int threads)
-      : plan_(plan), width_(width), policy_(policy), threads_(threads), counted_(height, false) {}
+      : conv_(plan), width_(width), policy_(policy), threads_(threads), counted_(height, false) {}
 
   const NonFiniteReport& report() const { return report_; }
+  const Conversion& conversion() const { return conv_; }
 
   // Counts and reports bad values of source row y once, in raster order; with kError the first
   // bad texel seen fails the read.
   Status scan_row(uint32_t y, const float* row) {
     if (counted_[y]) return Status::Ok();
     counted_[y] = true;
-    const uint32_t sc = plan_.source_channels;
+    const uint32_t sc = conv_.source_channels;
     for (uint32_t x = 0; x < width_; ++x) {
       for (uint32_t c = 0; c < sc; ++c) {
         const float v = row[size_t(x) * sc + c];
         const bool bad_nf = !std::isfinite(v);
-        const bool bad_neg = !bad_nf && plan_.colour && v < 0;
+        const bool bad_neg = !bad_nf && conv_.colour && v < 0;
         if (!bad_nf && !bad_neg) continue;
         const bool first =
             !report_.any() || y < report_.first_y || (y == report_.first_y && x < report_.first_x);
@@ -62,8 +80,8 @@ class Level0Converter {
   // Converts `rows` source rows into working rows, on all threads. `src` may equal `dst` when
   // the source and working channel counts are the same (each texel is read before written).
   void convert(const float* src, float* dst, uint32_t rows) const {
-    const size_t in_row = size_t(width_) * plan_.source_channels;
-    const size_t out_row = size_t(width_) * plan_.work_channels;
+    const size_t in_row = size_t(width_) * conv_.source_channels;
+    const size_t out_row = size_t(width_) * conv_.work_channels;
     parallel_for(rows, threads_,
                  [&](size_t k) { convert_row(src + k * in_row, dst + k * out_row); });
   }
@@ -80,16 +98,16 @@ class Level0Converter {
   }
 
   void convert_row(const float* src, float* dst) const {
-    const uint32_t w = width_, sc = plan_.source_channels, wc = plan_.work_channels;
-    const bool colour = plan_.colour;
+    const uint32_t w = width_, sc = conv_.source_channels, wc = conv_.work_channels;
+    const bool colour = conv_.colour;
     for (uint32_t x = 0; x < w; ++x) {
       const float* s = src + size_t(x) * sc;
       float* d = dst + size_t(x) * wc;
-      if (plan_.normal) {
+      if (conv_.normal) {
         double n[3];
         for (int c = 0; c < 3; ++c) {
           double v = c < int(sc) ? fix(s[c], false) : 0.0;
-          n[c] = plan_.decode_unorm_normal ? v * 2.0 - 1.0 : v;
+          n[c] = conv_.decode_unorm_normal ? v * 2.0 - 1.0 : v;
         }
         if (sc == 2) n[2] = std::sqrt(std::max(0.0, 1.0 - n[0] * n[0] - n[1] * n[1]));
         double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
@@ -109,7 +127,7 @@ class Level0Converter {
       }
     }
     if (!colour) return;
-    plan_.to_linear->apply(dst, w, int(wc));
+    conv_.to_linear->apply(dst, w, int(wc));
     for (uint32_t x = 0; x < w; ++x) {
       float* d = dst + size_t(x) * wc;
       for (uint32_t c = 0; c < wc; ++c) {
@@ -117,15 +135,15 @@ class Level0Converter {
         if (!(d[c] >= 0)) d[c] = 0;
         if (d[c] > kFloatMax) d[c] = kFloatMax;
       }
-      if (plan_.alpha >= 0) {
-        float a = std::min(d[plan_.alpha], 1.0f);
-        d[plan_.alpha] = a;
+      if (conv_.alpha >= 0) {
+        float a = std::min(d[conv_.alpha], 1.0f);
+        d[conv_.alpha] = a;
         for (int c = 0; c < 3; ++c) d[c] *= a;
       }
     }
   }
 
-  const LayerPlan& plan_;
+  const Conversion conv_;
   uint32_t width_;
   NonFinitePolicy policy_;
   int threads_;
@@ -139,17 +157,16 @@ class StreamedLevel0 final : public LevelSource {
   StreamedLevel0(std::shared_ptr<ImageSource> source, const LayerPlan& plan, NonFinitePolicy policy,
                  int threads, bool count)
       : source_(std::move(source)),
-        plan_(plan),
         converter_(plan, source_->info().width, source_->info().height, policy, threads),
         count_(count) {}
 
   uint32_t width() const override { return source_->info().width; }
   uint32_t height() const override { return source_->info().height; }
-  uint32_t channels() const override { return plan_.work_channels; }
+  uint32_t channels() const override { return converter_.conversion().work_channels; }
   NonFiniteReport non_finite() const override { return converter_.report(); }
 
   Status read(uint32_t y0, uint32_t y1, float* out) override {
-    const size_t in_row = size_t(width()) * plan_.source_channels;
+    const size_t in_row = size_t(width()) * converter_.conversion().source_channels;
     raw_.resize(size_t(y1 - y0) * in_row);
     VT_RETURN_IF_ERROR(source_->read_rows(y0, y1, raw_.data()));
     if (count_) {
@@ -162,7 +179,6 @@ class StreamedLevel0 final : public LevelSource {
 
  private:
   std::shared_ptr<ImageSource> source_;
-  const LayerPlan& plan_;
   Level0Converter converter_;
   bool count_;
   std::vector<float> raw_;
