@@ -6,6 +6,19 @@
 
 namespace vt::scene {
 
+std::array<double, 6> TextureTransform::matrix() const {
+  double c = std::cos(double(rotation)), s = std::sin(double(rotation));
+  // Rotation [c s; -s c] (row-major) after the scale: the sign that makes the extension's own
+  // example (offset [0, 1], rotation pi/2, scale 0.5) pick the lower-left quadrant.
+  return {c * scale[0], -s * scale[0], s * scale[1], c * scale[1], offset[0], offset[1]};
+}
+
+std::array<double, 2> TextureTransform::apply(double u, double v) const {
+  if (identity()) return {u, v};
+  auto m = matrix();
+  return {m[0] * u + m[2] * v + m[4], m[1] * u + m[3] * v + m[5]};
+}
+
 Mat4 multiply(const Mat4& a, const Mat4& b) {
   Mat4 r{};
   for (int c = 0; c < 4; ++c)

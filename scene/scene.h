@@ -24,14 +24,33 @@ using Mat4 = std::array<double, 16>;
 constexpr Mat4 kIdentity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
 
 enum class WrapMode { kRepeat, kClampToEdge, kMirroredRepeat };
+enum class FilterMode { kLinear, kNearest };
 enum class AlphaMode { kOpaque, kMask, kBlend };
+
+// KHR_texture_transform: uv' = T(offset) * R(rotation) * S(scale) * uv. Affine, so applying it
+// to each vertex's UV and interpolating equals applying it per sample: the bake and the
+// validator's reference both use apply() per vertex or per sample with the same result.
+struct TextureTransform {
+  Vec2 offset = {0, 0};
+  float rotation = 0;  // radians, as in KHR_texture_transform
+  Vec2 scale = {1, 1};
+
+  bool identity() const {
+    return offset[0] == 0 && offset[1] == 0 && rotation == 0 && scale[0] == 1 && scale[1] == 1;
+  }
+  // The 2x3 matrix (column-major linear part, then offset): uv' = m[0..3] * uv + m[4..5].
+  std::array<double, 6> matrix() const;
+  std::array<double, 2> apply(double u, double v) const;
+};
 
 // One texture slot of a material. image < 0 means the slot is unused.
 struct TextureRef {
   int image = -1;    // index into Scene::images
-  int texcoord = 0;  // which UV set of the primitive (TEXCOORD_n) it reads
+  int texcoord = 0;  // which UV set of the primitive (TEXCOORD_n) it reads, after overrides
   WrapMode wrap_s = WrapMode::kRepeat;
   WrapMode wrap_t = WrapMode::kRepeat;
+  FilterMode mag_filter = FilterMode::kLinear;  // the sampler's magFilter
+  TextureTransform transform;
   bool valid() const { return image >= 0; }
 };
 
@@ -48,7 +67,8 @@ struct Material {
   TextureRef occlusion_texture;  // R = occlusion (may be the same image as metallic-roughness)
   float occlusion_strength = 1.0f;
   Vec3 emissive_factor = {0, 0, 0};
-  TextureRef emissive_texture;  // sRGB RGB
+  float emissive_strength = 1.0f;  // KHR_materials_emissive_strength: multiplies the factor
+  TextureRef emissive_texture;     // sRGB RGB
   AlphaMode alpha_mode = AlphaMode::kOpaque;
   float alpha_cutoff = 0.5f;
   bool double_sided = false;
@@ -106,6 +126,10 @@ struct Scene {
   std::vector<Image> images;
   std::vector<Node> nodes;
   std::vector<int> roots;  // nodes of the displayed scene
+  // What the importer ignored or repaired, one line each, naming the file and the feature
+  // (e.g. "a.gltf: KHR_lights_punctual: 3 lights ignored (lighting is not baked)"). The CLI
+  // prints them as warnings and the bake summary lists them.
+  std::vector<std::string> warnings;
 
   // Every mesh instance in the node hierarchy below `roots`, depth first, with world matrices.
   // A node reached twice or a cycle is visited once (cycles are broken, never followed).

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "scene/scene.h"
 #include "common/status.h"
+#include "scene/scene.h"
 
 namespace vt::scene::detail {
 
