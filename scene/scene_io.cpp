@@ -1,7 +1,12 @@
 // load_scene dispatch and the file helpers the importers share.
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
 
 #include "scene/scene.h"
 #include "scene/scene_io_util.h"
@@ -106,6 +111,79 @@ std::string base64_encode(const uint8_t* data, size_t size) {
   return out;
 }
 
+namespace {
+
+namespace fs = std::filesystem;
+
+bool exists_file(const fs::path& p) {
+  std::error_code ec;
+  return fs::is_regular_file(p, ec);
+}
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+// `rel` under `base`, matching each component without regard to case; "" when none matches.
+fs::path case_insensitive_match(const fs::path& base, const fs::path& rel) {
+  fs::path at = base.empty() ? fs::path(".") : base;
+  for (const fs::path& part : rel) {
+    if (part == "." || part.empty()) continue;
+    if (part == "..") {
+      at /= part;
+      continue;
+    }
+    std::error_code ec;
+    fs::path found;
+    std::string want = lower(part.string());
+    for (fs::directory_iterator it(at, ec), end; !ec && it != end; it.increment(ec)) {
+      if (lower(it->path().filename().string()) == want) {
+        found = it->path();
+        break;
+      }
+    }
+    if (found.empty()) return {};
+    at = found;
+  }
+  return exists_file(at) ? at : fs::path();
+}
+
+}  // namespace
+
+std::string resolve_texture_path(const std::string& folder, const std::string& written,
+                                 const std::string& scene_path,
+                                 std::vector<std::string>* warnings) {
+  std::string w = written;
+  while (!w.empty() && (w.back() == ' ' || w.back() == '\t' || w.back() == '\r')) w.pop_back();
+  if (w.size() >= 2 && (w.front() == '"' || w.front() == '\'') && w.back() == w.front())
+    w = w.substr(1, w.size() - 2);
+  std::replace(w.begin(), w.end(), '\\', '/');
+  while (w.rfind("./", 0) == 0) w = w.substr(2);
+  bool drive = w.size() >= 2 && std::isalpha(static_cast<unsigned char>(w[0])) && w[1] == ':';
+  bool absolute = drive || (!w.empty() && w[0] == '/');
+  std::string plain = absolute && !drive ? w : folder + w;
+  if (exists_file(plain)) return plain;
+  auto use = [&](const fs::path& p, const char* how) {
+    if (warnings)
+      warnings->push_back(scene_path + ": texture '" + written + "' not found; using '" +
+                          p.string() + "' (" + how + ")");
+    return p.string();
+  };
+  fs::path base = folder.empty() ? fs::path() : fs::path(folder);
+  if (!absolute) {
+    fs::path m = case_insensitive_match(base, fs::path(w));
+    if (!m.empty()) return use(m, "the same name in another letter case");
+  }
+  fs::path name = fs::path(w).filename();
+  if (!name.empty() && name != fs::path(w)) {
+    if (exists_file(base / name)) return use(base / name, "the file name beside the scene");
+    fs::path m = case_insensitive_match(base, name);
+    if (!m.empty()) return use(m, "the file name beside the scene, in another letter case");
+  }
+  return plain;
+}
+
 Scene single_mesh_scene(const std::string& path, std::string name, std::vector<Primitive> prims,
                         std::vector<Material> materials) {
   Scene scene;
@@ -125,14 +203,45 @@ Scene single_mesh_scene(const std::string& path, std::string name, std::vector<P
 
 }  // namespace detail
 
+namespace {
+
+// glTF 1.0 (a .glb header of version 1, or asset.version "1.x"): the own importer reads 2.0
+// only, assimp reads 1.0.
+bool is_gltf1(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  char head[8] = {};
+  f.read(head, 8);
+  if (std::memcmp(head, "glTF", 4) == 0) {
+    uint32_t version;
+    std::memcpy(&version, head + 4, 4);
+    return version == 1;
+  }
+  f.clear();
+  f.seekg(0);
+  nlohmann::json doc = nlohmann::json::parse(f, nullptr, false);
+  if (!doc.is_object() || !doc.contains("asset") || !doc["asset"].is_object()) return false;
+  const auto& v = doc["asset"].value("version", nlohmann::json());
+  return v.is_string() && v.get<std::string>().rfind("1", 0) == 0;
+}
+
+}  // namespace
+
 Expected<Scene> load_scene(const std::string& path) {
   std::string ext = detail::lower_extension(path);
-  if (ext == "gltf" || ext == "glb") return detail::load_gltf(path);
+  if (ext == "gltf" || ext == "glb") {
+    if (!is_gltf1(path)) return detail::load_gltf(path);
+    auto scene = detail::load_assimp(path);
+    if (scene.ok()) scene->warnings.push_back(path + ": glTF 1.0, read through assimp");
+    return scene;
+  }
   if (ext == "obj") return detail::load_obj(path);
   if (ext == "ply") return detail::load_ply(path);
   if (ext == "drc") return detail::load_drc(path);
+  if (detail::assimp_reads(ext)) return detail::load_assimp(path);
   return Error(ErrorCode::kUnsupported,
-               path + ": unknown scene format (expected .gltf, .glb, .obj, .ply or .drc)");
+               path +
+                   ": unknown scene format (expected .gltf, .glb, .obj, .ply, .drc or a format "
+                   "assimp reads: .fbx, .dae, .3ds, .blend, ...)");
 }
 
 }  // namespace vt::scene

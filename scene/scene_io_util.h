@@ -18,11 +18,23 @@ Expected<std::vector<uint8_t>> decode_data_uri(const std::string& uri, std::stri
 std::string base64_encode(const uint8_t* data, size_t size);
 std::string percent_decode(const std::string& uri);
 
+// The file a texture path written by an exporter names, relative to `folder` (parent_folder of
+// the scene): backslashes and surrounding quotes are undone; when that file does not exist, a
+// case-insensitive match (per path component) and then the bare file name beside the scene
+// (for absolute paths from the author's machine, "D:\\art\\wall.jpg") are tried, with a
+// warning naming the file used. When nothing exists the plain resolution is returned, so the
+// missing-texture error names the path the file asked for.
+std::string resolve_texture_path(const std::string& folder, const std::string& written,
+                                 const std::string& scene_path, std::vector<std::string>* warnings);
+
 Expected<Scene> load_gltf(const std::string& path);
 Expected<Scene> load_obj(const std::string& path);
 Expected<Scene> load_ply(const std::string& path);
 Expected<Scene> load_ply_own(const std::string& path);  // fallback: tristrips
 Expected<Scene> load_drc(const std::string& path);
+// Any other format assimp reads (FBX, COLLADA, 3DS, ...; glTF 1.0).
+Expected<Scene> load_assimp(const std::string& path);
+bool assimp_reads(const std::string& extension);  // lower case, without the dot
 // Decodes a Draco-compressed mesh into a primitive. attribute_ids maps glTF attribute names
 // (POSITION, NORMAL, TEXCOORD_n, COLOR_0, TANGENT) to Draco unique ids; when empty the Draco
 // attribute types are used instead (a .drc or PLY file).

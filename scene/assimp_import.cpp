@@ -1,0 +1,281 @@
+// Every other scene format assimp reads (FBX, COLLADA, 3DS, Blender, X, LightWave, STL, ...)
+// mapped onto the scene model: one primitive per assimp mesh, the node hierarchy kept (a node
+// with several meshes gets one scene mesh holding them all), materials onto glTF
+// metallic-roughness, embedded textures kept as image bytes. Only the bake side links assimp.
+#include <assimp/GltfMaterial.h>
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <assimp/Importer.hpp>
+#include <cmath>
+#include <cstring>
+#include <map>
+
+#include "scene/scene_io_util.h"
+
+namespace vt::scene::detail {
+namespace {
+
+Mat4 to_mat4(const aiMatrix4x4& m) {
+  // assimp is row-major with translation in the last column: transpose into glTF's order.
+  return {m.a1, m.b1, m.c1, m.d1, m.a2, m.b2, m.c2, m.d2,
+          m.a3, m.b3, m.c3, m.d3, m.a4, m.b4, m.c4, m.d4};
+}
+
+WrapMode wrap_mode(aiTextureMapMode m) {
+  switch (m) {
+    case aiTextureMapMode_Clamp:
+    case aiTextureMapMode_Decal:
+      return WrapMode::kClampToEdge;
+    case aiTextureMapMode_Mirror:
+      return WrapMode::kMirroredRepeat;
+    default:
+      return WrapMode::kRepeat;
+  }
+}
+
+std::string mime_from_hint(const char* hint) {
+  std::string h(hint);
+  std::transform(h.begin(), h.end(), h.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (h == "jpg" || h == "jpeg") return "image/jpeg";
+  if (h == "png") return "image/png";
+  if (h == "exr") return "image/x-exr";
+  if (h == "webp") return "image/webp";
+  if (h == "tga") return "image/x-tga";
+  if (h == "bmp") return "image/bmp";
+  if (h == "dds") return "image/vnd-ms.dds";
+  return h.empty() ? std::string() : "image/" + h;
+}
+
+class AssimpScene {
+ public:
+  AssimpScene(const std::string& path, const aiScene& ai) : path_(path), ai_(ai) {
+    scene_.source_path = path;
+    folder_ = parent_folder(path);
+  }
+
+  Expected<Scene> convert() {
+    for (unsigned i = 0; i < ai_.mNumMaterials; ++i)
+      scene_.materials.push_back(material(*ai_.mMaterials[i]));
+    VT_RETURN_IF_ERROR(add_node(*ai_.mRootNode, -1));
+    scene_.roots.push_back(0);
+    if (skipped_faces_ > 0)
+      warn(std::to_string(skipped_faces_) + " point and line primitives skipped (no surface)");
+    if (ai_.mNumAnimations > 0)
+      warn(std::to_string(ai_.mNumAnimations) + " animations ignored (baked in the rest pose)");
+    if (boned_meshes_ > 0)
+      warn(std::to_string(boned_meshes_) + " skinned meshes baked in their bind pose");
+    if (ai_.mNumLights > 0)
+      warn(std::to_string(ai_.mNumLights) + " lights ignored (lighting is not baked yet)");
+    return std::move(scene_);
+  }
+
+ private:
+  void warn(const std::string& what) { scene_.warnings.push_back(path_ + ": " + what); }
+
+  // The image for a texture path: an embedded texture ("*N" or a name assimp holds) or a file
+  // beside the scene; one Scene::Image per distinct path.
+  int image_for(const std::string& raw) {
+    auto it = images_.find(raw);
+    if (it != images_.end()) return it->second;
+    Image image;
+    if (const aiTexture* t = ai_.GetEmbeddedTexture(raw.c_str())) {
+      image.name = t->mFilename.length ? t->mFilename.C_Str() : raw;
+      if (t->mHeight == 0) {
+        const auto* bytes = reinterpret_cast<const uint8_t*>(t->pcData);
+        image.bytes.assign(bytes, bytes + t->mWidth);
+        image.mime_type = mime_from_hint(t->achFormatHint);
+      } else {
+        warn("embedded uncompressed texture '" + raw + "' is not supported: slot left empty");
+        return images_[raw] = -1;
+      }
+    } else {
+      image.name = raw;
+      image.uri = raw;
+      image.path = resolve_texture_path(folder_, raw, path_, &scene_.warnings);
+    }
+    scene_.images.push_back(std::move(image));
+    return images_[raw] = int(scene_.images.size() - 1);
+  }
+
+  TextureRef texture(const aiMaterial& m, aiTextureType type) {
+    TextureRef ref;
+    if (m.GetTextureCount(type) == 0) return ref;
+    aiString file;
+    aiTextureMapping mapping = aiTextureMapping_UV;
+    unsigned uv_index = 0;
+    aiTextureMapMode modes[2] = {aiTextureMapMode_Wrap, aiTextureMapMode_Wrap};
+    if (m.GetTexture(type, 0, &file, &mapping, &uv_index, nullptr, nullptr, modes) != AI_SUCCESS)
+      return ref;
+    if (mapping != aiTextureMapping_UV) {
+      warn("material '" + std::string(m.GetName().C_Str()) +
+           "': a texture with non-UV (projected) mapping is ignored");
+      return ref;
+    }
+    ref.image = image_for(file.C_Str());
+    if (ref.image < 0) return {};
+    ref.texcoord = int(uv_index);
+    ref.wrap_s = wrap_mode(modes[0]);
+    ref.wrap_t = wrap_mode(modes[1]);
+    aiUVTransform tr;
+    if (m.Get(AI_MATKEY_UVTRANSFORM(type, 0), tr) == AI_SUCCESS) {
+      ref.transform.offset = {tr.mTranslation.x, tr.mTranslation.y};
+      ref.transform.scale = {tr.mScaling.x, tr.mScaling.y};
+      ref.transform.rotation = tr.mRotation;
+    }
+    return ref;
+  }
+
+  Material material(const aiMaterial& m) {
+    Material mat;
+    mat.name = m.GetName().C_Str();
+    aiColor4D c;
+    if (m.Get(AI_MATKEY_BASE_COLOR, c) == AI_SUCCESS ||
+        m.Get(AI_MATKEY_COLOR_DIFFUSE, c) == AI_SUCCESS)
+      mat.base_color_factor = {c.r, c.g, c.b, c.a};
+    float opacity = 1;
+    if (m.Get(AI_MATKEY_OPACITY, opacity) == AI_SUCCESS && opacity < 1) {
+      mat.base_color_factor[3] *= opacity;
+      mat.alpha_mode = AlphaMode::kBlend;
+    }
+    mat.base_color_texture = texture(m, aiTextureType_BASE_COLOR);
+    if (!mat.base_color_texture.valid()) mat.base_color_texture = texture(m, aiTextureType_DIFFUSE);
+    mat.normal_texture = texture(m, aiTextureType_NORMALS);
+    if (!mat.normal_texture.valid() && m.GetTextureCount(aiTextureType_HEIGHT) > 0)
+      warn("material '" + mat.name + "': a height (bump) map is ignored (only normal maps bake)");
+    aiColor3D e;
+    if (m.Get(AI_MATKEY_COLOR_EMISSIVE, e) == AI_SUCCESS) mat.emissive_factor = {e.r, e.g, e.b};
+    float strength;
+    if (m.Get(AI_MATKEY_EMISSIVE_INTENSITY, strength) == AI_SUCCESS && strength > 0)
+      mat.emissive_strength = strength;
+    mat.emissive_texture = texture(m, aiTextureType_EMISSIVE);
+    if (mat.emissive_texture.valid() && mat.emissive_factor == Vec3{0, 0, 0})
+      mat.emissive_factor = {1, 1, 1};
+    // assimp's own scale for formats without PBR: a plain material is rough and not metallic.
+    mat.metallic_factor = 0, mat.roughness_factor = 1;
+    m.Get(AI_MATKEY_METALLIC_FACTOR, mat.metallic_factor);
+    m.Get(AI_MATKEY_ROUGHNESS_FACTOR, mat.roughness_factor);
+    mat.occlusion_texture = texture(m, aiTextureType_AMBIENT_OCCLUSION);
+    if (!mat.occlusion_texture.valid()) mat.occlusion_texture = texture(m, aiTextureType_LIGHTMAP);
+    if (m.GetTextureCount(aiTextureType_METALNESS) +
+            m.GetTextureCount(aiTextureType_DIFFUSE_ROUGHNESS) >
+        0)
+      warn("material '" + mat.name +
+           "': separate metalness/roughness maps are ignored (factors used)");
+    if (m.GetTextureCount(aiTextureType_OPACITY) > 0)
+      warn("material '" + mat.name + "': a separate opacity map is ignored");
+    int two_sided = 0;
+    if (m.Get(AI_MATKEY_TWOSIDED, two_sided) == AI_SUCCESS) mat.double_sided = two_sided != 0;
+    return mat;
+  }
+
+  Primitive primitive(const aiMesh& mesh) {
+    Primitive p;
+    p.material = int(mesh.mMaterialIndex);
+    p.positions.resize(mesh.mNumVertices);
+    for (unsigned v = 0; v < mesh.mNumVertices; ++v)
+      p.positions[v] = {mesh.mVertices[v].x, mesh.mVertices[v].y, mesh.mVertices[v].z};
+    if (mesh.mNormals) {
+      p.normals.resize(mesh.mNumVertices);
+      for (unsigned v = 0; v < mesh.mNumVertices; ++v)
+        p.normals[v] = {mesh.mNormals[v].x, mesh.mNormals[v].y, mesh.mNormals[v].z};
+    }
+    for (unsigned s = 0; s < AI_MAX_NUMBER_OF_TEXTURECOORDS && mesh.mTextureCoords[s]; ++s) {
+      auto& uv = p.uvs.emplace_back(mesh.mNumVertices);
+      // assimp's UVs have v up; the scene model follows glTF (v down).
+      for (unsigned v = 0; v < mesh.mNumVertices; ++v)
+        uv[v] = {mesh.mTextureCoords[s][v].x, 1.0f - mesh.mTextureCoords[s][v].y};
+    }
+    if (mesh.mColors[0]) {
+      p.colors.resize(mesh.mNumVertices);
+      for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+        const aiColor4D& c = mesh.mColors[0][v];
+        p.colors[v] = {c.r, c.g, c.b, c.a};
+      }
+    }
+    p.indices.reserve(size_t(mesh.mNumFaces) * 3);
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+      const aiFace& face = mesh.mFaces[f];
+      if (face.mNumIndices != 3) {
+        ++skipped_faces_;
+        continue;
+      }
+      p.indices.insert(p.indices.end(), face.mIndices, face.mIndices + 3);
+    }
+    if (mesh.mNumBones > 0) ++boned_meshes_;
+    return p;
+  }
+
+  // The scene mesh for a node's list of assimp meshes (shared by nodes with the same list).
+  int mesh_for(const aiNode& node) {
+    std::vector<unsigned> key(node.mMeshes, node.mMeshes + node.mNumMeshes);
+    auto it = meshes_.find(key);
+    if (it != meshes_.end()) return it->second;
+    Mesh mesh;
+    mesh.name = node.mName.C_Str();
+    for (unsigned i : key) {
+      if (i >= ai_.mNumMeshes) continue;
+      Primitive p = primitive(*ai_.mMeshes[i]);
+      if (!p.indices.empty()) mesh.primitives.push_back(std::move(p));
+    }
+    scene_.meshes.push_back(std::move(mesh));
+    return meshes_[key] = int(scene_.meshes.size() - 1);
+  }
+
+  Status add_node(const aiNode& ai_node, int parent) {
+    // assimp hands a tree, but a hostile file may still nest without end.
+    if (++depth_ > 4096) return Error(ErrorCode::kCorrupt, path_ + ": node hierarchy too deep");
+    int index = int(scene_.nodes.size());
+    Node node;
+    node.name = ai_node.mName.C_Str();
+    node.local = to_mat4(ai_node.mTransformation);
+    scene_.nodes.push_back(node);
+    if (parent >= 0) scene_.nodes[parent].children.push_back(index);
+    if (ai_node.mNumMeshes > 0) {
+      int mesh = mesh_for(ai_node);
+      scene_.nodes[index].mesh = mesh;
+    }
+    for (unsigned c = 0; c < ai_node.mNumChildren; ++c)
+      VT_RETURN_IF_ERROR(add_node(*ai_node.mChildren[c], index));
+    --depth_;
+    return Status::Ok();
+  }
+
+  std::string path_, folder_;
+  const aiScene& ai_;
+  Scene scene_;
+  std::map<std::string, int> images_;
+  std::map<std::vector<unsigned>, int> meshes_;
+  uint64_t skipped_faces_ = 0;
+  int boned_meshes_ = 0;
+  int depth_ = 0;
+};
+
+}  // namespace
+
+bool assimp_reads(const std::string& extension) {
+  Assimp::Importer importer;
+  return importer.IsExtensionSupported("." + extension);
+}
+
+Expected<Scene> load_assimp(const std::string& path) {
+  Assimp::Importer importer;
+  // Points and lines are dropped by SortByPType; normals are made only where a mesh has none.
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                         aiProcess_SortByPType | aiProcess_GenSmoothNormals |
+                         aiProcess_ValidateDataStructure | aiProcess_FindInvalidData;
+  const aiScene* ai = importer.ReadFile(path, flags);
+  if (!ai || !ai->mRootNode) {
+    std::string why = importer.GetErrorString();
+    return Error(ErrorCode::kCorrupt, path + ": " + (why.empty() ? "assimp cannot read it" : why));
+  }
+  if (ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE)
+    return Error(ErrorCode::kCorrupt, path + ": assimp read an incomplete scene (no meshes?)");
+  return AssimpScene(path, *ai).convert();
+}
+
+}  // namespace vt::scene::detail

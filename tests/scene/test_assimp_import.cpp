@@ -1,0 +1,187 @@
+// Scenes read through assimp (COLLADA and STL written by the tests), glTF 1.0 routed to it, and
+// the texture-path resolution every importer shares (Windows separators, letter case, absolute
+// paths from the author's machine).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "scene/scene.h"
+#include "scene/scene_io_util.h"
+
+namespace vt::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path fresh_dir(const std::string& name) {
+  fs::path d = fs::path(::testing::TempDir()) / ("vt_assimp_" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+// A COLLADA quad (two triangles) with UVs, vertex colours and a diffuse texture `image`, a
+// node translated by (5, 0, 0).
+std::string collada_quad(const std::string& image) {
+  return R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="meter" meter="1"/><up_axis>Y_UP</up_axis></asset>
+  <library_images><image id="img"><init_from>)" +
+         image + R"(</init_from></image></library_images>
+  <library_effects><effect id="fx"><profile_COMMON>
+    <newparam sid="surf"><surface type="2D"><init_from>img</init_from></surface></newparam>
+    <newparam sid="samp"><sampler2D><source>surf</source></sampler2D></newparam>
+    <technique sid="common"><lambert>
+      <diffuse><texture texture="samp" texcoord="UV0"/></diffuse>
+    </lambert></technique>
+  </profile_COMMON></effect></library_effects>
+  <library_materials><material id="mat" name="Painted"><instance_effect url="#fx"/></material></library_materials>
+  <library_geometries><geometry id="quad"><mesh>
+    <source id="pos"><float_array id="pos-a" count="12">0 0 0 1 0 0 1 1 0 0 1 0</float_array>
+      <technique_common><accessor source="#pos-a" count="4" stride="3">
+        <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+      </accessor></technique_common></source>
+    <source id="uv"><float_array id="uv-a" count="8">0 0 1 0 1 1 0 1</float_array>
+      <technique_common><accessor source="#uv-a" count="4" stride="2">
+        <param name="S" type="float"/><param name="T" type="float"/>
+      </accessor></technique_common></source>
+    <source id="col"><float_array id="col-a" count="12">1 0 0 0 1 0 0 0 1 1 1 1</float_array>
+      <technique_common><accessor source="#col-a" count="4" stride="3">
+        <param name="R" type="float"/><param name="G" type="float"/><param name="B" type="float"/>
+      </accessor></technique_common></source>
+    <vertices id="verts"><input semantic="POSITION" source="#pos"/></vertices>
+    <triangles count="2" material="m">
+      <input semantic="VERTEX" source="#verts" offset="0"/>
+      <input semantic="TEXCOORD" source="#uv" offset="0" set="0"/>
+      <input semantic="COLOR" source="#col" offset="0"/>
+      <p>0 1 2 0 2 3</p>
+    </triangles>
+  </mesh></geometry></library_geometries>
+  <library_visual_scenes><visual_scene id="scene">
+    <node id="n" name="Quad"><translate>5 0 0</translate>
+      <instance_geometry url="#quad"><bind_material><technique_common>
+        <instance_material symbol="m" target="#mat">
+          <bind_vertex_input semantic="UV0" input_semantic="TEXCOORD" input_set="0"/>
+        </instance_material>
+      </technique_common></bind_material></instance_geometry>
+    </node>
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>
+)";
+}
+
+TEST(AssimpImport, ColladaQuadWithTextureColoursAndTransform) {
+  fs::path d = fresh_dir("dae");
+  fs::create_directories(d / "maps");
+  write_text(d / "maps" / "wall.png", "not read by the importer");
+  write_text(d / "quad.dae", collada_quad("maps/wall.png"));
+  auto s = scene::load_scene((d / "quad.dae").string());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  ASSERT_EQ(s->triangle_count(), 2u);
+  auto instances = s->instances();
+  ASSERT_EQ(instances.size(), 1u);
+  auto p = scene::transform_point(instances[0].world, {0, 0, 0});
+  EXPECT_NEAR(p[0], 5.0, 1e-9);
+  const scene::Primitive& prim = s->meshes[instances[0].mesh].primitives[0];
+  ASSERT_EQ(prim.uvs.size(), 1u);
+  ASSERT_EQ(prim.colors.size(), prim.positions.size());
+  ASSERT_EQ(prim.normals.size(), prim.positions.size());  // generated: the file has none
+  // COLLADA's v is up; the scene model's is down (glTF). Find the corner at position (1, 1).
+  bool seen = false;
+  for (size_t v = 0; v < prim.positions.size(); ++v) {
+    if (prim.positions[v][0] == 1 && prim.positions[v][1] == 1) {
+      EXPECT_FLOAT_EQ(prim.uvs[0][v][0], 1.0f);
+      EXPECT_FLOAT_EQ(prim.uvs[0][v][1], 0.0f);
+      EXPECT_FLOAT_EQ(prim.colors[v][2], 1.0f);  // third vertex: blue
+      seen = true;
+    }
+  }
+  EXPECT_TRUE(seen);
+  ASSERT_GE(prim.material, 0);
+  const scene::Material& m = s->materials[prim.material];
+  EXPECT_EQ(m.name, "Painted");
+  ASSERT_TRUE(m.base_color_texture.valid());
+  EXPECT_EQ(s->images[m.base_color_texture.image].path, (d / "maps" / "wall.png").string());
+}
+
+TEST(AssimpImport, TexturePathsFromOtherMachinesAreFoundWithAWarning) {
+  fs::path d = fresh_dir("paths");
+  fs::create_directories(d / "Tex");
+  write_text(d / "Tex" / "Wall.PNG", "x");
+  write_text(d / "floor.jpg", "x");
+  std::string folder = d.string() + "/";
+  std::vector<std::string> warnings;
+  // Windows separators alone: found directly, no warning.
+  write_text(d / "Tex" / "ok.png", "x");
+  EXPECT_EQ(scene::detail::resolve_texture_path(folder, ".\\Tex\\ok.png", "s.obj", &warnings),
+            folder + "Tex/ok.png");
+  EXPECT_TRUE(warnings.empty());
+  // Letter case differs on a case-sensitive file system.
+  EXPECT_EQ(scene::detail::resolve_texture_path(folder, "tex\\wall.png", "s.obj", &warnings),
+            (d / "Tex" / "Wall.PNG").string());
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("letter case"), std::string::npos) << warnings[0];
+  // An absolute path from the author's machine: the file name beside the scene.
+  EXPECT_EQ(scene::detail::resolve_texture_path(folder, "D:\\art\\floor.jpg", "s.obj", &warnings),
+            (d / "floor.jpg").string());
+  EXPECT_EQ(scene::detail::resolve_texture_path(folder, "\"floor.jpg\"", "s.obj", &warnings),
+            folder + "floor.jpg");
+  // Nothing anywhere: the plain resolution, so the error names what the file asked for.
+  EXPECT_EQ(scene::detail::resolve_texture_path(folder, "gone/none.png", "s.obj", &warnings),
+            folder + "gone/none.png");
+}
+
+TEST(AssimpImport, AsciiStlAndUnreadableFiles) {
+  fs::path d = fresh_dir("stl");
+  write_text(d / "tri.stl",
+             "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+             "endloop\nendfacet\nendsolid t\n");
+  auto s = scene::load_scene((d / "tri.stl").string());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  EXPECT_EQ(s->triangle_count(), 1u);
+  write_text(d / "bad.fbx", "this is not an FBX file");
+  auto bad = scene::load_scene((d / "bad.fbx").string());
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("bad.fbx"), std::string::npos) << bad.status().message();
+  auto unknown = scene::load_scene((d / "x.notaformat").string());
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.status().message().find("unknown scene format"), std::string::npos);
+}
+
+TEST(AssimpImport, Gltf1IsReadThroughAssimp) {
+  fs::path d = fresh_dir("gltf1");
+  // A glTF 1.0 document: object-valued maps, asset.version "1.0". One triangle, embedded buffer.
+  // Buffer: 3 float positions (36 bytes) + 3 u16 indices (6 bytes).
+  const char* b64 = "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIA";
+  write_text(d / "tri.gltf", std::string(R"({
+  "asset": {"version": "1.0"},
+  "buffers": {"b": {"uri": "data:application/octet-stream;base64,)") +
+                                 b64 +
+                                 R"(", "byteLength": 42}},
+  "bufferViews": {
+    "v": {"buffer": "b", "byteOffset": 0, "byteLength": 36, "target": 34962},
+    "i": {"buffer": "b", "byteOffset": 36, "byteLength": 6, "target": 34963}},
+  "accessors": {
+    "pos": {"bufferView": "v", "byteOffset": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
+    "idx": {"bufferView": "i", "byteOffset": 0, "componentType": 5123, "count": 3, "type": "SCALAR"}},
+  "meshes": {"m": {"primitives": [{"attributes": {"POSITION": "pos"}, "indices": "idx", "mode": 4}]}},
+  "nodes": {"n": {"meshes": ["m"]}},
+  "scenes": {"s": {"nodes": ["n"]}},
+  "scene": "s"
+})");
+  auto s = scene::load_scene((d / "tri.gltf").string());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  EXPECT_EQ(s->triangle_count(), 1u);
+  bool noted = false;
+  for (const auto& w : s->warnings) noted |= w.find("glTF 1.0") != std::string::npos;
+  EXPECT_TRUE(noted);
+}
+
+}  // namespace
+}  // namespace vt::test
