@@ -162,7 +162,7 @@ std::string resolve_texture_path(const std::string& folder, const std::string& w
   while (w.rfind("./", 0) == 0) w = w.substr(2);
   bool drive = w.size() >= 2 && std::isalpha(static_cast<unsigned char>(w[0])) && w[1] == ':';
   bool absolute = drive || (!w.empty() && w[0] == '/');
-  std::string plain = absolute && !drive ? w : folder + w;
+  std::string plain = absolute ? w : folder + w;
   if (exists_file(plain)) return plain;
   auto use = [&](const fs::path& p, const char* how) {
     if (warnings)

@@ -1,0 +1,262 @@
+#!/usr/bin/env python3
+"""The conformance run's driver (scripts/conformance.sh sets it up): picks the models, bakes
+and validates each with `vtbake --json`, and writes the Markdown table.
+
+A model is in the run when it can show whether materials bake right: a glTF 2.0 file with a
+material, or an OBJ/FBX/COLLADA/PLY/3DS file that names a texture. Each gets one of:
+  pass     baked, and validate passed every view within the default bounds
+  refused  vtbake said no with exit status 2 and a message (an unsupported feature, a bad file)
+  FAIL     anything else: a crash, a timeout, exit 1, or a bake that does not validate
+"""
+import argparse
+import json
+import os
+import re
+import struct
+import subprocess
+import sys
+import time
+
+SCENE_EXTS = {".gltf": "glTF", ".glb": "glTF", ".obj": "OBJ", ".fbx": "FBX", ".dae": "COLLADA",
+              ".ply": "PLY", ".3ds": "3DS"}
+IMAGE_EXT_RE = re.compile(rb"\.(png|jpe?g|tga|bmp|dds|tiff?|exr|gif)\b", re.I)
+NAME_BYTES = set(b"abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-. \\/:")
+
+
+def image_names(data):
+    """File names with an image extension inside a binary or text scene file."""
+    names = set()
+    for m in IMAGE_EXT_RE.finditer(data):
+        start = m.start()
+        while start > 0 and m.start() - start < 200 and data[start - 1] in NAME_BYTES:
+            start -= 1
+        if start < m.start():
+            names.add(data[start:m.end()].strip().lower())
+    return names
+
+
+def gltf_document(path):
+    with open(path, "rb") as f:
+        data = f.read()
+    if data[:4] == b"glTF":
+        if len(data) < 20:
+            return None
+        length, kind = struct.unpack_from("<II", data, 12)
+        if kind != 0x4E4F534A:
+            return None
+        data = data[20:20 + length]
+    try:
+        doc = json.loads(data.decode("utf-8-sig"))
+    except (ValueError, UnicodeDecodeError):
+        return None
+    return doc if isinstance(doc, dict) else None
+
+
+def entries(value):
+    """The entries of a glTF array (2.0) or object map (1.0); dicts only."""
+    seq = value.values() if isinstance(value, dict) else value if isinstance(value, list) else []
+    return [e for e in seq if isinstance(e, dict)]
+
+
+def gltf_features(doc):
+    """What the file asks of the material model, in words the table can show."""
+    feats = set()
+    if str(doc.get("asset", {}).get("version", "2")).startswith("1"):
+        feats.add("glTF 1.0")
+    for e in doc.get("extensionsUsed", []) or []:
+        feats.add(e)
+    for s in entries(doc.get("samplers")):
+        for k in ("wrapS", "wrapT"):
+            if s.get(k) == 33648:
+                feats.add("MIRRORED_REPEAT")
+            elif s.get(k) == 33071:
+                feats.add("CLAMP_TO_EDGE")
+    for m in entries(doc.get("meshes")):
+        for p in entries(m.get("primitives")):
+            attrs = p.get("attributes", {}) if isinstance(p.get("attributes"), dict) else {}
+            if "COLOR_0" in attrs:
+                feats.add("COLOR_0")
+            if "TEXCOORD_1" in attrs:
+                feats.add("TEXCOORD_1")
+            if "TANGENT" not in attrs and "NORMAL" in attrs:
+                feats.add("no tangents")
+            if "targets" in p:
+                feats.add("morph targets")
+            if p.get("mode", 4) not in (4,):
+                feats.add("mode %d" % p.get("mode", 4))
+    if doc.get("skins"):
+        feats.add("skins")
+    for m in entries(doc.get("materials")):
+        if m.get("alphaMode") in ("MASK", "BLEND"):
+            feats.add("alpha " + m["alphaMode"])
+        if m.get("doubleSided"):
+            feats.add("double-sided")
+        if "normalTexture" in m:
+            feats.add("normal map")
+        if "emissiveTexture" in m or any(m.get("emissiveFactor", [0, 0, 0])):
+            feats.add("emissive")
+    if any("sparse" in a for a in entries(doc.get("accessors"))):
+        feats.add("sparse accessors")
+    for im in entries(doc.get("images")):
+        if "bufferView" in im or str(im.get("uri", "")).startswith("data:"):
+            feats.add("embedded images")
+    return sorted(feats)
+
+
+def select(corpus, only):
+    """(path, format, features) for every model the run covers."""
+    picked = []
+    for folder, _, files in os.walk(corpus):
+        for name in sorted(files):
+            path = os.path.join(folder, name)
+            rel = os.path.relpath(path, corpus)
+            ext = os.path.splitext(name)[1].lower()
+            if ext not in SCENE_EXTS or (only and not re.search(only, rel)):
+                continue
+            fmt = SCENE_EXTS[ext]
+            if fmt == "glTF":
+                doc = gltf_document(path)
+                if doc is None:
+                    picked.append((path, fmt, ["not readable as glTF JSON"]))
+                    continue
+                mats = doc.get("materials")
+                if mats:  # a list (2.0) or an object (1.0) with entries
+                    picked.append((path, fmt, gltf_features(doc)))
+                continue
+            with open(path, "rb") as f:
+                data = f.read()
+            if fmt == "OBJ":
+                names = []
+                for m in re.findall(rb"^\s*mtllib\s+(.+?)\s*$", data, re.M):
+                    mtl = os.path.join(folder, m.decode("latin-1").replace("\\", "/"))
+                    if os.path.exists(mtl):
+                        with open(mtl, "rb") as f:
+                            names += re.findall(rb"^\s*(?:map_\w+|bump|norm)\s+(.+)$",
+                                                f.read(), re.M | re.I)
+                if names:
+                    picked.append((path, fmt, ["MTL maps: %d" % len(names)]))
+                continue
+            hits = image_names(data)
+            if hits:
+                picked.append((path, fmt, ["textures named: %d" % len(hits)]))
+    return sorted(picked)
+
+
+def run(cmd, timeout):
+    start = time.monotonic()
+    try:
+        p = subprocess.run(cmd, capture_output=True, timeout=timeout)
+        return p.returncode, p.stdout.decode("utf-8", "replace"), p.stderr.decode(
+            "utf-8", "replace"), time.monotonic() - start
+    except subprocess.TimeoutExpired:
+        return None, "", "timed out after %d s" % timeout, time.monotonic() - start
+
+
+def last_error(stderr):
+    lines = [l for l in stderr.strip().splitlines() if l.strip()]
+    errs = [l for l in lines if not l.startswith("warning")]
+    return (errs or lines or [""])[-1][:300]
+
+
+def warnings_of(stderr):
+    return [l[len("warning: "):] for l in stderr.splitlines() if l.startswith("warning: ")]
+
+
+def one_model(args, path, index):
+    base = os.path.join(args.work, "m%03d" % index)
+    rec = {"bake": None, "bake_s": 0.0, "layers": [], "views": [], "warnings": []}
+    rc, out, err, secs = run([args.vtbake, "--json", "bake", path, "-o", base + ".vtpf"],
+                             args.timeout)
+    rec["bake_s"] = secs
+    rec["warnings"] = warnings_of(err)
+    if rc != 0:
+        if rc == 2:
+            rec["result"], rec["why"] = "refused", last_error(err)
+        else:
+            rec["result"] = "FAIL"
+            rec["why"] = ("exit %s: " % rc if rc is not None else "") + last_error(err)
+        return rec
+    try:
+        summary = json.loads(out)
+        rec["layers"] = [l["name"] for l in summary["build"]["layers"]]
+        rec["atlas"] = "%dx%d" % (summary["build"]["width"], summary["build"]["height"])
+    except (ValueError, KeyError):
+        pass
+    rc, out, err, secs = run([args.vtbake, "--json", "validate", path, base + ".vtpf"],
+                             args.timeout)
+    rec["validate_s"] = secs
+    try:
+        report = json.loads(out)
+        rec["views"] = ["%.1f" % v["psnr_rgb"] for v in report.get("views", [])]
+        failures = [f for v in report.get("views", []) for f in v.get("failures", [])]
+    except ValueError:
+        report, failures = None, []
+    if rc == 0:
+        rec["result"] = "pass"
+    else:
+        rec["result"] = "FAIL"
+        rec["why"] = "validate exit %s: %s" % (rc, failures[0] if failures else last_error(err))
+    return rec
+
+
+def write_table(args, rows):
+    counts = {}
+    for _, _, _, rec in rows:
+        counts[rec["result"]] = counts.get(rec["result"], 0) + 1
+    gl = [r for r in rows if r[1] == "glTF"]
+    gl_pass = sum(1 for r in gl if r[3]["result"] == "pass")
+    lines = [
+        "# Conformance: Debian's assimp-testmodels",
+        "",
+        "Written by `scripts/conformance.sh` (do not edit by hand): every model of the",
+        "`assimp-testmodels` package that has a material (glTF) or names a texture (OBJ, FBX,",
+        "COLLADA, PLY, 3DS), baked with default flags and validated with default bounds.",
+        "**pass**: baked and every view validated; **refused**: exit 2 with the message shown;",
+        "**FAIL**: a crash, a timeout, exit 1, or a bake that does not validate.",
+        "PSNR is per validation view (albedo layer, dB). Times are wall-clock seconds on the",
+        "machine that ran it (load average at the start: %s)." % args.load,
+        "",
+        "Totals: %s. glTF models passing: %d of %d (%.0f%%)." % (
+            ", ".join("%d %s" % (n, k) for k, n in sorted(counts.items())), gl_pass, len(gl),
+            100.0 * gl_pass / max(1, len(gl))),
+        "",
+        "| model | format | features | result | bake s | layers | validate PSNR per view | note |",
+        "| --- | --- | --- | --- | ---: | --- | --- | --- |",
+    ]
+    for path, fmt, feats, rec in rows:
+        note = rec.get("why", "")
+        if not note and rec["warnings"]:
+            note = "warning: " + "; ".join(rec["warnings"][:2])
+        note = note.replace("|", "\\|").replace(args.corpus + "/", "")
+        lines.append("| %s | %s | %s | %s | %.1f | %s | %s | %s |" % (
+            os.path.relpath(path, args.corpus), fmt, ", ".join(feats).replace("|", "/"),
+            rec["result"], rec["bake_s"], " ".join(rec["layers"]), " / ".join(rec["views"]),
+            note))
+    with open(args.out, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    return counts
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    for k in ("vtbake", "corpus", "work", "out", "only"):
+        ap.add_argument("--" + k, default="")
+    ap.add_argument("--timeout", type=int, default=600)
+    args = ap.parse_args()
+    args.corpus = os.path.abspath(args.corpus)
+    args.load = open("/proc/loadavg").read().split()[0] if os.path.exists("/proc/loadavg") else "?"
+    models = select(args.corpus, args.only)
+    rows = []
+    for i, (path, fmt, feats) in enumerate(models):
+        rec = one_model(args, path, i)
+        rows.append((path, fmt, feats, rec))
+        print("[%d/%d] %-8s %6.1f s  %s  %s" % (i + 1, len(models), rec["result"], rec["bake_s"],
+                                                os.path.relpath(path, args.corpus),
+                                                rec.get("why", "")), flush=True)
+    counts = write_table(args, rows)
+    print("conformance: %s; table in %s" % (counts, args.out))
+    return 1 if counts.get("FAIL") else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
