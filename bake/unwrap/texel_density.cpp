@@ -351,8 +351,8 @@ void report_density(const DensityPlan& plan, const scene::Scene& scene,
       w << (i ? ", '" : "'") << coarse[i]->name << "' " << coarse[i]->achieved << " vs "
         << coarse[i]->source << " texels/unit";
     if (coarse.size() > 3) w << ", ...";
-    w << " (raise --max-size or --memory-limit, or set densities with --texels-per-unit or "
-         "--density)";
+    w << " (a larger --size, --max-size or --memory-limit, or a density of their own with "
+         "--texels-per-unit or --density)";
     st->warnings.push_back(w.str());
   }
   if (!plan.source.unreadable.empty())
