@@ -15,6 +15,17 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A sx x sy quad (two triangles) at x offset `x0`, UV set 0 covering [0, uv]^2, material `m`.
+Primitive quad(double sx, double sy, int m, float uv = 1.0f, float x0 = 0.0f) {
+  Primitive p = flat_grid(1, 1, sx, sy);
+  for (auto& v : p.positions) v[0] += x0;
+  p.uvs.resize(1);
+  for (const auto& v : p.positions)
+    p.uvs[0].push_back({float((v[0] - x0) / sx) * uv, float(v[1] / sy) * uv});
+  p.material = m;
+  return p;
+}
+
 class TexelDensity : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -50,23 +61,19 @@ class TexelDensity : public ::testing::Test {
     return int(s.materials.size()) - 1;
   }
 
+  // A 1 x 1 quad whose material `name` has a side x side base colour.
+  Scene textured_quad(const std::string& name, int side) {
+    Scene s = scene_of(quad(1, 1, 0));
+    textured(s, name, png(side, side));
+    return s;
+  }
+
   void write(const std::string& name, const std::string& text) {
     std::ofstream(dir_ / name) << text;
   }
 
   fs::path dir_;
 };
-
-// A sx x sy quad (two triangles) at x offset `x0`, UV set 0 covering [0, uv]^2, material `m`.
-Primitive quad(double sx, double sy, int m, float uv = 1.0f, float x0 = 0.0f) {
-  Primitive p = flat_grid(1, 1, sx, sy);
-  for (auto& v : p.positions) v[0] += x0;
-  p.uvs.resize(1);
-  for (const auto& v : p.positions)
-    p.uvs[0].push_back({float((v[0] - x0) / sx) * uv, float(v[1] / sy) * uv});
-  p.material = m;
-  return p;
-}
 
 unwrap::UnwrapOptions options() {
   unwrap::UnwrapOptions o;
@@ -134,8 +141,7 @@ TEST_F(TexelDensity, EmbeddedImagesAndMissingOnes) {
 }
 
 TEST_F(TexelDensity, DefaultIsTheSourcesDensity) {
-  Scene s = scene_of(quad(1, 1, 0));
-  textured(s, "wall", png(256, 256));
+  Scene s = textured_quad("wall", 256);
   auto o = options();
   o.min_size_pages = 1;
   auto r = unwrap::unwrap_scene(s, o);
@@ -152,8 +158,7 @@ TEST_F(TexelDensity, DefaultIsTheSourcesDensity) {
 }
 
 TEST_F(TexelDensity, CapAndFloor) {
-  Scene dense = scene_of(quad(1, 1, 0));
-  textured(dense, "dense", png(2048, 2048));  // would be 18 pages wide
+  Scene dense = textured_quad("dense", 2048);  // would be 18 pages wide
   auto o = options();
   o.max_size_pages = 8;
   auto r = unwrap::unwrap_scene(dense, o);
@@ -166,8 +171,7 @@ TEST_F(TexelDensity, CapAndFloor) {
   ASSERT_EQ(r->stats.warnings.size(), 1u);     // 2048 vs < 960: more than 2x coarser
   EXPECT_NE(r->stats.warnings[0].find("'dense'"), std::string::npos) << r->stats.warnings[0];
 
-  Scene coarse = scene_of(quad(1, 1, 0));
-  textured(coarse, "coarse", png(16, 16));
+  Scene coarse = textured_quad("coarse", 16);
   auto f = unwrap::unwrap_scene(coarse, options());
   ASSERT_TRUE(f.ok()) << f.status().message();
   EXPECT_EQ(f->stats.density_rule, "sources, floored");
@@ -245,8 +249,7 @@ TEST_F(TexelDensity, MaterialAndObjectDensitiesScaleTheirCharts) {
 }
 
 TEST_F(TexelDensity, ExplicitDensityCoarserThanSourcesWarns) {
-  Scene s = scene_of(quad(1, 1, 0));
-  textured(s, "wall", png(256, 256));
+  Scene s = textured_quad("wall", 256);
   auto o = options();
   o.texels_per_unit = 32;
   auto r = unwrap::unwrap_scene(s, o);
@@ -261,8 +264,7 @@ TEST_F(TexelDensity, ExplicitDensityCoarserThanSourcesWarns) {
 }
 
 TEST_F(TexelDensity, DensityFileBesideTheSceneIsFound) {
-  Scene s = scene_of(quad(1, 1, 0));
-  textured(s, "wall", png(64, 64));
+  Scene s = textured_quad("wall", 64);
   s.source_path = (dir_ / "level.gltf").string();
   EXPECT_EQ(unwrap::default_density_file(s.source_path), (dir_ / "level.density.json").string());
   write("level.density.json", R"({"size_pages": 2})");
@@ -281,8 +283,7 @@ TEST_F(TexelDensity, DensityFileBesideTheSceneIsFound) {
 }
 
 TEST_F(TexelDensity, BadDensityFilesNameTheFileAndTheProblem) {
-  Scene s = scene_of(quad(1, 1, 0));
-  textured(s, "wall", png(8, 8));
+  Scene s = textured_quad("wall", 8);
   s.nodes[0].name = "House";
   const std::pair<const char*, const char*> cases[] = {
       {R"({"materials": {"Wal": 10}})", "no material named 'Wal' (it has 'wall')"},
