@@ -1,12 +1,14 @@
 // The main job (see scene_bake.h).
 #include "bake/scene_bake.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "bake/build_summary_json.h"
+#include "bake/unwrap/texel_density.h"
 
 namespace vt {
 namespace {
@@ -15,6 +17,9 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
+
+// The transfer's buffers per atlas texel: 13 floats at most, plus coverage.
+constexpr uint64_t kTransferBytesPerTexel = 13 * sizeof(float) + 1 + 24;
 
 std::string default_unwrapped(const std::string& output) {
   std::filesystem::path p(output);
@@ -96,6 +101,11 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   unwrap::UnwrapOptions uo = options.unwrap;
   uo.page_payload = int(options.build.payload);
   uo.threads = options.build.threads;
+  // A density from the sources is capped where the transfer's buffers would pass the limit.
+  uo.max_size_pages = std::max(
+      1, std::min(uo.max_size_pages,
+                  unwrap::pages_within(double(options.build.memory_limit) / kTransferBytesPerTexel,
+                                       uo.page_payload)));
   auto unwrapped = unwrap::unwrap_scene(input, uo);
   if (!unwrapped.ok()) return unwrapped.status().with_context("unwrap");
   summary.unwrap = unwrapped->stats;
@@ -103,11 +113,11 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   summary.stages.push_back({"unwrap", seconds_since(t0)});
   report("unwrap", 1.0);
 
-  // Transfer. Its buffers: 13 floats per texel at most, plus coverage.
+  // Transfer.
   t0 = Clock::now();
   const uint32_t W = uint32_t(unwrapped->stats.atlas_width),
                  H = uint32_t(unwrapped->stats.atlas_height);
-  uint64_t transfer_bytes = uint64_t(W) * H * (13 * sizeof(float) + 1 + 24);
+  uint64_t transfer_bytes = uint64_t(W) * H * kTransferBytesPerTexel;
   if (transfer_bytes > options.build.memory_limit) {
     return Error(ErrorCode::kResourceLimit,
                  "transfer: an atlas of " + std::to_string(W) + "x" + std::to_string(H) +
@@ -178,7 +188,8 @@ nlohmann::json to_json(const SceneBakeSummary& s) {
         {"charts", u.charts},
         {"texels_per_unit", u.texels_per_unit},
         {"utilisation", u.utilisation},
-        {"stretch_l2", u.stretch_l2}}},
+        {"stretch_l2", u.stretch_l2},
+        {"density", unwrap::density_json(u)}}},
       {"transfer",
        {{"covered_texels", t.covered_texels},
         {"edge_only_texels", t.edge_only_texels},

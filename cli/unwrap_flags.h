@@ -9,7 +9,8 @@
 
 namespace vt::cli {
 
-// --texels-per-unit and --size (excluding each other), --padding, --method, --share-instances,
+// --texels-per-unit and --size (excluding each other), --max-size, --density, --padding, --method,
+// --share-instances,
 // --max-stretch, --split-rounds, --chart-angle. The page payload and threads are the command's.
 void add_unwrap_flags(CLI::App& app, unwrap::UnwrapOptions& options);
 

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 #include "bake/image_source.h"
 #include "scene/gltf_export.h"
@@ -381,7 +382,14 @@ Status write_sample_scene(const std::string& dir, const SampleSceneOptions& o) {
   add_sample_materials(sc, dir);
   add_sample_meshes(sc, o);
   sc.source_path = (fs::path(dir) / "scene.gltf").string();
-  return scene::save_gltf(sc, sc.source_path, kSampleSceneGltf);
+  VT_RETURN_IF_ERROR(scene::save_gltf(sc, sc.source_path, kSampleSceneGltf));
+  // The scene's own atlas size (bake/unwrap/texel_density.h): its textures would ask for about
+  // 52 x 53 pages (the bricks' 427 texels per unit); 16 keeps the main job within its few
+  // minutes and its output as it always was.
+  const std::string density = (fs::path(dir) / "scene.density.json").string();
+  std::ofstream(density) << "{\"size_pages\": 16}\n";
+  if (!fs::exists(density, ec)) return Error(ErrorCode::kIo, density + ": cannot write");
+  return Status::Ok();
 }
 
 }  // namespace vt

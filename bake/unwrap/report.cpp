@@ -22,6 +22,7 @@ std::string report_json(const UnwrapStats& s) {
                         {"pages_x", s.pages_x},
                         {"pages_y", s.pages_y}}},
                       {"texels_per_unit", s.texels_per_unit},
+                      {"density", density_json(s)},
                       {"utilisation", s.utilisation},
                       {"stretch", {{"l2", s.stretch_l2}, {"linf", s.stretch_linf}}},
                       {"flipped_triangles", s.flipped_triangles},
@@ -35,6 +36,21 @@ std::string report_json(const UnwrapStats& s) {
                         {"output", s.seconds.output},
                         {"check", s.seconds.check}}}};
   return j.dump(2);
+}
+
+nlohmann::json density_json(const UnwrapStats& s) {
+  nlohmann::json materials = nlohmann::json::array();
+  for (const auto& m : s.materials)
+    materials.push_back({{"name", m.name},
+                         {"source", m.source},
+                         {"requested", m.requested},
+                         {"achieved", m.achieved}});
+  return {{"texels_per_unit", s.texels_per_unit},
+          {"source_texels_per_unit", s.source_texels_per_unit},
+          {"rule", s.density_rule},
+          {"file", s.density_file},
+          {"materials", materials},
+          {"warnings", s.warnings}};
 }
 
 namespace {

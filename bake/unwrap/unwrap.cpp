@@ -40,6 +40,7 @@ double cross2(Vec2d a, Vec2d b, Vec2d c) {
 // One primitive of one instance (or of one mesh with share_instances), in world space.
 struct Surface {
   int source_mesh = 0;             // in the input scene
+  int material = -1, node = -1;    // the primitive's material and the instance's node
   int out_mesh = 0, out_prim = 0;  // in the output scene
   std::vector<Vec3d> pos;          // welded vertices, world space minus `origin`
   std::vector<uint32_t> weld;      // source vertex -> welded vertex
@@ -614,8 +615,8 @@ Status check_options(const UnwrapOptions& opt) {
     return Error(ErrorCode::kInvalidArgument, "page payload must be positive");
   if (!(opt.texels_per_unit >= 0) || !std::isfinite(opt.texels_per_unit))
     return Error(ErrorCode::kInvalidArgument, "texels per unit must be a finite positive number");
-  if (opt.texels_per_unit == 0 && opt.size_pages <= 0)
-    return Error(ErrorCode::kInvalidArgument, "give texels per unit or a positive size in pages");
+  if (opt.size_pages < 0 || opt.max_size_pages < 1 || opt.min_size_pages < 1)
+    return Error(ErrorCode::kInvalidArgument, "atlas sizes in pages must be positive");
   return Status::Ok();
 }
 
@@ -624,17 +625,21 @@ Status check_options(const UnwrapOptions& opt) {
 Expected<std::vector<Surface>> collect_surfaces(const scene::Scene& in, const UnwrapOptions& opt,
                                                 int threads, scene::Scene* out) {
   // Which meshes to unwrap, with which world matrix.
-  std::vector<std::pair<int, scene::Mat4>> jobs;  // output mesh -> (source mesh, world)
+  struct Job {
+    int mesh, node;
+    scene::Mat4 world;
+  };
+  std::vector<Job> jobs;  // per output mesh
   std::vector<scene::Instance> instances = in.instances();
   if (opt.share_instances) {
     for (size_t m = 0; m < in.meshes.size(); ++m) {
-      scene::Mat4 world = scene::kIdentity;
+      Job job{static_cast<int>(m), -1, scene::kIdentity};
       for (const auto& inst : instances)
         if (inst.mesh == static_cast<int>(m)) {
-          world = inst.world;
+          job.world = inst.world, job.node = inst.node;
           break;
         }
-      jobs.push_back({static_cast<int>(m), world});
+      jobs.push_back(job);
     }
   } else {
     out->meshes.clear();
@@ -642,16 +647,18 @@ Expected<std::vector<Surface>> collect_surfaces(const scene::Scene& in, const Un
     for (const auto& inst : instances) {
       out->nodes[inst.node].mesh = static_cast<int>(out->meshes.size());
       out->meshes.push_back(in.meshes[inst.mesh]);
-      jobs.push_back({inst.mesh, inst.world});
+      jobs.push_back({inst.mesh, inst.node, inst.world});
     }
   }
   std::vector<Surface> surfaces;
   for (size_t j = 0; j < jobs.size(); ++j) {
-    const scene::Mesh& mesh = in.meshes[jobs[j].first];
+    const scene::Mesh& mesh = in.meshes[jobs[j].mesh];
     for (size_t p = 0; p < mesh.primitives.size(); ++p) {
       if (mesh.primitives[p].indices.empty()) continue;
       Surface s;
-      s.source_mesh = jobs[j].first;
+      s.source_mesh = jobs[j].mesh;
+      s.material = mesh.primitives[p].material;
+      s.node = jobs[j].node;
       s.out_mesh = static_cast<int>(j);
       s.out_prim = static_cast<int>(p);
       surfaces.push_back(std::move(s));
@@ -659,14 +666,14 @@ Expected<std::vector<Surface>> collect_surfaces(const scene::Scene& in, const Un
   }
   for (const auto& s : surfaces) {
     // World matrices can still overflow a finite mesh into inf: name the instance.
-    for (double v : jobs[s.out_mesh].second)
+    for (double v : jobs[s.out_mesh].world)
       if (!std::isfinite(v))
         return Error(ErrorCode::kInvalidArgument,
                      "mesh '" + in.meshes[s.source_mesh].name + "': non-finite node transform");
   }
   parallel_for(surfaces.size(), threads, [&](size_t i) {
     Surface& s = surfaces[i];
-    weld(in.meshes[s.source_mesh].primitives[s.out_prim], &s, jobs[s.out_mesh].second);
+    weld(in.meshes[s.source_mesh].primitives[s.out_prim], &s, jobs[s.out_mesh].world);
     build_topology(&s);
   });
   for (const auto& s : surfaces)
@@ -730,15 +737,17 @@ std::vector<Chart> parameterize_until_valid(const std::vector<Surface>& surfaces
   return done;
 }
 
-// Charts scaled to `tpu` texels per world unit, rotated and boxed for packing.
-std::vector<detail::PackChart> make_pack_charts(const std::vector<Chart>& charts, double tpu,
+// Charts scaled to `tpu` texels per world unit times their weight (their own density over the
+// scene's; 1 for most), rotated and boxed for packing.
+std::vector<detail::PackChart> make_pack_charts(const std::vector<Chart>& charts,
+                                                const std::vector<double>& weight, double tpu,
                                                 int threads) {
   std::vector<detail::PackChart> pcs(charts.size());
   parallel_for(charts.size(), threads, [&](size_t i) {
     const Chart& c = charts[i];
     double k = (c.degenerate || !(c.area3d > 0) || !(c.area_uv > 0))
-                   ? (c.degenerate ? 0.5 : tpu)
-                   : std::sqrt(c.area3d / c.area_uv) * tpu;
+                   ? (c.degenerate ? 0.5 : tpu * weight[i])
+                   : std::sqrt(c.area3d / c.area_uv) * tpu * weight[i];
     if (!std::isfinite(k)) k = 0.5;
     detail::PackChart& pc = pcs[i];
     pc.points.resize(c.uv.size());
@@ -764,8 +773,10 @@ int atlas_width_for(const std::vector<detail::PackChart>& pcs, const UnwrapOptio
 
 // A packed atlas: the charts as packed and where they went.
 struct PackedAtlas {
-  double texels_per_unit = 0;
+  double texels_per_unit = 0;  // of weight 1
   int width = 0;
+  bool square = false;  // fitted to a size: as high as wide
+  std::string bound;    // ", capped" or ", floored" when the sources' density left the bounds
   std::vector<detail::PackChart> charts;
   detail::PackResult packed;
 };
@@ -773,50 +784,56 @@ struct PackedAtlas {
 // The starting density for a square atlas `width` texels wide: an optimistic fill, bounded so
 // that no chart is longer than the atlas (a chart's bounding-box diagonal at one texel per unit
 // bounds every rotation's extent).
-double first_density_guess(const std::vector<Chart>& charts, int width) {
+double first_density_guess(const std::vector<Chart>& charts, const std::vector<double>& weight,
+                           int width) {
   double area3d = 0;
-  for (const auto& c : charts) area3d += c.area3d;
+  for (size_t i = 0; i < charts.size(); ++i) area3d += charts[i].area3d * weight[i] * weight[i];
   double tpu = std::sqrt(0.7 * static_cast<double>(width) * width / std::max(area3d, 1e-300));
   if (!(area3d > 0)) tpu = 1;
   double longest = 0;
-  for (const auto& c : charts) {
+  for (size_t i = 0; i < charts.size(); ++i) {
+    const Chart& c = charts[i];
     if (c.degenerate || !(c.area3d > 0) || !(c.area_uv > 0)) continue;
     const auto [lo, hi] = bounds_of(c.uv);
-    longest =
-        std::max(longest, std::hypot(hi.x - lo.x, hi.y - lo.y) * std::sqrt(c.area3d / c.area_uv));
+    longest = std::max(longest, std::hypot(hi.x - lo.x, hi.y - lo.y) *
+                                    std::sqrt(c.area3d / c.area_uv) * weight[i]);
   }
   if (longest > 0) tpu = std::min(tpu, (width - 2.0) / longest);
   return tpu;
 }
 
-// Stage 4: chooses the texel density and packs. With texels_per_unit given the atlas width
-// follows from it; otherwise the density is searched (bisection on the scale) so that the
-// packed atlas fits size_pages × size_pages pages.
-Expected<PackedAtlas> choose_density_and_pack(const std::vector<Chart>& charts,
-                                              const UnwrapOptions& opt, int threads) {
+// At `tpu` exactly: the atlas width follows from the charts, its height from the packing.
+Expected<PackedAtlas> pack_at_density(const std::vector<Chart>& charts,
+                                      const std::vector<double>& weight, double tpu,
+                                      const UnwrapOptions& opt, int threads) {
   PackedAtlas best;
-  if (opt.texels_per_unit > 0) {
-    best.texels_per_unit = opt.texels_per_unit;
-    best.charts = make_pack_charts(charts, opt.texels_per_unit, threads);
-    best.width = atlas_width_for(best.charts, opt);
-    if (static_cast<int64_t>(best.width) * best.width > opt.max_atlas_texels)
-      return Error(ErrorCode::kResourceLimit, "atlas of " + std::to_string(best.width) +
-                                                  " texels wide at " +
-                                                  std::to_string(opt.texels_per_unit) +
-                                                  " texels per unit exceeds the atlas limit");
-    best.packed = detail::pack_charts(best.charts, best.width, opt.padding, threads);
-    return best;
-  }
-  const int width = opt.size_pages * opt.page_payload;
+  best.texels_per_unit = tpu;
+  best.charts = make_pack_charts(charts, weight, tpu, threads);
+  best.width = atlas_width_for(best.charts, opt);
+  if (static_cast<int64_t>(best.width) * best.width > opt.max_atlas_texels)
+    return Error(ErrorCode::kResourceLimit, "atlas of " + std::to_string(best.width) +
+                                                " texels wide at " + std::to_string(tpu) +
+                                                " texels per unit exceeds the atlas limit");
+  best.packed = detail::pack_charts(best.charts, best.width, opt.padding, threads);
+  return best;
+}
+
+// The densest scale at which the charts fit `pages` x `pages` (bisection on the scale).
+Expected<PackedAtlas> pack_to_fit(const std::vector<Chart>& charts,
+                                  const std::vector<double>& weight, int pages,
+                                  const UnwrapOptions& opt, int threads) {
+  PackedAtlas best;
+  const int width = pages * opt.page_payload;
   if (static_cast<int64_t>(width) * width > opt.max_atlas_texels)
     return Error(ErrorCode::kResourceLimit,
-                 "atlas of " + std::to_string(opt.size_pages) + " pages exceeds the atlas limit");
+                 "atlas of " + std::to_string(pages) + " pages exceeds the atlas limit");
   best.width = width;
+  best.square = true;
   double lo = 0, hi = 0;
-  double tpu = first_density_guess(charts, width);
+  double tpu = first_density_guess(charts, weight, width);
   bool have_fit = false;
   for (int iter = 0; iter < 16; ++iter) {
-    auto trial = make_pack_charts(charts, tpu, threads);
+    auto trial = make_pack_charts(charts, weight, tpu, threads);
     int w = atlas_width_for(trial, opt);
     bool fits = false;
     detail::PackResult pr;
@@ -840,8 +857,70 @@ Expected<PackedAtlas> choose_density_and_pack(const std::vector<Chart>& charts,
   }
   if (!have_fit)
     return Error(ErrorCode::kResourceLimit,
-                 "charts do not fit in " + std::to_string(opt.size_pages) + " pages");
+                 "charts do not fit in " + std::to_string(pages) + " pages");
   return best;
+}
+
+// Stage 4: chooses the texel density and packs, as the density plan says: at a given density,
+// fitted to a size, or at the sources' density unless the atlas side would leave the bounds
+// (then fitted to the bound it crossed).
+Expected<PackedAtlas> choose_density_and_pack(const std::vector<Chart>& charts,
+                                              const std::vector<double>& weight,
+                                              const detail::DensityPlan& plan,
+                                              const UnwrapOptions& opt, int threads) {
+  using Mode = detail::DensityPlan::Mode;
+  if (plan.mode == Mode::kExact)
+    return pack_at_density(charts, weight, plan.texels_per_unit, opt, threads);
+  if (plan.mode == Mode::kFitPages) return pack_to_fit(charts, weight, plan.pages, opt, threads);
+  const int lo = plan.min_pages * opt.page_payload, hi = plan.max_pages * opt.page_payload;
+  // The width estimate alone rules out an atlas far over the cap before any packing.
+  int width = atlas_width_for(make_pack_charts(charts, weight, plan.texels_per_unit, threads), opt);
+  if (width <= hi) {
+    auto exact = pack_at_density(charts, weight, plan.texels_per_unit, opt, threads);
+    if (!exact.ok()) return exact;
+    int side = std::max(exact->width, exact->packed.height);
+    if (side <= hi && !exact->packed.overflow && side >= lo) return exact;
+    width = side;
+  }
+  auto fitted =
+      pack_to_fit(charts, weight, width > hi ? plan.max_pages : plan.min_pages, opt, threads);
+  if (fitted.ok()) fitted->bound = width > hi ? ", capped" : ", floored";
+  return fitted;
+}
+
+// Each chart's density over the scene's: its object's or material's own density, 1 for most.
+// Without a scene density (a fitted size and no textures), own densities are taken relative to
+// the first guess for that size.
+std::vector<double> chart_weights(const std::vector<Surface>& surfaces,
+                                  const std::vector<Chart>& charts, const detail::DensityPlan& plan,
+                                  const UnwrapOptions& opt) {
+  std::vector<double> weight(charts.size(), 1.0);
+  double base = plan.texels_per_unit;
+  for (size_t i = 0; i < charts.size(); ++i) {
+    const Surface& s = surfaces[charts[i].surface];
+    double own = plan.wanted(s.material, s.node);
+    if (!(own > 0)) continue;
+    if (!(base > 0))
+      base = first_density_guess(charts, std::vector<double>(charts.size(), 1.0),
+                                 plan.pages * opt.page_payload);
+    weight[i] = own / base;
+  }
+  return weight;
+}
+
+// The area-weighted density each material's charts got.
+std::vector<double> material_densities(const scene::Scene& in, const std::vector<Surface>& surfaces,
+                                       const std::vector<Chart>& charts,
+                                       const std::vector<double>& weight, double tpu) {
+  std::vector<double> sum(in.materials.size(), 0.0), area(in.materials.size(), 0.0);
+  for (size_t i = 0; i < charts.size(); ++i) {
+    int m = surfaces[charts[i].surface].material;
+    if (m < 0 || m >= static_cast<int>(sum.size()) || charts[i].degenerate) continue;
+    sum[m] += charts[i].area3d * tpu * weight[i];
+    area[m] += charts[i].area3d;
+  }
+  for (size_t m = 0; m < sum.size(); ++m) sum[m] = area[m] > 0 ? sum[m] / area[m] : 0.0;
+  return sum;
 }
 
 // Per-surface sums for the stretch statistics.
@@ -978,6 +1057,10 @@ Expected<UnwrapResult> unwrap_scene(const scene::Scene& in, const UnwrapOptions&
   UnwrapStats& st = result.stats;
   result.scene = in;
 
+  // The density plan first: a bad density file fails before any work.
+  auto plan = detail::plan_density(in, opt);
+  if (!plan.ok()) return plan.status();
+
   auto t0 = Clock::now();
   auto surfaces = collect_surfaces(in, opt, threads, &result.scene);
   if (!surfaces.ok()) return surfaces.status();
@@ -995,13 +1078,17 @@ Expected<UnwrapResult> unwrap_scene(const scene::Scene& in, const UnwrapOptions&
   st.seconds.parameterize = seconds_since(t0);
 
   t0 = Clock::now();
-  auto atlas = choose_density_and_pack(charts, opt, threads);
+  const std::vector<double> weight = chart_weights(*surfaces, charts, *plan, opt);
+  auto atlas = choose_density_and_pack(charts, weight, *plan, opt, threads);
   if (!atlas.ok()) return atlas.status();
   const int page = opt.page_payload;
   st.texels_per_unit = atlas->texels_per_unit;
+  st.density_rule = plan->rule + atlas->bound;
+  detail::report_density(
+      *plan, in, material_densities(in, *surfaces, charts, weight, atlas->texels_per_unit), &st);
   st.atlas_width = atlas->width;
   st.atlas_height = std::max(page, (atlas->packed.height + page - 1) / page * page);
-  if (opt.texels_per_unit == 0) st.atlas_height = atlas->width;  // a requested size is a square
+  if (atlas->square) st.atlas_height = atlas->width;  // a fitted size is a square
   st.pages_x = st.atlas_width / page;
   st.pages_y = st.atlas_height / page;
   st.seconds.pack = seconds_since(t0);

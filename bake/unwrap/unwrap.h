@@ -1,12 +1,14 @@
 // vtbake's unwrapper: gives every triangle of a scene its own texels in one atlas.
 // Charts are grown on normal deviation (material boundaries and original UV seams always cut),
 // cut to disks, parameterised with CGAL (LSCM or ARAP), checked for flips, self-overlap and
-// stretch (failing charts are split and redone), scaled to one world texel density and packed
-// with rotation and a gutter into an atlas that is a whole number of pages.
+// stretch (failing charts are split and redone), scaled to a world texel density (the scene's,
+// from its textures by default, or a material's or object's own) and packed with rotation and a
+// gutter into an atlas that is a whole number of pages.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 
@@ -18,19 +20,32 @@ namespace vt::unwrap {
 enum class Method { kLscm, kArap };
 
 struct UnwrapOptions {
-  // World texel density. 0 = derive it so the atlas fits `size_pages` × `size_pages` pages.
+  // World texel density (texels per world unit). 0 = chosen: to fit `size_pages` when given,
+  // else the sources' density (texel_density.h) held within [min_size_pages, max_size_pages],
+  // else (nothing textured) to fit kDefaultSizePages.
   double texels_per_unit = 0.0;
-  int size_pages = 16;     // target atlas side in pages when texels_per_unit is 0
+  int size_pages = 0;      // fit the atlas to size_pages × size_pages pages; 0 = not asked
   int page_payload = 120;  // the atlas is a whole number of pages of this many texels
   int padding = 4;         // empty texels kept between any two charts (the gutter)
   Method method = Method::kLscm;
   bool share_instances = false;       // false: every instance gets its own texels (megatexture)
   double max_chart_angle_deg = 60.0;  // a face joins a chart only within this cone of normals
   double max_chart_stretch = 1.05;    // chart L2 stretch above this is split and redone
-  int max_split_rounds = 4;           // stretch-driven split rounds (disk/flip splits always run)
+  int max_split_rounds = 4;           // stretch split-and-redo rounds (disk/flip splits always run)
   int threads = 0;                    // 0 = hardware concurrency
   int64_t max_atlas_texels = int64_t{16384} * 16384;  // larger atlases are a resource error
+  // Bounds on the side of an atlas sized by the sources' density: a larger one is fitted to
+  // max_size_pages (every density scaled alike), a smaller one to min_size_pages.
+  int max_size_pages = 128;
+  int min_size_pages = 4;
+  // Per-material and per-object densities and the scene's own density or size, as a density
+  // file (texel_density.h). "" = the scene's NAME.density.json when it exists; "-" = none.
+  // --texels-per-unit and --size (the fields above) win over the file's.
+  std::string density_file;
 };
+
+// The atlas side, in pages, when nothing sets the density: no texture gives one.
+constexpr int kDefaultSizePages = 16;
 
 // Time spent per stage, seconds.
 struct StageTimes {
@@ -45,7 +60,22 @@ struct UnwrapStats {
   int64_t charts_split = 0;  // charts split for non-disk topology, flips, overlap or stretch
   int atlas_width = 0, atlas_height = 0;  // texels
   int pages_x = 0, pages_y = 0;
-  double texels_per_unit = 0;
+  double texels_per_unit = 0;         // achieved by every chart without its own density
+  double source_texels_per_unit = 0;  // the sources' density (kSourcePercentile), 0 = none
+  // How the density was chosen: "texels_per_unit" (asked), "size" (fit size_pages), "sources",
+  // "sources, capped" (fitted to max_size_pages), "sources, floored" (to min_size_pages),
+  // "default size" (nothing textured).
+  std::string density_rule;
+  std::string density_file;  // the density file read, "" = none
+  struct MaterialDensity {
+    std::string name;
+    double source = 0;     // texels per unit its textures give (area-weighted median), 0 = none
+    double requested = 0;  // its own density from the density file, 0 = none
+    double achieved = 0;   // texels per unit its charts got (area-weighted mean)
+  };
+  std::vector<MaterialDensity> materials;  // materials with a source or a requested density
+  // E.g. the bake is more than 2x coarser than its sources, naming the worst materials.
+  std::vector<std::string> warnings;
   double utilisation = 0;  // texel centres covered by a triangle / atlas texels
   double stretch_l2 = 0;   // Sander et al., area weighted, normalised so UV area = 3D area
   double stretch_linf = 0;
@@ -91,6 +121,10 @@ AtlasCheck check_atlas(const std::vector<AtlasTriangle>& triangles, int width, i
 
 // The unwrap report as JSON text.
 std::string report_json(const UnwrapStats& stats);
+// The density part of the report (also in the scene bake's): {"texels_per_unit",
+// "source_texels_per_unit", "rule", "file", "materials": [{"name", "source", "requested",
+// "achieved"}], "warnings"}.
+nlohmann::json density_json(const UnwrapStats& stats);
 // A PNG of the atlas: left half charts in distinct colours, right half L2 stretch (blue = 1,
 // red >= 1.5), background dark. At most max_side pixels per half-side (the atlas is scaled down).
 Status write_atlas_picture(const UnwrapResult& result, const std::string& path,

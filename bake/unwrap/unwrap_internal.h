@@ -6,6 +6,9 @@
 #include <cstdint>
 #include <vector>
 
+#include <string>
+
+#include "bake/unwrap/texel_density.h"
 #include "bake/unwrap/unwrap.h"
 #include "common/vec.h"
 
@@ -70,5 +73,31 @@ PackResult pack_charts(const std::vector<PackChart>& charts, int width, int padd
 
 // Applies a placement to a local point (the inverse of nothing: used to write atlas UVs).
 Vec2d place_point(const PackChart& chart, const Placement& placement, const Vec2d& p);
+
+// How stage 4 sizes the atlas: the options, the density file and the sources' density decide
+// (texel_density.cpp).
+struct DensityPlan {
+  enum class Mode {
+    kExact,     // texels_per_unit as given
+    kFitPages,  // scaled to fill pages x pages
+    kBounded,   // texels_per_unit unless the atlas side leaves [min_pages, max_pages]
+  };
+  Mode mode = Mode::kFitPages;
+  double texels_per_unit = 0;  // the density of a chart with no density of its own; 0 = none
+  int pages = 0;
+  int min_pages = 0, max_pages = 0;
+  std::vector<double> material_texels_per_unit, node_texels_per_unit;  // 0 = none
+  SourceDensity source;
+  std::string rule, file;  // UnwrapStats::density_rule (before bounds) and density_file
+
+  // The density a surface of `material` under `node` asks for; 0 = the scene's.
+  double wanted(int material, int node) const;
+};
+Expected<DensityPlan> plan_density(const scene::Scene& scene, const UnwrapOptions& options);
+
+// Fills UnwrapStats' density fields but the rule after packing: `achieved` is the area-weighted
+// density per material (0 = not drawn), and the warning names materials under half their sources.
+void report_density(const DensityPlan& plan, const scene::Scene& scene,
+                    const std::vector<double>& achieved, UnwrapStats* stats);
 
 }  // namespace vt::unwrap::detail

@@ -1,0 +1,81 @@
+// Texel density from the sources: how many texels per world unit a scene's textures give on its
+// surfaces, the statistic the atlas is sized by, and the density side file (per-material and
+// per-object densities). Image sizes come from headers only (OpenImageIO), never from pixels.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "common/status.h"
+#include "scene/scene.h"
+
+namespace vt::unwrap {
+
+// The fraction of textured area the default atlas density must serve: the area-weighted 90th
+// percentile of the per-triangle source density. The median would halve the density of the
+// detailed tenth of a scene (signs, faces); the maximum would let one small, densely mapped
+// decal size the whole atlas.
+constexpr double kSourcePercentile = 0.9;
+
+// One textured triangle: its linear source density (texels per world unit) and its world area.
+struct DensitySample {
+  double texels_per_unit = 0;
+  double area = 0;
+};
+
+// The area-weighted quantile `p` (0..1) of `samples`: the smallest density d such that the
+// triangles with density <= d hold at least p of the total area. 0 when there is no area.
+double area_percentile(std::vector<DensitySample> samples, double p);
+
+// The linear source density of one triangle: sqrt(width * height * uv_area / world_area) for a
+// texture of width x height texels, uv_area in UV units (1 = the whole texture once) and
+// world_area in square world units. 0 when either area is zero or not finite.
+double triangle_source_density(double width, double height, double uv_area, double world_area);
+
+// Width and height of an image from its header (a file or embedded bytes).
+Expected<std::array<int, 2>> image_size(const scene::Image& image);
+
+struct SourceDensity {
+  // Per material (Scene::materials order): the area-weighted median density of its textured
+  // triangles (the slot with the most texels per triangle), 0 = untextured or never drawn.
+  std::vector<double> material;
+  std::vector<double> material_area;  // world area of each material's textured triangles
+  double scene = 0;                   // kSourcePercentile over every textured triangle, 0 = none
+  // Images whose header could not be read ("NAME: why"): their slots give no density. Transfer
+  // reports missing textures by its own policy, so this is not an error here.
+  std::vector<std::string> unreadable;
+};
+
+// Measures the scene's source density over every mesh instance in world space (with
+// share_instances, each mesh once, placed by its first instance, as the unwrapper does). Reads
+// the header of every image a drawn material uses.
+SourceDensity measure_source_density(const scene::Scene& scene, bool share_instances);
+
+// The density side file, JSON:
+//   {"texels_per_unit": 40, "size_pages": 16,
+//    "materials": {"Brick": 200}, "objects": {"Sign": 400}}
+// every key optional. "texels_per_unit" and "size_pages" are the scene's density or atlas size
+// (as --texels-per-unit and --size; the command line wins); "materials" name materials and
+// "objects" name nodes (a node's density covers its subtree; the deepest named node wins, and an
+// object's density wins over its material's). Densities are texels per world unit.
+struct DensityFile {
+  std::string path;
+  double texels_per_unit = 0;
+  int size_pages = 0;
+  std::vector<double> material_texels_per_unit;  // per material, 0 = not named
+  std::vector<double> node_texels_per_unit;      // per node, 0 = not named (subtrees applied)
+};
+
+// Reads and checks a side file against the scene: errors name the file and the problem (bad
+// JSON, a non-positive density, a material or object the scene does not have).
+Expected<DensityFile> load_density_file(const std::string& path, const scene::Scene& scene);
+
+// The side file looked for beside a scene when none is named: "DIR/NAME.gltf" ->
+// "DIR/NAME.density.json". "" for a scene with no source path.
+std::string default_density_file(const std::string& scene_path);
+
+// The largest square atlas side, in pages of `page_payload` texels, whose texels fit `texels`.
+int pages_within(double texels, int page_payload);
+
+}  // namespace vt::unwrap
