@@ -115,9 +115,11 @@ std::vector<JsonFields> JsonFields::objects(const char* key) const {
     fail(key, "expected an array");
     return result;
   }
-  for (size_t i = 0; i < it->size(); ++i)
+  for (size_t i = 0; i < it->size(); ++i) {
     result.emplace_back(errors_, (*it)[i],
                         where(key) + "[" + std::to_string(i) + "]" + quoted_name((*it)[i]));
+    result.back().string("name");  // every glTF object's name is a string
+  }
   return result;
 }
 

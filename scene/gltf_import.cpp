@@ -110,17 +110,17 @@ Expected<Scene> load_document(Gltf& g, std::vector<uint8_t>* glb_bin) {
   FieldErrors errors(g);
   JsonFields root(&errors, g.doc, "");
   VT_RETURN_IF_ERROR(check_required_extensions(root));
+  // The JSON-only steps first: a bad document is refused before any buffer is read.
   check_mesh_fields(root, &warnings);
-  VT_RETURN_IF_ERROR(errors.status());
-  VT_RETURN_IF_ERROR(load_buffers(&g, glb_bin));
-  VT_RETURN_IF_ERROR(load_images(g, root, &scene));
   ExtensionUses uses;
   scene.materials = load_materials(root, &uses, &warnings);
   VT_RETURN_IF_ERROR(errors.status());
-  VT_RETURN_IF_ERROR(load_meshes(g, &scene));
   VT_RETURN_IF_ERROR(load_nodes(root, &scene));
   warn_about_extensions(root, uses, &warnings);
   VT_RETURN_IF_ERROR(errors.status());
+  VT_RETURN_IF_ERROR(load_buffers(&g, glb_bin));
+  VT_RETURN_IF_ERROR(load_images(g, root, &scene));
+  VT_RETURN_IF_ERROR(load_meshes(g, &scene));
   return scene;
 }
 
