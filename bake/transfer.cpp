@@ -867,7 +867,8 @@ Status check_texcoord_sets(const scene::Scene& scene) {
                      "mesh '" + mesh.name + "' primitive " + std::to_string(pi) + ": " +
                          material_label(scene, m) + " " + ts.name + " reads TEXCOORD_" +
                          std::to_string(r.texcoord) + ", which the primitive lacks (it has " +
-                         std::to_string(p.uvs.size()) + " UV sets)");
+                         std::to_string(p.uvs.size()) +
+                         (p.uvs.size() == 1 ? " UV set)" : " UV sets)"));
       }
     }
   }
