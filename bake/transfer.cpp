@@ -397,6 +397,7 @@ Status Transfer::setup_images() {
     if (!spec) {
       // Reported per material slot by check_missing_textures.
       slot.error = ts_->geterror();
+      slot.error = slot.error.substr(0, slot.error.find('\n'));  // further lines repeat it
       if (slot.error.empty()) slot.error = "OpenImageIO cannot read it";
       continue;
     }
