@@ -324,6 +324,8 @@ class Transfer {
   void evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, const double l[3],
                 Sample& s) const;
   void make_eval(uint32_t t, TriEval& te) const;
+  std::vector<TransferLayer> make_layers(std::vector<float> (&acc)[kSlots],
+                                         const std::vector<uint8_t>& coverage) const;
 
   const scene::Scene& scene_;
   const TransferOptions& opt_;
@@ -702,6 +704,55 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
   }
 }
 
+// The layers called for, from the accumulators: alpha only if some covered texel is not
+// opaque, normals renormalised, values above 1 counted.
+std::vector<TransferLayer> Transfer::make_layers(std::vector<float> (&acc)[kSlots],
+                                                 const std::vector<uint8_t>& coverage) const {
+  const size_t N = coverage.size();
+  std::vector<TransferLayer> layers;
+  for (int l = 0; l < kSlots; ++l) {
+    if (!want_[l]) continue;
+    TransferLayer layer;
+    layer.semantic = kSlotInfo[l].semantic;
+    layer.channels = kSlotInfo[l].channels;
+    if (l != kNormalSlot) {
+      // Channels 0-2 of albedo are colour, 3 is alpha (counted before alpha is dropped).
+      const uint32_t channels = kSlotInfo[l].channels;
+      const uint32_t counted = l == kAlbedoSlot ? 3 : channels;
+      for (size_t i = 0; i < N; ++i) {
+        if (!coverage[i]) continue;
+        const float* v = &acc[l][i * channels];
+        const float top = *std::max_element(v, v + counted);
+        if (top > 1.0f) ++layer.texels_above_one, layer.max_value = std::max(layer.max_value, top);
+      }
+    }
+    if (l == kAlbedoSlot) {
+      bool alpha = false;
+      for (size_t i = 0; i < N && !alpha; ++i) alpha = coverage[i] && acc[l][4 * i + 3] < kOpaque;
+      if (!alpha) {
+        std::vector<float> rgb(N * 3);
+        for (size_t i = 0; i < N; ++i)
+          for (int c = 0; c < 3; ++c) rgb[3 * i + c] = acc[l][4 * i + c];
+        acc[l] = std::move(rgb);
+        layer.channels = 3;
+      }
+    }
+    if (l == kNormalSlot) {
+      for (size_t i = 0; i < N; ++i) {
+        float* n = &acc[l][3 * i];
+        if (!coverage[i]) continue;
+        Vec3d v = normalized(Vec3d{n[0], n[1], n[2]}, {0, 0, 1});
+        n[0] = float(v.x), n[1] = float(v.y), n[2] = float(v.z);
+      }
+    } else {
+      for (float v : acc[l]) layer.hdr |= v > 1.0f;
+    }
+    layer.texels = std::move(acc[l]);
+    layers.push_back(std::move(layer));
+  }
+  return layers;
+}
+
 Expected<TransferResult> Transfer::run() {
   auto start = std::chrono::steady_clock::now();
   const uint32_t W = opt_.width, H = opt_.height;
@@ -791,48 +842,7 @@ Expected<TransferResult> Transfer::run() {
   });
   if (lookup_failed_) return Error(ErrorCode::kIo, lookup_error_);
 
-  // Layers: only those called for; alpha only if some covered texel is not opaque.
-  for (int l = 0; l < kSlots; ++l) {
-    if (!want_[l]) continue;
-    TransferLayer layer;
-    layer.semantic = kSlotInfo[l].semantic;
-    layer.channels = kSlotInfo[l].channels;
-    if (l != kNormalSlot) {
-      // Channels 0-2 of albedo are colour, 3 is alpha (counted before alpha is dropped).
-      const uint32_t channels = kSlotInfo[l].channels;
-      const uint32_t counted = l == kAlbedoSlot ? 3 : channels;
-      for (size_t i = 0; i < N; ++i) {
-        if (!(*coverage)[i]) continue;
-        const float* v = &acc[l][i * channels];
-        const float top = *std::max_element(v, v + counted);
-        if (top > 1.0f) ++layer.texels_above_one, layer.max_value = std::max(layer.max_value, top);
-      }
-    }
-    if (l == kAlbedoSlot) {
-      bool alpha = false;
-      for (size_t i = 0; i < N && !alpha; ++i)
-        alpha = (*coverage)[i] && acc[l][4 * i + 3] < kOpaque;
-      if (!alpha) {
-        std::vector<float> rgb(N * 3);
-        for (size_t i = 0; i < N; ++i)
-          for (int c = 0; c < 3; ++c) rgb[3 * i + c] = acc[l][4 * i + c];
-        acc[l] = std::move(rgb);
-        layer.channels = 3;
-      }
-    }
-    if (l == kNormalSlot) {
-      for (size_t i = 0; i < N; ++i) {
-        float* n = &acc[l][3 * i];
-        if (!(*coverage)[i]) continue;
-        Vec3d v = normalized(Vec3d{n[0], n[1], n[2]}, {0, 0, 1});
-        n[0] = float(v.x), n[1] = float(v.y), n[2] = float(v.z);
-      }
-    } else {
-      for (float v : acc[l]) layer.hdr |= v > 1.0f;
-    }
-    layer.texels = std::move(acc[l]);
-    result.layers.push_back(std::move(layer));
-  }
+  result.layers = make_layers(acc, *coverage);
   result.coverage = coverage;
   result.missing_textures = missing_;
   result.stats.triangles = tris_.size();

@@ -189,12 +189,17 @@ TEST(TransferRules, VertexColoursMultiplyBaseColour) {
     }
 }
 
-TEST(TransferRules, MissingTextureIsAnErrorNamingMaterialSlotAndPath) {
-  test::ScratchDir dir;
+// Material 'Brick': a base colour factor and a texture file that does not exist.
+scene::Scene brick_scene(const test::ScratchDir& dir) {
   scene::Material m;
   m.name = "Brick";
   m.base_color_factor = {0.5f, 0.25f, 1.0f, 1.0f};
-  scene::Scene s = test::textured_scene(atlas_quad(), dir.file("missing.png"), m);
+  return test::textured_scene(atlas_quad(), dir.file("missing.png"), m);
+}
+
+TEST(TransferRules, MissingTextureIsAnErrorNamingMaterialSlotAndPath) {
+  test::ScratchDir dir;
+  scene::Scene s = brick_scene(dir);
   auto r = transfer_materials(s, atlas_options());
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), ErrorCode::kNotFound);
@@ -207,10 +212,7 @@ TEST(TransferRules, MissingTextureIsAnErrorNamingMaterialSlotAndPath) {
 
 TEST(TransferRules, MissingTextureWarnBakesTheFactorAlone) {
   test::ScratchDir dir;
-  scene::Material m;
-  m.name = "Brick";
-  m.base_color_factor = {0.5f, 0.25f, 1.0f, 1.0f};
-  scene::Scene s = test::textured_scene(atlas_quad(), dir.file("missing.png"), m);
+  scene::Scene s = brick_scene(dir);
   s.materials[0].emissive_texture.image = s.materials[0].base_color_texture.image;
   s.materials[0].emissive_factor = {1, 1, 1};
   TransferOptions o = atlas_options();
