@@ -27,6 +27,50 @@ std::string default_unwrapped(const std::string& output) {
   return p.string();
 }
 
+// 1234567 -> "1,234,567".
+std::string with_thousands(uint64_t n) {
+  std::string digits = std::to_string(n), out;
+  for (size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
+    out += digits[i];
+  }
+  return out;
+}
+
+// The transferred layers with values above 1 (`clipped` is known once the layers are built).
+std::vector<LayerRange> layer_ranges(const std::vector<TransferLayer>& transferred) {
+  std::vector<LayerRange> out;
+  for (const TransferLayer& t : transferred) {
+    if (t.texels_above_one == 0) continue;
+    LayerRange r;
+    r.semantic = t.semantic;
+    r.layer = to_string(t.semantic);
+    r.texels_above_one = t.texels_above_one;
+    r.max_value = t.max_value;
+    out.push_back(r);
+  }
+  return out;
+}
+
+// An 8-bit layer clips to 1; a float one keeps the values.
+void mark_clipped(const BuildSummary& built, std::vector<LayerRange>& ranges) {
+  for (LayerRange& r : ranges)
+    for (const LayerSummary& l : built.layers)
+      if (l.spec.semantic == r.semantic)
+        r.layer = l.name, r.clipped = l.spec.texel_type == TexelType::kU8;
+}
+
+std::string range_warning(const LayerRange& r) {
+  char max[32];
+  std::snprintf(max, sizeof max, "%.4g", double(r.max_value));
+  std::string line =
+      r.layer + ": " + with_thousands(r.texels_above_one) + " texels above 1.0 (max " + max + ")";
+  return r.clipped ? line +
+                         " clipped: the layer stores 8 bits (HDR storage comes with BC6H; "
+                         "--codec raw keeps float)"
+                   : line + " kept: the layer stores float";
+}
+
 }  // namespace
 
 std::vector<LayerInput> layer_inputs(TransferResult& transfer) {
@@ -89,7 +133,10 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   if (input.triangle_count() == 0) {
     return Error(ErrorCode::kInvalidArgument, "the scene has no triangles to bake");
   }
+  // Before the unwrapper adds the atlas set, which a slot reading a missing set would read.
+  VT_RETURN_IF_ERROR(check_texcoord_sets(input));
   SceneBakeSummary summary;
+  summary.warnings = input.warnings;
   summary.output = output;
   summary.unwrapped = options.unwrapped.empty()  ? default_unwrapped(output)
                       : options.unwrapped == "-" ? ""
@@ -127,6 +174,9 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   TransferOptions to;
   to.width = W, to.height = H;
   to.supersample = options.supersample;
+  to.missing_textures = options.missing_textures;
+  to.charts.reserve(unwrapped->triangles.size());
+  for (const unwrap::AtlasTriangle& t : unwrapped->triangles) to.charts.push_back(t.chart);
   to.threads = options.build.threads;
   to.scratch_dir = options.build.scratch_dir.empty()
                        ? std::filesystem::path(output).parent_path().string()
@@ -135,6 +185,10 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   auto transfer = transfer_materials(unwrapped->scene, to);
   if (!transfer.ok()) return transfer.status().with_context("transfer");
   summary.transfer = transfer->stats;
+  summary.missing_textures = transfer->missing_textures;
+  for (const MissingTexture& m : summary.missing_textures)
+    summary.warnings.push_back(m.message() + " (baked from the factor alone)");
+  summary.above_one = layer_ranges(transfer->layers);
   summary.stages.push_back({"transfer", seconds_since(t0)});
 
   // Pyramid, paging, encode.
@@ -158,6 +212,8 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   auto built = build_page_file(bo);
   if (!built.ok()) return built.status().with_context("build");
   summary.build = std::move(built).value();
+  mark_clipped(summary.build, summary.above_one);
+  for (const LayerRange& r : summary.above_one) summary.warnings.push_back(range_warning(r));
   summary.stages.push_back({"build", seconds_since(t0)});
 
   // The unwrapped scene beside it.
@@ -178,6 +234,23 @@ nlohmann::json to_json(const SceneBakeSummary& s) {
   for (const StageTime& st : s.stages) stages[st.name] = st.seconds;
   const unwrap::UnwrapStats& u = s.unwrap;
   const TransferStats& t = s.transfer;
+  nlohmann::json above_one = nlohmann::json::array();
+  for (const LayerRange& r : s.above_one) {
+    above_one.push_back({{"layer", r.layer},
+                         {"texels_above_one", r.texels_above_one},
+                         {"max_value", r.max_value},
+                         {"clipped", r.clipped},
+                         {"clipped_texels", r.clipped ? r.texels_above_one : 0}});
+  }
+  nlohmann::json missing = nlohmann::json::array();
+  for (const MissingTexture& m : s.missing_textures) {
+    missing.push_back({{"material", m.material},
+                       {"material_index", m.material_index},
+                       {"slot", m.slot},
+                       {"image", m.image},
+                       {"path", m.path},
+                       {"reason", m.reason}});
+  }
   return {
       {"output", s.output},
       {"unwrapped", s.unwrapped},
@@ -195,10 +268,13 @@ nlohmann::json to_json(const SceneBakeSummary& s) {
         {"edge_only_texels", t.edge_only_texels},
         {"contested_texels", t.contested_texels},
         {"samples", t.samples},
-        {"texels_per_second", t.seconds > 0 ? double(t.covered_texels) / t.seconds : 0.0}}},
+        {"texels_per_second", t.seconds > 0 ? double(t.covered_texels) / t.seconds : 0.0},
+        {"above_one", above_one},
+        {"missing_textures", missing}}},
       {"build", to_json(s.build)},
       {"seconds", stages},
       {"total_seconds", s.seconds},
+      {"warnings", s.warnings},
   };
 }
 

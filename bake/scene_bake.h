@@ -32,10 +32,21 @@ struct SceneBakeOptions {
   std::string unwrapped;         // the unwrapped scene (.glb); "" = output with .glb, "-" = none
   unwrap::UnwrapOptions unwrap;  // page_payload and threads are taken from `build`
   int supersample = 1;           // 1, 4 or 16 transfer samples per texel
+  MissingTextures missing_textures = MissingTextures::kError;  // see TransferOptions
   std::function<void(const SceneBakeProgress&)> progress;
 
   // A scene bake holds the transfer's buffers too: 8 GiB by default rather than the build's 2.
   SceneBakeOptions() { build.memory_limit = uint64_t(8) << 30; }
+};
+
+// A baked layer some of whose covered texels have a channel above 1 (HDR emissive, bright
+// factors): kept when the layer stores floats (--codec raw), clipped to 1 when it stores 8 bits.
+struct LayerRange {
+  LayerSemantic semantic = LayerSemantic::kEmissive;
+  std::string layer;  // the page file's layer name ("emissive")
+  uint64_t texels_above_one = 0;
+  float max_value = 0;
+  bool clipped = false;
 };
 
 struct SceneBakeSummary {
@@ -43,7 +54,12 @@ struct SceneBakeSummary {
   uint64_t triangles = 0;  // unwrapped (instances counted separately)
   unwrap::UnwrapStats unwrap;
   TransferStats transfer;
-  BuildSummary build;             // raw bytes and ratio: bake/build_summary_json.h
+  std::vector<LayerRange> above_one;             // layers with values above 1 only
+  std::vector<MissingTexture> missing_textures;  // MissingTextures::kWarn
+  BuildSummary build;                            // raw bytes and ratio: bake/build_summary_json.h
+  // Every warning, one line each: the scene importer's (scene::Scene::warnings), then missing
+  // textures, then clipped layers. The CLI prints them as "warning: LINE".
+  std::vector<std::string> warnings;
   std::vector<StageTime> stages;  // load, unwrap, transfer, build, write scene
   double seconds = 0;
 };

@@ -16,11 +16,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <mutex>
 #include <thread>
+#include <unordered_map>
 
 namespace vt {
 namespace {
@@ -106,10 +108,20 @@ uint64_t raster_triangle(const RasterTriangle& tri, int32_t t, int32_t chart, Ba
 // ---- Materials -------------------------------------------------------------------------------
 
 struct ImageSlot {
-  OIIO::TextureSystem::TextureHandle* handle = nullptr;
+  OIIO::TextureSystem::TextureHandle* handle = nullptr;  // null: the image could not be read
   int channels = 0;
   bool linear = false;  // float data or tagged linear: never sRGB-decoded
   std::string name;
+  std::string tried;  // the file opened (for an embedded image, its scratch copy)
+  std::string error;  // why it could not be read
+};
+
+constexpr TextureSlot kTextureSlots[] = {
+    {"baseColorTexture", &scene::Material::base_color_texture},
+    {"metallicRoughnessTexture", &scene::Material::metallic_roughness_texture},
+    {"normalTexture", &scene::Material::normal_texture},
+    {"occlusionTexture", &scene::Material::occlusion_texture},
+    {"emissiveTexture", &scene::Material::emissive_texture},
 };
 
 // One primitive as the transfer sees it.
@@ -228,8 +240,65 @@ bool material_has_orm(const scene::Material& m) {
          m.metallic_factor != 1.0f || m.roughness_factor != 1.0f;
 }
 bool material_has_emissive(const scene::Material& m) {
-  return m.emissive_texture.valid() || m.emissive_factor[0] > 0 || m.emissive_factor[1] > 0 ||
-         m.emissive_factor[2] > 0;
+  return m.emissive_strength > 0 && (m.emissive_texture.valid() || m.emissive_factor[0] > 0 ||
+                                     m.emissive_factor[1] > 0 || m.emissive_factor[2] > 0);
+}
+
+std::string material_label(const std::string& name, int64_t index) {
+  if (!name.empty()) return "material '" + name + "'";
+  if (index < 0) return "the default material";
+  return "material " + std::to_string(index) + " (unnamed)";
+}
+std::string material_label(const scene::Scene& scene, const scene::Material& m) {
+  const scene::Material* first = scene.materials.data();
+  const bool listed =
+      !std::less<>()(&m, first) && std::less<>()(&m, first + scene.materials.size());
+  return material_label(m.name, listed ? &m - first : -1);
+}
+
+// The materials that primitives with triangles use, in scene order.
+std::vector<const scene::Material*> materials_in_use(const scene::Scene& scene) {
+  std::vector<bool> used(scene.materials.size(), false);
+  for (const auto& mesh : scene.meshes)
+    for (const auto& p : mesh.primitives)
+      if (!p.indices.empty() && p.material >= 0 && size_t(p.material) < used.size())
+        used[p.material] = true;
+  std::vector<const scene::Material*> out;
+  for (size_t m = 0; m < used.size(); ++m)
+    if (used[m]) out.push_back(&scene.materials[m]);
+  return out;
+}
+
+// Chart ids per triangle of one primitive: triangles connected through a shared vertex or
+// through vertices at bit-identical atlas UVs (a chart's vertices split for normals or source
+// UVs), numbered from `base`. Two charts never share an atlas position (the gutter).
+std::vector<int32_t> connected_charts(const scene::Primitive& p, const std::vector<Vec2>& atlas,
+                                      int64_t base) {
+  std::vector<uint32_t> parent(p.positions.size());
+  for (uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
+  auto find = [&](uint32_t a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  auto join = [&](uint32_t a, uint32_t b) {
+    a = find(a), b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  };
+  for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
+    join(p.indices[f], p.indices[f + 1]);
+    join(p.indices[f], p.indices[f + 2]);
+  }
+  std::unordered_map<uint64_t, uint32_t> at;  // atlas UV bits -> first vertex there
+  for (uint32_t i = 0; i < atlas.size(); ++i) {
+    uint32_t u, v;
+    std::memcpy(&u, &atlas[i][0], 4);
+    std::memcpy(&v, &atlas[i][1], 4);
+    auto [it, inserted] = at.try_emplace((uint64_t(u) << 32) | v, i);
+    if (!inserted) join(it->second, i);
+  }
+  std::vector<int32_t> chart(p.indices.size() / 3);
+  for (size_t f = 0; f < chart.size(); ++f) chart[f] = int32_t(base + find(p.indices[3 * f]));
+  return chart;
 }
 
 class Transfer {
@@ -247,17 +316,22 @@ class Transfer {
 
  private:
   Status setup_images();
+  Status check_missing_textures();
   Status setup_prims();
+  Status setup_raster();
   bool sample_texture(OIIO::TextureSystem::Perthread* pt, const scene::TextureRef& ref,
                       const TriEval& te, const double l[3], float out[4]) const;
   void evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, const double l[3],
                 Sample& s) const;
   void make_eval(uint32_t t, TriEval& te) const;
+  std::vector<TransferLayer> make_layers(std::vector<float> (&acc)[kSlots],
+                                         const std::vector<uint8_t>& coverage) const;
 
   const scene::Scene& scene_;
   const TransferOptions& opt_;
   OIIO::TextureSystem* ts_ = nullptr;
   std::vector<ImageSlot> images_;
+  std::vector<MissingTexture> missing_;
   std::vector<std::string> temp_files_;
   std::vector<PrimInfo> prims_;
   std::vector<RasterTriangle> tris_;
@@ -273,15 +347,16 @@ class Transfer {
 
 Status Transfer::setup_images() {
   std::vector<bool> used(scene_.images.size(), false);
-  for (const auto& m : scene_.materials) {
-    for (const auto* r : {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture,
-                          &m.occlusion_texture, &m.emissive_texture}) {
-      if (!r->valid()) continue;
-      if (size_t(r->image) >= scene_.images.size()) {
-        return Error(ErrorCode::kCorrupt, "material '" + m.name + "' names image " +
-                                              std::to_string(r->image) + ", which does not exist");
+  for (const scene::Material* m : materials_in_use(scene_)) {
+    for (const TextureSlot& ts : kTextureSlots) {
+      const scene::TextureRef& r = m->*ts.ref;
+      if (!r.valid()) continue;
+      if (size_t(r.image) >= scene_.images.size()) {
+        return Error(ErrorCode::kCorrupt, material_label(scene_, *m) + " " + ts.name +
+                                              ": names image " + std::to_string(r.image) +
+                                              ", which does not exist");
       }
-      used[r->image] = true;
+      used[r.image] = true;
     }
   }
   ts_ = OIIO::TextureSystem::create(false);
@@ -319,10 +394,14 @@ Status Transfer::setup_images() {
       temp_files_.push_back(path);
     }
     OIIO::ustring name(path);
+    slot.tried = path;
     const OIIO::ImageSpec* spec = ts_->imagespec(name, 0);
     if (!spec) {
-      std::string err = ts_->geterror();
-      return Error(ErrorCode::kNotFound, slot.name + ": cannot read image (" + err + ")");
+      // Reported per material slot by check_missing_textures.
+      slot.error = ts_->geterror();
+      slot.error = slot.error.substr(0, slot.error.find('\n'));  // further lines repeat it
+      if (slot.error.empty()) slot.error = "OpenImageIO cannot read it";
+      continue;
     }
     slot.channels = std::min(spec->nchannels, 4);
     std::string cs = spec->get_string_attribute("oiio:ColorSpace");
@@ -356,10 +435,35 @@ Status Transfer::setup_images() {
     }
     slot.handle = ts_->get_texture_handle(name);
   }
+  return check_missing_textures();
+}
+
+Status Transfer::check_missing_textures() {
+  for (const scene::Material* m : materials_in_use(scene_)) {
+    for (const TextureSlot& ts : kTextureSlots) {
+      const scene::TextureRef& r = m->*ts.ref;
+      if (!r.valid() || images_[r.image].handle) continue;
+      const scene::Image& img = scene_.images[r.image];
+      MissingTexture miss;
+      miss.material = m->name;
+      miss.material_index = int(m - scene_.materials.data());
+      miss.slot = ts.name;
+      miss.image = !img.name.empty()  ? img.name
+                   : !img.uri.empty() ? img.uri
+                                      : "image " + std::to_string(r.image);
+      if (img.embedded()) miss.image += " (embedded)";
+      miss.path = images_[r.image].tried;
+      miss.reason = images_[r.image].error;
+      if (opt_.missing_textures == MissingTextures::kError)
+        return Error(ErrorCode::kNotFound, miss.message());
+      missing_.push_back(std::move(miss));
+    }
+  }
   return Status::Ok();
 }
 
 Status Transfer::setup_prims() {
+  VT_RETURN_IF_ERROR(check_texcoord_sets(scene_));
   bool any_normal = false, any_orm = false, any_emissive = false;
   for (size_t m = 0; m < scene_.meshes.size(); ++m) {
     const scene::Mesh& mesh = scene_.meshes[m];
@@ -382,15 +486,6 @@ Status Transfer::setup_prims() {
       }
       info.mat = p.material >= 0 ? &scene_.materials[p.material] : &default_material_;
       const scene::Material& mat = *info.mat;
-      for (const auto* r : {&mat.base_color_texture, &mat.metallic_roughness_texture,
-                            &mat.normal_texture, &mat.occlusion_texture, &mat.emissive_texture}) {
-        if (r->valid() && (size_t(r->texcoord) >= p.uvs.size() ||
-                           p.uvs[r->texcoord].size() != p.positions.size())) {
-          return Error(ErrorCode::kInvalidArgument,
-                       where + ": material '" + mat.name + "' reads TEXCOORD_" +
-                           std::to_string(r->texcoord) + ", which it lacks");
-        }
-      }
       for (uint32_t idx : p.indices) {
         if (idx >= p.positions.size())
           return Error(ErrorCode::kCorrupt, where + ": index out of range");
@@ -411,25 +506,19 @@ Status Transfer::setup_prims() {
   want_[kNormalSlot] = any_normal;
   want_[kOrmSlot] = any_orm;
   want_[kEmissiveSlot] = any_emissive;
+  return setup_raster();
+}
 
+// Atlas triangles and their charts: the unwrapper's when given, else connected_charts.
+Status Transfer::setup_raster() {
   const double W = opt_.width, H = opt_.height;
-  int64_t chart_base = 0;  // chart ids: vertex-component roots, offset per primitive
+  int64_t chart_base = 0;  // fallback chart ids: vertex roots, offset per primitive
   for (uint32_t pi = 0; pi < prims_.size(); ++pi) {
     const scene::Primitive& p = *prims_[pi].prim;
     const auto& uv = p.uvs[prims_[pi].atlas_set];
-    // Charts = connected components of atlas vertices (the unwrapper gives each chart its own).
-    std::vector<uint32_t> parent(p.positions.size());
-    for (uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
-    auto find = [&](uint32_t a) {
-      while (parent[a] != a) a = parent[a] = parent[parent[a]];
-      return a;
-    };
-    for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
-      uint32_t a = find(p.indices[f]);
-      for (int k = 1; k < 3; ++k) {
-        uint32_t b = find(p.indices[f + k]);
-        if (a != b) parent[b] = a;
-      }
+    if (opt_.charts.empty()) {
+      auto charts = connected_charts(p, uv, chart_base);
+      chart_.insert(chart_.end(), charts.begin(), charts.end());
     }
     for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
       std::array<double, 6> q;
@@ -438,10 +527,17 @@ Status Transfer::setup_prims() {
         q[2 * k] = double(a[0]) * W, q[2 * k + 1] = double(a[1]) * H;
       }
       tris_.emplace_back(q);
-      chart_.push_back(int32_t(chart_base + find(p.indices[f])));
       tri_src_.push_back({pi, uint32_t(f / 3)});
     }
-    chart_base += p.positions.size();
+    chart_base += int64_t(p.positions.size());
+  }
+  if (!opt_.charts.empty()) {
+    if (opt_.charts.size() != tris_.size()) {
+      return Error(ErrorCode::kInvalidArgument, "transfer: " + std::to_string(opt_.charts.size()) +
+                                                    " chart ids for " +
+                                                    std::to_string(tris_.size()) + " triangles");
+    }
+    chart_ = opt_.charts;
   }
   return Status::Ok();
 }
@@ -480,10 +576,21 @@ void Transfer::make_eval(uint32_t t, TriEval& te) const {
 bool Transfer::sample_texture(OIIO::TextureSystem::Perthread* pt, const scene::TextureRef& ref,
                               const TriEval& te, const double l[3], float out[4]) const {
   const ImageSlot& slot = images_[ref.image];
+  if (!slot.handle) return false;  // a missing texture (MissingTextures::kWarn): factor alone
   const auto& uv = te.p->prim->uvs[ref.texcoord];
   double s = uv[te.v[0]][0] * l[0] + uv[te.v[1]][0] * l[1] + uv[te.v[2]][0] * l[2];
   double t = uv[te.v[0]][1] * l[0] + uv[te.v[1]][1] * l[1] + uv[te.v[2]][1] * l[2];
-  const auto& d = te.duv[ref.texcoord];
+  std::array<double, 4> d = te.duv[ref.texcoord];
+  if (!ref.transform.identity()) {
+    // Affine: the point takes the whole transform, the derivatives its linear part.
+    const auto m = ref.transform.matrix();
+    const double s0 = s;
+    s = m[0] * s0 + m[2] * t + m[4], t = m[1] * s0 + m[3] * t + m[5];
+    for (int k = 0; k < 4; k += 2) {
+      const double ds = d[k], dt = d[k + 1];
+      d[k] = m[0] * ds + m[2] * dt, d[k + 1] = m[1] * ds + m[3] * dt;
+    }
+  }
   auto wrap = [](scene::WrapMode m) {
     switch (m) {
       case scene::WrapMode::kClampToEdge:
@@ -497,7 +604,8 @@ bool Transfer::sample_texture(OIIO::TextureSystem::Perthread* pt, const scene::T
   OIIO::TextureOpt opt;
   opt.swrap = wrap(ref.wrap_s);
   opt.twrap = wrap(ref.wrap_t);
-  opt.interpmode = OIIO::TextureOpt::InterpBilinear;
+  opt.interpmode = ref.mag_filter == scene::FilterMode::kNearest ? OIIO::TextureOpt::InterpClosest
+                                                                 : OIIO::TextureOpt::InterpBilinear;
   opt.mipmode = OIIO::TextureOpt::MipModeAniso;
   opt.anisotropic = 16;
   float r[4] = {0, 0, 0, 1};
@@ -552,7 +660,7 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
   if (want_[kEmissiveSlot]) {
     float e[4] = {1, 1, 1, 1};
     colour(m.emissive_texture, e);
-    for (int c = 0; c < 3; ++c) s.emissive[c] = e[c] * m.emissive_factor[c];
+    for (int c = 0; c < 3; ++c) s.emissive[c] = e[c] * m.emissive_factor[c] * m.emissive_strength;
   }
   if (want_[kOrmSlot]) {
     float occ = 1, rough = m.roughness_factor, metal = m.metallic_factor;
@@ -594,6 +702,55 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
     s.normal[1] = float(dot(world, ba));
     s.normal[2] = float(dot(world, n));
   }
+}
+
+// The layers called for, from the accumulators: alpha only if some covered texel is not
+// opaque, normals renormalised, values above 1 counted.
+std::vector<TransferLayer> Transfer::make_layers(std::vector<float> (&acc)[kSlots],
+                                                 const std::vector<uint8_t>& coverage) const {
+  const size_t N = coverage.size();
+  std::vector<TransferLayer> layers;
+  for (int l = 0; l < kSlots; ++l) {
+    if (!want_[l]) continue;
+    TransferLayer layer;
+    layer.semantic = kSlotInfo[l].semantic;
+    layer.channels = kSlotInfo[l].channels;
+    if (l != kNormalSlot) {
+      // Channels 0-2 of albedo are colour, 3 is alpha (counted before alpha is dropped).
+      const uint32_t channels = kSlotInfo[l].channels;
+      const uint32_t counted = l == kAlbedoSlot ? 3 : channels;
+      for (size_t i = 0; i < N; ++i) {
+        if (!coverage[i]) continue;
+        const float* v = &acc[l][i * channels];
+        const float top = *std::max_element(v, v + counted);
+        if (top > 1.0f) ++layer.texels_above_one, layer.max_value = std::max(layer.max_value, top);
+      }
+    }
+    if (l == kAlbedoSlot) {
+      bool alpha = false;
+      for (size_t i = 0; i < N && !alpha; ++i) alpha = coverage[i] && acc[l][4 * i + 3] < kOpaque;
+      if (!alpha) {
+        std::vector<float> rgb(N * 3);
+        for (size_t i = 0; i < N; ++i)
+          for (int c = 0; c < 3; ++c) rgb[3 * i + c] = acc[l][4 * i + c];
+        acc[l] = std::move(rgb);
+        layer.channels = 3;
+      }
+    }
+    if (l == kNormalSlot) {
+      for (size_t i = 0; i < N; ++i) {
+        float* n = &acc[l][3 * i];
+        if (!coverage[i]) continue;
+        Vec3d v = normalized(Vec3d{n[0], n[1], n[2]}, {0, 0, 1});
+        n[0] = float(v.x), n[1] = float(v.y), n[2] = float(v.z);
+      }
+    } else {
+      for (float v : acc[l]) layer.hdr |= v > 1.0f;
+    }
+    layer.texels = std::move(acc[l]);
+    layers.push_back(std::move(layer));
+  }
+  return layers;
 }
 
 Expected<TransferResult> Transfer::run() {
@@ -685,38 +842,9 @@ Expected<TransferResult> Transfer::run() {
   });
   if (lookup_failed_) return Error(ErrorCode::kIo, lookup_error_);
 
-  // Layers: only those called for; alpha only if some covered texel is not opaque.
-  for (int l = 0; l < kSlots; ++l) {
-    if (!want_[l]) continue;
-    TransferLayer layer;
-    layer.semantic = kSlotInfo[l].semantic;
-    layer.channels = kSlotInfo[l].channels;
-    if (l == kAlbedoSlot) {
-      bool alpha = false;
-      for (size_t i = 0; i < N && !alpha; ++i)
-        alpha = (*coverage)[i] && acc[l][4 * i + 3] < kOpaque;
-      if (!alpha) {
-        std::vector<float> rgb(N * 3);
-        for (size_t i = 0; i < N; ++i)
-          for (int c = 0; c < 3; ++c) rgb[3 * i + c] = acc[l][4 * i + c];
-        acc[l] = std::move(rgb);
-        layer.channels = 3;
-      }
-    }
-    if (l == kNormalSlot) {
-      for (size_t i = 0; i < N; ++i) {
-        float* n = &acc[l][3 * i];
-        if (!(*coverage)[i]) continue;
-        Vec3d v = normalized(Vec3d{n[0], n[1], n[2]}, {0, 0, 1});
-        n[0] = float(v.x), n[1] = float(v.y), n[2] = float(v.z);
-      }
-    } else {
-      for (float v : acc[l]) layer.hdr |= v > 1.0f;
-    }
-    layer.texels = std::move(acc[l]);
-    result.layers.push_back(std::move(layer));
-  }
+  result.layers = make_layers(acc, *coverage);
   result.coverage = coverage;
+  result.missing_textures = missing_;
   result.stats.triangles = tris_.size();
   result.stats.sampled_texels = sampled;
   result.stats.edge_only_texels = edge_only;
@@ -729,6 +857,46 @@ Expected<TransferResult> Transfer::run() {
 }
 
 }  // namespace
+
+std::span<const TextureSlot> texture_slots() {
+  return kTextureSlots;
+}
+
+Status check_texcoord_sets(const scene::Scene& scene) {
+  for (const scene::Mesh& mesh : scene.meshes) {
+    for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
+      const scene::Primitive& p = mesh.primitives[pi];
+      if (p.indices.empty() || p.material < 0 || size_t(p.material) >= scene.materials.size())
+        continue;
+      const scene::Material& m = scene.materials[p.material];
+      for (const TextureSlot& ts : kTextureSlots) {
+        const scene::TextureRef& r = m.*ts.ref;
+        if (!r.valid() || (r.texcoord >= 0 && size_t(r.texcoord) < p.uvs.size() &&
+                           p.uvs[r.texcoord].size() == p.positions.size()))
+          continue;
+        return Error(ErrorCode::kInvalidArgument,
+                     "mesh '" + mesh.name + "' primitive " + std::to_string(pi) + ": " +
+                         material_label(scene, m) + " " + ts.name + " reads TEXCOORD_" +
+                         std::to_string(r.texcoord) + ", which the primitive lacks (it has " +
+                         std::to_string(p.uvs.size()) +
+                         (p.uvs.size() == 1 ? " UV set)" : " UV sets)"));
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+Expected<MissingTextures> parse_missing_textures(const std::string& name) {
+  if (name == "error") return MissingTextures::kError;
+  if (name == "warn") return MissingTextures::kWarn;
+  return Error(ErrorCode::kInvalidArgument,
+               "unknown missing-texture policy '" + name + "' (known: error, warn)");
+}
+
+std::string MissingTexture::message() const {
+  return material_label(material, material_index) + " " + slot + ": cannot read image '" + image +
+         "' (tried " + path + "): " + reason;
+}
 
 std::vector<std::array<double, 2>> supersample_pattern(int supersample) {
   int k = supersample >= 16 ? 4 : supersample >= 4 ? 2 : 1;

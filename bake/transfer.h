@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,13 @@
 #include "scene/scene.h"
 
 namespace vt {
+
+// What a texture that cannot be read does to the transfer.
+enum class MissingTextures {
+  kError,  // the transfer fails naming the material, the slot, the image and the path tried
+  kWarn,   // the slot uses its factor alone; every miss is listed in TransferResult
+};
+Expected<MissingTextures> parse_missing_textures(const std::string& name);  // "error", "warn"
 
 struct TransferOptions {
   uint32_t width = 0, height = 0;  // atlas size in texels
@@ -36,6 +44,11 @@ struct TransferOptions {
   // sample per texel (0.048 -> 0.034) but raises it at 4 and 16 (0.0003 -> 0.018 / 0.006),
   // so the default keeps the box levels.
   std::string mip_filter;
+  MissingTextures missing_textures = MissingTextures::kError;
+  // The atlas chart of every triangle, in transfer order (meshes, primitives that have
+  // triangles, faces): unwrap::UnwrapResult::triangles[i].chart. Empty = charts are the
+  // triangles connected through shared vertices or equal atlas UVs of a primitive.
+  std::vector<int32_t> charts;
   std::function<void(double fraction)> progress;  // from the calling thread, 0..1
 };
 
@@ -43,6 +56,10 @@ struct TransferLayer {
   LayerSemantic semantic = LayerSemantic::kAlbedo;
   uint32_t channels = 0;  // albedo 3 or 4 (alpha only if a texel is not opaque), normal 3, ...
   bool hdr = false;       // some value is above 1 (emissive or linear EXR sources)
+  // Covered texels with a colour or data channel above 1 (alpha and normals excluded), and
+  // the largest such value: what an 8-bit layer clips.
+  uint64_t texels_above_one = 0;
+  float max_value = 0;
   // width * height * channels floats. Albedo/emissive: linear RGB(A), not premultiplied.
   // ORM: occlusion, roughness, metallic. Normal: unit xyz in the atlas tangent frame.
   // Uncovered texels are 0 (the build dilates them away).
@@ -59,12 +76,38 @@ struct TransferStats {
   double seconds = 0;
 };
 
+// A material texture slot whose image could not be read (MissingTextures::kWarn).
+struct MissingTexture {
+  std::string material;  // the material's name (may be empty)
+  int material_index = -1;
+  std::string slot;    // glTF's name for it: "baseColorTexture", "normalTexture", ...
+  std::string image;   // the image's name, or "embedded image N 'name'"
+  std::string path;    // the file tried (for an embedded image, its scratch copy)
+  std::string reason;  // OpenImageIO's words
+  // "material 'M' baseColorTexture: image 'I' (tried /a/b.png): REASON"
+  std::string message() const;
+};
+
 struct TransferResult {
   uint32_t width = 0, height = 0;
   std::shared_ptr<const std::vector<uint8_t>> coverage;  // width * height, 1 = covered
   std::vector<TransferLayer> layers;  // in LayerSemantic order, only those the scene uses
+  std::vector<MissingTexture> missing_textures;  // in material, then slot order
   TransferStats stats;
 };
+
+// A material's texture slots under glTF's names ("baseColorTexture", ...), in the order
+// errors and misses are reported.
+struct TextureSlot {
+  const char* name;
+  scene::TextureRef scene::Material::*ref;
+};
+std::span<const TextureSlot> texture_slots();
+
+// Every texture slot of a material a primitive uses reads a UV set the primitive has. The error
+// names the mesh, primitive, material, slot and set. Run on the scene before unwrapping: the
+// atlas set the unwrapper appends would otherwise pass for a missing one.
+Status check_texcoord_sets(const scene::Scene& scene);
 
 // Which layers the materials of `scene` call for: albedo always; normal if some material has a
 // normal map; ORM if some material has a metallic-roughness or occlusion texture or factors
@@ -72,7 +115,10 @@ struct TransferResult {
 std::vector<LayerSemantic> layers_used(const scene::Scene& scene);
 
 // Transfers the materials of an unwrapped scene (meshes carrying atlas UVs in [0,1], glTF
-// orientation: v down, texel row y = v * height). Errors name the image or mesh at fault.
+// orientation: v down, texel row y = v * height). Texture slots honour their sampler (wrap
+// modes, magFilter nearest), TEXCOORD_n and KHR_texture_transform; emissive is factor x
+// strength x texture; base colour is factor x texture x COLOR_0. Errors name the image or mesh
+// at fault; an unreadable texture names the material and slot too (see MissingTextures).
 Expected<TransferResult> transfer_materials(const scene::Scene& scene,
                                             const TransferOptions& options);
 

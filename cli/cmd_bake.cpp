@@ -60,6 +60,17 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
                  "Where to write the unwrapped scene (.glb; default OUT.glb; '-' = not written)");
   app.add_option("--supersample", o.supersample, "Transfer samples per texel: 1, 4 or 16")
       ->check(CLI::IsMember({1, 4, 16}));
+  app.add_option_function<std::string>(
+         "--missing-textures",
+         [&o](const std::string& v) {
+           auto policy = vt::parse_missing_textures(v);
+           if (!policy.ok())
+             throw CLI::ValidationError("--missing-textures", policy.status().message());
+           o.missing_textures = *policy;
+         },
+         "A texture that cannot be read: error (default: fail naming the material, slot and "
+         "path) or warn (bake the slot from its factor alone and list the miss)")
+      ->default_str("error");
   vt::cli::add_unwrap_flags(app, o.unwrap);
   vt::cli::add_build_flags(app, o.build);
   return [args](const vt::cli::GlobalOptions& global) -> int {
@@ -77,6 +88,7 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
     auto summary = vt::bake_scene(args->scene, o);
     progress.done();
     if (!summary.ok()) return vt::cli::report_error("bake", summary.status());
+    for (const std::string& w : summary->warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     if (global.json) {
       std::printf("%s\n", vt::to_json(*summary).dump(2).c_str());
     } else {

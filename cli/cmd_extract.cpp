@@ -1,6 +1,8 @@
 // `vtbake extract FILE --level L [--layer N] -o out.exr|png`: one level's payload reassembled
 // into an image of exactly the level's size. Absent pages are filled from their nearest present
-// ancestor, upsampled nearest (docs/FORMAT.md, "Extracting a level").
+// ancestor, upsampled nearest (docs/FORMAT.md, "Extracting a level"). The texels are written
+// as stored: a colour layer's alpha is unassociated (PNG's convention), and a 2- or 4-channel
+// data layer (normal XY, custom) has no alpha at all, so nothing is divided by a last channel.
 #include <OpenImageIO/imageio.h>
 
 #include <cstdio>
@@ -31,6 +33,21 @@ OIIO::TypeDesc oiio_type(vt::TexelType type) {
   return OIIO::TypeDesc::UINT8;
 }
 
+// The image spec that makes OpenImageIO write the layer's texels unchanged.
+OIIO::ImageSpec output_spec(const vt::LevelImage& image, const vt::LayerSpec& layer) {
+  OIIO::ImageSpec spec(int(image.width), int(image.height), int(image.channels),
+                       oiio_type(image.texel_type));
+  const bool colour = layer.semantic == vt::LayerSemantic::kAlbedo ||
+                      layer.semantic == vt::LayerSemantic::kEmissive;
+  const bool alpha = colour && (image.channels == 2 || image.channels == 4);
+  spec.alpha_channel = alpha ? int(image.channels) - 1 : -1;
+  if (!alpha && image.channels == 4) spec.channelnames[3] = "W";  // data, not an alpha
+  // The page file never premultiplies: without this, the PNG writer divides colour by the last
+  // channel of every 2- and 4-channel image, taking it for associated alpha.
+  spec.attribute("oiio:UnassociatedAlpha", 1);
+  return spec;
+}
+
 vt::cli::CommandRunner make_extract(CLI::App& sub) {
   auto opt = std::make_shared<ExtractOptions>();
   sub.add_option("file", opt->path, "Page file (.vtpf)")->required();
@@ -48,7 +65,7 @@ vt::cli::CommandRunner make_extract(CLI::App& sub) {
           "extract", opt->output + ": cannot write this kind of image: " + OIIO::geterror());
     }
     const OIIO::TypeDesc type = oiio_type(image->texel_type);
-    OIIO::ImageSpec spec(int(image->width), int(image->height), int(image->channels), type);
+    const OIIO::ImageSpec spec = output_spec(*image, (*reader)->layers()[opt->layer]);
     if (!out->open(opt->output, spec) || !out->write_image(type, image->texels.data()) ||
         !out->close()) {
       return vt::cli::report_error(

@@ -46,6 +46,7 @@ vt::cli::CommandRunner make_unwrap(CLI::App& sub) {
     auto scene = vt::scene::load_scene(a.input);
     if (!scene.ok()) return vt::cli::report_error("unwrap", scene.status());
     double load_s = std::chrono::duration<double>(Clock::now() - t0).count();
+    for (const std::string& w : scene->warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     if (!global.quiet)
       std::fprintf(stderr, "loaded %s: %zu meshes, %zu triangles (%.2f s)\n", a.input.c_str(),
                    scene->meshes.size(), scene->triangle_count(), load_s);

@@ -63,8 +63,11 @@ TEST_F(Reports, SceneBakeNestsTheBuildSchema) {
   ASSERT_EQ(r.exit_code, 0) << r.out;
   auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(keys(j), (std::set<std::string>{"output", "unwrapped", "triangles", "atlas", "transfer",
-                                            "build", "seconds", "total_seconds"}));
+                                            "build", "seconds", "total_seconds", "warnings"}));
   EXPECT_EQ(j["unwrapped"], "");
+  EXPECT_EQ(j["warnings"], nlohmann::json::array());  // the sample scene bakes cleanly
+  EXPECT_EQ(j["transfer"]["above_one"], nlohmann::json::array());
+  EXPECT_EQ(j["transfer"]["missing_textures"], nlohmann::json::array());
   EXPECT_EQ(keys(j["build"]),
             (std::set<std::string>{"width", "height", "payload", "border", "pages", "bytes",
                                    "levels", "layers", "seconds"}));

@@ -1,0 +1,66 @@
+// End-to-end: `vtbake bake` on an OBJ whose MTL names a texture that is not there: an error
+// naming the material, slot and path by default; with --missing-textures warn a bake from the
+// factor alone, the miss printed as a warning and listed in --json.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "tests/cli/cli_test_util.h"
+#include "tests/format/page_file_test_util.h"
+
+namespace vt {
+namespace {
+
+using namespace vt::testing;
+
+// A textured quad whose map_Kd file does not exist; returns the .obj path.
+std::string quad_with_missing_texture() {
+  const std::string obj = temp_path("quad.obj");
+  const std::string dir = obj.substr(0, obj.rfind('/'));
+  std::ofstream(obj) << "mtllib quad.mtl\n"
+                        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                        "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                        "usemtl Brick\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+  std::ofstream(dir + "/quad.mtl") << "newmtl Brick\nKd 0.5 0.25 1.0\nmap_Kd textures/brick.png\n";
+  return obj;
+}
+
+TEST(CliBake, MissingTextureIsAnErrorNamingMaterialSlotAndPath) {
+  const std::string obj = quad_with_missing_texture();
+  const std::string dir = obj.substr(0, obj.rfind('/'));
+  RunResult r = run_vtbake("bake " + obj + " -o " + dir + "/q.vtpf --size 1 --unwrapped -", true);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("material 'Brick' baseColorTexture: cannot read image"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("(tried " + dir + "/textures/brick.png)"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/q.vtpf"));
+}
+
+TEST(CliBake, MissingTextureWarnBakesAndReports) {
+  const std::string obj = quad_with_missing_texture();
+  const std::string dir = obj.substr(0, obj.rfind('/'));
+  const std::string args =
+      "bake " + obj + " -o " + dir + "/q.vtpf --size 1 --unwrapped - --missing-textures warn";
+  RunResult r = run_vtbake("-q " + args, true);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_EQ(r.out.rfind("warning: material 'Brick' baseColorTexture: cannot read image", 0), 0u)
+      << r.out;
+  EXPECT_NE(r.out.find("(baked from the factor alone)"), std::string::npos) << r.out;
+
+  r = run_vtbake("--json " + args, false);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["transfer"]["missing_textures"].size(), 1u);
+  const auto& miss = j["transfer"]["missing_textures"][0];
+  EXPECT_EQ(miss["material"], "Brick");
+  EXPECT_EQ(miss["slot"], "baseColorTexture");
+  EXPECT_EQ(miss["path"], dir + "/textures/brick.png");
+  ASSERT_EQ(j["warnings"].size(), 1u);
+
+  EXPECT_EQ(run_vtbake(args + "x", false).exit_code, 2);  // an unknown policy is bad usage
+}
+
+}  // namespace
+}  // namespace vt
