@@ -47,20 +47,19 @@ unsigned format_bit(const AccessorView& a) {
 // What an attribute may be: glTF 2.0's accessor table, widened by KHR_mesh_quantization for
 // POSITION, NORMAL, TANGENT and TEXCOORD_n. The quantised types are accepted whether or not
 // the file declares the extension: they are read exactly as it specifies.
+constexpr const char* kQuantizedText = "float or (normalized) byte, short or their unsigned";
+constexpr const char* kDirectionText = "float, normalized byte or normalized short";
+
 struct AttributeRule {
   const char* types;  // for messages
   int min_components, max_components;
   unsigned formats;
   const char* formats_text;
 };
-constexpr AttributeRule kPositionRule{"VEC3", 3, 3, kAnyQuantized,
-                                      "float or (normalized) byte, short or their unsigned"};
-constexpr AttributeRule kDirectionRule3{"VEC3", 3, 3, kF32 | kI8N | kI16N,
-                                        "float, normalized byte or normalized short"};
-constexpr AttributeRule kDirectionRule4{"VEC4", 4, 4, kF32 | kI8N | kI16N,
-                                        "float, normalized byte or normalized short"};
-constexpr AttributeRule kTexcoordRule{"VEC2", 2, 2, kAnyQuantized,
-                                      "float or (normalized) byte, short or their unsigned"};
+constexpr AttributeRule kPositionRule{"VEC3", 3, 3, kAnyQuantized, kQuantizedText};
+constexpr AttributeRule kDirectionRule3{"VEC3", 3, 3, kF32 | kI8N | kI16N, kDirectionText};
+constexpr AttributeRule kDirectionRule4{"VEC4", 4, 4, kF32 | kI8N | kI16N, kDirectionText};
+constexpr AttributeRule kTexcoordRule{"VEC2", 2, 2, kAnyQuantized, kQuantizedText};
 constexpr AttributeRule kColorRule{"VEC3 or VEC4", 3, 4, kF32 | kU8N | kU16N,
                                    "float, normalized unsigned byte or normalized unsigned short"};
 constexpr AttributeRule kIndexRule{"SCALAR", 1, 1, kU8 | kU16 | kU32,

@@ -343,7 +343,6 @@ Status read_elements(const std::string& path, const Header& h, const std::vector
 Expected<Scene> load_ply(const std::string& path) {
   VT_ASSIGN_OR_RETURN(auto bytes, read_file(path));
   VT_ASSIGN_OR_RETURN(Header h, parse_header(path, bytes));
-  VT_RETURN_IF_ERROR(check_budget(path, h, bytes.size()));
   bool faces = false;
   uint64_t vertices = 0;
   for (const Element& e : h.elements) {
@@ -354,6 +353,7 @@ Expected<Scene> load_ply(const std::string& path) {
     return Error(ErrorCode::kUnsupported, "PLY: " + path + " has no faces (a point cloud of " +
                                               std::to_string(vertices) +
                                               " vertices): nothing to bake");
+  VT_RETURN_IF_ERROR(check_budget(path, h, bytes.size()));
   Primitive prim;
   try {
     VT_RETURN_IF_ERROR(read_elements(path, h, bytes, &prim));
