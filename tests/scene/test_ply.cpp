@@ -60,8 +60,8 @@ TEST(Ply, HeaderCountsBeyondTheFileAreRefusedBeforeAllocating) {
   auto a = scene::load_scene(
       write("huge_ascii.ply",
             "ply\nformat ascii 1.0\nelement vertex 100000000\nproperty float x\n"
-            "property float y\nproperty float z\nelement face 0\n"
-            "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n"));
+            "property float y\nproperty float z\nelement face 1\n"
+            "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n3 0 1 2\n"));
   ASSERT_FALSE(a.ok());
   EXPECT_NE(a.status().message().find("element vertex: count 100000000 x 6 bytes needs"),
             std::string::npos)
