@@ -1,8 +1,13 @@
-// Draco: .drc files, KHR_draco_mesh_compression buffer views, and PLY through draco's decoder.
+// Draco: .drc files and KHR_draco_mesh_compression buffer views. (PLY has its own reader,
+// ply_import.cpp: Draco's trusts the header's counts.) Draco sizes its own buffers from the
+// stream, before vtbake can see a count, so its allocation failures are caught here; the
+// decoded mesh is then checked against the ceilings before it is converted.
 #include <draco/compression/decode.h>
-#include <draco/io/ply_decoder.h>
 #include <draco/mesh/mesh.h>
 
+#include <new>
+
+#include "scene/import_budget.h"
 #include "scene/scene_io_util.h"
 
 namespace vt::scene::detail {
@@ -24,6 +29,9 @@ bool read_attribute(const draco::PointAttribute* att, const draco::Mesh& mesh,
 }
 
 Expected<Primitive> convert(const draco::Mesh& mesh, const std::vector<DracoAttribute>& ids) {
+  VT_RETURN_IF_ERROR(check_ceiling("Draco mesh", mesh.num_points(), kMaxVertices, "vertices"));
+  VT_RETURN_IF_ERROR(
+      check_ceiling("Draco mesh", uint64_t{mesh.num_faces()} * 3, kMaxIndices, "indices"));
   Primitive prim;
   auto by_name = [&](const std::string& name) -> const draco::PointAttribute* {
     for (const auto& a : ids)
@@ -83,10 +91,17 @@ Expected<Primitive> decode_draco(const uint8_t* data, size_t size,
   draco::DecoderBuffer buffer;
   buffer.Init(reinterpret_cast<const char*>(data), size);
   draco::Decoder decoder;
-  auto result = decoder.DecodeMeshFromBuffer(&buffer);
-  if (!result.ok())
-    return Error(ErrorCode::kCorrupt, "Draco decode failed: " + result.status().error_msg_string());
-  return convert(*result.value(), attribute_ids);
+  try {
+    auto result = decoder.DecodeMeshFromBuffer(&buffer);
+    if (!result.ok())
+      return Error(ErrorCode::kCorrupt,
+                   "Draco decode failed: " + result.status().error_msg_string());
+    return convert(*result.value(), attribute_ids);
+  } catch (const std::bad_alloc&) {
+    return Error(ErrorCode::kResourceLimit, "Draco decode ran out of memory (" +
+                                                format_bytes(static_cast<double>(size)) +
+                                                " of compressed data)");
+  }
 }
 
 Expected<Scene> load_drc(const std::string& path) {
@@ -96,23 +111,6 @@ Expected<Scene> load_drc(const std::string& path) {
   std::vector<Primitive> prims;
   prims.push_back(std::move(prim).value());
   return single_mesh_scene(path, "drc", std::move(prims));
-}
-
-Expected<Scene> load_ply(const std::string& path) {
-  draco::Mesh mesh;
-  draco::PlyDecoder decoder;
-  draco::Status st = decoder.DecodeFromFile(path, &mesh);
-  if (!st.ok()) {
-    // Draco reads no `tristrips` element: fall back to the small reader for such files.
-    auto own = load_ply_own(path);
-    if (own.ok() && own->triangle_count() > 0) return own;
-    return Error(ErrorCode::kCorrupt, path + ": PLY: " + st.error_msg_string());
-  }
-  auto prim = convert(mesh, {});
-  if (!prim.ok()) return prim.status().with_context(path);
-  std::vector<Primitive> prims;
-  prims.push_back(std::move(prim).value());
-  return single_mesh_scene(path, "ply", std::move(prims));
 }
 
 }  // namespace vt::scene::detail

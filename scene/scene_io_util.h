@@ -30,7 +30,6 @@ std::string resolve_texture_path(const std::string& folder, const std::string& w
 Expected<Scene> load_gltf(const std::string& path);
 Expected<Scene> load_obj(const std::string& path);
 Expected<Scene> load_ply(const std::string& path);
-Expected<Scene> load_ply_own(const std::string& path);  // fallback: tristrips
 Expected<Scene> load_drc(const std::string& path);
 // Any other format assimp reads (FBX, COLLADA, 3DS, ...; glTF 1.0).
 Expected<Scene> load_assimp(const std::string& path);

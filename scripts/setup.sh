@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config clang-format
   libopenimageio-dev openimageio-tools libopenexr-dev libopencolorio-dev
-  libcgal-dev libeigen3-dev libtbb-dev libdraco-dev libassimp-dev
+  libcgal-dev libeigen3-dev libtbb-dev libdraco-dev libmeshoptimizer-dev libassimp-dev
   libzstd-dev libxxhash-dev
   libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
