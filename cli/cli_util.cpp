@@ -106,6 +106,26 @@ Status parse_codec(const std::string& text, PageEncoderOptions* options) {
   return bad;
 }
 
+Status parse_procedural_size(const std::string& text, uint32_t* width, uint32_t* height) {
+  const std::string prefix = "procedural:";
+  const Status bad = Error(ErrorCode::kInvalidArgument,
+                           "'" + text + "': expected procedural:WIDTHxHEIGHT, each 1..16777216");
+  if (text.rfind(prefix, 0) != 0) return bad;
+  uint64_t side[2] = {0, 0};
+  size_t pos = prefix.size();
+  for (int i = 0; i < 2; ++i) {
+    const size_t start = pos;
+    while (pos < text.size() && text[pos] >= '0' && text[pos] <= '9' && side[i] <= (1u << 24))
+      side[i] = side[i] * 10 + uint64_t(text[pos++] - '0');
+    if (pos == start || side[i] == 0 || side[i] > (1u << 24)) return bad;
+    if (i == 0 && (pos >= text.size() || text[pos++] != 'x')) return bad;
+  }
+  if (pos != text.size()) return bad;
+  *width = uint32_t(side[0]);
+  *height = uint32_t(side[1]);
+  return Status::Ok();
+}
+
 Status parse_byte_size(const std::string& text, uint64_t* bytes) {
   char* end = nullptr;
   const double value = std::strtod(text.c_str(), &end);

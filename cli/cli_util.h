@@ -46,6 +46,11 @@ class ProgressLine {
 // --codec: dct, dct:QUALITY (1..100), bc, bc:high, bc:fast, raw.
 Status parse_codec(const std::string& text, PageEncoderOptions* options);
 
+// An input named "procedural:WIDTHxHEIGHT" (the generated sample pattern, no file): both sides
+// plain decimal integers 1..2^24 with nothing after them. A negative, zero, huge or malformed
+// size is kInvalidArgument naming the text (sscanf's %u read "-5" as 4294967291).
+Status parse_procedural_size(const std::string& text, uint32_t* width, uint32_t* height);
+
 // --memory-limit and other byte sizes: a positive number with an optional K, M or G (KiB, MiB,
 // GiB) suffix; no suffix means bytes.
 Status parse_byte_size(const std::string& text, uint64_t* bytes);

@@ -27,7 +27,11 @@ int main(int argc, char** argv) {
       " - offline virtual-texture baking: scenes and images into tiled page files (.vtpf)"};
   app.footer(
       "Exit status: 0 the work succeeded; 1 the work ran and failed (a write, a memory limit, a "
-      "bad page, a threshold missed); 2 bad usage or bad input (docs/REPORTS.md).");
+      "bad page, a threshold missed); 2 bad usage or bad input (docs/REPORTS.md).\n"
+      "Outputs (-o): written under a temporary name beside the target and renamed into place "
+      "when complete; a symlink at the path is written through (its target is replaced in the "
+      "target's folder, the link stays); a directory, device, FIFO or socket there is refused "
+      "(exit 2). `bake` replaces its .vtpf and .glb together. Inputs must be regular files.");
   app.require_subcommand(1);
   app.fallthrough();  // global flags may follow the subcommand: `vtbake info --json f.vtpf`
   app.set_version_flag("--version", VTBAKE_VERSION);

@@ -1160,7 +1160,21 @@ Status dct_decode_page(const DctTables& tables, std::span<const uint8_t> data, i
                        int height, uint8_t* texels) {
   VT_RETURN_IF_ERROR(check_size(width, height));
   if (texels == nullptr) return Error(ErrorCode::kInvalidArgument, "dct: null texels");
+  const size_t bytes = size_t(width) * size_t(height) * size_t(tables.settings.channels);
+  return dct_decode_page(tables, data, width, height, std::span<uint8_t>(texels, bytes));
+}
+
+Status dct_decode_page(const DctTables& tables, std::span<const uint8_t> data, int width,
+                       int height, std::span<uint8_t> out) {
+  VT_RETURN_IF_ERROR(check_size(width, height));
   const DctSettings& s = tables.settings;
+  const size_t texel_bytes = size_t(width) * size_t(height) * size_t(s.channels);
+  if (out.size() != texel_bytes)
+    return Error(ErrorCode::kInvalidArgument,
+                 "dct: output of " + std::to_string(out.size()) + " bytes, the tables decode " +
+                     std::to_string(s.channels) + " channels of " + std::to_string(width) + "x" +
+                     std::to_string(height) + " (" + std::to_string(texel_bytes) + " bytes)");
+  uint8_t* const texels = out.data();
   const int n = plane_count(s);
   const int ch = s.channels;
   if (data.empty()) return corrupt_page(0, "empty");

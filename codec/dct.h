@@ -82,9 +82,14 @@ DctTablesShape dct_tables_shape(const DctTables& tables);
 // Replaces the contents of `out`. Deterministic: the same texels and tables give the same bytes.
 Status dct_encode_page(const DctTables& tables, const uint8_t* texels, int width, int height,
                        std::vector<uint8_t>& out);
-// Decodes one page into width*height*channels bytes. Never reads past `data` or writes past
-// `texels`; truncated, damaged or over-long data gives kCorrupt (texels may then be partly
-// written). Time is bounded by the page size whatever the bytes.
+// Decodes one page into `texels`, which must be exactly width * height * channels bytes for the
+// tables' channel count (dct_tables_shape), else kInvalidArgument before anything is written:
+// whatever the tables say, the decoder writes only inside `texels`. Never reads past `data`;
+// truncated, damaged or over-long data gives kCorrupt (texels may then be partly written).
+// Time is bounded by the page size whatever the bytes.
+Status dct_decode_page(const DctTables& tables, std::span<const uint8_t> data, int width,
+                       int height, std::span<uint8_t> texels);
+// As above for a caller that sized `texels` from the same tables (width * height * channels).
 Status dct_decode_page(const DctTables& tables, std::span<const uint8_t> data, int width,
                        int height, uint8_t* texels);
 

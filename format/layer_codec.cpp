@@ -67,7 +67,8 @@ Status LayerCodec::encode(const uint8_t* texels, const LayerEncodeSettings& sett
       return Status::Ok();
     case PageCodec::kDct:
       VT_RETURN_IF_ERROR(dct_encode_page(*dct_, texels, size, size, out));
-      return decoded ? dct_decode_page(*dct_, out, size, size, decoded) : Status::Ok();
+      return decoded ? dct_decode_page(*dct_, out, size, size, {decoded, page.size()})
+                     : Status::Ok();
     case PageCodec::kBcZstd: {
       std::vector<uint8_t> blocks(bc_page_bytes());
       VT_RETURN_IF_ERROR(bc_encode_image(*bc_, settings.bc_quality, texels, size, size,
@@ -97,7 +98,7 @@ Status LayerCodec::decode(std::span<const uint8_t> data, std::span<uint8_t> out)
     case PageCodec::kRawZstd:
       return zstd_decompress_exact(data, out);
     case PageCodec::kDct:
-      return dct_decode_page(*dct_, data, size, size, out.data());
+      return dct_decode_page(*dct_, data, size, size, out);
     case PageCodec::kBcZstd: {
       std::vector<uint8_t> blocks(bc_page_bytes());
       VT_RETURN_IF_ERROR(zstd_decompress_exact(data, blocks));

@@ -109,8 +109,12 @@ struct ReaderOptions {
 // Reads a page file. Never trusts a size or offset from the file: every malformed file gives a
 // kCorrupt/kUnsupported Status naming the file and the problem, never a crash, a hang or an
 // allocation beyond what the file's own size justifies. Thread-safe for concurrent reads.
-// The file is memory-mapped: it must not be truncated or rewritten in place while open (writers
-// replace files by rename, which is safe).
+// The header and index are read into memory at open; page bytes are read with pread into memory
+// the reader owns (never a mapping), so a file truncated or rewritten in place while open gives
+// an error on the next read (kCorrupt "file changed while open", or a checksum mismatch when
+// ReaderOptions verify), never SIGBUS. Writers replace files by rename, which open readers do
+// not see. `path` must be a regular file: a FIFO, device or directory gives kInvalidArgument
+// without blocking.
 class PageFileReader {
  public:
   static Expected<std::unique_ptr<PageFileReader>> open(const std::string& path,

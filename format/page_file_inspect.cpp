@@ -4,11 +4,24 @@
 #include "common/parallel.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <tuple>
 
 namespace vt {
+
+namespace {
+
+// "68719476736 bytes (64.0 GiB)": exact, and readable at a glance.
+std::string format_bytes(uint64_t bytes) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%llu bytes (%.1f GiB)", (unsigned long long)bytes,
+                double(bytes) / double(uint64_t(1) << 30));
+  return text;
+}
+
+}  // namespace
 
 PageFileStats page_file_stats(const PageFileReader& reader) {
   const PageGeometry& g = reader.geometry();
@@ -76,7 +89,8 @@ Status PageFileReader::verify() const {
   return report.bad_pages.empty() ? Status::Ok() : report.bad_pages.front().status;
 }
 
-Expected<LevelImage> extract_level(const PageFileReader& reader, uint32_t level, uint32_t layer) {
+Expected<LevelImage> extract_level(const PageFileReader& reader, uint32_t level, uint32_t layer,
+                                   uint64_t max_bytes) {
   const PageGeometry& g = reader.geometry();
   if (level >= g.level_count())
     return Error(ErrorCode::kInvalidArgument, reader.path() + ": no level " +
@@ -89,6 +103,15 @@ Expected<LevelImage> extract_level(const PageFileReader& reader, uint32_t level,
   const LayerSpec& spec = reader.layers()[layer];
   const size_t tb = spec.texel_bytes();
   const uint32_t P = g.payload, B = g.border, S = g.page_size();
+  // Width and height are below 2^24 (PageGeometry::validate): the product fits 64 bits.
+  const uint64_t bytes = uint64_t(g.level_width(level)) * g.level_height(level) * tb;
+  if (bytes > max_bytes)
+    return Error(ErrorCode::kInvalidArgument,
+                 reader.path() + ": level " + std::to_string(level) + " of layer " +
+                     std::to_string(layer) + " is " + std::to_string(g.level_width(level)) + "x" +
+                     std::to_string(g.level_height(level)) + " texels of " + std::to_string(tb) +
+                     " bytes: " + format_bytes(bytes) + ", more than the " +
+                     format_bytes(max_bytes) + " an extracted image may hold");
   LevelImage image;
   image.width = g.level_width(level);
   image.height = g.level_height(level);

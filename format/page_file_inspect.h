@@ -60,7 +60,12 @@ struct LevelImage {
 // Reassembles a level from its pages' payloads (borders dropped). An absent page is filled from
 // its nearest present ancestor (page (x >> d, y >> d) of level + d), upsampled nearest: level
 // texel (tx, ty) reads ancestor level texel (tx >> d, ty >> d); with no present ancestor it
-// stays zero. A page that fails to read or decode gives its error.
-Expected<LevelImage> extract_level(const PageFileReader& reader, uint32_t level, uint32_t layer);
+// stays zero. A page that fails to read or decode gives its error. A level image larger than
+// `max_bytes` gives kInvalidArgument naming the file, the level and the size before anything is
+// allocated: a header is small whatever geometry it claims (an 11 KB file can describe a
+// 2^24 x 2^24 level), so the size a file asks for is never trusted.
+inline constexpr uint64_t kMaxLevelImageBytes = uint64_t(4) << 30;  // 4 GiB
+Expected<LevelImage> extract_level(const PageFileReader& reader, uint32_t level, uint32_t layer,
+                                   uint64_t max_bytes = kMaxLevelImageBytes);
 
 }  // namespace vt

@@ -1,7 +1,7 @@
-// The runtime page-file reader: maps the file, validates every count, offset and size against
-// the real file size before using it, then serves pages to any number of threads.
+// The runtime page-file reader: reads the header and index into owned memory, validates every
+// count, offset and size against the real file size before using it, then serves pages to any
+// number of threads with pread.
 #include <fcntl.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <xxhash.h>
@@ -26,26 +26,24 @@ class PageFileReaderImpl final : public PageFileReader {
       : path_(std::move(path)), options_(options) {}
 
   ~PageFileReaderImpl() override {
-    if (map_) ::munmap(const_cast<uint8_t*>(map_), size_t(size_));
     if (fd_ >= 0) ::close(fd_);
   }
 
   Status open_and_validate() {
-    fd_ = ::open(path_.c_str(), O_RDONLY | O_CLOEXEC);
+    // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer forever.
+    fd_ = ::open(path_.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
     if (fd_ < 0) {
       ErrorCode code = errno == ENOENT ? ErrorCode::kNotFound : ErrorCode::kIo;
       return Error(code, std::string("cannot open: ") + std::strerror(errno));
     }
     struct stat st;
     if (::fstat(fd_, &st) != 0) return Error(ErrorCode::kIo, "cannot stat");
-    if (!S_ISREG(st.st_mode)) return Error(ErrorCode::kInvalidArgument, "not a regular file");
+    if (!S_ISREG(st.st_mode))
+      return Error(ErrorCode::kInvalidArgument,
+                   std::string("not a regular file (") + file_kind_name(st.st_mode) + ")");
     size_ = uint64_t(st.st_size);
     if (size_ < kFixedHeaderBytes)
       return corrupt("truncated: " + std::to_string(size_) + " bytes is less than a header");
-    void* map = ::mmap(nullptr, size_t(size_), PROT_READ, MAP_SHARED, fd_, 0);
-    if (map == MAP_FAILED)
-      return Error(ErrorCode::kIo, std::string("mmap: ") + std::strerror(errno));
-    map_ = static_cast<const uint8_t*>(map);
     VT_RETURN_IF_ERROR(parse_header());
     VT_RETURN_IF_ERROR(validate_index());
     return Status::Ok();
@@ -64,8 +62,9 @@ class PageFileReaderImpl final : public PageFileReader {
   }
 
   Expected<std::vector<uint8_t>> read_stored(const PageId& id, uint32_t layer) const override {
-    VT_ASSIGN_OR_RETURN(std::span<const uint8_t> bytes, stored_bytes(id, layer));
-    return std::vector<uint8_t>(bytes.begin(), bytes.end());
+    std::vector<uint8_t> bytes;
+    VT_RETURN_IF_ERROR(stored_bytes(id, layer, bytes));
+    return bytes;
   }
 
   Status read_texels(const PageId& id, uint32_t layer, std::span<uint8_t> out) const override {
@@ -83,7 +82,13 @@ class PageFileReaderImpl final : public PageFileReader {
       for (size_t i = 0; i < out.size(); i += tb) std::memcpy(out.data() + i, e.constant, tb);
       return Status::Ok();
     }
-    VT_ASSIGN_OR_RETURN(std::span<const uint8_t> bytes, stored_bytes(id, layer));
+    if (layers_[layer].codec == PageCodec::kRaw) {
+      // validate_index() checked that a raw page is exactly out.size() bytes: read in place.
+      VT_RETURN_IF_ERROR(read_at(e.offset, out, &id, layer));
+      return options_.verify_checksums ? check_stored(id, layer, e, out) : Status::Ok();
+    }
+    thread_local std::vector<uint8_t> bytes;
+    VT_RETURN_IF_ERROR(stored_bytes(id, layer, bytes));
     return codecs_[layer].decode(bytes, out).with_context(path_ + ": " + page_name(id, layer));
   }
 
@@ -98,11 +103,45 @@ class PageFileReaderImpl final : public PageFileReader {
   Status verify_page(const PageId& id, uint32_t layer) const override {
     VT_ASSIGN_OR_RETURN(uint64_t slot, slot_of(id, layer));
     PageEntry e = parse_entry(slot);
-    return e.state == PageState::kStored ? check_stored(id, layer, e) : Status::Ok();
+    if (e.state != PageState::kStored) return Status::Ok();
+    thread_local std::vector<uint8_t> bytes;
+    bytes.resize(e.size);
+    VT_RETURN_IF_ERROR(read_at(e.offset, bytes, &id, layer));
+    return check_stored(id, layer, e, bytes);
   }
 
  private:
   Status corrupt(const std::string& what) const { return Error(ErrorCode::kCorrupt, what); }
+
+  static const char* file_kind_name(mode_t mode) {
+    if (S_ISDIR(mode)) return "a directory";
+    if (S_ISFIFO(mode)) return "a FIFO";
+    if (S_ISCHR(mode) || S_ISBLK(mode)) return "a device";
+    if (S_ISSOCK(mode)) return "a socket";
+    return "not a plain file";
+  }
+
+  // Reads exactly out.size() bytes at `offset` into memory this reader owns. Page reads use
+  // pread, never a mapping, so a file truncated or rewritten while open gives an error here
+  // rather than SIGBUS.
+  Status read_at(uint64_t offset, std::span<uint8_t> out, const PageId* id = nullptr,
+                 uint32_t layer = 0) const {
+    size_t done = 0;
+    while (done < out.size()) {
+      const ssize_t n = ::pread(fd_, out.data() + done, out.size() - done, off_t(offset + done));
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        // Page reads name the file and page; open() adds the path to its own errors.
+        const std::string what = id ? path_ + ": " + page_name(*id, layer) + ": " : std::string();
+        if (n < 0) return Error(ErrorCode::kIo, what + "read failed: " + std::strerror(errno));
+        return corrupt(what + "file changed while open: " + std::to_string(out.size()) +
+                       " bytes at offset " + std::to_string(offset) +
+                       " end past its end (truncated)");
+      }
+      done += size_t(n);
+    }
+    return Status::Ok();
+  }
 
   Expected<uint64_t> slot_of(const PageId& id, uint32_t layer) const {
     if (!geometry_.contains(id) || layer >= layers_.size())
@@ -115,7 +154,7 @@ class PageFileReaderImpl final : public PageFileReader {
 
   // Decodes an index entry that open() has already validated.
   PageEntry parse_entry(uint64_t slot) const {
-    const uint8_t* p = map_ + index_offset_ + slot * kEntryBytes;
+    const uint8_t* p = index_.data() + slot * kEntryBytes;
     PageEntry e;
     e.state = PageState(p[0]);
     e.codec = PageCodec(p[1]);
@@ -126,22 +165,25 @@ class PageFileReaderImpl final : public PageFileReader {
     return e;
   }
 
-  Status check_stored(const PageId& id, uint32_t layer, const PageEntry& e) const {
-    if (XXH3_64bits(map_ + e.offset, e.size) != e.checksum)
+  Status check_stored(const PageId& id, uint32_t layer, const PageEntry& e,
+                      std::span<const uint8_t> bytes) const {
+    if (XXH3_64bits(bytes.data(), bytes.size()) != e.checksum)
       return Error(ErrorCode::kCorrupt,
                    path_ + ": " + page_name(id, layer) + ": checksum mismatch in stored bytes");
     return Status::Ok();
   }
 
-  Expected<std::span<const uint8_t>> stored_bytes(const PageId& id, uint32_t layer) const {
+  // The stored bytes of a kStored page into `out` (resized), checksum-verified if asked.
+  Status stored_bytes(const PageId& id, uint32_t layer, std::vector<uint8_t>& out) const {
     VT_ASSIGN_OR_RETURN(uint64_t slot, slot_of(id, layer));
     PageEntry e = parse_entry(slot);
     if (e.state != PageState::kStored)
       return Error(ErrorCode::kNotFound,
                    path_ + ": " + page_name(id, layer) + " is " +
                        (e.state == PageState::kAbsent ? "absent" : "constant") + ", not stored");
-    if (options_.verify_checksums) VT_RETURN_IF_ERROR(check_stored(id, layer, e));
-    return std::span<const uint8_t>(map_ + e.offset, e.size);
+    out.resize(e.size);
+    VT_RETURN_IF_ERROR(read_at(e.offset, out, &id, layer));
+    return options_.verify_checksums ? check_stored(id, layer, e, out) : Status::Ok();
   }
 
   Status parse_header();
@@ -151,9 +193,10 @@ class PageFileReaderImpl final : public PageFileReader {
   std::string path_;
   ReaderOptions options_;
   int fd_ = -1;
-  const uint8_t* map_ = nullptr;
   uint64_t size_ = 0;
   uint32_t version_ = 0;
+  std::vector<uint8_t> header_;  // the whole header, checksum included
+  std::vector<uint8_t> index_;   // the whole index, read once at open
   PageGeometry geometry_;
   std::vector<LayerSpec> layers_;
   std::vector<LayerCodec> codecs_;
@@ -165,8 +208,10 @@ class PageFileReaderImpl final : public PageFileReader {
 };
 
 Status PageFileReaderImpl::parse_header() {
-  const uint8_t* h = map_;
-  if (std::memcmp(h, kMagic, 8) != 0) return corrupt("not a page file (bad magic)");
+  header_.resize(kFixedHeaderBytes);
+  VT_RETURN_IF_ERROR(read_at(0, header_));
+  if (std::memcmp(header_.data(), kMagic, 8) != 0) return corrupt("not a page file (bad magic)");
+  const uint8_t* h = header_.data();
   version_ = get_u32(h + kOffVersion);
   if (version_ == 0) return corrupt("version 0 is not valid");
   if (version_ > kVersion)
@@ -178,6 +223,9 @@ Status PageFileReaderImpl::parse_header() {
                    std::to_string(size_));
   if (header_size < kFixedHeaderBytes + 8 || header_size % 8 != 0)
     return corrupt("header size " + std::to_string(header_size) + " is invalid");
+  header_.resize(size_t(header_size));  // at most the file's size, checked above
+  VT_RETURN_IF_ERROR(read_at(0, header_));
+  h = header_.data();
   if (XXH3_64bits(h, size_t(header_size - 8)) != get_u64(h + header_size - 8))
     return corrupt("header checksum mismatch");
   if (get_u32(h + kOffFlags) & ~kFlagAlign4k)
@@ -234,11 +282,16 @@ Status PageFileReaderImpl::parse_header() {
   if (meta_offset != data_offset_ + data_size_)
     return corrupt("metadata does not follow the data area");
   if (meta_size != size_ - meta_offset) return corrupt("metadata does not end the file");
-  if (XXH3_64bits(map_ + index_offset_, size_t(index_size_)) != get_u64(h + kOffIndexChecksum))
+  // Both sizes lie inside the file (checked above), so these buffers are backed by its bytes.
+  index_.resize(size_t(index_size_));
+  VT_RETURN_IF_ERROR(read_at(index_offset_, index_));
+  if (XXH3_64bits(index_.data(), index_.size()) != get_u64(h + kOffIndexChecksum))
     return corrupt("index checksum mismatch");
-  if (XXH3_64bits(map_ + meta_offset, size_t(meta_size)) != get_u64(h + kOffMetadataChecksum))
+  std::vector<uint8_t> meta(static_cast<size_t>(meta_size));
+  VT_RETURN_IF_ERROR(read_at(meta_offset, meta));
+  if (XXH3_64bits(meta.data(), meta.size()) != get_u64(h + kOffMetadataChecksum))
     return corrupt("metadata checksum mismatch");
-  metadata_.assign(reinterpret_cast<const char*>(map_ + meta_offset), size_t(meta_size));
+  metadata_.assign(meta.begin(), meta.end());
   return Status::Ok();
 }
 
@@ -246,7 +299,7 @@ Status PageFileReaderImpl::parse_layers(uint64_t pos, uint64_t end) {
   for (size_t i = 0; i < layers_.size(); ++i) {
     const std::string which = "layer " + std::to_string(i);
     if (end - pos < kLayerRecordFixedBytes) return corrupt(which + " record overruns the header");
-    const uint8_t* p = map_ + pos;
+    const uint8_t* p = header_.data() + pos;
     LayerSpec& l = layers_[i];
     l.semantic = LayerSemantic(p[0]);
     l.channels = p[1];
@@ -290,7 +343,7 @@ Status PageFileReaderImpl::validate_index() {
   const uint64_t data_end = data_offset_ + data_size_;
   const uint32_t layer_count = uint32_t(layers_.size());
   for (uint64_t slot = 0; slot < entry_count_; ++slot) {
-    const uint8_t* p = map_ + index_offset_ + slot * kEntryBytes;
+    const uint8_t* p = index_.data() + slot * kEntryBytes;
     const uint32_t layer = uint32_t(slot % layer_count);
     const LayerSpec& spec = layers_[layer];
     auto bad = [&](const std::string& what) {

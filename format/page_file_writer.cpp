@@ -12,6 +12,7 @@
 #include <cstring>
 #include <mutex>
 
+#include "format/atomic_output.h"
 #include "format/page_file.h"
 #include "format/page_file_layout.h"
 
@@ -120,8 +121,8 @@ std::string dir_of(const std::string& path) {
 
 class PageFileWriterImpl final : public PageFileWriter {
  public:
-  PageFileWriterImpl(std::string path, PageFileDesc desc)
-      : path_(std::move(path)), desc_(std::move(desc)) {}
+  PageFileWriterImpl(std::string path, std::string target, PageFileDesc desc)
+      : path_(std::move(path)), target_(std::move(target)), desc_(std::move(desc)) {}
 
   ~PageFileWriterImpl() override {
     if (spill_fd_ >= 0) ::close(spill_fd_);
@@ -142,14 +143,14 @@ class PageFileWriterImpl final : public PageFileWriter {
     level_first_.resize(g.level_count());
     for (uint32_t l = 0; l < g.level_count(); ++l) level_first_[l] = level_first_page(g, l);
 
-    temp_path_ = path_ + ".tmp-XXXXXX";
+    temp_path_ = target_ + ".tmp-XXXXXX";
     out_fd_ = ::mkstemp(temp_path_.data());
     if (out_fd_ < 0) {
       std::string err = errno_text();
       temp_path_.clear();
       return Error(ErrorCode::kIo, path_ + ": cannot create temporary file: " + err);
     }
-    std::string spill = path_ + ".spill-XXXXXX";
+    std::string spill = target_ + ".spill-XXXXXX";
     spill_fd_ = ::mkstemp(spill.data());
     if (spill_fd_ < 0)
       return Error(ErrorCode::kIo, path_ + ": cannot create spill file: " + errno_text());
@@ -253,6 +254,7 @@ class PageFileWriterImpl final : public PageFileWriter {
   Status write_file();
 
   std::string path_;
+  std::string target_;  // resolve_output_path(path_): what the rename replaces
   PageFileDesc desc_;
   uint32_t layer_count_ = 0;
   std::vector<uint64_t> level_first_;
@@ -391,11 +393,11 @@ Status PageFileWriterImpl::write_file() {
   mode_t mask = ::umask(0);
   ::umask(mask);
   ::chmod(temp_path_.c_str(), 0666 & ~mask);
-  if (::rename(temp_path_.c_str(), path_.c_str()) != 0)
+  if (::rename(temp_path_.c_str(), target_.c_str()) != 0)
     return Error(ErrorCode::kIo, "rename into place failed: " + errno_text());
   renamed_ = true;
   // Make the rename itself durable.
-  int dir_fd = ::open(dir_of(path_).c_str(), O_RDONLY | O_DIRECTORY);
+  int dir_fd = ::open(dir_of(target_).c_str(), O_RDONLY | O_DIRECTORY);
   if (dir_fd >= 0) {
     ::fsync(dir_fd);
     ::close(dir_fd);
@@ -426,7 +428,9 @@ Expected<std::unique_ptr<PageFileWriter>> PageFileWriter::create(const std::stri
       return Error(ErrorCode::kInvalidArgument, path + ": layer " + std::to_string(i) + " \"" +
                                                     desc.layers[i].name + "\": " + problem);
   }
-  auto writer = std::make_unique<PageFileWriterImpl>(path, desc);
+  // The temporary lives beside what is really replaced: a symlink's target, never a device.
+  VT_ASSIGN_OR_RETURN(std::string target, resolve_output_path(path));
+  auto writer = std::make_unique<PageFileWriterImpl>(path, std::move(target), desc);
   VT_RETURN_IF_ERROR(writer->init());
   return std::unique_ptr<PageFileWriter>(std::move(writer));
 }

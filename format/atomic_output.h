@@ -1,0 +1,56 @@
+// Output and input paths that hostile or careless arguments cannot turn against the machine:
+// an output replaces only a regular file (or a symlink's regular target), only once complete,
+// and a set of outputs (a bake's .vtpf and .glb) is replaced together. docs/FORMAT.md,
+// "Writing outputs", states the rules every `-o` follows.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "common/status.h"
+
+namespace vt {
+
+// Where writing `path` lands. `path` itself when nothing or a regular file is there; the final
+// target of a symlink (followed through any chain, relative links from their own folder), so
+// that the target is replaced in its own folder and the link stays a link. A directory,
+// device, FIFO or socket at the path (or at the link's target) gives kInvalidArgument naming
+// the path and what is there: a writer never replaces what is not a file.
+Expected<std::string> resolve_output_path(const std::string& path);
+
+// Ok when `path` names a regular file (symlinks followed), without opening it: opening a FIFO
+// blocks until a writer comes, a device never ends. kNotFound when nothing is there,
+// kInvalidArgument naming what is there otherwise.
+Status check_input_file(const std::string& path);
+
+// Outputs staged under temporary names beside their final targets and renamed into place
+// together by commit(): both or neither for an error anywhere before or during commit. What
+// stays: a kill in the few microseconds between two renames of commit() leaves the first
+// replaced and not the second (POSIX has no multi-file rename). Uncommitted staged files are
+// removed by the destructor. Not thread-safe.
+class OutputSet {
+ public:
+  OutputSet() = default;
+  ~OutputSet();
+  OutputSet(const OutputSet&) = delete;
+  OutputSet& operator=(const OutputSet&) = delete;
+
+  // Checks `final_path` (resolve_output_path) and creates an empty temporary file beside its
+  // target; returns the temporary's path, which the caller writes (or renames a file onto).
+  Expected<std::string> stage(const std::string& final_path);
+  // Syncs every staged file and renames each over its target, in staging order. If a rename
+  // fails, the targets already replaced get their previous files back (or are removed when
+  // there were none) and the error names the path.
+  Status commit();
+
+ private:
+  struct Staged {
+    std::string final_path;  // as the caller named it (messages)
+    std::string target;      // resolve_output_path(final_path)
+    std::string temp;
+  };
+  std::vector<Staged> staged_;
+  bool committed_ = false;
+};
+
+}  // namespace vt
