@@ -353,7 +353,9 @@ void MtlReader::finish() {
 
 Status load_mtl(const std::string& path, Scene* scene, std::map<std::string, int>* by_name) {
   VT_ASSIGN_OR_RETURN(auto bytes, read_file(path));
-  VT_ASSIGN_OR_RETURN(std::string text, decode_text(bytes, path));
+  std::string note;
+  VT_ASSIGN_OR_RETURN(std::string text, decode_text(bytes, path, &note));
+  if (!note.empty()) scene->warnings.push_back(path + ": " + note);
   MtlReader reader(path, scene, by_name);
   LineCursor c{text.data(), text.data() + text.size()};
   while (c.p < c.end) {

@@ -40,6 +40,7 @@ class ObjReader {
   }
   Status statement(const std::string& key, LineCursor* c);
   Scene finish() &&;
+  void warn(std::string what) { scene_.warnings.push_back(std::move(what)); }
   size_t line = 1;
 
  private:
@@ -140,11 +141,19 @@ void ObjReader::load_library(const std::string& written) {
   if (!libraries_.insert(file).second) return;
   if (!note.empty()) scene_.warnings.push_back(where() + ": mtllib " + note);
   Status s = load_mtl(file, &scene_, &materials_);
-  if (!s.ok()) {
-    library_missing_ = true;
-    scene_.warnings.push_back(where() + ": mtllib '" + written + "': " + s.message() +
-                              "; its materials are defaults");
+  if (s.ok()) return;
+  // As assimp does: a library that is not there is often the OBJ's own name with .mtl.
+  std::string own = path_.substr(0, path_.size() - lower_extension(path_).size()) + "mtl";
+  std::error_code ec;
+  if (s.code() == ErrorCode::kNotFound && std::filesystem::is_regular_file(own, ec) &&
+      libraries_.insert(own).second && load_mtl(own, &scene_, &materials_).ok()) {
+    scene_.warnings.push_back(where() + ": mtllib '" + written + "' not found; using '" + own +
+                              "' (the OBJ's name)");
+    return;
   }
+  library_missing_ = true;
+  scene_.warnings.push_back(where() + ": mtllib '" + written + "': " + s.message() +
+                            "; its materials are defaults");
 }
 
 // One library whose name has spaces, or several separated by blanks (both are written).
@@ -243,9 +252,11 @@ Scene ObjReader::finish() && {
 
 Expected<Scene> load_obj(const std::string& path) {
   VT_ASSIGN_OR_RETURN(auto bytes, read_file(path));
-  VT_ASSIGN_OR_RETURN(std::string text, decode_text(bytes, path));
+  std::string note;
+  VT_ASSIGN_OR_RETURN(std::string text, decode_text(bytes, path, &note));
   bytes = {};
   ObjReader reader(path);
+  if (!note.empty()) reader.warn(path + ": " + note);
   LineCursor c{text.data(), text.data() + text.size()};
   while (c.p < c.end) {
     std::string key = c.word();

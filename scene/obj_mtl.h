@@ -14,8 +14,10 @@
 namespace vt::scene::detail {
 
 // The file's text in UTF-8: a UTF-8 BOM is dropped, UTF-16 (a BOM, or ASCII with every other
-// byte zero) is converted. The error names `path` (odd-length UTF-16).
-Expected<std::string> decode_text(const std::vector<uint8_t>& bytes, const std::string& path);
+// byte zero) is converted, and text that is not valid UTF-8 is read as Latin-1 (`note` then
+// says so; empty otherwise). The error names `path` (odd-length UTF-16).
+Expected<std::string> decode_text(const std::vector<uint8_t>& bytes, const std::string& path,
+                                  std::string* note);
 
 // Reads one OBJ/MTL statement at a time; `p` is at the start of a line after next_line().
 struct LineCursor {
@@ -26,7 +28,7 @@ struct LineCursor {
   bool at_line_end();          // after skipping blanks: end of line, of file, or a comment
   std::string word();          // the next blank-separated token
   std::string rest_of_line();  // trimmed; comments are part of it (names may hold '#')
-  bool number(float* out);     // also "+1", "2.", "nan", "inf"
+  bool number(float* out);     // also "+1", "2.", "nan", "inf"; false: nothing read
   void next_line();
 };
 

@@ -51,6 +51,21 @@ Expected<std::string> utf16_to_utf8(const uint8_t* data, size_t size, bool big_e
   return out;
 }
 
+bool valid_utf8(const uint8_t* d, size_t n) {
+  for (size_t i = 0; i < n;) {
+    int extra = d[i] < 0x80           ? 0
+                : (d[i] >> 5) == 0x06 ? 1
+                : (d[i] >> 4) == 0x0e ? 2
+                : (d[i] >> 3) == 0x1e ? 3
+                                      : -1;
+    if (extra < 0 || i + extra >= n) return false;
+    for (int k = 1; k <= extra; ++k)
+      if ((d[i + k] & 0xc0) != 0x80) return false;
+    i += extra + 1;
+  }
+  return true;
+}
+
 bool same_ignoring_case(const std::string& a, const std::string& b) {
   if (a.size() != b.size()) return false;
   for (size_t i = 0; i < a.size(); ++i)
@@ -94,7 +109,9 @@ std::string find_ignoring_case(const std::string& folder, const std::string& rel
 
 }  // namespace
 
-Expected<std::string> decode_text(const std::vector<uint8_t>& bytes, const std::string& path) {
+Expected<std::string> decode_text(const std::vector<uint8_t>& bytes, const std::string& path,
+                                  std::string* note) {
+  note->clear();
   const uint8_t* d = bytes.data();
   size_t n = bytes.size();
   if (n >= 3 && d[0] == 0xef && d[1] == 0xbb && d[2] == 0xbf) return std::string(d + 3, d + n);
@@ -103,7 +120,12 @@ Expected<std::string> decode_text(const std::vector<uint8_t>& bytes, const std::
   // No BOM: ASCII text written as UTF-16 has a zero in every other byte.
   if (n >= 2 && d[0] != 0 && d[1] == 0) return utf16_to_utf8(d, n, false, path);
   if (n >= 2 && d[0] == 0 && d[1] != 0) return utf16_to_utf8(d, n, true, path);
-  return std::string(d, d + n);
+  if (valid_utf8(d, n)) return std::string(d, d + n);
+  // Older exporters write names in an 8-bit code page; Latin-1 is the common one.
+  *note = "not UTF-8: read as Latin-1";
+  std::string out;
+  for (size_t i = 0; i < n; ++i) append_utf8(d[i], &out);
+  return out;
 }
 
 void LineCursor::skip_space() {
@@ -138,15 +160,13 @@ bool LineCursor::number(float* out) {
     *out = static_cast<float>(std::strtod(std::string(p, r.ptr).c_str(), nullptr));
   } else if (r.ec != std::errc()) {
     // from_chars rejects a leading '+' and "nan"/"inf" spellings some exporters use.
+    // A malformed tail ("3.1+e2") is left unread, as assimp reads it.
     const char* s = p;
     std::string w = word();
     char* e = nullptr;
     if (!w.empty()) *out = std::strtof(w.c_str(), &e);
-    if (w.empty() || !e || *e != 0) {
-      p = s;  // not a number: leave it for the caller
-      return false;
-    }
-    return true;
+    p = s + (e ? e - w.c_str() : 0);
+    return p != s;
   }
   p = r.ptr;
   return true;

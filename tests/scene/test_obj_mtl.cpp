@@ -310,6 +310,15 @@ TEST(ObjMtl, MissingLibraryAndMissingMaterialAreWarned) {
   EXPECT_EQ(warnings_with(s, {"a.obj:1", "nowhere.mtl", "defaults"}), 1);
   EXPECT_EQ(warnings_with(s, {"a.obj", "usemtl 'wood'", "default"}), 1);
 
+  // A library that is not there, beside one with the OBJ's name (as assimp reads it).
+  std::string own = folder("own_name");
+  scene::Scene fallback = load(own, "newmtl wood\nKd 0.5 0.25 0\n",
+                               "mtllib a.mat\n" + kQuadVertices + "usemtl wood\nf 1/1 2/2 3/3\n");
+  EXPECT_EQ(fallback.meshes[0].primitives[0].material, 0);
+  ASSERT_EQ(fallback.warnings.size(), 1u);
+  EXPECT_EQ(fallback.warnings[0],
+            own + "a.obj:1: mtllib 'a.mat' not found; using '" + own + "a.mtl' (the OBJ's name)");
+
   // usemtl before mtllib still finds the material; an unknown name is warned once.
   scene::Scene late = load(folder("late"), "newmtl stone\nKd 0.5 0.5 0.5\n",
                            kQuadVertices +
@@ -350,6 +359,21 @@ TEST(ObjMtl, Utf16AndBomText) {
   ASSERT_FALSE(odd.ok());
   EXPECT_EQ(odd.status().code(), ErrorCode::kCorrupt);
   EXPECT_NE(odd.status().message().find("odd.obj: UTF-16"), std::string::npos);
+}
+
+// Old exporters: a Latin-1 material name (0xE6 is 'æ'), numbers with a malformed tail.
+TEST(ObjMtl, Latin1NamesAndMalformedNumberTails) {
+  std::string dir = folder("latin1");
+  scene::Scene s = load(dir, "newmtl Terraind\xe6k\nKd 0.4 0.3 0.3\n",
+                        "mtllib a.mtl\nv 0 0 0\nv +1e+2 0 0\nv 0 1 3.1+e2\n"
+                        "usemtl Terraind\xe6k\nf 1 2 3\n");
+  ASSERT_EQ(s.materials.size(), 1u);
+  EXPECT_EQ(s.materials[0].name, "Terraind\xc3\xa6k");
+  EXPECT_EQ(s.meshes[0].primitives[0].material, 0);
+  EXPECT_FLOAT_EQ(s.meshes[0].primitives[0].positions[1][0], 100.0f);
+  EXPECT_FLOAT_EQ(s.meshes[0].primitives[0].positions[2][2], 3.1f);
+  EXPECT_EQ(warnings_with(s, {"a.mtl: not UTF-8: read as Latin-1"}), 1);
+  EXPECT_EQ(warnings_with(s, {"a.obj: not UTF-8: read as Latin-1"}), 1);
 }
 
 }  // namespace
