@@ -1,121 +1,21 @@
-// Wavefront OBJ + MTL: one primitive per material, polygons fanned into triangles, vertices
-// shared by identical (position, uv, normal) triples. OBJ's v-up UVs become glTF's v-down.
-#include <charconv>
-#include <cmath>
-#include <cstring>
-#include <map>
+// Wavefront OBJ: one primitive per `usemtl` name, polygons fanned into triangles, vertices shared
+// by identical (position, uv, normal) triples. OBJ's v-up UVs become glTF's v-down. Materials
+// come from the MTL libraries (scene/mtl_import.cpp), resolved by name once the whole file is
+// read, so `usemtl` may come before `mtllib`.
+// Vertex colours (`v x y z r g b [a]`) are read as sRGB-encoded, the way MeshLab, ZBrush and
+// Blender write them (8-bit colours over 255, what their viewports show), and stored linear.
+// A file with a component above 1 wrote 0..255 and is scaled (with a warning).
+#include <algorithm>
+#include <filesystem>
+#include <set>
 #include <unordered_map>
 
+#include "common/srgb.h"
+#include "scene/obj_mtl.h"
 #include "scene/scene_io_util.h"
 
 namespace vt::scene::detail {
 namespace {
-
-struct Cursor {
-  const char* p;
-  const char* end;
-  void skip_space() {
-    while (p < end && (*p == ' ' || *p == '\t' || *p == '\r')) ++p;
-  }
-  bool at_line_end() {
-    skip_space();
-    return p >= end || *p == '\n' || *p == '#';
-  }
-  std::string word() {
-    skip_space();
-    const char* s = p;
-    while (p < end && !std::isspace(static_cast<unsigned char>(*p))) ++p;
-    return std::string(s, p);
-  }
-  std::string rest_of_line() {
-    skip_space();
-    const char* s = p;
-    while (p < end && *p != '\n') ++p;
-    const char* e = p;
-    while (e > s && (e[-1] == '\r' || e[-1] == ' ' || e[-1] == '\t')) --e;
-    return std::string(s, e);
-  }
-  bool number(float* out) {
-    skip_space();
-    auto r = std::from_chars(p, end, *out);
-    if (r.ec == std::errc::result_out_of_range) {  // keep huge values as inf, not an error
-      double d = std::strtod(std::string(p, r.ptr).c_str(), nullptr);
-      *out = static_cast<float>(d);
-    } else if (r.ec != std::errc()) {
-      // from_chars rejects "nan"/"inf" spellings some exporters use with a sign or case.
-      std::string w = word();
-      if (w.empty()) return false;
-      char* e = nullptr;
-      *out = std::strtof(w.c_str(), &e);
-      return e && *e == 0;
-    }
-    p = r.ptr;
-    return true;
-  }
-  void next_line() {
-    while (p < end && *p != '\n') ++p;
-    if (p < end) ++p;
-  }
-};
-
-// The last whitespace-separated token of an MTL map statement is the file (options come first).
-std::string map_file(const std::string& rest) {
-  size_t pos = rest.find_last_of(" \t");
-  return pos == std::string::npos ? rest : rest.substr(pos + 1);
-}
-
-void parse_mtl(const std::string& path, Scene* scene, std::map<std::string, int>* by_name) {
-  auto bytes = read_file(path);
-  if (!bytes.ok()) return;  // a missing .mtl leaves default materials, as most tools do
-  std::string folder = parent_folder(path);
-  auto image_for = [&](const std::string& file) {
-    for (size_t i = 0; i < scene->images.size(); ++i)
-      if (scene->images[i].uri == file) return static_cast<int>(i);
-    Image img;
-    img.uri = file;
-    img.path = folder + file;
-    img.name = file;
-    scene->images.push_back(img);
-    return static_cast<int>(scene->images.size() - 1);
-  };
-  Cursor c{reinterpret_cast<const char*>(bytes->data()),
-           reinterpret_cast<const char*>(bytes->data()) + bytes->size()};
-  Material* m = nullptr;
-  while (c.p < c.end) {
-    std::string key = c.word();
-    if (key == "newmtl") {
-      Material mat;
-      mat.name = c.rest_of_line();
-      mat.metallic_factor = 0.0f;  // OBJ materials are dielectric unless Pm says otherwise
-      scene->materials.push_back(mat);
-      (*by_name)[mat.name] = static_cast<int>(scene->materials.size() - 1);
-      m = &scene->materials.back();
-    } else if (m && key == "Kd") {
-      for (int k = 0; k < 3; ++k) c.number(&m->base_color_factor[k]);
-    } else if (m && key == "d") {
-      c.number(&m->base_color_factor[3]);
-      if (m->base_color_factor[3] < 1.0f) m->alpha_mode = AlphaMode::kBlend;
-    } else if (m && key == "Tr") {
-      float tr = 0;
-      c.number(&tr);
-      m->base_color_factor[3] = 1.0f - tr;
-      if (tr > 0.0f) m->alpha_mode = AlphaMode::kBlend;
-    } else if (m && key == "Ke") {
-      for (int k = 0; k < 3; ++k) c.number(&m->emissive_factor[k]);
-    } else if (m && key == "Pr") {
-      c.number(&m->roughness_factor);
-    } else if (m && key == "Pm") {
-      c.number(&m->metallic_factor);
-    } else if (m && key == "map_Kd") {
-      m->base_color_texture.image = image_for(map_file(c.rest_of_line()));
-    } else if (m && (key == "map_Bump" || key == "map_bump" || key == "bump" || key == "norm")) {
-      m->normal_texture.image = image_for(map_file(c.rest_of_line()));
-    } else if (m && key == "map_Ke") {
-      m->emissive_texture.image = image_for(map_file(c.rest_of_line()));
-    }
-    c.next_line();
-  }
-}
 
 struct KeyHash {
   size_t operator()(const std::array<int, 3>& k) const {
@@ -124,114 +24,247 @@ struct KeyHash {
   }
 };
 
+// The triangles of one `usemtl` name.
+struct Builder {
+  std::string material_name;
+  Primitive prim;
+  std::unordered_map<std::array<int, 3>, uint32_t, KeyHash> map;
+  std::vector<int> position_of;  // per vertex: its `v` (for colours, filled in at the end)
+  bool any_uv = false, any_normal = false;
+};
+
+class ObjReader {
+ public:
+  explicit ObjReader(const std::string& path) : path_(path), folder_(parent_folder(path)) {
+    scene_.source_path = path;
+  }
+  Status statement(const std::string& key, LineCursor* c);
+  Scene finish() &&;
+  void warn(std::string what) { scene_.warnings.push_back(std::move(what)); }
+  size_t line = 1;
+
+ private:
+  std::string where() const { return path_ + ":" + std::to_string(line); }
+  Status vertex(LineCursor* c);
+  Status face(LineCursor* c);
+  void mtllib(const std::string& rest);
+  void load_library(const std::string& written);
+  int material_index(const std::string& name);
+  void fill_colors(Builder* b) const;
+
+  std::string path_, folder_;
+  Scene scene_;
+  std::map<std::string, int> materials_;
+  std::set<std::string> libraries_;  // loaded, by resolved path
+  bool library_missing_ = false;
+  std::vector<Vec3> v_, vn_;
+  std::vector<Vec2> vt_;
+  std::vector<Vec4> colors_;  // per `v`, as written; empty while no `v` had a colour
+  float color_peak_ = 0.0f;
+  std::vector<Builder> builders_;
+  std::map<std::string, size_t> builder_of_;  // usemtl name -> builders_ index
+  std::string current_;                       // the current usemtl name
+  size_t ignored_elements_ = 0;               // points, lines, curves
+  std::vector<std::array<int, 3>> face_;
+};
+
+Status ObjReader::vertex(LineCursor* c) {
+  Vec3 p{};
+  for (int k = 0; k < 3; ++k)
+    if (!c->number(&p[k])) return Error(ErrorCode::kCorrupt, where() + ": bad vertex");
+  float extra[4] = {1, 1, 1, 1};
+  int n = 0;
+  while (n < 4 && !c->at_line_end() && c->number(&extra[n])) ++n;
+  v_.push_back(p);
+  if (n >= 3) {  // x y z r g b [a]; a lone fourth number is the rational weight w
+    if (colors_.empty()) colors_.assign(v_.size() - 1, Vec4{1, 1, 1, 1});
+    if (n == 3) extra[3] = 1.0f;
+    colors_.push_back({extra[0], extra[1], extra[2], extra[3]});
+    color_peak_ = std::max({color_peak_, extra[0], extra[1], extra[2]});
+  } else if (!colors_.empty()) {
+    colors_.push_back({1, 1, 1, 1});
+  }
+  return Status::Ok();
+}
+
+Status ObjReader::face(LineCursor* c) {
+  face_.clear();
+  while (!c->at_line_end()) {
+    std::string w = c->word();
+    std::array<int, 3> idx = {0, 0, 0};
+    int field = 0;
+    size_t start = 0;
+    for (size_t i = 0; i <= w.size(); ++i) {
+      if (i == w.size() || w[i] == '/') {
+        if (i > start && field < 3) idx[field] = std::atoi(w.c_str() + start);
+        ++field;
+        start = i + 1;
+      }
+    }
+    const size_t counts[3] = {v_.size(), vt_.size(), vn_.size()};
+    for (int k = 0; k < 3; ++k) {
+      if (idx[k] < 0) idx[k] = static_cast<int>(counts[k]) + idx[k] + 1;
+      if (idx[k] < 0 || static_cast<size_t>(idx[k]) > counts[k] || (k == 0 && idx[k] == 0))
+        return Error(ErrorCode::kCorrupt, where() + ": face index '" + w + "' out of range");
+    }
+    face_.push_back(idx);
+  }
+  if (face_.size() < 3) return Status::Ok();
+  auto [slot, added] = builder_of_.try_emplace(current_, builders_.size());
+  if (added) builders_.emplace_back().material_name = current_;
+  Builder& b = builders_[slot->second];
+  auto vertex = [&](const std::array<int, 3>& k) {
+    auto [it, inserted] = b.map.try_emplace(k, static_cast<uint32_t>(b.prim.positions.size()));
+    if (inserted) {
+      b.prim.positions.push_back(v_[k[0] - 1]);
+      b.position_of.push_back(k[0] - 1);
+      b.prim.uvs.resize(1);
+      b.prim.uvs[0].push_back(k[1] ? vt_[k[1] - 1] : Vec2{0, 0});
+      b.prim.normals.push_back(k[2] ? vn_[k[2] - 1] : Vec3{0, 0, 0});
+      b.any_uv |= k[1] != 0;
+      b.any_normal |= k[2] != 0;
+    }
+    return it->second;
+  };
+  uint32_t first = vertex(face_[0]);
+  for (size_t i = 1; i + 1 < face_.size(); ++i) {
+    b.prim.indices.push_back(first);
+    b.prim.indices.push_back(vertex(face_[i]));
+    b.prim.indices.push_back(vertex(face_[i + 1]));
+  }
+  return Status::Ok();
+}
+
+void ObjReader::load_library(const std::string& written) {
+  std::string note;
+  std::string file = resolve_written_path(folder_, written, &note);
+  if (!libraries_.insert(file).second) return;
+  if (!note.empty()) scene_.warnings.push_back(where() + ": mtllib " + note);
+  Status s = load_mtl(file, &scene_, &materials_);
+  if (s.ok()) return;
+  // As assimp does: a library that is not there is often the OBJ's own name with .mtl.
+  std::string own = path_.substr(0, path_.size() - lower_extension(path_).size()) + "mtl";
+  std::error_code ec;
+  if (s.code() == ErrorCode::kNotFound && std::filesystem::is_regular_file(own, ec) &&
+      libraries_.insert(own).second && load_mtl(own, &scene_, &materials_).ok()) {
+    scene_.warnings.push_back(where() + ": mtllib '" + written + "' not found; using '" + own +
+                              "' (the OBJ's name)");
+    return;
+  }
+  library_missing_ = true;
+  scene_.warnings.push_back(where() + ": mtllib '" + written + "': " + s.message() +
+                            "; its materials are defaults");
+}
+
+// One library whose name has spaces, or several separated by blanks (both are written).
+void ObjReader::mtllib(const std::string& rest) {
+  std::vector<Token> tokens = split_tokens(rest);
+  std::string note;
+  std::error_code ec;
+  bool whole = tokens.size() > 1 && rest.front() != '"' &&
+               std::filesystem::is_regular_file(resolve_written_path(folder_, rest, &note), ec);
+  if (whole || tokens.size() == 1) {
+    load_library(whole ? rest : tokens[0].text);
+    return;
+  }
+  for (const auto& t : tokens) load_library(t.text);
+}
+
+Status ObjReader::statement(const std::string& key, LineCursor* c) {
+  if (key == "v") return vertex(c);
+  if (key == "f" || key == "fo") return face(c);
+  if (key == "vt") {
+    Vec2 t{};
+    c->number(&t[0]);
+    c->number(&t[1]);
+    t[1] = 1.0f - t[1];
+    vt_.push_back(t);
+  } else if (key == "vn") {
+    Vec3 n{};
+    for (int k = 0; k < 3; ++k) c->number(&n[k]);
+    vn_.push_back(n);
+  } else if (key == "usemtl") {
+    current_ = c->rest_of_line();
+  } else if (key == "mtllib") {
+    std::string rest = c->rest_of_line();
+    if (!rest.empty()) mtllib(rest);
+  } else if (key == "l" || key == "p" || key == "curv" || key == "curv2" || key == "surf") {
+    ++ignored_elements_;
+  }
+  return Status::Ok();
+}
+
+int ObjReader::material_index(const std::string& name) {
+  if (name.empty()) return -1;
+  auto it = materials_.find(name);
+  if (it != materials_.end()) return it->second;
+  std::string why = libraries_.empty() ? "the OBJ names no mtllib"
+                    : library_missing_ ? "not in the MTL libraries that could be read"
+                                       : "not in its MTL libraries";
+  scene_.warnings.push_back(path_ + ": usemtl '" + name + "': " + why +
+                            "; a default (untextured) material is used");
+  return -1;
+}
+
+void ObjReader::fill_colors(Builder* b) const {
+  if (colors_.empty()) return;
+  const float scale = color_peak_ > 1.0f ? 1.0f / 255.0f : 1.0f;
+  for (int pi : b->position_of) {
+    Vec4 c = colors_[pi];
+    for (int k = 0; k < 3; ++k) c[k] = srgb_to_linear(c[k] * scale);
+    c[3] = std::min(c[3] * scale, 1.0f);
+    b->prim.colors.push_back(c);
+  }
+}
+
+Scene ObjReader::finish() && {
+  if (!colors_.empty() && color_peak_ > 1.0f)
+    scene_.warnings.push_back(path_ + ": vertex colours above 1 (up to " +
+                              std::to_string(color_peak_) + ") read as 0..255");
+  if (ignored_elements_ > 0)
+    scene_.warnings.push_back(path_ + ": " + std::to_string(ignored_elements_) +
+                              " point, line or curve elements ignored (only faces are baked)");
+  std::vector<std::pair<int, size_t>> order;  // (material, builder): default material first
+  for (size_t i = 0; i < builders_.size(); ++i)
+    order.emplace_back(material_index(builders_[i].material_name), i);
+  std::stable_sort(order.begin(), order.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  Mesh mesh;
+  mesh.name = "obj";
+  for (auto [material, i] : order) {
+    Builder& b = builders_[i];
+    if (!b.any_uv) b.prim.uvs.clear();
+    if (!b.any_normal) b.prim.normals.clear();
+    fill_colors(&b);
+    b.prim.material = material;
+    mesh.primitives.push_back(std::move(b.prim));
+  }
+  scene_.meshes.push_back(std::move(mesh));
+  Node node;
+  node.name = "obj";
+  node.mesh = 0;
+  scene_.nodes.push_back(node);
+  scene_.roots.push_back(0);
+  return std::move(scene_);
+}
+
 }  // namespace
 
 Expected<Scene> load_obj(const std::string& path) {
   VT_ASSIGN_OR_RETURN(auto bytes, read_file(path));
-  Scene scene;
-  scene.source_path = path;
-  std::map<std::string, int> materials;
-  std::vector<Vec3> v, vn;
-  std::vector<Vec2> vt;
-  struct Builder {
-    Primitive prim;
-    std::unordered_map<std::array<int, 3>, uint32_t, KeyHash> map;
-    bool any_uv = false, any_normal = false;
-  };
-  std::map<int, Builder> builders;  // by material, so output order is deterministic
-  int current_material = -1;
-  Cursor c{reinterpret_cast<const char*>(bytes.data()),
-           reinterpret_cast<const char*>(bytes.data()) + bytes.size()};
-  size_t line = 1;
-  std::vector<std::array<int, 3>> face;
+  std::string note;
+  VT_ASSIGN_OR_RETURN(std::string text, decode_text(bytes, path, &note));
+  bytes = {};
+  ObjReader reader(path);
+  if (!note.empty()) reader.warn(path + ": " + note);
+  LineCursor c{text.data(), text.data() + text.size()};
   while (c.p < c.end) {
     std::string key = c.word();
-    if (key == "v") {
-      Vec3 p{};
-      for (int k = 0; k < 3; ++k)
-        if (!c.number(&p[k]))
-          return Error(ErrorCode::kCorrupt, path + ":" + std::to_string(line) + ": bad vertex");
-      v.push_back(p);
-    } else if (key == "vt") {
-      Vec2 t{};
-      c.number(&t[0]);
-      c.number(&t[1]);
-      t[1] = 1.0f - t[1];
-      vt.push_back(t);
-    } else if (key == "vn") {
-      Vec3 n{};
-      for (int k = 0; k < 3; ++k) c.number(&n[k]);
-      vn.push_back(n);
-    } else if (key == "f") {
-      face.clear();
-      while (!c.at_line_end()) {
-        std::string w = c.word();
-        std::array<int, 3> idx = {0, 0, 0};
-        int field = 0;
-        size_t start = 0;
-        for (size_t i = 0; i <= w.size(); ++i) {
-          if (i == w.size() || w[i] == '/') {
-            if (i > start && field < 3) idx[field] = std::atoi(w.c_str() + start);
-            ++field;
-            start = i + 1;
-          }
-        }
-        const size_t counts[3] = {v.size(), vt.size(), vn.size()};
-        for (int k = 0; k < 3; ++k) {
-          if (idx[k] < 0) idx[k] = static_cast<int>(counts[k]) + idx[k] + 1;
-          if (idx[k] < 0 || static_cast<size_t>(idx[k]) > counts[k] || (k == 0 && idx[k] == 0))
-            return Error(ErrorCode::kCorrupt, path + ":" + std::to_string(line) + ": face index '" +
-                                                  w + "' out of range");
-        }
-        face.push_back(idx);
-      }
-      if (face.size() >= 3) {
-        Builder& b = builders[current_material];
-        auto vertex = [&](const std::array<int, 3>& k) {
-          auto [it, inserted] =
-              b.map.try_emplace(k, static_cast<uint32_t>(b.prim.positions.size()));
-          if (inserted) {
-            b.prim.positions.push_back(v[k[0] - 1]);
-            b.prim.uvs.resize(1);
-            b.prim.uvs[0].push_back(k[1] ? vt[k[1] - 1] : Vec2{0, 0});
-            b.prim.normals.push_back(k[2] ? vn[k[2] - 1] : Vec3{0, 0, 0});
-            b.any_uv |= k[1] != 0;
-            b.any_normal |= k[2] != 0;
-          }
-          return it->second;
-        };
-        uint32_t first = vertex(face[0]);
-        for (size_t i = 1; i + 1 < face.size(); ++i) {
-          b.prim.indices.push_back(first);
-          b.prim.indices.push_back(vertex(face[i]));
-          b.prim.indices.push_back(vertex(face[i + 1]));
-        }
-      }
-    } else if (key == "usemtl") {
-      std::string name = c.rest_of_line();
-      auto it = materials.find(name);
-      current_material = it == materials.end() ? -1 : it->second;
-    } else if (key == "mtllib") {
-      parse_mtl(parent_folder(path) + c.rest_of_line(), &scene, &materials);
-    }
+    if (!key.empty() && key[0] != '#') VT_RETURN_IF_ERROR(reader.statement(key, &c));
     c.next_line();
-    ++line;
+    ++reader.line;
   }
-  Mesh mesh;
-  mesh.name = "obj";
-  for (auto& [material, b] : builders) {
-    if (!b.any_uv) b.prim.uvs.clear();
-    if (!b.any_normal) b.prim.normals.clear();
-    b.prim.material = material;
-    mesh.primitives.push_back(std::move(b.prim));
-  }
-  scene.meshes.push_back(std::move(mesh));
-  Node node;
-  node.name = "obj";
-  node.mesh = 0;
-  scene.nodes.push_back(node);
-  scene.roots.push_back(0);
-  return scene;
+  return std::move(reader).finish();
 }
 
 }  // namespace vt::scene::detail

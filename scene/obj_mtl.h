@@ -1,0 +1,57 @@
+// Internal to vt_scene: what the OBJ and MTL readers share. Text as exporters write it (UTF-8
+// with or without a BOM, UTF-16 LE/BE), a line cursor, quoted tokens, and file names as
+// exporters write them (backslashes, Windows drive paths, case that differs from the disk).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "common/status.h"
+#include "scene/scene.h"
+
+namespace vt::scene::detail {
+
+// The file's text in UTF-8: a UTF-8 BOM is dropped, UTF-16 (a BOM, or ASCII with every other
+// byte zero) is converted, and text that is not valid UTF-8 is read as Latin-1 (`note` then
+// says so; empty otherwise). The error names `path` (odd-length UTF-16).
+Expected<std::string> decode_text(const std::vector<uint8_t>& bytes, const std::string& path,
+                                  std::string* note);
+
+// Reads one OBJ/MTL statement at a time; `p` is at the start of a line after next_line().
+struct LineCursor {
+  const char* p;
+  const char* end;
+
+  void skip_space();
+  bool at_line_end();          // after skipping blanks: end of line, of file, or a comment
+  std::string word();          // the next blank-separated token
+  std::string rest_of_line();  // trimmed; comments are part of it (names may hold '#')
+  bool number(float* out);     // also "+1", "2.", "nan", "inf"; false: nothing read
+  void next_line();
+};
+
+// A statement's arguments split at blanks, with "double quoted" runs kept whole (quotes
+// removed). `begin` is each token's offset in `text`, so a caller can take the unsplit rest.
+struct Token {
+  std::string text;
+  size_t begin = 0;
+};
+std::vector<Token> split_tokens(const std::string& text);
+
+// The file an exporter meant by `written` (relative to `folder`, "" or ending in '/'):
+// backslashes read as '/', a leading "./" dropped; when that file does not exist, a
+// case-insensitive match in the same folders, then the base name next to `folder` (an absolute
+// or Windows path from the exporter's machine). `note` receives what was substituted (empty
+// when the file was found as written). When nothing matches, the path as written resolved
+// against `folder` is returned (the caller reports it missing).
+std::string resolve_written_path(const std::string& folder, const std::string& written,
+                                 std::string* note);
+
+// An MTL library read into `scene->materials` (and the images they use into scene->images);
+// `by_name` maps material names to indices. Warnings name the MTL file; an error only when the
+// file cannot be read (the OBJ then keeps default materials).
+Status load_mtl(const std::string& path, Scene* scene, std::map<std::string, int>* by_name);
+
+}  // namespace vt::scene::detail

@@ -1,0 +1,237 @@
+// Text and file names as OBJ/MTL exporters write them (see scene/obj_mtl.h).
+#include <cctype>
+#include <charconv>
+#include <cstdlib>
+#include <filesystem>
+
+#include "scene/obj_mtl.h"
+
+namespace vt::scene::detail {
+namespace {
+
+void append_utf8(uint32_t cp, std::string* out) {
+  if (cp < 0x80) {
+    out->push_back(static_cast<char>(cp));
+  } else if (cp < 0x800) {
+    out->push_back(static_cast<char>(0xc0 | (cp >> 6)));
+    out->push_back(static_cast<char>(0x80 | (cp & 0x3f)));
+  } else if (cp < 0x10000) {
+    out->push_back(static_cast<char>(0xe0 | (cp >> 12)));
+    out->push_back(static_cast<char>(0x80 | ((cp >> 6) & 0x3f)));
+    out->push_back(static_cast<char>(0x80 | (cp & 0x3f)));
+  } else {
+    out->push_back(static_cast<char>(0xf0 | (cp >> 18)));
+    out->push_back(static_cast<char>(0x80 | ((cp >> 12) & 0x3f)));
+    out->push_back(static_cast<char>(0x80 | ((cp >> 6) & 0x3f)));
+    out->push_back(static_cast<char>(0x80 | (cp & 0x3f)));
+  }
+}
+
+Expected<std::string> utf16_to_utf8(const uint8_t* data, size_t size, bool big_endian,
+                                    const std::string& path) {
+  if (size % 2 != 0)
+    return Error(ErrorCode::kCorrupt, path + ": UTF-16 text with an odd number of bytes");
+  auto unit = [&](size_t i) {
+    return big_endian ? uint32_t(data[i] << 8 | data[i + 1]) : uint32_t(data[i + 1] << 8 | data[i]);
+  };
+  std::string out;
+  out.reserve(size / 2);
+  for (size_t i = 0; i < size; i += 2) {
+    uint32_t cp = unit(i);
+    if (cp >= 0xd800 && cp < 0xdc00 && i + 3 < size) {
+      uint32_t low = unit(i + 2);
+      if (low >= 0xdc00 && low < 0xe000) {
+        cp = 0x10000 + ((cp - 0xd800) << 10) + (low - 0xdc00);
+        i += 2;
+      }
+    }
+    if (cp >= 0xd800 && cp < 0xe000) cp = 0xfffd;  // an unpaired surrogate
+    append_utf8(cp, &out);
+  }
+  return out;
+}
+
+bool valid_utf8(const uint8_t* d, size_t n) {
+  for (size_t i = 0; i < n;) {
+    int extra = d[i] < 0x80           ? 0
+                : (d[i] >> 5) == 0x06 ? 1
+                : (d[i] >> 4) == 0x0e ? 2
+                : (d[i] >> 3) == 0x1e ? 3
+                                      : -1;
+    if (extra < 0 || i + extra >= n) return false;
+    for (int k = 1; k <= extra; ++k)
+      if ((d[i + k] & 0xc0) != 0x80) return false;
+    i += extra + 1;
+  }
+  return true;
+}
+
+bool same_ignoring_case(const std::string& a, const std::string& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (std::tolower(static_cast<unsigned char>(a[i])) !=
+        std::tolower(static_cast<unsigned char>(b[i])))
+      return false;
+  return true;
+}
+
+bool exists(const std::string& path) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path, ec);
+}
+
+// `relative` ('/'-separated) below `folder`, matching each component case-insensitively where
+// the exact name is absent. Empty when some component has no match.
+std::string find_ignoring_case(const std::string& folder, const std::string& relative) {
+  std::string at = folder;
+  size_t start = 0;
+  while (start <= relative.size()) {
+    size_t slash = relative.find('/', start);
+    std::string part = relative.substr(start, slash == std::string::npos ? slash : slash - start);
+    start = slash == std::string::npos ? relative.size() + 1 : slash + 1;
+    if (part.empty() || part == ".") continue;
+    std::error_code ec;
+    if (std::filesystem::exists(at + part, ec)) {
+      at += part;
+    } else {
+      std::string match;
+      for (const auto& entry : std::filesystem::directory_iterator(at.empty() ? "." : at, ec)) {
+        std::string name = entry.path().filename().string();
+        if (same_ignoring_case(name, part) && (match.empty() || name < match)) match = name;
+      }
+      if (match.empty()) return "";
+      at += match;
+    }
+    if (start <= relative.size()) at += '/';
+  }
+  return exists(at) ? at : "";
+}
+
+}  // namespace
+
+Expected<std::string> decode_text(const std::vector<uint8_t>& bytes, const std::string& path,
+                                  std::string* note) {
+  note->clear();
+  const uint8_t* d = bytes.data();
+  size_t n = bytes.size();
+  if (n >= 3 && d[0] == 0xef && d[1] == 0xbb && d[2] == 0xbf) return std::string(d + 3, d + n);
+  if (n >= 2 && d[0] == 0xff && d[1] == 0xfe) return utf16_to_utf8(d + 2, n - 2, false, path);
+  if (n >= 2 && d[0] == 0xfe && d[1] == 0xff) return utf16_to_utf8(d + 2, n - 2, true, path);
+  // No BOM: ASCII text written as UTF-16 has a zero in every other byte.
+  if (n >= 2 && d[0] != 0 && d[1] == 0) return utf16_to_utf8(d, n, false, path);
+  if (n >= 2 && d[0] == 0 && d[1] != 0) return utf16_to_utf8(d, n, true, path);
+  if (valid_utf8(d, n)) return std::string(d, d + n);
+  // Older exporters write names in an 8-bit code page; Latin-1 is the common one.
+  *note = "not UTF-8: read as Latin-1";
+  std::string out;
+  for (size_t i = 0; i < n; ++i) append_utf8(d[i], &out);
+  return out;
+}
+
+void LineCursor::skip_space() {
+  while (p < end && (*p == ' ' || *p == '\t' || *p == '\r')) ++p;
+}
+
+bool LineCursor::at_line_end() {
+  skip_space();
+  return p >= end || *p == '\n' || *p == '#';
+}
+
+std::string LineCursor::word() {
+  skip_space();
+  const char* s = p;
+  while (p < end && !std::isspace(static_cast<unsigned char>(*p))) ++p;
+  return std::string(s, p);
+}
+
+std::string LineCursor::rest_of_line() {
+  skip_space();
+  const char* s = p;
+  while (p < end && *p != '\n') ++p;
+  const char* e = p;
+  while (e > s && (e[-1] == '\r' || e[-1] == ' ' || e[-1] == '\t')) --e;
+  return std::string(s, e);
+}
+
+bool LineCursor::number(float* out) {
+  skip_space();
+  auto r = std::from_chars(p, end, *out);
+  if (r.ec == std::errc::result_out_of_range) {  // keep huge values as inf, not an error
+    *out = static_cast<float>(std::strtod(std::string(p, r.ptr).c_str(), nullptr));
+  } else if (r.ec != std::errc()) {
+    // from_chars rejects a leading '+' and "nan"/"inf" spellings some exporters use.
+    // A malformed tail ("3.1+e2") is left unread, as assimp reads it.
+    const char* s = p;
+    std::string w = word();
+    char* e = nullptr;
+    if (!w.empty()) *out = std::strtof(w.c_str(), &e);
+    p = s + (e ? e - w.c_str() : 0);
+    return p != s;
+  }
+  p = r.ptr;
+  return true;
+}
+
+void LineCursor::next_line() {
+  while (p < end && *p != '\n') ++p;
+  if (p < end) ++p;
+}
+
+std::vector<Token> split_tokens(const std::string& text) {
+  std::vector<Token> out;
+  size_t i = 0;
+  while (i < text.size()) {
+    if (std::isspace(static_cast<unsigned char>(text[i]))) {
+      ++i;
+      continue;
+    }
+    Token t;
+    t.begin = i;
+    if (text[i] == '"') {
+      size_t close = text.find('"', i + 1);
+      if (close == std::string::npos) close = text.size();
+      t.text = text.substr(i + 1, close - i - 1);
+      i = close + 1;
+    } else {
+      while (i < text.size() && !std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+      t.text = text.substr(t.begin, i - t.begin);
+    }
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
+std::string resolve_written_path(const std::string& folder, const std::string& written,
+                                 std::string* note) {
+  note->clear();
+  std::string s = written;
+  for (char& ch : s)
+    if (ch == '\\') ch = '/';
+  while (s.rfind("./", 0) == 0) s.erase(0, 2);
+  bool windows_absolute =
+      (s.size() >= 2 && std::isalpha(static_cast<unsigned char>(s[0])) && s[1] == ':') ||
+      s.rfind("//", 0) == 0;
+  bool absolute = windows_absolute || (!s.empty() && s[0] == '/');
+  std::string as_written = absolute ? s : folder + s;
+  if (!windows_absolute && exists(as_written)) return as_written;
+  if (!absolute) {
+    std::string found = find_ignoring_case(folder, s);
+    if (!found.empty()) {
+      *note = "'" + written + "' not found; using '" + found + "' (letter case differs)";
+      return found;
+    }
+  }
+  size_t slash = s.find_last_of('/');
+  std::string base = slash == std::string::npos ? s : s.substr(slash + 1);
+  if (base != s && !base.empty()) {
+    std::string beside = folder + base;
+    if (!exists(beside)) beside = find_ignoring_case(folder, base);
+    if (!beside.empty()) {
+      *note = "'" + written + "' not found; using '" + beside + "' (same name, next to it)";
+      return beside;
+    }
+  }
+  return windows_absolute ? folder + base : as_written;
+}
+
+}  // namespace vt::scene::detail
