@@ -9,6 +9,7 @@
 
 #include "bake/build_summary_json.h"
 #include "bake/unwrap/texel_density.h"
+#include "format/atomic_output.h"
 
 namespace vt {
 namespace {
@@ -141,6 +142,14 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   summary.unwrapped = options.unwrapped.empty()  ? default_unwrapped(output)
                       : options.unwrapped == "-" ? ""
                                                  : options.unwrapped;
+  // The page file and the unwrapped scene replace what was there as a pair, or not at all; a
+  // bad output path fails here, before the work.
+  OutputSet outputs;
+  VT_ASSIGN_OR_RETURN(std::string staged_pages, outputs.stage(output));
+  std::string staged_scene;
+  if (!summary.unwrapped.empty()) {
+    VT_ASSIGN_OR_RETURN(staged_scene, outputs.stage(summary.unwrapped));
+  }
 
   // Unwrap.
   auto t0 = Clock::now();
@@ -194,6 +203,7 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   // Pyramid, paging, encode.
   t0 = Clock::now();
   BuildOptions bo = options.build;
+  bo.output = staged_pages;
   bo.layers = layer_inputs(*transfer);
   bo.address = AddressMode::kClamp;
   nlohmann::json meta = {
@@ -221,9 +231,10 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
     t0 = Clock::now();
     report("write scene", 0.0);
     VT_RETURN_IF_ERROR(
-        scene::save_glb(unwrapped->scene, summary.unwrapped).with_context(summary.unwrapped));
+        scene::save_glb(unwrapped->scene, staged_scene).with_context(summary.unwrapped));
     summary.stages.push_back({"write scene", seconds_since(t0)});
   }
+  VT_RETURN_IF_ERROR(outputs.commit());
 
   summary.seconds = seconds_since(start);
   return summary;

@@ -13,6 +13,7 @@
 #include "cli/cli_util.h"
 #include "cli/command.h"
 #include "cli/unwrap_flags.h"
+#include "format/atomic_output.h"
 
 namespace {
 
@@ -85,6 +86,8 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
       progress.print("%-12s %5.1f%%  %6.1f s   ", p.stage, 100.0 * p.fraction,
                      progress.elapsed_seconds());
     };
+    if (vt::Status in = vt::check_input_file(args->scene); !in.ok())
+      return vt::cli::report_error("bake", in);
     auto summary = vt::bake_scene(args->scene, o);
     progress.done();
     if (!summary.ok()) return vt::cli::report_error("bake", summary.status());

@@ -11,6 +11,7 @@
 #include "cli/build_flags.h"
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "format/atomic_output.h"
 #include "samples/procedural.h"
 
 namespace {
@@ -106,12 +107,16 @@ int run_build(BuildArgs& f, const vt::cli::GlobalOptions& global) {
     vt::LayerInput in;
     // procedural:WIDTHxHEIGHT is the generated sample pattern (benchmarks of any size, no file).
     uint32_t pw = 0, ph = 0;
-    if (std::sscanf(path.c_str(), "procedural:%ux%u", &pw, &ph) == 2) {
-      if (pw == 0 || ph == 0) return bad("bad size in '" + path + "'");
+    if (path.rfind("procedural:", 0) == 0) {
+      if (vt::Status s = vt::cli::parse_procedural_size(path, &pw, &ph); !s.ok())
+        return bad(s.message());
       auto pattern =
           name == "normal" ? vt::ProceduralPattern::kNormal : vt::ProceduralPattern::kAlbedo;
       in.source = std::make_shared<vt::ProceduralImageSource>(pattern, pw, ph, 3, 1);
     } else {
+      if (!vt::is_udim_pattern(path)) {
+        if (vt::Status s = vt::check_input_file(path); !s.ok()) return bad(s.message());
+      }
       auto src = vt::is_udim_pattern(path) ? vt::open_udim_image(path) : vt::open_image_file(path);
       if (!src.ok()) return vt::cli::report_error("build", src.status());
       in.source = std::shared_ptr<vt::ImageSource>(std::move(src).value());

@@ -9,6 +9,7 @@
 
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "format/atomic_output.h"
 #include "format/page_file.h"
 #include "format/page_file_inspect.h"
 
@@ -59,6 +60,9 @@ vt::cli::CommandRunner make_extract(CLI::App& sub) {
     if (!reader.ok()) return vt::cli::report_error("extract", reader.status());
     auto image = vt::extract_level(**reader, opt->level, opt->layer);
     if (!image.ok()) return vt::cli::report_error("extract", image.status());
+    // Never through a FIFO or onto a device: OpenImageIO would block or replace it.
+    auto target = vt::resolve_output_path(opt->output);
+    if (!target.ok()) return vt::cli::report_error("extract", target.status());
     auto out = OIIO::ImageOutput::create(opt->output);
     if (!out) {
       return vt::cli::bad_usage(
@@ -66,7 +70,7 @@ vt::cli::CommandRunner make_extract(CLI::App& sub) {
     }
     const OIIO::TypeDesc type = oiio_type(image->texel_type);
     const OIIO::ImageSpec spec = output_spec(*image, (*reader)->layers()[opt->layer]);
-    if (!out->open(opt->output, spec) || !out->write_image(type, image->texels.data()) ||
+    if (!out->open(*target, spec) || !out->write_image(type, image->texels.data()) ||
         !out->close()) {
       return vt::cli::report_error(
           "extract", vt::Error(vt::ErrorCode::kIo, opt->output + ": " + out->geterror()));

@@ -11,6 +11,7 @@
 #include <assimp/Importer.hpp>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <map>
 
 #include "scene/scene_io_util.h"
@@ -94,7 +95,9 @@ class AssimpScene {
     } else {
       image.name = raw;
       image.uri = raw;
-      image.path = resolve_texture_path(folder_, raw, path_, &scene_.warnings);
+      std::string note;
+      image.path = resolve_written_path(folder_, raw, &note);
+      if (!note.empty()) warn("texture " + note);
     }
     scene_.images.push_back(std::move(image));
     return images_[raw] = int(scene_.images.size() - 1);
@@ -261,6 +264,9 @@ bool assimp_reads(const std::string& extension) {
 }
 
 Expected<Scene> load_assimp(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    return Error(ErrorCode::kNotFound, path + ": cannot open (no such file)");
   Assimp::Importer importer;
   // Points and lines are dropped by SortByPType; normals are made only where a mesh has none.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,

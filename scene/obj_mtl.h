@@ -10,6 +10,7 @@
 
 #include "common/status.h"
 #include "scene/scene.h"
+#include "scene/scene_io_util.h"
 
 namespace vt::scene::detail {
 
@@ -39,15 +40,6 @@ struct Token {
   size_t begin = 0;
 };
 std::vector<Token> split_tokens(const std::string& text);
-
-// The file an exporter meant by `written` (relative to `folder`, "" or ending in '/'):
-// backslashes read as '/', a leading "./" dropped; when that file does not exist, a
-// case-insensitive match in the same folders, then the base name next to `folder` (an absolute
-// or Windows path from the exporter's machine). `note` receives what was substituted (empty
-// when the file was found as written). When nothing matches, the path as written resolved
-// against `folder` is returned (the caller reports it missing).
-std::string resolve_written_path(const std::string& folder, const std::string& written,
-                                 std::string* note);
 
 // An MTL library read into `scene->materials` (and the images they use into scene->images);
 // `by_name` maps material names to indices. Warnings name the MTL file; an error only when the

@@ -66,47 +66,6 @@ bool valid_utf8(const uint8_t* d, size_t n) {
   return true;
 }
 
-bool same_ignoring_case(const std::string& a, const std::string& b) {
-  if (a.size() != b.size()) return false;
-  for (size_t i = 0; i < a.size(); ++i)
-    if (std::tolower(static_cast<unsigned char>(a[i])) !=
-        std::tolower(static_cast<unsigned char>(b[i])))
-      return false;
-  return true;
-}
-
-bool exists(const std::string& path) {
-  std::error_code ec;
-  return std::filesystem::is_regular_file(path, ec);
-}
-
-// `relative` ('/'-separated) below `folder`, matching each component case-insensitively where
-// the exact name is absent. Empty when some component has no match.
-std::string find_ignoring_case(const std::string& folder, const std::string& relative) {
-  std::string at = folder;
-  size_t start = 0;
-  while (start <= relative.size()) {
-    size_t slash = relative.find('/', start);
-    std::string part = relative.substr(start, slash == std::string::npos ? slash : slash - start);
-    start = slash == std::string::npos ? relative.size() + 1 : slash + 1;
-    if (part.empty() || part == ".") continue;
-    std::error_code ec;
-    if (std::filesystem::exists(at + part, ec)) {
-      at += part;
-    } else {
-      std::string match;
-      for (const auto& entry : std::filesystem::directory_iterator(at.empty() ? "." : at, ec)) {
-        std::string name = entry.path().filename().string();
-        if (same_ignoring_case(name, part) && (match.empty() || name < match)) match = name;
-      }
-      if (match.empty()) return "";
-      at += match;
-    }
-    if (start <= relative.size()) at += '/';
-  }
-  return exists(at) ? at : "";
-}
-
 }  // namespace
 
 Expected<std::string> decode_text(const std::vector<uint8_t>& bytes, const std::string& path,
@@ -199,39 +158,6 @@ std::vector<Token> split_tokens(const std::string& text) {
     out.push_back(std::move(t));
   }
   return out;
-}
-
-std::string resolve_written_path(const std::string& folder, const std::string& written,
-                                 std::string* note) {
-  note->clear();
-  std::string s = written;
-  for (char& ch : s)
-    if (ch == '\\') ch = '/';
-  while (s.rfind("./", 0) == 0) s.erase(0, 2);
-  bool windows_absolute =
-      (s.size() >= 2 && std::isalpha(static_cast<unsigned char>(s[0])) && s[1] == ':') ||
-      s.rfind("//", 0) == 0;
-  bool absolute = windows_absolute || (!s.empty() && s[0] == '/');
-  std::string as_written = absolute ? s : folder + s;
-  if (!windows_absolute && exists(as_written)) return as_written;
-  if (!absolute) {
-    std::string found = find_ignoring_case(folder, s);
-    if (!found.empty()) {
-      *note = "'" + written + "' not found; using '" + found + "' (letter case differs)";
-      return found;
-    }
-  }
-  size_t slash = s.find_last_of('/');
-  std::string base = slash == std::string::npos ? s : s.substr(slash + 1);
-  if (base != s && !base.empty()) {
-    std::string beside = folder + base;
-    if (!exists(beside)) beside = find_ignoring_case(folder, base);
-    if (!beside.empty()) {
-      *note = "'" + written + "' not found; using '" + beside + "' (same name, next to it)";
-      return beside;
-    }
-  }
-  return windows_absolute ? folder + base : as_written;
 }
 
 }  // namespace vt::scene::detail

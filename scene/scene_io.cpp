@@ -113,75 +113,76 @@ std::string base64_encode(const uint8_t* data, size_t size) {
 
 namespace {
 
-namespace fs = std::filesystem;
-
-bool exists_file(const fs::path& p) {
-  std::error_code ec;
-  return fs::is_regular_file(p, ec);
-}
-
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
   return s;
 }
 
-// `rel` under `base`, matching each component without regard to case; "" when none matches.
-fs::path case_insensitive_match(const fs::path& base, const fs::path& rel) {
-  fs::path at = base.empty() ? fs::path(".") : base;
-  for (const fs::path& part : rel) {
-    if (part == "." || part.empty()) continue;
-    if (part == "..") {
-      at /= part;
-      continue;
-    }
+bool exists(const std::string& path) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path, ec);
+}
+
+// `relative` ('/'-separated) below `folder`, matching each component case-insensitively where
+// the exact name is absent. Empty when some component has no match.
+std::string find_ignoring_case(const std::string& folder, const std::string& relative) {
+  std::string at = folder;
+  size_t start = 0;
+  while (start <= relative.size()) {
+    size_t slash = relative.find('/', start);
+    std::string part = relative.substr(start, slash == std::string::npos ? slash : slash - start);
+    start = slash == std::string::npos ? relative.size() + 1 : slash + 1;
+    if (part.empty() || part == ".") continue;
     std::error_code ec;
-    fs::path found;
-    std::string want = lower(part.string());
-    for (fs::directory_iterator it(at, ec), end; !ec && it != end; it.increment(ec)) {
-      if (lower(it->path().filename().string()) == want) {
-        found = it->path();
-        break;
+    if (std::filesystem::exists(at + part, ec)) {
+      at += part;
+    } else {
+      std::string match;
+      for (const auto& entry : std::filesystem::directory_iterator(at.empty() ? "." : at, ec)) {
+        std::string name = entry.path().filename().string();
+        if (lower(name) == lower(part) && (match.empty() || name < match)) match = name;
       }
+      if (match.empty()) return "";
+      at += match;
     }
-    if (found.empty()) return {};
-    at = found;
+    if (start <= relative.size()) at += '/';
   }
-  return exists_file(at) ? at : fs::path();
+  return exists(at) ? at : "";
 }
 
 }  // namespace
 
-std::string resolve_texture_path(const std::string& folder, const std::string& written,
-                                 const std::string& scene_path,
-                                 std::vector<std::string>* warnings) {
-  std::string w = written;
-  while (!w.empty() && (w.back() == ' ' || w.back() == '\t' || w.back() == '\r')) w.pop_back();
-  if (w.size() >= 2 && (w.front() == '"' || w.front() == '\'') && w.back() == w.front())
-    w = w.substr(1, w.size() - 2);
-  std::replace(w.begin(), w.end(), '\\', '/');
-  while (w.rfind("./", 0) == 0) w = w.substr(2);
-  bool drive = w.size() >= 2 && std::isalpha(static_cast<unsigned char>(w[0])) && w[1] == ':';
-  bool absolute = drive || (!w.empty() && w[0] == '/');
-  std::string plain = absolute ? w : folder + w;
-  if (exists_file(plain)) return plain;
-  auto use = [&](const fs::path& p, const char* how) {
-    if (warnings)
-      warnings->push_back(scene_path + ": texture '" + written + "' not found; using '" +
-                          p.string() + "' (" + how + ")");
-    return p.string();
-  };
-  fs::path base = folder.empty() ? fs::path() : fs::path(folder);
+std::string resolve_written_path(const std::string& folder, const std::string& written,
+                                 std::string* note) {
+  note->clear();
+  std::string s = written;
+  for (char& ch : s)
+    if (ch == '\\') ch = '/';
+  while (s.rfind("./", 0) == 0) s.erase(0, 2);
+  bool windows_absolute =
+      (s.size() >= 2 && std::isalpha(static_cast<unsigned char>(s[0])) && s[1] == ':') ||
+      s.rfind("//", 0) == 0;
+  bool absolute = windows_absolute || (!s.empty() && s[0] == '/');
+  std::string as_written = absolute ? s : folder + s;
+  if (!windows_absolute && exists(as_written)) return as_written;
   if (!absolute) {
-    fs::path m = case_insensitive_match(base, fs::path(w));
-    if (!m.empty()) return use(m, "the same name in another letter case");
+    std::string found = find_ignoring_case(folder, s);
+    if (!found.empty()) {
+      *note = "'" + written + "' not found; using '" + found + "' (letter case differs)";
+      return found;
+    }
   }
-  fs::path name = fs::path(w).filename();
-  if (!name.empty() && name != fs::path(w)) {
-    if (exists_file(base / name)) return use(base / name, "the file name beside the scene");
-    fs::path m = case_insensitive_match(base, name);
-    if (!m.empty()) return use(m, "the file name beside the scene, in another letter case");
+  size_t slash = s.find_last_of('/');
+  std::string base = slash == std::string::npos ? s : s.substr(slash + 1);
+  if (base != s && !base.empty()) {
+    std::string beside = folder + base;
+    if (!exists(beside)) beside = find_ignoring_case(folder, base);
+    if (!beside.empty()) {
+      *note = "'" + written + "' not found; using '" + beside + "' (same name, next to it)";
+      return beside;
+    }
   }
-  return plain;
+  return windows_absolute ? folder + base : as_written;
 }
 
 Scene single_mesh_scene(const std::string& path, std::string name, std::vector<Primitive> prims,
@@ -229,10 +230,15 @@ bool is_gltf1(const std::string& path) {
 Expected<Scene> load_scene(const std::string& path) {
   std::string ext = detail::lower_extension(path);
   if (ext == "gltf" || ext == "glb") {
-    if (!is_gltf1(path)) return detail::load_gltf(path);
-    auto scene = detail::load_assimp(path);
-    if (scene.ok()) scene->warnings.push_back(path + ": glTF 1.0, read through assimp");
-    return scene;
+    // glTF 1.0 goes through assimp; should assimp fail too, the own importer says why not.
+    if (is_gltf1(path)) {
+      auto scene = detail::load_assimp(path);
+      if (scene.ok()) {
+        scene->warnings.push_back(path + ": glTF 1.0, read through assimp");
+        return scene;
+      }
+    }
+    return detail::load_gltf(path);
   }
   if (ext == "obj") return detail::load_obj(path);
   if (ext == "ply") return detail::load_ply(path);

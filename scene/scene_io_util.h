@@ -18,14 +18,14 @@ Expected<std::vector<uint8_t>> decode_data_uri(const std::string& uri, std::stri
 std::string base64_encode(const uint8_t* data, size_t size);
 std::string percent_decode(const std::string& uri);
 
-// The file a texture path written by an exporter names, relative to `folder` (parent_folder of
-// the scene): backslashes and surrounding quotes are undone; when that file does not exist, a
-// case-insensitive match (per path component) and then the bare file name beside the scene
-// (for absolute paths from the author's machine, "D:\\art\\wall.jpg") are tried, with a
-// warning naming the file used. When nothing exists the plain resolution is returned, so the
-// missing-texture error names the path the file asked for.
-std::string resolve_texture_path(const std::string& folder, const std::string& written,
-                                 const std::string& scene_path, std::vector<std::string>* warnings);
+// The file an exporter meant by `written` (relative to `folder`, "" or ending in '/'):
+// backslashes read as '/', a leading "./" dropped; when that file does not exist, a
+// case-insensitive match in the same folders, then the base name next to `folder` (an absolute
+// or Windows path from the exporter's machine). `note` receives what was substituted (empty
+// when the file was found as written). When nothing matches, the path as written resolved
+// against `folder` is returned (the caller reports it missing).
+std::string resolve_written_path(const std::string& folder, const std::string& written,
+                                 std::string* note);
 
 Expected<Scene> load_gltf(const std::string& path);
 Expected<Scene> load_obj(const std::string& path);

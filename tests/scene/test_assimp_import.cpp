@@ -116,25 +116,21 @@ TEST(AssimpImport, TexturePathsFromOtherMachinesAreFoundWithAWarning) {
   write_text(d / "Tex" / "Wall.PNG", "x");
   write_text(d / "floor.jpg", "x");
   std::string folder = d.string() + "/";
-  std::vector<std::string> warnings;
+  std::string note;
+  auto resolve = [&](const std::string& written) {
+    return scene::detail::resolve_written_path(folder, written, &note);
+  };
   // Windows separators alone: found directly, no warning.
   write_text(d / "Tex" / "ok.png", "x");
-  EXPECT_EQ(scene::detail::resolve_texture_path(folder, ".\\Tex\\ok.png", "s.obj", &warnings),
-            folder + "Tex/ok.png");
-  EXPECT_TRUE(warnings.empty());
+  EXPECT_EQ(resolve(".\\Tex\\ok.png"), folder + "Tex/ok.png");
+  EXPECT_TRUE(note.empty());
   // Letter case differs on a case-sensitive file system.
-  EXPECT_EQ(scene::detail::resolve_texture_path(folder, "tex\\wall.png", "s.obj", &warnings),
-            (d / "Tex" / "Wall.PNG").string());
-  ASSERT_EQ(warnings.size(), 1u);
-  EXPECT_NE(warnings[0].find("letter case"), std::string::npos) << warnings[0];
+  EXPECT_EQ(resolve("tex\\wall.png"), (d / "Tex" / "Wall.PNG").string());
+  EXPECT_NE(note.find("letter case"), std::string::npos) << note;
   // An absolute path from the author's machine: the file name beside the scene.
-  EXPECT_EQ(scene::detail::resolve_texture_path(folder, "D:\\art\\floor.jpg", "s.obj", &warnings),
-            (d / "floor.jpg").string());
-  EXPECT_EQ(scene::detail::resolve_texture_path(folder, "\"floor.jpg\"", "s.obj", &warnings),
-            folder + "floor.jpg");
+  EXPECT_EQ(resolve("D:\\art\\floor.jpg"), (d / "floor.jpg").string());
   // Nothing anywhere: the plain resolution, so the error names what the file asked for.
-  EXPECT_EQ(scene::detail::resolve_texture_path(folder, "gone/none.png", "s.obj", &warnings),
-            folder + "gone/none.png");
+  EXPECT_EQ(resolve("gone/none.png"), folder + "gone/none.png");
 }
 
 TEST(AssimpImport, AsciiStlAndUnreadableFiles) {

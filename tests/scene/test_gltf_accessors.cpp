@@ -327,7 +327,7 @@ TEST(GltfAccessors, MeshoptViewsWithEveryModeAndFilter) {
       f.accessor(meshopt_view(&f, iseq, 6, 4, "INDICES", "NONE", 136), 5125, "SCALAR", 6);
   f.doc["meshes"][0]["primitives"].push_back(second);
   f.doc["extensionsUsed"] = {"EXT_meshopt_compression", "KHR_mesh_quantization"};
-  auto s = f.load("meshopt", {kPlaceholder});
+  auto s = f.load("meshopt", json::array({kPlaceholder}));
   ASSERT_TRUE(s.ok()) << s.status().message();
   const auto& p = only_primitive(*s);
   EXPECT_EQ(p.positions, (std::vector<scene::Vec3>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0.5f}}));
@@ -349,7 +349,7 @@ TEST(GltfAccessors, MeshoptErrorsNameTheView) {
   GltfFile f;
   f.primitive()["attributes"]["POSITION"] =
       f.accessor(meshopt_view(&f, broken, 3, 12, "ATTRIBUTES", "NONE", 0), 5126, "VEC3", 3);
-  auto s = f.load("meshopt_bad", {kPlaceholder});
+  auto s = f.load("meshopt_bad", json::array({kPlaceholder}));
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.status().message().find("bufferView 0: EXT_meshopt_compression: ATTRIBUTES data "
                                       "does not decode"),
@@ -357,7 +357,7 @@ TEST(GltfAccessors, MeshoptErrorsNameTheView) {
       << s.status().message();
   // A filter the spec forbids for the stride, and a count the compressed bytes cannot hold.
   f.doc["bufferViews"][0]["extensions"]["EXT_meshopt_compression"]["filter"] = "QUATERNION";
-  auto t = f.load("meshopt_filter", {kPlaceholder});
+  auto t = f.load("meshopt_filter", json::array({kPlaceholder}));
   ASSERT_FALSE(t.ok());
   EXPECT_NE(t.status().message().find("filter 'QUATERNION' is not allowed"), std::string::npos)
       << t.status().message();
@@ -365,7 +365,7 @@ TEST(GltfAccessors, MeshoptErrorsNameTheView) {
   size_t huge = size_t{1} << 26;
   g.primitive()["attributes"]["POSITION"] =
       g.accessor(meshopt_view(&g, enc, huge, 12, "ATTRIBUTES", "NONE", 0), 5126, "VEC3", huge);
-  std::string path = g.write("meshopt_huge", {kPlaceholder});
+  std::string path = g.write("meshopt_huge", json::array({kPlaceholder}));
   std::optional<Expected<scene::Scene>> u;
   size_t largest = largest_allocation_during([&] { u.emplace(scene::load_scene(path)); });
   ASSERT_FALSE(u->ok());

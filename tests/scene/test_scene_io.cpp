@@ -83,7 +83,8 @@ TEST(SceneIo, ObjErrorsNameFileAndLine) {
   ASSERT_FALSE(missing.ok());
   EXPECT_EQ(missing.status().code(), ErrorCode::kNotFound);
   EXPECT_NE(missing.status().message().find("does_not_exist.obj"), std::string::npos);
-  EXPECT_EQ(scene::load_scene(temp("x.fbx")).status().code(), ErrorCode::kUnsupported);
+  EXPECT_EQ(scene::load_scene(temp("x.fbx")).status().code(), ErrorCode::kNotFound);
+  EXPECT_EQ(scene::load_scene(temp("x.notascene")).status().code(), ErrorCode::kUnsupported);
 }
 
 TEST(SceneIo, PlyAsciiAndBinary) {
