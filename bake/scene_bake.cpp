@@ -118,6 +118,7 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   to.width = W, to.height = H;
   to.supersample = options.supersample;
   to.threads = options.build.threads;
+  to.color_config = options.build.color_config;
   to.scratch_dir = options.build.scratch_dir.empty()
                        ? std::filesystem::path(output).parent_path().string()
                        : options.build.scratch_dir;

@@ -21,6 +21,8 @@
 
 namespace vt {
 
+class ColorConfig;
+
 struct TransferOptions {
   uint32_t width = 0, height = 0;  // atlas size in texels
   int atlas_uv_set = -1;           // UV set holding atlas UVs; -1 = each primitive's last set
@@ -36,6 +38,9 @@ struct TransferOptions {
   // sample per texel (0.048 -> 0.034) but raises it at 4 and 16 (0.0003 -> 0.018 / 0.006),
   // so the default keeps the box levels.
   std::string mip_filter;
+  // Base colour and emissive textures are converted from their colour space (file rules,
+  // metadata, else sRGB/float linear) to this config's working space. Null = built-in config.
+  std::shared_ptr<const ColorConfig> color_config;
   std::function<void(double fraction)> progress;  // from the calling thread, 0..1
 };
 
