@@ -146,6 +146,10 @@ OCIO::ConstConfigRcPtr make_builtin_color_config() {
   config->setRole(OCIO::ROLE_DEFAULT, "linear");
   config->setRole(OCIO::ROLE_DATA, "raw");
   config->setRole("aces_interchange", "ACES2065-1");
+  // Not used by vtbake; OpenColorIO's validation (and every tool reading the YAML) wants one.
+  config->addDisplayView("sRGB", "Standard", "sRGB", "");
+  config->addDisplayView("sRGB", "Raw", "raw", "");
+  config->validate();
   return config;
 }
 
