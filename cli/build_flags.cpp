@@ -1,6 +1,8 @@
 // The build flags (see build_flags.h).
 #include "cli/build_flags.h"
 
+#include <cstdlib>
+
 #include "bake/color.h"
 #include "cli/cli_util.h"
 
@@ -59,7 +61,8 @@ void add_build_flags(CLI::App& app, BuildOptions& o) {
          "--colorconfig",
          [&o](const std::string& path) {
            auto config = ColorConfig::load(path);
-           throw_if_error("--colorconfig", config.status());
+           const char* env = std::getenv("OCIO");  // CLI11 reads $OCIO when the flag is absent
+           throw_if_error(env && path == env ? "$OCIO" : "--colorconfig", config.status());
            o.color_config = *config;
          },
          "OpenColorIO config (.ocio) for the colour textures: their spaces by name, alias, role "
