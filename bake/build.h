@@ -24,6 +24,8 @@
 
 namespace vt {
 
+class ColorConfig;
+
 // What happens to NaN/Inf inputs, and to negative values in colour layers.
 enum class NonFinitePolicy : uint8_t {
   kBlack = 0,  // NaN, Inf and negatives become 0
@@ -37,7 +39,9 @@ struct LayerInput {
   std::string name;  // "" = the semantic's name
   // Normal maps: the source holds xyz (or xy) in [0, 1] as n * 0.5 + 0.5 unless float.
   std::shared_ptr<ImageSource> source;
-  std::string color_space;  // "" = the source's metadata (ImageInfo::color_space)
+  // Colour layers: "" = ColorConfig::texture_space of the source's metadata
+  // (ImageInfo::color_space): sRGB for 8/16-bit data and the working space for float data.
+  std::string color_space;
   // Optional level-0 coverage (width * height bytes, non-zero = covered); empty = all covered.
   // With a mask, every level is dilated by pull-push and pages with no covered payload texel
   // are absent; the levels must then fit in the memory limit.
@@ -72,6 +76,9 @@ struct BuildOptions {
   // scaled so that the fraction of texels with alpha >= this reference matches level 0's.
   float alpha_coverage_reference = 0;
   std::string scratch_dir;  // "" = the output's directory
+  // Colour spaces of the colour layers (LayerInput::color_space, metadata) are this config's;
+  // its scene_linear role is the working space. Null = the built-in config (bake/color.h).
+  std::shared_ptr<const ColorConfig> color_config;
   std::string metadata_json = "{}";
   std::function<void(const BuildProgress&)> progress;
 };

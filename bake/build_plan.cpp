@@ -56,11 +56,15 @@ Expected<LayerPlan> plan_layer(const LayerInput& in, const BuildOptions& options
     p.alpha = has_alpha ? 3 : -1;
     p.spec.channels = uint8_t(p.work_channels);
     p.spec.texel_type = want_float ? TexelType::kF32 : TexelType::kU8;
-    std::string src_space = in.color_space.empty() ? info.color_space : in.color_space;
-    if (src_space.empty()) src_space = info.is_float ? "linear" : "sRGB";
-    auto to_lin = ColorConverter::create(src_space, "linear");
+    const ColorConfig& colours =
+        options.color_config ? *options.color_config : *ColorConfig::builtin();
+    const std::string src_space = in.color_space.empty()
+                                      ? colours.texture_space("", info.color_space, info.is_float)
+                                      : in.color_space;
+    auto to_lin = colours.converter(src_space, colours.working_space());
     if (!to_lin.ok()) return to_lin.status().with_context(p.spec.name);
     p.to_linear = std::move(to_lin).value();
+    // Stored 8-bit texels carry the sRGB curve over the working space's values.
     auto to_store = ColorConverter::create("linear", want_float ? "linear" : "sRGB");
     if (!to_store.ok()) return to_store.status().with_context(p.spec.name);
     p.to_storage = std::move(to_store).value();
@@ -222,6 +226,11 @@ std::string build_metadata(const BuildOptions& options, const std::vector<LayerP
       {"filter", to_string(options.filter)},        {"address", to_string(options.address)},
       {"codec", int(options.codec.codec)},          {"dct_quality", options.codec.dct_quality},
       {"dct_adaptive", options.codec.dct_adaptive}, {"layers", sources}};
+  if (options.color_config && !options.color_config->is_builtin()) {
+    meta["build"]["color_config"] = {{"path", options.color_config->path()},
+                                     {"working_space", options.color_config->working_space()},
+                                     {"cache_id", options.color_config->cache_id()}};
+  }
   return meta.dump();
 }
 

@@ -1,212 +1,208 @@
+// ColorConfig (see color.h): the built-in config or an OpenColorIO config file, names resolved
+// through the config, file rules, and converters between its spaces.
 #include "bake/color.h"
-
-#include <OpenColorIO/OpenColorIO.h>
 
 #include <algorithm>
 #include <cctype>
-#include <cmath>
-#include <cstring>
-#include <mutex>
+#include <cstdlib>
 #include <sstream>
-#include <vector>
 
-#include "common/srgb.h"
+#include "bake/color_ocio.h"
 
 namespace vt {
 namespace {
-
-namespace OCIO = OCIO_NAMESPACE;
 
 std::string lower(std::string s) {
   for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
   return s;
 }
 
-// Built once: Config objects are immutable after setup and safe to share.
-OCIO::ConstConfigRcPtr make_config() {
-  OCIO::ConfigRcPtr config = OCIO::Config::Create();
-  config->setName("vtbake");
-  auto linear = OCIO::ColorSpace::Create();
-  linear->setName("linear");
-  linear->setFamily("vtbake");
-  config->addColorSpace(linear);
-
-  auto srgb = OCIO::ColorSpace::Create();
-  srgb->setName("sRGB");
-  srgb->setFamily("vtbake");
-  // common/srgb.h's curve: ExponentWithLinear is the exact one (not the 2.2 approximation).
-  auto curve = OCIO::ExponentWithLinearTransform::Create();
-  curve->setGamma({kSrgbGamma, kSrgbGamma, kSrgbGamma, 1.0});
-  curve->setOffset({kSrgbOffset, kSrgbOffset, kSrgbOffset, 0.0});
-  curve->setDirection(OCIO::TRANSFORM_DIR_FORWARD);
-  srgb->setTransform(curve, OCIO::COLORSPACE_DIR_TO_REFERENCE);
-  config->addColorSpace(srgb);
-
-  auto raw = OCIO::ColorSpace::Create();
-  raw->setName("raw");
-  raw->setFamily("vtbake");
-  raw->setIsData(true);
-  config->addColorSpace(raw);
-
-  config->setRole(OCIO::ROLE_SCENE_LINEAR, "linear");
-  config->setRole(OCIO::ROLE_DEFAULT, "linear");
-  config->setRole(OCIO::ROLE_DATA, "raw");
-  return config;
+// Names other tools write for the same space, tried in a user config that lacks the name it
+// was asked for. The first name of each family is the built-in config's.
+const std::vector<std::vector<const char*>>& space_families() {
+  static const std::vector<std::vector<const char*>> kFamilies = {
+      {"linear", "lin_rec709", "lin_srgb", "linear_srgb", "Linear Rec.709 (sRGB)",
+       "Utility - Linear - sRGB", "lin_rec709_srgb", "srgb linear", "linear srgb", "rec709 linear"},
+      {"sRGB", "sRGB - Texture", "srgb_tx", "srgb_texture", "Utility - sRGB - Texture",
+       "srgb texture", "srgb gamma"},
+      {"Rec709", "Rec.709", "rec709_camera", "Camera Rec.709"},
+      {"Gamma1.8", "Gamma 1.8", "g18_rec709", "Gamma 1.8 Rec.709 - Texture"},
+      {"Gamma2.2", "Gamma 2.2", "g22_rec709", "Gamma 2.2 Rec.709 - Texture",
+       "Utility - Gamma 2.2 - Rec.709 - Texture"},
+      {"Gamma2.4", "Gamma 2.4", "g24_rec709", "Gamma 2.4 Rec.709 - Texture"},
+      {"ACEScg", "ACES - ACEScg", "lin_ap1"},
+      {"ACES2065-1", "ACES - ACES2065-1", "lin_ap0", "aces", "aces_interchange"},
+      {"raw", "Raw", "Utility - Raw", "Non-Color", "data", "none"},
+  };
+  return kFamilies;
 }
 
-const OCIO::ConstConfigRcPtr& config() {
-  static const OCIO::ConstConfigRcPtr c = make_config();
-  return c;
+// The exponent of "GammaX.Y" / "Gamma X.Y" (OpenImageIO's name for a PNG gAMA), or 0.
+double gamma_of(const std::string& name) {
+  std::string n = lower(name);
+  if (n.rfind("gamma", 0) != 0) return 0;
+  const char* p = n.c_str() + 5;
+  while (*p == ' ' || *p == '_') ++p;
+  char* end = nullptr;
+  const double g = std::strtod(p, &end);
+  return end != p && *end == '\0' && g > 0 && g < 10 ? g : 0;
 }
 
-inline uint8_t round_u8(float v) {
-  if (!(v > 0)) return 0;
-  if (v >= 1) return 255;
-  return uint8_t(v * 255.0f + 0.5f);
-}
-
-// Ordered integer key of a float (monotonic for all non-NaN floats).
-inline int32_t float_key(float f) {
-  int32_t i;
-  std::memcpy(&i, &f, 4);
-  return i >= 0 ? i : int32_t(0x80000000u - uint32_t(i));
-}
-inline float key_float(int32_t k) {
-  int32_t i = k >= 0 ? k : int32_t(0x80000000u - uint32_t(k));
-  float f;
-  std::memcpy(&f, &i, 4);
-  return f;
-}
-
-class OcioConverter final : public ColorConverter {
- public:
-  explicit OcioConverter(OCIO::ConstCPUProcessorRcPtr cpu) : cpu_(std::move(cpu)) {
-    if (is_identity()) return;
-    for (int k = 0; k < 256; ++k) lut_[k] = convert_one(float(k) / 255.0f);
-    // Boundary k (1..255): the smallest float whose converted, rounded code is >= k. The curves
-    // vtbake converts with are increasing, so bisection over ordered floats finds it exactly.
-    for (int k = 1; k < 256; ++k) {
-      int64_t lo = float_key(-1.0f), hi = float_key(3.4e38f);
-      while (hi - lo > 1) {
-        int64_t mid = lo + (hi - lo) / 2;
-        if (round_u8(convert_one(key_float(int32_t(mid)))) >= k) {
-          hi = mid;
-        } else {
-          lo = mid;
-        }
-      }
-      bounds_[k - 1] = key_float(int32_t(hi));
-    }
-    // Code of the first float of every bucket of 2^15 floats in [0, 1]; a bucket spans at most
-    // a few codes, so encode_u8 steps up from there.
-    bucket_code_.resize((0x3F800000u >> kBucketShift) + 1);
-    for (size_t b = 0; b < bucket_code_.size(); ++b) {
-      uint32_t bits = uint32_t(b) << kBucketShift;
-      float v;
-      std::memcpy(&v, &bits, 4);
-      bucket_code_[b] = uint8_t(std::upper_bound(bounds_, bounds_ + 255, v) - bounds_);
-    }
-  }
-  bool is_identity() const override { return !cpu_ || cpu_->isNoOp(); }
-
-  void apply(float* texels, size_t count, int channels) const override {
-    if (is_identity() || count == 0) return;
-    const int colour = channels >= 3 ? 3 : 1;
-    for (size_t i = 0; i < count; ++i) {
-      float* t = texels + i * channels;
-      bool coded = true;
-      int code[3];
-      for (int c = 0; c < colour; ++c) {
-        float v = t[c];
-        int k = (v >= 0.0f && v <= 1.0f) ? int(v * 255.0f + 0.5f) : -1;
-        code[c] = k;
-        coded &= k >= 0 && std::abs(v * 255.0f - float(k)) <= 1e-4f;  // any k/255 rounding
-      }
-      if (coded) {
-        for (int c = 0; c < colour; ++c) t[c] = lut_[code[c]];
-      } else if (colour == 3) {
-        cpu_->applyRGB(t);
-      } else {
-        t[0] = convert_one(t[0]);
-      }
-    }
-  }
-
-  void apply_to_u8(const float* texels, size_t count, int channels, uint8_t* out) const override {
-    const int colour = is_identity() ? 0 : channels >= 3 ? 3 : 1;
-    for (size_t i = 0; i < count; ++i) {
-      const float* t = texels + i * channels;
-      uint8_t* o = out + i * channels;
-      for (int c = 0; c < colour; ++c) o[c] = encode_u8(t[c]);
-      for (int c = colour; c < channels; ++c) o[c] = round_u8(t[c]);
-    }
-  }
-
- private:
-  static constexpr int kBucketShift = 15;
-
-  uint8_t encode_u8(float v) const {
-    if (!(v > 0)) return 0;  // NaN too
-    if (v >= 1.0f) return round_u8(convert_one(v));
-    uint32_t bits;
-    std::memcpy(&bits, &v, 4);
-    int code = bucket_code_[bits >> kBucketShift];
-    while (code < 255 && v >= bounds_[code]) ++code;
-    return uint8_t(code);
-  }
-
-  float convert_one(float v) const {
-    float rgb[3] = {v, v, v};
-    cpu_->applyRGB(rgb);
-    return rgb[0];
-  }
-
-  OCIO::ConstCPUProcessorRcPtr cpu_;
-  float lut_[256] = {};
-  float bounds_[255] = {};
-  std::vector<uint8_t> bucket_code_;
+struct Space {
+  std::string name;  // the config's name (for a bare gamma: its linear Rec.709 space)
+  double gamma = 0;  // > 0: a power `gamma` over `name`, a space the config does not have
 };
 
 }  // namespace
 
-Expected<std::string> canonical_color_space(const std::string& name) {
-  std::string n = lower(name);
-  static const char* kLinear[] = {"linear",      "scene_linear",          "lin_srgb",
-                                  "lin_rec709",  "linear rec.709 (srgb)", "srgb linear",
-                                  "linear srgb", "rec709 linear",         "acescg"};
-  static const char* kSrgb[] = {"srgb",    "srgb_texture", "srgb - texture",
-                                "srgb_tx", "srgb texture", "srgb gamma"};
-  static const char* kRaw[] = {"raw", "data", "non-color", "utility - raw", "none"};
-  for (const char* s : kSrgb)
-    if (n == s) return std::string("sRGB");
-  for (const char* s : kLinear)
-    if (n == s) return std::string("linear");
-  for (const char* s : kRaw)
-    if (n == s) return std::string("raw");
+ColorConfig::ColorConfig(std::string path, std::unique_ptr<Impl> impl)
+    : path_(std::move(path)), impl_(std::move(impl)) {
+  auto cs = impl_->config->getColorSpace(OCIO::ROLE_SCENE_LINEAR);
+  if (cs) working_ = cs->getName();
+}
+
+ColorConfig::~ColorConfig() = default;
+
+std::shared_ptr<const ColorConfig> ColorConfig::builtin() {
+  // Config objects are immutable after setup and safe to share between threads.
+  static const std::shared_ptr<const ColorConfig> c(
+      new ColorConfig("", std::make_unique<Impl>(Impl{make_builtin_color_config()})));
+  return c;
+}
+
+Expected<std::shared_ptr<const ColorConfig>> ColorConfig::load(const std::string& path) {
+  auto impl = std::make_unique<Impl>();
+  try {
+    impl->config = OCIO::Config::CreateFromFile(path.c_str());
+    impl->config->validate();
+  } catch (const OCIO::Exception& e) {
+    return Status(ErrorCode::kInvalidArgument,
+                  path + ": not a usable OpenColorIO config: " + std::string(e.what()));
+  }
+  std::shared_ptr<const ColorConfig> c(new ColorConfig(path, std::move(impl)));
+  if (c->working_.empty()) {
+    return Status(ErrorCode::kInvalidArgument,
+                  path +
+                      ": the OpenColorIO config has no scene_linear role (vtbake's working "
+                      "space)");
+  }
+  return c;
+}
+
+std::vector<std::string> ColorConfig::color_spaces() const {
+  std::vector<std::string> names;
+  const auto& config = *impl_->config;
+  for (int i = 0; i < config.getNumColorSpaces(); ++i)
+    names.emplace_back(config.getColorSpaceNameByIndex(i));
+  return names;
+}
+
+Expected<std::string> ColorConfig::resolve(const std::string& name) const {
+  const auto& config = *impl_->config;
+  if (auto cs = config.getColorSpace(name.c_str())) return std::string(cs->getName());
+  if (!is_builtin()) {
+    const std::string n = lower(name);
+    if (n == "linear") return working_;
+    for (const auto& family : space_families()) {
+      if (std::none_of(family.begin(), family.end(), [&](const char* f) { return lower(f) == n; }))
+        continue;
+      for (const char* f : family)
+        if (auto cs = config.getColorSpace(f)) return std::string(cs->getName());
+    }
+  }
+  std::string known;
+  for (const std::string& s : color_spaces()) known += (known.empty() ? "" : ", ") + s;
   return Status(ErrorCode::kNotFound,
-                "unknown colour space '" + name + "' (known: linear, sRGB, raw and aliases)");
+                "unknown colour space '" + name + "' in " +
+                    (is_builtin() ? std::string("the built-in colour config") : path_) +
+                    " (its colour spaces: " + known + "; aliases and roles are accepted too)");
+}
+
+bool ColorConfig::is_data(const std::string& name) const {
+  auto resolved = resolve(name);
+  if (!resolved.ok()) return false;
+  auto cs = impl_->config->getColorSpace(resolved->c_str());
+  return cs && cs->isData();
+}
+
+std::string ColorConfig::space_from_file_rules(const std::string& path) const {
+  if (is_builtin() || path.empty()) return "";
+  const auto& config = *impl_->config;
+  try {
+    if (config.filepathOnlyMatchesDefaultRule(path.c_str())) return "";
+    return config.getColorSpaceFromFilepath(path.c_str());
+  } catch (const OCIO::Exception&) {
+    return "";  // a rule the config validated cannot fail on a path; be safe regardless
+  }
+}
+
+std::string ColorConfig::texture_space(const std::string& path, const std::string& metadata,
+                                       bool is_float) const {
+  std::string ruled = space_from_file_rules(path);
+  if (!ruled.empty()) return ruled;
+  if (!metadata.empty()) return metadata;
+  return is_float ? working_ : "sRGB";
+}
+
+Expected<std::unique_ptr<ColorConverter>> ColorConfig::converter(const std::string& from,
+                                                                 const std::string& to) const {
+  auto find = [&](const std::string& name) -> Expected<Space> {
+    auto resolved = resolve(name);
+    if (resolved.ok()) return Space{*resolved, 0};
+    const double g = gamma_of(name);
+    if (g == 0) return resolved.status();
+    // A power the config has no space for: over its linear Rec.709 space.
+    auto lin = is_builtin() ? Expected<std::string>(working_) : resolve("lin_rec709");
+    if (!lin.ok()) return resolved.status();
+    return Space{*lin, g};
+  };
+  VT_ASSIGN_OR_RETURN(Space src, find(from));
+  VT_ASSIGN_OR_RETURN(Space dst, find(to));
+  const auto& config = impl_->config;
+  const bool data = config->getColorSpace(src.name.c_str())->isData() ||
+                    config->getColorSpace(dst.name.c_str())->isData();
+  if (data || (src.name == dst.name && src.gamma == dst.gamma)) {
+    return make_color_converter(nullptr, false);
+  }
+  try {
+    auto group = OCIO::GroupTransform::Create();
+    auto power = [](double g, OCIO::TransformDirection dir) {
+      auto t = OCIO::ExponentTransform::Create();
+      t->setValue({g, g, g, 1.0});
+      t->setDirection(dir);
+      return t;
+    };
+    if (src.gamma > 0) group->appendTransform(power(src.gamma, OCIO::TRANSFORM_DIR_FORWARD));
+    auto cst = OCIO::ColorSpaceTransform::Create();
+    cst->setSrc(src.name.c_str());
+    cst->setDst(dst.name.c_str());
+    group->appendTransform(cst);
+    if (dst.gamma > 0) group->appendTransform(power(dst.gamma, OCIO::TRANSFORM_DIR_INVERSE));
+    auto processor = src.gamma > 0 || dst.gamma > 0
+                         ? config->getProcessor(group)
+                         : config->getProcessor(src.name.c_str(), dst.name.c_str());
+    const bool srgb_decode = is_builtin() && src.name == "sRGB" && dst.name == "linear";
+    return make_color_converter(processor, srgb_decode);
+  } catch (const OCIO::Exception& e) {
+    return Status(ErrorCode::kInvalidArgument,
+                  (is_builtin() ? std::string("built-in colour config") : path_) + ": " + from +
+                      " to " + to + ": " + e.what());
+  }
+}
+
+std::string ColorConfig::yaml() const {
+  std::ostringstream s;
+  impl_->config->serialize(s);
+  return s.str();
+}
+
+std::string ColorConfig::cache_id() const {
+  return impl_->config->getCacheID();
 }
 
 Expected<std::unique_ptr<ColorConverter>> ColorConverter::create(const std::string& from,
                                                                  const std::string& to) {
-  VT_ASSIGN_OR_RETURN(std::string src, canonical_color_space(from));
-  VT_ASSIGN_OR_RETURN(std::string dst, canonical_color_space(to));
-  if (src == dst || src == "raw" || dst == "raw") {
-    return std::unique_ptr<ColorConverter>(new OcioConverter(nullptr));
-  }
-  try {
-    auto processor = config()->getProcessor(src.c_str(), dst.c_str());
-    return std::unique_ptr<ColorConverter>(
-        new OcioConverter(processor->getOptimizedCPUProcessor(OCIO::OPTIMIZATION_DEFAULT)));
-  } catch (const OCIO::Exception& e) {
-    return Status(ErrorCode::kInternal, std::string("OpenColorIO: ") + e.what());
-  }
-}
-
-std::string color_config_yaml() {
-  std::ostringstream s;
-  config()->serialize(s);
-  return s.str();
+  return ColorConfig::builtin()->converter(from, to);
 }
 
 }  // namespace vt

@@ -104,8 +104,9 @@ Expected<std::unique_ptr<ImageSource>> open_image_file(const std::string& path) 
                   spec.format.basetype == OIIO::TypeDesc::FLOAT ||
                   spec.format.basetype == OIIO::TypeDesc::DOUBLE;
   info.alpha_channel = spec.alpha_channel < int(info.channels) ? spec.alpha_channel : -1;
+  // What the file declares ("sRGB", "Linear", "Gamma2.2" for a PNG gAMA, ...); the build
+  // decides what "" means (ColorConfig::texture_space).
   info.color_space = spec.get_string_attribute("oiio:ColorSpace");
-  if (info.color_space.empty()) info.color_space = info.is_float ? "linear" : "sRGB";
   uint32_t file_channels = uint32_t(spec.nchannels);
   return std::unique_ptr<ImageSource>(
       new FileImageSource(path, std::move(in), std::move(info), file_channels));

@@ -18,7 +18,7 @@ struct ImageInfo {
   uint32_t channels = 0;    // 1..4 (extra channels of a file are dropped)
   bool is_float = false;    // half/float data (HDR): values are not limited to [0, 1]
   int alpha_channel = -1;   // index of the alpha channel or -1
-  std::string color_space;  // from the file's metadata ("sRGB", "linear", ...) or ""
+  std::string color_space;  // from the file's metadata ("sRGB", "Linear", "Gamma2.2", ...) or ""
 };
 
 // Rows of texels, `channels` floats per texel, row-major. 8/16-bit files give values in

@@ -187,6 +187,7 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   to.charts.reserve(unwrapped->triangles.size());
   for (const unwrap::AtlasTriangle& t : unwrapped->triangles) to.charts.push_back(t.chart);
   to.threads = options.build.threads;
+  to.color_config = options.build.color_config;
   to.scratch_dir = options.build.scratch_dir.empty()
                        ? std::filesystem::path(output).parent_path().string()
                        : options.build.scratch_dir;

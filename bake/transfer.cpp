@@ -1,9 +1,9 @@
 // Material transfer (see transfer.h). Work is split into bands of atlas rows; each band walks
 // the triangles that overlap it in index order, so the result does not depend on threads.
 #include "bake/transfer.h"
+#include "bake/color.h"
 #include "bake/unwrap/atlas_raster.h"
 #include "common/parallel.h"
-#include "common/srgb.h"
 #include "common/vec.h"
 
 #include <OpenImageIO/imagebufalgo.h>
@@ -110,7 +110,9 @@ uint64_t raster_triangle(const RasterTriangle& tri, int32_t t, int32_t chart, Ba
 struct ImageSlot {
   OIIO::TextureSystem::TextureHandle* handle = nullptr;  // null: the image could not be read
   int channels = 0;
-  bool linear = false;  // float data or tagged linear: never sRGB-decoded
+  // Colour use (base colour, emissive): from the image's colour space to the working space;
+  // null = none (already linear). Data uses (normal, ORM) never convert.
+  std::shared_ptr<const ColorConverter> to_working;
   std::string name;
   std::string tried;  // the file opened (for an embedded image, its scratch copy)
   std::string error;  // why it could not be read
@@ -317,6 +319,8 @@ class Transfer {
  private:
   Status setup_images();
   Status check_missing_textures();
+  Status set_colour_space(ImageSlot& slot, const std::string& path,
+                          const OIIO::ImageSpec& spec) const;
   Status setup_prims();
   Status setup_raster();
   bool sample_texture(OIIO::TextureSystem::Perthread* pt, const scene::TextureRef& ref,
@@ -344,6 +348,30 @@ class Transfer {
   mutable std::mutex error_mutex_;
   mutable std::string lookup_error_;
 };
+
+// Base colour and emissive textures are colour; the other slots are data.
+bool used_as_colour(const scene::Scene& scene, size_t image) {
+  return std::any_of(scene.materials.begin(), scene.materials.end(), [&](const auto& m) {
+    return (m.base_color_texture.valid() && size_t(m.base_color_texture.image) == image) ||
+           (m.emissive_texture.valid() && size_t(m.emissive_texture.image) == image);
+  });
+}
+
+// The colour space: the config's file rules for `path` (a file, not an embedded image), else
+// the image's metadata, else sRGB (8/16-bit) or the working space (float).
+Status Transfer::set_colour_space(ImageSlot& slot, const std::string& path,
+                                  const OIIO::ImageSpec& spec) const {
+  const ColorConfig& colours = opt_.color_config ? *opt_.color_config : *ColorConfig::builtin();
+  const bool is_float = spec.format.basetype == OIIO::TypeDesc::FLOAT ||
+                        spec.format.basetype == OIIO::TypeDesc::HALF ||
+                        spec.format.basetype == OIIO::TypeDesc::DOUBLE;
+  const std::string space =
+      colours.texture_space(path, spec.get_string_attribute("oiio:ColorSpace"), is_float);
+  auto converter = colours.converter(space, colours.working_space());
+  if (!converter.ok()) return converter.status().with_context(slot.name);
+  if (!(*converter)->is_identity()) slot.to_working = std::move(converter).value();
+  return Status::Ok();
+}
 
 Status Transfer::setup_images() {
   std::vector<bool> used(scene_.images.size(), false);
@@ -404,13 +432,9 @@ Status Transfer::setup_images() {
       continue;
     }
     slot.channels = std::min(spec->nchannels, 4);
-    std::string cs = spec->get_string_attribute("oiio:ColorSpace");
-    std::transform(cs.begin(), cs.end(), cs.begin(),
-                   [](unsigned char c) { return std::tolower(c); });
-    bool is_float = spec->format.basetype == OIIO::TypeDesc::FLOAT ||
-                    spec->format.basetype == OIIO::TypeDesc::HALF ||
-                    spec->format.basetype == OIIO::TypeDesc::DOUBLE;
-    slot.linear = is_float || cs == "linear" || cs == "scene_linear" || cs == "lin_srgb";
+    if (used_as_colour(scene_, i)) {
+      VT_RETURN_IF_ERROR(set_colour_space(slot, img.embedded() ? "" : img.path, *spec));
+    }
     // Optionally, untiled sources get MIP levels made with another filter (as maketx does);
     // should that fail, OpenImageIO's automatic levels still give a result.
     bool untiled = false;
@@ -640,10 +664,8 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
   float tex[4];
   auto colour = [&](const scene::TextureRef& ref, float* rgb) {
     if (!ref.valid() || !sample_texture(pt, ref, te, l, tex)) return false;
-    bool srgb = !images_[ref.image].linear;
-    for (int c = 0; c < 3; ++c)
-      rgb[c] = srgb ? srgb_to_linear(std::clamp(tex[c], 0.0f, 1.0f)) : tex[c];
-    rgb[3] = tex[3];
+    for (int c = 0; c < 4; ++c) rgb[c] = tex[c];
+    if (const auto& to_working = images_[ref.image].to_working) to_working->apply_rgb(rgb);
     return true;
   };
   // Albedo: factor x texture x vertex colour (glTF).

@@ -22,6 +22,8 @@
 
 namespace vt {
 
+class ColorConfig;
+
 // What a texture that cannot be read does to the transfer.
 enum class MissingTextures {
   kError,  // the transfer fails naming the material, the slot, the image and the path tried
@@ -49,6 +51,9 @@ struct TransferOptions {
   // triangles, faces): unwrap::UnwrapResult::triangles[i].chart. Empty = charts are the
   // triangles connected through shared vertices or equal atlas UVs of a primitive.
   std::vector<int32_t> charts;
+  // Base colour and emissive textures are converted from their colour space (file rules,
+  // metadata, else sRGB/float linear) to this config's working space. Null = built-in config.
+  std::shared_ptr<const ColorConfig> color_config;
   std::function<void(double fraction)> progress;  // from the calling thread, 0..1
 };
 

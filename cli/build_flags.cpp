@@ -1,6 +1,9 @@
 // The build flags (see build_flags.h).
 #include "cli/build_flags.h"
 
+#include <cstdlib>
+
+#include "bake/color.h"
 #include "cli/cli_util.h"
 
 namespace vt::cli {
@@ -54,6 +57,19 @@ void add_build_flags(CLI::App& app, BuildOptions& o) {
       ->default_str(format_byte_size(o.memory_limit));
   app.add_option("--scratch-dir", o.scratch_dir,
                  "Where levels larger than memory go (default: beside the output)");
+  app.add_option_function<std::string>(
+         "--colorconfig",
+         [&o](const std::string& path) {
+           auto config = ColorConfig::load(path);
+           const char* env = std::getenv("OCIO");  // CLI11 reads $OCIO when the flag is absent
+           throw_if_error(env && path == env ? "$OCIO" : "--colorconfig", config.status());
+           o.color_config = *config;
+         },
+         "OpenColorIO config (.ocio) for the colour textures: their spaces by name, alias, role "
+         "or the config's file rules; its scene_linear role is the working space (default: "
+         "$OCIO, else the built-in config: linear, sRGB, Rec709, Gamma1.8/2.2/2.4, ACEScg, "
+         "ACES2065-1, raw)")
+      ->envname("OCIO");
 }
 
 }  // namespace vt::cli

@@ -8,6 +8,7 @@
 
 #include "bake/build.h"
 #include "bake/build_summary_json.h"
+#include "bake/color.h"
 #include "cli/build_flags.h"
 #include "cli/cli_util.h"
 #include "cli/command.h"
@@ -128,7 +129,10 @@ int run_build(BuildArgs& f, const vt::cli::GlobalOptions& global) {
       in.semantic = vt::LayerSemantic::kCustom;
       in.name = name;
     }
-    in.color_space = f.colorspace;
+    // --colorspace, else what a user config's file rules say; "" = the file's metadata.
+    in.color_space = !f.colorspace.empty() || !o.color_config
+                         ? f.colorspace
+                         : o.color_config->space_from_file_rules(path);
     o.layers.push_back(std::move(in));
   }
 
@@ -164,7 +168,9 @@ vt::cli::CommandRunner make_build(CLI::App& sub) {
   sub.add_option("--layer", f->layers,
                  "A layer NAME=PATH; NAME albedo, normal, orm, emissive or any custom name");
   sub.add_option("--colorspace", f->colorspace,
-                 "Colour space of the inputs (linear, sRGB, raw); default from file metadata");
+                 "Colour space of the colour layers' inputs: a name, alias or role of the colour "
+                 "config (sRGB, linear, ACEScg, Gamma2.2, raw ...); default: the config's file "
+                 "rules, else the file's metadata, else sRGB (8/16-bit) or linear (float)");
   vt::BuildOptions& o = f->options;
   sub.add_option_function<std::string>(
          "--address",
