@@ -108,6 +108,10 @@ vt::cli::CommandRunner make_validate(CLI::App& app) {
   auto* atlas_only = app.add_flag(
       "--atlas-only", [&f](int64_t) { f.render_views = false; },
       "Only the atlas-space page check (every page of every layer; no Vulkan)");
+  app.add_option("--atlas-offset-db", f.atlas.psnr_offset_db,
+                 "Added to every layer's per-page PSNR bound in the atlas check (negative loosens)")
+      ->check(CLI::Range(-60.0, 60.0))
+      ->capture_default_str();
   app.add_flag(
          "--no-atlas-check", [&f](int64_t) { f.atlas.enabled = false; },
          "Skip the atlas-space page check")
