@@ -24,15 +24,16 @@ void print_atlas(const vt::render::AtlasCheckReport& a) {
     return;
   }
   std::printf("  atlas check (%.1f s, transfer %.1f s)\n", a.seconds, a.transfer_seconds);
-  std::printf("  layer       codec  runtime  pages  failed  min dB  mean dB  bound dB\n");
+  std::printf("  layer       codec  runtime  pages  failed  min dB  mean dB  bound dB  shift\n");
   for (const auto& l : a.layers) {
     if (!l.note.empty()) {
       std::printf("  %-10s  %s\n", l.name.c_str(), l.note.c_str());
       continue;
     }
-    std::printf("  %-10s  %5s  %7s  %5llu  %6llu  %6.1f  %7.1f  %8.1f\n", l.name.c_str(),
+    std::printf("  %-10s  %5s  %7s  %5llu  %6llu  %6.1f  %7.1f  %8.1f  %5.2f\n", l.name.c_str(),
                 l.codec.c_str(), l.runtime_format.c_str(), (unsigned long long)l.pages_checked,
-                (unsigned long long)l.pages_failed, l.min_psnr, l.mean_psnr, l.bounds.min_psnr);
+                (unsigned long long)l.pages_failed, l.min_psnr, l.mean_psnr, l.bounds.min_psnr,
+                l.worst_mean_shift);
   }
   for (const std::string& f : a.failures) std::printf("  FAIL %s\n", f.c_str());
 }
