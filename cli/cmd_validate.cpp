@@ -18,7 +18,32 @@ struct ValidateArgs {
   vt::render::BakeValidationOptions options;
 };
 
+void print_atlas(const vt::render::AtlasCheckReport& a) {
+  if (!a.ran) {
+    std::printf("  atlas check: %s\n", a.note.c_str());
+    return;
+  }
+  std::printf("  atlas check (%.1f s, transfer %.1f s)\n", a.seconds, a.transfer_seconds);
+  std::printf("  layer       codec  runtime  pages  failed  min dB  mean dB  bound dB  shift\n");
+  for (const auto& l : a.layers) {
+    if (!l.note.empty()) {
+      std::printf("  %-10s  %s\n", l.name.c_str(), l.note.c_str());
+      continue;
+    }
+    std::printf("  %-10s  %5s  %7s  %5llu  %6llu  %6.1f  %7.1f  %8.1f  %5.2f\n", l.name.c_str(),
+                l.codec.c_str(), l.runtime_format.c_str(), (unsigned long long)l.pages_checked,
+                (unsigned long long)l.pages_failed, l.min_psnr, l.mean_psnr, l.bounds.min_psnr,
+                l.worst_mean_shift);
+  }
+  for (const std::string& f : a.failures) std::printf("  FAIL %s\n", f.c_str());
+}
+
 void print_text(const vt::render::ValidationReport& r) {
+  print_atlas(r.atlas);
+  if (r.views.empty()) {
+    std::printf("%s\n", r.passed() ? "PASS" : "FAIL");
+    return;
+  }
   std::printf("validate %s (layer %u, %s cache) on %s, %ux%u\n", r.page_file.c_str(), r.layer,
               r.cache_format.c_str(), r.device.c_str(), r.width, r.height);
   std::printf("  view  PSNR dB  tile dB   SSIM    coarser  frames  result\n");
@@ -81,6 +106,17 @@ vt::cli::CommandRunner make_validate(CLI::App& app) {
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
   app.add_flag("--hardware", f.prefer_hardware, "Prefer a hardware Vulkan device over lavapipe");
+  auto* atlas_only = app.add_flag(
+      "--atlas-only", [&f](int64_t) { f.render_views = false; },
+      "Only the atlas-space page check (every page of every layer; no Vulkan)");
+  app.add_option("--atlas-offset-db", f.atlas.psnr_offset_db,
+                 "Added to every layer's per-page PSNR bound in the atlas check (negative loosens)")
+      ->check(CLI::Range(-60.0, 60.0))
+      ->capture_default_str();
+  app.add_flag(
+         "--no-atlas-check", [&f](int64_t) { f.atlas.enabled = false; },
+         "Skip the atlas-space page check")
+      ->excludes(atlas_only);
   app.add_option("--out", f.out_dir,
                  "Folder for the PNGs and report.json (default PAGE_FILE.validate)");
   app.footer(
@@ -90,8 +126,9 @@ vt::cli::CommandRunner make_validate(CLI::App& app) {
       "eye and target are required; up defaults to [0, 1, 0], fov_y_deg (vertical, in (0, 180))\n"
       "to 50, near and far to 1/100 and 100 times the eye-target distance. 1-256 cameras;\n"
       "unknown keys, non-finite numbers, eye == target and up parallel to the view are errors.\n"
-      "Exit status: 0 every view passes, 1 a view fails its bounds or a write fails, 2 bad input\n"
-      "or no Vulkan device.");
+      "Exit status: 0 every view and every page passes, 1 a view or a page (atlas check: each\n"
+      "page of each layer against the original materials) fails its bounds or a write fails,\n"
+      "2 bad input or no Vulkan device.");
   return [args](const vt::cli::GlobalOptions& global) { return run(*args, global); };
 }
 

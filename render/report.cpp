@@ -71,7 +71,8 @@ Status write_png(const std::string& path, const Rgba8Image& image) {
 }
 
 bool ValidationReport::passed() const {
-  if (views.empty()) return false;
+  if (!atlas.passed()) return false;
+  if (views.empty()) return atlas.ran;
   for (const ViewReport& v : views) {
     if (!v.failures.empty()) return false;
   }
@@ -129,7 +130,8 @@ std::string report_json(const ValidationReport& r) {
                 {"max_coarser_share", r.thresholds.max_coarser_share},
                 {"max_coverage_mismatch", r.thresholds.max_coverage_mismatch}}},
               {"passed", r.passed()},
-              {"views", views}};
+              {"views", views},
+              {"atlas", to_json(r.atlas)}};
   return doc.dump(2);
 }
 

@@ -295,6 +295,7 @@ namespace {
 struct BakeInputs {
   std::vector<Camera> cameras;  // from the camera file; empty = automatic views
   std::shared_ptr<const PageFileReader> reader;
+  scene::Scene original, baked;  // for the atlas check
   SceneDraws reference, virt;
   uint32_t layer = 0;
 };
@@ -326,10 +327,10 @@ Expected<BakeInputs> read_bake_inputs(const BakeValidationOptions& o) {
       o.unwrapped.empty() ? std::filesystem::path(o.page_file).replace_extension(".glb").string()
                           : o.unwrapped;
   VT_ASSIGN_OR_RETURN(in.reader, PageFileReader::open(o.page_file));
-  VT_ASSIGN_OR_RETURN(scene::Scene original, scene::load_scene(o.scene));
-  VT_ASSIGN_OR_RETURN(scene::Scene baked, scene::load_scene(unwrapped));
-  VT_ASSIGN_OR_RETURN(in.reference, reference_scene_draws(original));
-  VT_ASSIGN_OR_RETURN(in.virt, virtual_scene_draws(baked));
+  VT_ASSIGN_OR_RETURN(in.original, scene::load_scene(o.scene));
+  VT_ASSIGN_OR_RETURN(in.baked, scene::load_scene(unwrapped));
+  VT_ASSIGN_OR_RETURN(in.reference, reference_scene_draws(in.original));
+  VT_ASSIGN_OR_RETURN(in.virt, virtual_scene_draws(in.baked));
   if (in.reference.meshes.empty() || in.virt.meshes.empty()) {
     return Error(ErrorCode::kInvalidArgument, o.scene + ": nothing to draw");
   }
@@ -341,6 +342,25 @@ Expected<BakeInputs> read_bake_inputs(const BakeValidationOptions& o) {
 
 Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
   VT_ASSIGN_OR_RETURN(BakeInputs in, read_bake_inputs(o));
+  const std::string out_dir =
+      o.out_dir.empty() ? std::filesystem::path(o.page_file).replace_extension(".validate").string()
+                        : o.out_dir;
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) return Error(ErrorCode::kIo, out_dir + ": cannot create: " + ec.message());
+  AtlasCheckOptions ao = o.atlas;
+  ao.out_dir = out_dir;
+  VT_ASSIGN_OR_RETURN(AtlasCheckReport atlas,
+                      check_atlas_pages(in.reader, in.original, in.baked, ao));
+  if (!o.render_views) {
+    ValidationReport report;
+    report.page_file = o.page_file;
+    report.layer = in.layer;
+    report.out_dir = out_dir;
+    report.atlas = std::move(atlas);
+    VT_RETURN_IF_ERROR(write_report_json(out_dir + "/report.json", report));
+    return report;
+  }
   VulkanOptions vo;
   vo.prefer_hardware = o.prefer_hardware;
   VT_ASSIGN_OR_RETURN(std::unique_ptr<VulkanContext> ctx, VulkanContext::create(vo));
@@ -367,12 +387,7 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
   vopt.streamer.slots_x = vopt.streamer.slots_y = o.slots;
   vopt.converge.max_frames = o.max_frames;
   vopt.thresholds = o.thresholds;
-  vopt.out_dir = o.out_dir.empty()
-                     ? std::filesystem::path(o.page_file).replace_extension(".validate").string()
-                     : o.out_dir;
-  std::error_code ec;
-  std::filesystem::create_directories(vopt.out_dir, ec);
-  if (ec) return Error(ErrorCode::kIo, vopt.out_dir + ": cannot create: " + ec.message());
+  vopt.out_dir = out_dir;
 
   VT_ASSIGN_OR_RETURN(
       ValidationReport report,
@@ -380,6 +395,7 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
                      vopt));
   report.page_file = o.page_file;
   report.device = ctx->device_name();
+  report.atlas = std::move(atlas);
   VT_RETURN_IF_ERROR(write_report_json(vopt.out_dir + "/report.json", report));
   return report;
 }

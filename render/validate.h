@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common/status.h"
+#include "render/atlas_check.h"
 #include "render/camera.h"
 #include "render/renderer.h"
 #include "runtime/streamer.h"
@@ -108,7 +109,10 @@ struct ValidationReport {
   uint32_t width = 0, height = 0;
   Thresholds thresholds;
   std::vector<ViewReport> views;
-  std::string out_dir;  // where the PNGs (and, from validate_bake, report.json) went; "" = none
+  std::string out_dir;     // where the PNGs (and, from validate_bake, report.json) went; "" = none
+  AtlasCheckReport atlas;  // validate_bake's atlas-space page check (atlas.ran: it ran)
+  // Every view passes and the atlas check found no failing page; with no views, the atlas check
+  // ran and passed.
   bool passed() const;
 };
 
@@ -144,13 +148,16 @@ struct BakeValidationOptions {
   uint32_t slots = 32;           // physical cache slots per side
   uint32_t max_frames = 48;      // per view, before giving up converging
   bool prefer_hardware = false;  // a hardware Vulkan device rather than lavapipe
+  AtlasCheckOptions atlas;       // out_dir is set to out_dir
+  bool render_views = true;      // false: the atlas check alone (no Vulkan needed)
 };
 
 // Reads the camera file (first, so that a bad one fails fast), the page file and both scenes,
-// renders every view through the virtual-texture path and from the original materials
-// (validate_views) and writes the PNGs and report.json into out_dir. A view out of bounds is a
-// report that has not passed(), not an error; errors are bad input (kInvalidArgument,
-// kNotFound, kCorrupt), no usable Vulkan device (kUnsupported) or a failed write (kIo).
+// checks every page in atlas space (check_atlas_pages, no GPU), renders every view through the
+// virtual-texture path and from the original materials (validate_views) and writes the PNGs and
+// report.json into out_dir. A view out of bounds is a report that has not passed(), not an error;
+// errors are bad input (kInvalidArgument, kNotFound, kCorrupt), no usable Vulkan device
+// (kUnsupported) or a failed write (kIo).
 Expected<ValidationReport> validate_bake(const BakeValidationOptions& options);
 
 }  // namespace vt::render

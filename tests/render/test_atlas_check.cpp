@@ -1,0 +1,340 @@
+// render::check_atlas_pages on small bakes of the procedural sample scene: a correct bake
+// passes (a raw bake matches its reference exactly), and each sabotage of the page file (pages
+// rewritten, checksums recomputed so that verify passes) fails on the pages it touched.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <numeric>
+
+#include "bake/scene_bake.h"
+#include "codec/metrics.h"
+#include "common/srgb.h"
+#include "format/layer_codec.h"
+#include "render/atlas_check.h"
+#include "samples/sample_scene.h"
+
+namespace vt::render {
+namespace {
+
+// Which page's content goes into (id, layer), and an edit of its decoded texels (returns true
+// when it changed them).
+using Remap = std::function<PageId(const PageId& id, uint32_t layer)>;
+using Edit = std::function<bool(const PageId& id, uint32_t layer, std::vector<uint8_t>& texels)>;
+
+// Copies the page file `in` to `out` page by page through `remap` and `edit`; edited pages are
+// coded again with the layer's codec, the rest copied as they are. The writer computes every
+// checksum, so the result verifies.
+Status rewrite(const std::string& in, const std::string& out, const Remap& remap,
+               const Edit& edit) {
+  VT_ASSIGN_OR_RETURN(auto reader, PageFileReader::open(in));
+  PageFileDesc desc;
+  desc.geometry = reader->geometry();
+  desc.layers = reader->layers();
+  desc.metadata_json = reader->metadata_json();
+  VT_ASSIGN_OR_RETURN(auto writer, PageFileWriter::create(out, desc));
+  const PageGeometry& g = desc.geometry;
+  for (uint32_t layer = 0; layer < desc.layers.size(); ++layer) {
+    std::vector<uint8_t> texels(reader->decoded_page_bytes(layer));
+    for (uint32_t l = 0; l < g.level_count(); ++l)
+      for (uint32_t y = 0; y < g.pages_y(l); ++y)
+        for (uint32_t x = 0; x < g.pages_x(l); ++x) {
+          const PageId id{l, x, y}, src = remap(id, layer);
+          VT_ASSIGN_OR_RETURN(PageEntry e, reader->entry(src, layer));
+          if (e.state == PageState::kAbsent) continue;
+          VT_RETURN_IF_ERROR(reader->read_texels(src, layer, texels));
+          if (edit(id, layer, texels)) {
+            std::vector<uint8_t> bytes;
+            VT_RETURN_IF_ERROR(reader->layer_codec(layer).encode(texels.data(), {}, bytes));
+            VT_RETURN_IF_ERROR(writer->add_page(id, layer, bytes));
+          } else if (e.state == PageState::kConstant) {
+            VT_RETURN_IF_ERROR(writer->add_constant_page(
+                id, layer, std::span<const uint8_t>(e.constant, desc.layers[layer].texel_bytes())));
+          } else {
+            VT_ASSIGN_OR_RETURN(auto bytes, reader->read_stored(src, layer));
+            VT_RETURN_IF_ERROR(writer->add_page(id, layer, bytes));
+          }
+        }
+  }
+  return writer->finish();
+}
+
+const Remap kSame = [](const PageId& id, uint32_t) { return id; };
+const Edit kNoEdit = [](const PageId&, uint32_t, std::vector<uint8_t>&) { return false; };
+
+class AtlasCheck : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ =
+        (std::filesystem::temp_directory_path() / ("vt_atlas_check_" + std::to_string(::getpid())))
+            .string();
+    std::filesystem::remove_all(dir_);
+    SampleSceneOptions so;
+    so.ground_cells = 4;
+    so.sphere_segments = 12;
+    so.texture_size = 256;  // the emissive lines fall between texel centres below that
+    Status s = write_sample_scene(dir_ + "/scene", so);
+    for (const char* codec : {"dct", "raw"}) {
+      if (!s.ok()) break;
+      SceneBakeOptions o;
+      o.build.output = dir_ + "/" + codec + ".vtpf";
+      o.build.codec.codec = std::string(codec) == "raw" ? CodecKind::kRaw : CodecKind::kDct;
+      o.unwrap.size_pages = 4;
+      auto baked = bake_scene(dir_ + "/scene/scene.gltf", o);
+      if (!baked.ok()) s = baked.status();
+    }
+    if (s.ok()) {
+      auto original = scene::load_scene(dir_ + "/scene/scene.gltf");
+      auto unwrapped = scene::load_scene(dir_ + "/dct.glb");
+      s = !original.ok() ? original.status() : unwrapped.status();
+      if (s.ok()) original_ = std::move(*original), unwrapped_ = std::move(*unwrapped);
+    }
+    if (!s.ok()) setup_error_ = s.message();
+  }
+  static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
+  void SetUp() override { ASSERT_TRUE(setup_error_.empty()) << setup_error_; }
+
+  static Expected<AtlasCheckReport> check(const std::string& file,
+                                          const AtlasCheckOptions& o = {}) {
+    VT_ASSIGN_OR_RETURN(auto reader, PageFileReader::open(file));
+    VT_RETURN_IF_ERROR(reader->verify());  // sabotaged files keep valid checksums
+    const std::string glb = std::filesystem::path(file).replace_extension(".glb").string();
+    scene::Scene unwrapped = unwrapped_;
+    if (std::filesystem::exists(glb)) {
+      VT_ASSIGN_OR_RETURN(unwrapped, scene::load_scene(glb));
+    }
+    return check_atlas_pages(std::move(reader), original_, unwrapped, o);
+  }
+
+  // The sabotaged copy of the DCT bake, checked.
+  static AtlasCheckReport sabotage(const std::string& name, const Remap& remap, const Edit& edit) {
+    const std::string out = dir_ + "/" + name + ".vtpf";
+    Status s = rewrite(dir_ + "/dct.vtpf", out, remap, edit);
+    EXPECT_TRUE(s.ok()) << s.message();
+    auto r = check(out);
+    EXPECT_TRUE(r.ok()) << r.status().message();
+    return r.ok() ? *r : AtlasCheckReport{};
+  }
+
+  static uint32_t layer_index(LayerSemantic s) {
+    auto reader = PageFileReader::open(dir_ + "/dct.vtpf");
+    for (uint32_t i = 0; reader.ok() && i < (*reader)->layers().size(); ++i)
+      if ((*reader)->layers()[i].semantic == s) return i;
+    ADD_FAILURE() << "no layer " << to_string(s);
+    return 0;
+  }
+
+  // Two level-0 pages of `layer` whose texels differ most: the brightest page and the page
+  // farthest from it.
+  static std::pair<PageId, PageId> distinct_pages(uint32_t layer) {
+    auto reader = PageFileReader::open(dir_ + "/dct.vtpf");
+    EXPECT_TRUE(reader.ok());
+    const PageGeometry& g = (*reader)->geometry();
+    std::vector<PageId> ids;
+    std::vector<std::vector<uint8_t>> pages;
+    for (uint32_t y = 0; y < g.pages_y(0); ++y)
+      for (uint32_t x = 0; x < g.pages_x(0); ++x) {
+        std::vector<uint8_t> t((*reader)->decoded_page_bytes(layer));
+        if (!(*reader)->read_texels({0, x, y}, layer, t).ok()) continue;
+        ids.push_back({0, x, y});
+        pages.push_back(std::move(t));
+      }
+    auto sum = [](const std::vector<uint8_t>& p) {
+      return std::accumulate(p.begin(), p.end(), 0.0);
+    };
+    size_t a = 0, b = 0;
+    for (size_t i = 0; i < pages.size(); ++i)
+      if (sum(pages[i]) > sum(pages[a])) a = i;
+    double far = -1;
+    for (size_t i = 0; i < pages.size(); ++i) {
+      double d = 0;
+      for (size_t k = 0; k < pages[i].size(); ++k) d += std::abs(int(pages[i][k]) - pages[a][k]);
+      if (d > far) far = d, b = i;
+    }
+    return {ids[a], ids[b]};
+  }
+
+  static const AtlasLayerReport& layer_report(const AtlasCheckReport& r, LayerSemantic s) {
+    for (const AtlasLayerReport& l : r.layers)
+      if (l.semantic == s) return l;
+    static AtlasLayerReport none;
+    ADD_FAILURE() << "no report for " << to_string(s);
+    return none;
+  }
+
+  static bool lists_failed(const AtlasLayerReport& l, const PageId& id) {
+    return std::any_of(l.worst.begin(), l.worst.end(),
+                       [&](const AtlasPageError& e) { return e.failed && e.id == id; });
+  }
+
+  static std::string dir_, setup_error_;
+  static scene::Scene original_, unwrapped_;
+};
+std::string AtlasCheck::dir_, AtlasCheck::setup_error_;
+scene::Scene AtlasCheck::original_, AtlasCheck::unwrapped_;
+
+TEST_F(AtlasCheck, CorrectBakePassesWithHeatMapsAndJson) {
+  AtlasCheckOptions o;
+  o.out_dir = dir_ + "/maps";
+  std::filesystem::create_directories(o.out_dir);
+  auto r = check(dir_ + "/dct.vtpf", o);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_TRUE(r->ran);
+  EXPECT_TRUE(r->passed()) << r->failures.front();
+  ASSERT_EQ(r->layers.size(), 4u);  // albedo, normal, orm, emissive
+  auto reader = PageFileReader::open(dir_ + "/dct.vtpf");
+  ASSERT_TRUE(reader.ok());
+  const PageGeometry& g = (*reader)->geometry();
+  for (const AtlasLayerReport& l : r->layers) {
+    EXPECT_TRUE(l.note.empty()) << l.name << ": " << l.note;
+    EXPECT_EQ(l.pages_failed, 0u) << l.name;
+    EXPECT_EQ(l.pages_checked, g.total_pages()) << l.name;  // every page is stored or constant
+    EXPECT_GE(l.min_psnr, l.bounds.min_psnr) << l.name;
+    ASSERT_EQ(l.heat_maps.size(), g.level_count());
+    for (const std::string& png : l.heat_maps) EXPECT_TRUE(std::filesystem::exists(png)) << png;
+  }
+  const nlohmann::json j = to_json(*r);
+  EXPECT_TRUE(j["passed"].get<bool>());
+  EXPECT_EQ(j["layers"].size(), 4u);
+  EXPECT_FALSE(j["layers"][0]["worst_pages"].empty());
+}
+
+TEST_F(AtlasCheck, RawBakeMatchesItsReferenceExactly) {
+  AtlasCheckOptions o;
+  o.stored_texels = true;  // before the runtime's BC transcode
+  auto r = check(dir_ + "/raw.vtpf", o);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  ASSERT_TRUE(r->passed());
+  for (const AtlasLayerReport& l : r->layers) {
+    EXPECT_EQ(l.min_psnr, kPsnrIdentical) << l.name;
+    EXPECT_EQ(l.worst_max_deg, 0.0) << l.name;
+  }
+  o.stored_texels = false;  // the upload: the BC transcode's error, within the BC bounds
+  r = check(dir_ + "/raw.vtpf", o);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_TRUE(r->passed()) << r->failures.front();
+}
+
+TEST_F(AtlasCheck, UnchangedRewriteStillPasses) {
+  AtlasCheckReport r = sabotage("copy", kSame, kNoEdit);
+  EXPECT_TRUE(r.passed());
+}
+
+TEST_F(AtlasCheck, SwappedLevel0PagesFailInEveryLayer) {
+  for (LayerSemantic s : {LayerSemantic::kAlbedo, LayerSemantic::kNormal, LayerSemantic::kOrm,
+                          LayerSemantic::kEmissive}) {
+    const uint32_t li = layer_index(s);
+    const auto [a, b] = distinct_pages(li);
+    AtlasCheckReport r = sabotage(
+        std::string("swap_") + to_string(s),
+        [&, a = a, b = b](const PageId& id, uint32_t layer) {
+          if (layer != li) return id;
+          return id == a ? b : id == b ? a : id;
+        },
+        kNoEdit);
+    ASSERT_FALSE(r.passed()) << to_string(s);
+    const AtlasLayerReport& l = layer_report(r, s);
+    EXPECT_EQ(l.pages_failed, 2u) << to_string(s);
+    EXPECT_TRUE(lists_failed(l, a) && lists_failed(l, b)) << to_string(s);
+    EXPECT_EQ(r.failures.size(), 1u);  // only the sabotaged layer
+    EXPECT_NE(r.failures[0].find(l.name + ": 2 of"), std::string::npos) << r.failures[0];
+  }
+}
+
+TEST_F(AtlasCheck, PageFromACoarserLevelFails) {
+  const uint32_t li = layer_index(LayerSemantic::kAlbedo);
+  const PageId a = distinct_pages(li).first;
+  AtlasCheckReport r = sabotage(
+      "coarser",
+      [&](const PageId& id, uint32_t layer) {
+        return layer == li && id == a ? PageId{1, a.x / 2, a.y / 2} : id;
+      },
+      kNoEdit);
+  const AtlasLayerReport& l = layer_report(r, LayerSemantic::kAlbedo);
+  EXPECT_EQ(l.pages_failed, 1u);
+  EXPECT_TRUE(lists_failed(l, a));
+}
+
+TEST_F(AtlasCheck, ZeroedBorderFails) {
+  const uint32_t li = layer_index(LayerSemantic::kAlbedo);
+  const PageId a = distinct_pages(li).first;
+  AtlasCheckReport r =
+      sabotage("border", kSame, [&](const PageId& id, uint32_t layer, std::vector<uint8_t>& t) {
+        if (layer != li || !(id == a)) return false;
+        const uint32_t S = 128, B = 4, c = 4;  // RGBA albedo
+        for (uint32_t y = 0; y < S; ++y)
+          for (uint32_t x = 0; x < S; ++x)
+            if (x < B || y < B || x >= S - B || y >= S - B)
+              std::fill_n(&t[(size_t(y) * S + x) * c], c, 0);
+        return true;
+      });
+  const AtlasLayerReport& l = layer_report(r, LayerSemantic::kAlbedo);
+  EXPECT_EQ(l.pages_failed, 1u);
+  ASSERT_FALSE(l.worst.empty());
+  EXPECT_EQ(l.worst[0].id, a);  // worst first
+}
+
+TEST_F(AtlasCheck, FlippedNormalGreenFails) {
+  const uint32_t li = layer_index(LayerSemantic::kNormal);
+  AtlasCheckReport r =
+      sabotage("green", kSame, [&](const PageId&, uint32_t layer, std::vector<uint8_t>& t) {
+        if (layer != li) return false;
+        for (size_t i = 1; i < t.size(); i += 2) t[i] = uint8_t(255 - t[i]);
+        return true;
+      });
+  EXPECT_GT(layer_report(r, LayerSemantic::kNormal).pages_failed, 0u);
+  EXPECT_GT(layer_report(r, LayerSemantic::kNormal).worst_mean_deg, 4.0);
+  EXPECT_EQ(r.failures.size(), 1u);
+}
+
+TEST_F(AtlasCheck, SwappedOrmChannelsFail) {
+  const uint32_t li = layer_index(LayerSemantic::kOrm);
+  AtlasCheckReport r =
+      sabotage("orm", kSame, [&](const PageId&, uint32_t layer, std::vector<uint8_t>& t) {
+        if (layer != li) return false;
+        for (size_t i = 0; i + 2 < t.size(); i += 3) std::swap(t[i], t[i + 2]);
+        return true;
+      });
+  EXPECT_GT(layer_report(r, LayerSemantic::kOrm).pages_failed, 0u);
+  EXPECT_EQ(r.failures.size(), 1u);
+}
+
+TEST_F(AtlasCheck, HalvedEmissiveFails) {
+  const uint32_t li = layer_index(LayerSemantic::kEmissive);
+  AtlasCheckReport r =
+      sabotage("emissive", kSame, [&](const PageId&, uint32_t layer, std::vector<uint8_t>& t) {
+        if (layer != li) return false;
+        for (uint8_t& v : t)
+          v = uint8_t(std::lround(linear_to_srgb(0.5f * srgb_to_linear(v / 255.0f)) * 255.0f));
+        return true;
+      });
+  EXPECT_GT(layer_report(r, LayerSemantic::kEmissive).pages_failed, 0u);
+  EXPECT_EQ(r.failures.size(), 1u);
+}
+
+TEST_F(AtlasCheck, InputErrorsSayWhatIsWrong) {
+  auto opened = PageFileReader::open(dir_ + "/dct.vtpf");
+  ASSERT_TRUE(opened.ok());
+  std::shared_ptr<const PageFileReader> reader = std::move(*opened);
+  scene::Scene other = original_;
+  other.materials.push_back({});
+  auto r = check_atlas_pages(reader, other, unwrapped_, {});
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(r.status().message().find("materials"), std::string::npos);
+
+  AtlasCheckOptions o;
+  o.memory_limit = 1 << 20;  // skipped with a note, not an error
+  r = check_atlas_pages(reader, original_, unwrapped_, o);
+  ASSERT_TRUE(r.ok());
+  EXPECT_FALSE(r->ran);
+  EXPECT_TRUE(r->passed());
+  EXPECT_NE(r->note.find("memory limit"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace vt::render
