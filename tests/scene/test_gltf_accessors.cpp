@@ -412,7 +412,7 @@ TEST(GltfAccessors, HugeCountsAreRefusedBeforeAllocating) {
       {{{"componentType", 5125}, {"type", "SCALAR"}, {"count", -1}},
        true,
        ErrorCode::kCorrupt,
-       "accessor 1: count is not a non-negative integer: -1"},
+       "accessors[1].count: expected a non-negative integer"},
       {{{"componentType", 5125},
         {"type", "SCALAR"},
         {"count", 3},
