@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <assimp/Importer.hpp>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <map>
@@ -62,6 +63,7 @@ class AssimpScene {
       scene_.materials.push_back(material(*ai_.mMaterials[i]));
     VT_RETURN_IF_ERROR(add_node(*ai_.mRootNode, -1));
     scene_.roots.push_back(0);
+    fit_uv_sets();
     if (skipped_faces_ > 0)
       warn(std::to_string(skipped_faces_) + " point and line primitives skipped (no surface)");
     if (ai_.mNumAnimations > 0)
@@ -75,6 +77,28 @@ class AssimpScene {
 
  private:
   void warn(const std::string& what) { scene_.warnings.push_back(path_ + ": " + what); }
+
+  // assimp's UV source index (COLLADA's set numbers, for one) can name a set the meshes that
+  // use the material do not have: such a slot reads set 0, with a warning.
+  void fit_uv_sets() {
+    std::vector<size_t> fewest(scene_.materials.size(), SIZE_MAX);
+    for (const Mesh& m : scene_.meshes)
+      for (const Primitive& p : m.primitives)
+        if (p.material >= 0 && size_t(p.material) < fewest.size())
+          fewest[p.material] = std::min(fewest[p.material], p.uvs.size());
+    for (size_t i = 0; i < scene_.materials.size(); ++i) {
+      Material& mat = scene_.materials[i];
+      for (TextureRef* r : {&mat.base_color_texture, &mat.normal_texture, &mat.emissive_texture,
+                            &mat.occlusion_texture, &mat.metallic_roughness_texture}) {
+        if (!r->valid() || fewest[i] == SIZE_MAX || fewest[i] == 0 ||
+            size_t(r->texcoord) < fewest[i])
+          continue;
+        warn("material '" + mat.name + "': a texture names UV set " + std::to_string(r->texcoord) +
+             ", which its meshes lack; set 0 is used");
+        r->texcoord = 0;
+      }
+    }
+  }
 
   // The image for a texture path: an embedded texture ("*N" or a name assimp holds) or a file
   // beside the scene; one Scene::Image per distinct path.

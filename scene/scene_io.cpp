@@ -159,6 +159,8 @@ std::string resolve_written_path(const std::string& folder, const std::string& w
   for (char& ch : s)
     if (ch == '\\') ch = '/';
   while (s.rfind("./", 0) == 0) s.erase(0, 2);
+  // "\..\maps\x.jpg": exporters mean the scene's folder, not the root of a drive.
+  if (written.size() > 1 && written[0] == '\\' && written[1] != '\\') s.erase(0, 1);
   bool windows_absolute =
       (s.size() >= 2 && std::isalpha(static_cast<unsigned char>(s[0])) && s[1] == ':') ||
       s.rfind("//", 0) == 0;

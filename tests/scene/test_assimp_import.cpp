@@ -129,6 +129,10 @@ TEST(AssimpImport, TexturePathsFromOtherMachinesAreFoundWithAWarning) {
   EXPECT_NE(note.find("letter case"), std::string::npos) << note;
   // An absolute path from the author's machine: the file name beside the scene.
   EXPECT_EQ(resolve("D:\\art\\floor.jpg"), (d / "floor.jpg").string());
+  // A leading backslash means the scene's folder ("\\..\\maps\\x.jpg"), not a drive's root.
+  fs::create_directories(d / "sub");
+  EXPECT_EQ(scene::detail::resolve_written_path(folder + "sub/", "\\..\\floor.jpg", &note),
+            folder + "sub/../floor.jpg");
   // Nothing anywhere: the plain resolution, so the error names what the file asked for.
   EXPECT_EQ(resolve("gone/none.png"), folder + "gone/none.png");
 }
