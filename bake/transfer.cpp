@@ -5,6 +5,7 @@
 #include "bake/unwrap/atlas_raster.h"
 #include "common/parallel.h"
 #include "common/vec.h"
+#include "scene/tangent_frame.h"
 
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
@@ -184,57 +185,6 @@ struct Sample {
 
 Vec3d lerp3(const std::vector<Vec3>& a, const uint32_t v[3], const double l[3]) {
   return v3(a[v[0]]) * l[0] + v3(a[v[1]]) * l[1] + v3(a[v[2]]) * l[2];
-}
-
-// Tangents from the UV set `set` per vertex (MikkTSpace-like: area-weighted per-face tangents,
-// Gram-Schmidt against the normal, handedness from the bitangent sum; glTF: v points down,
-// the bitangent points up the image).
-std::vector<Vec4> compute_tangents(const scene::Primitive& p, const std::vector<Vec3>& normals,
-                                   int set) {
-  size_t n = p.positions.size();
-  std::vector<Vec3d> tsum(n), bsum(n);
-  const auto& uv = p.uvs[set];
-  for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
-    uint32_t i0 = p.indices[f], i1 = p.indices[f + 1], i2 = p.indices[f + 2];
-    Vec3d e1 = v3(p.positions[i1]) - v3(p.positions[i0]),
-          e2 = v3(p.positions[i2]) - v3(p.positions[i0]);
-    double du1 = uv[i1][0] - uv[i0][0], dv1 = uv[i1][1] - uv[i0][1];
-    double du2 = uv[i2][0] - uv[i0][0], dv2 = uv[i2][1] - uv[i0][1];
-    double det = du1 * dv2 - du2 * dv1;
-    if (!(std::abs(det) > 1e-20)) continue;
-    Vec3d dpdu = (e1 * dv2 - e2 * dv1) * (1.0 / det);
-    Vec3d dpdv = (e2 * du1 - e1 * du2) * (1.0 / det);
-    double area = std::sqrt(dot(cross(e1, e2), cross(e1, e2)));
-    Vec3d tu = normalized(dpdu, {}) * area, tv = normalized(dpdv, {}) * area;
-    for (uint32_t i : {i0, i1, i2}) tsum[i] = tsum[i] + tu, bsum[i] = bsum[i] - tv;
-  }
-  std::vector<Vec4> out(n);
-  for (size_t i = 0; i < n; ++i) {
-    Vec3d nn = normalized(v3(normals[i]), {0, 0, 1});
-    Vec3d t = normalized(tsum[i] - nn * dot(nn, tsum[i]), {});
-    if (dot(t, t) == 0) {  // no UV gradient: any tangent perpendicular to the normal
-      t = normalized(cross(std::abs(nn.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0}, nn), {1, 0, 0});
-    }
-    double w = dot(cross(nn, t), bsum[i]) < 0 ? -1.0 : 1.0;
-    out[i] = {float(t.x), float(t.y), float(t.z), float(w)};
-  }
-  return out;
-}
-
-std::vector<Vec3> compute_normals(const scene::Primitive& p) {
-  std::vector<Vec3d> sum(p.positions.size());
-  for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
-    uint32_t i0 = p.indices[f], i1 = p.indices[f + 1], i2 = p.indices[f + 2];
-    Vec3d n =
-        cross(v3(p.positions[i1]) - v3(p.positions[i0]), v3(p.positions[i2]) - v3(p.positions[i0]));
-    for (uint32_t i : {i0, i1, i2}) sum[i] = sum[i] + n;
-  }
-  std::vector<Vec3> out(sum.size());
-  for (size_t i = 0; i < sum.size(); ++i) {
-    Vec3d n = normalized(sum[i], {0, 0, 1});
-    out[i] = {float(n.x), float(n.y), float(n.z)};
-  }
-  return out;
 }
 
 bool material_has_orm(const scene::Material& m) {
@@ -517,11 +467,11 @@ Status Transfer::setup_prims() {
       any_normal |= mat.normal_texture.valid();
       any_orm |= material_has_orm(mat);
       any_emissive |= material_has_emissive(mat);
-      info.normals = p.normals.size() == p.positions.size() ? p.normals : compute_normals(p);
+      info.normals = p.normals.size() == p.positions.size() ? p.normals : scene::compute_normals(p);
       if (mat.normal_texture.valid()) {
         info.tangents = p.tangents.size() == p.positions.size()
                             ? p.tangents
-                            : compute_tangents(p, info.normals, mat.normal_texture.texcoord);
+                            : scene::compute_tangents(p, info.normals, mat.normal_texture.texcoord);
       }
       prims_.push_back(std::move(info));
     }

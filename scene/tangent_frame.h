@@ -1,0 +1,21 @@
+// Per-vertex shading frames for primitives that do not carry them: the baker's transfer, the
+// validator's lit reference and the glTF export all derive them here, so that a normal map is
+// decoded in one and the same frame everywhere.
+#pragma once
+
+#include <vector>
+
+#include "scene/scene.h"
+
+namespace vt::scene {
+
+// Area-weighted vertex normals (unit; +Z where a vertex touches only degenerate faces).
+std::vector<Vec3> compute_normals(const Primitive& p);
+
+// Tangents from UV set `uv_set` per vertex (MikkTSpace-like: area-weighted per-face tangents,
+// Gram-Schmidt against the normal, handedness from the bitangent sum; glTF: v points down, the
+// bitangent points up the image). `normals` has one entry per vertex.
+std::vector<Vec4> compute_tangents(const Primitive& p, const std::vector<Vec3>& normals,
+                                   int uv_set);
+
+}  // namespace vt::scene
