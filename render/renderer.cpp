@@ -246,14 +246,17 @@ Expected<VkPipeline> Renderer::Impl::make_pipeline(VkPipelineLayout layout,
   stages[1].pName = "main";
 
   VkVertexInputBindingDescription binding{0, sizeof(Vertex), VK_VERTEX_INPUT_RATE_VERTEX};
-  VkVertexInputAttributeDescription attrs[2] = {
+  VkVertexInputAttributeDescription attrs[5] = {
       {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, x)},
-      {1, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, u)}};
+      {1, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, u)},
+      {2, 0, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(Vertex, r)},
+      {3, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, nx)},
+      {4, 0, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(Vertex, tx)}};
   VkPipelineVertexInputStateCreateInfo vi{
       VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
   vi.vertexBindingDescriptionCount = 1;
   vi.pVertexBindingDescriptions = &binding;
-  vi.vertexAttributeDescriptionCount = 2;
+  vi.vertexAttributeDescriptionCount = 5;
   vi.pVertexAttributeDescriptions = attrs;
   VkPipelineInputAssemblyStateCreateInfo ia{
       VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};

@@ -19,9 +19,15 @@
 
 namespace vt::render {
 
+// One vertex as every pass reads it (shaders/mesh.vert locations 0-4). The virtual pass uses
+// position and UV only; colour (linear RGBA, vertex colours times nothing else), normal and
+// tangent (w = handedness) feed the reference and lit passes.
 struct Vertex {
   float x, y, z;
   float u, v;
+  float r = 1, g = 1, b = 1, a = 1;
+  float nx = 0, ny = 0, nz = 1;
+  float tx = 1, ty = 0, tz = 0, tw = 1;
 };
 
 struct MeshData {
