@@ -5,6 +5,7 @@
 #include "bake/unwrap/atlas_raster.h"
 #include "common/parallel.h"
 #include "common/vec.h"
+#include "scene/material_rules.h"
 #include "scene/tangent_frame.h"
 
 #include <OpenImageIO/imagebufalgo.h>
@@ -552,19 +553,10 @@ bool Transfer::sample_texture(OIIO::TextureSystem::Perthread* pt, const scene::T
   const ImageSlot& slot = images_[ref.image];
   if (!slot.handle) return false;  // a missing texture (MissingTextures::kWarn): factor alone
   const auto& uv = te.p->prim->uvs[ref.texcoord];
-  double s = uv[te.v[0]][0] * l[0] + uv[te.v[1]][0] * l[1] + uv[te.v[2]][0] * l[2];
-  double t = uv[te.v[0]][1] * l[0] + uv[te.v[1]][1] * l[1] + uv[te.v[2]][1] * l[2];
-  std::array<double, 4> d = te.duv[ref.texcoord];
-  if (!ref.transform.identity()) {
-    // Affine: the point takes the whole transform, the derivatives its linear part.
-    const auto m = ref.transform.matrix();
-    const double s0 = s;
-    s = m[0] * s0 + m[2] * t + m[4], t = m[1] * s0 + m[3] * t + m[5];
-    for (int k = 0; k < 4; k += 2) {
-      const double ds = d[k], dt = d[k + 1];
-      d[k] = m[0] * ds + m[2] * dt, d[k + 1] = m[1] * ds + m[3] * dt;
-    }
-  }
+  const auto [s, t] =
+      scene::texture_uv(ref, uv[te.v[0]][0] * l[0] + uv[te.v[1]][0] * l[1] + uv[te.v[2]][0] * l[2],
+                        uv[te.v[0]][1] * l[0] + uv[te.v[1]][1] * l[1] + uv[te.v[2]][1] * l[2]);
+  const std::array<double, 4> d = scene::texture_uv_derivatives(ref, te.duv[ref.texcoord]);
   auto wrap = [](scene::WrapMode m) {
     switch (m) {
       case scene::WrapMode::kClampToEdge:
@@ -619,16 +611,16 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
     return true;
   };
   // Albedo: factor x texture x vertex colour (glTF).
-  float a[4] = {1, 1, 1, 1};
-  colour(m.base_color_texture, a);
-  for (int c = 0; c < 4; ++c) s.albedo[c] = a[c] * m.base_color_factor[c];
+  Vec4 a = {1, 1, 1, 1}, vertex = {1, 1, 1, 1};
+  colour(m.base_color_texture, a.data());
   if (!p.colors.empty()) {
     for (int c = 0; c < 4; ++c) {
-      s.albedo[c] *= float(p.colors[te.v[0]][c] * l[0] + p.colors[te.v[1]][c] * l[1] +
-                           p.colors[te.v[2]][c] * l[2]);
+      vertex[c] = float(p.colors[te.v[0]][c] * l[0] + p.colors[te.v[1]][c] * l[1] +
+                        p.colors[te.v[2]][c] * l[2]);
     }
   }
-  if (m.alpha_mode == scene::AlphaMode::kOpaque) s.albedo[3] = 1;
+  const Vec4 albedo = scene::base_color(m, a, vertex);
+  for (int c = 0; c < 4; ++c) s.albedo[c] = albedo[c];
   if (want_[kEmissiveSlot]) {
     float e[4] = {1, 1, 1, 1};
     colour(m.emissive_texture, e);
@@ -843,9 +835,7 @@ Status check_texcoord_sets(const scene::Scene& scene) {
       const scene::Material& m = scene.materials[p.material];
       for (const TextureSlot& ts : kTextureSlots) {
         const scene::TextureRef& r = m.*ts.ref;
-        if (!r.valid() || (r.texcoord >= 0 && size_t(r.texcoord) < p.uvs.size() &&
-                           p.uvs[r.texcoord].size() == p.positions.size()))
-          continue;
+        if (!r.valid() || scene::texture_uv_set(p, r)) continue;
         return Error(ErrorCode::kInvalidArgument,
                      "mesh '" + mesh.name + "' primitive " + std::to_string(pi) + ": " +
                          material_label(scene, m) + " " + ts.name + " reads TEXCOORD_" +

@@ -132,8 +132,13 @@ struct Renderer::Impl {
     VkDescriptorSet set = VK_NULL_HANDLE;
     uint32_t width = 0, height = 0, max_level = 0;
     AddressMode mode = AddressMode::kClamp;
+    bool sampler_addressing = false;  // a material sampler addresses the taps
   };
   std::vector<GpuTexture> textures;
+  // Material samplers (trilinear, per-axis addressing, magFilter), made once per distinct kind.
+  std::vector<std::pair<uint32_t, VkSampler>> material_samplers;
+  Expected<VkSampler> material_sampler(const TextureSampler& sampler);
+  Expected<VkSampler> reference_sampler(const ReferenceTexture& tex);
 
   bool has_vt = false;
   VirtualTextureSetup vt;
@@ -193,6 +198,47 @@ Renderer::Impl::~Impl() {
   for (VkSampler s : {trilinear_clamp, trilinear_repeat, cache_sampler, table_sampler}) {
     if (s) vkDestroySampler(dev, s, nullptr);
   }
+  for (const auto& [kind, s] : material_samplers) vkDestroySampler(dev, s, nullptr);
+}
+
+namespace {
+
+VkSamplerAddressMode vk_address(scene::WrapMode m) {
+  switch (m) {
+    case scene::WrapMode::kClampToEdge:
+      return VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    case scene::WrapMode::kMirroredRepeat:
+      return VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT;
+    case scene::WrapMode::kRepeat:
+      break;
+  }
+  return VK_SAMPLER_ADDRESS_MODE_REPEAT;
+}
+
+}  // namespace
+
+Expected<VkSampler> Renderer::Impl::material_sampler(const TextureSampler& m) {
+  const uint32_t kind = uint32_t(m.wrap_s) | uint32_t(m.wrap_t) << 4 | uint32_t(m.mag_filter) << 8;
+  for (const auto& [k, s] : material_samplers) {
+    if (k == kind) return s;
+  }
+  VkSamplerCreateInfo ci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+  ci.magFilter = m.mag_filter == scene::FilterMode::kNearest ? VK_FILTER_NEAREST : VK_FILTER_LINEAR;
+  ci.minFilter = VK_FILTER_LINEAR;
+  ci.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;
+  ci.addressModeU = vk_address(m.wrap_s);
+  ci.addressModeV = vk_address(m.wrap_t);
+  ci.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+  ci.maxLod = VK_LOD_CLAMP_NONE;
+  VkSampler s;
+  VT_VK(vkCreateSampler(dev, &ci, nullptr, &s));
+  material_samplers.emplace_back(kind, s);
+  return s;
+}
+
+Expected<VkSampler> Renderer::Impl::reference_sampler(const ReferenceTexture& tex) {
+  if (tex.sampler) return material_sampler(*tex.sampler);
+  return tex.address_mode == AddressMode::kWrap ? trilinear_repeat : trilinear_clamp;
 }
 
 Expected<VkSampler> Renderer::Impl::make_sampler(VkFilter filter, VkSamplerMipmapMode mip,
@@ -564,6 +610,8 @@ Status Renderer::set_reference_textures(std::span<const ReferenceTexture> textur
     g.height = tex.height;
     g.max_level = std::min(levels - 1, tex.max_level);
     g.mode = tex.address_mode;
+    g.sampler_addressing = tex.sampler.has_value();
+    VT_ASSIGN_OR_RETURN(VkSampler sampler, s.reference_sampler(tex));
     ImageDesc d;
     d.width = tex.width;
     d.height = tex.height;
@@ -571,8 +619,7 @@ Status Renderer::set_reference_textures(std::span<const ReferenceTexture> textur
     VT_ASSIGN_OR_RETURN(g.image, s.ctx.create_image(d));
     VT_RETURN_IF_ERROR(s.upload_image(g.image, staging, copies, VK_IMAGE_LAYOUT_UNDEFINED));
     VT_ASSIGN_OR_RETURN(g.set, s.allocate_set(s.ref_pool, s.ref_set_layout));
-    VkDescriptorImageInfo ii{g.mode == AddressMode::kWrap ? s.trilinear_repeat : s.trilinear_clamp,
-                             g.image.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    VkDescriptorImageInfo ii{sampler, g.image.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
     w.dstSet = g.set;
     w.descriptorCount = 1;
@@ -791,7 +838,7 @@ Expected<ReferenceFrame> Renderer::render_reference(const Camera& camera) {
       p.tex[1] = float(t.height);
       p.tex[2] = 1.0f;
       p.tex[3] = m.alpha_cutoff;
-      p.misc[1] = t.mode == AddressMode::kWrap ? 1 : 0;
+      p.misc[1] = t.sampler_addressing ? 2 : t.mode == AddressMode::kWrap ? 1 : 0;
       p.misc[2] = int32_t(t.max_level);
       draw_mesh(cmd, s.ref_layout, p, m);
     }

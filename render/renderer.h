@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "format/page_geometry.h"
 #include "render/camera.h"
 #include "render/vulkan_context.h"
+#include "scene/scene.h"
 
 namespace vt::render {
 
@@ -37,13 +39,23 @@ struct MeshData {
   float alpha_cutoff = -1.0f;      // < 0: no alpha test
 };
 
+// A material texture's own sampler (glTF): addressing per axis and the magnification filter.
+struct TextureSampler {
+  scene::WrapMode wrap_s = scene::WrapMode::kRepeat;
+  scene::WrapMode wrap_t = scene::WrapMode::kRepeat;
+  scene::FilterMode mag_filter = scene::FilterMode::kLinear;
+};
+
 // An RGBA8 texture with its whole mip chain in Vulkan's sizes (level L is
 // max(1, width >> L) x max(1, height >> L)), row-major, tightly packed.
 struct ReferenceTexture {
   uint32_t width = 0;
   uint32_t height = 0;
   std::vector<std::vector<uint8_t>> levels;
+  // Without a sampler, `address_mode` wraps or clamps both axes in the shader's taps (as the
+  // virtual texture addresses its layer); with one, the sampler addresses each tap instead.
   AddressMode address_mode = AddressMode::kClamp;
+  std::optional<TextureSampler> sampler;
   uint32_t max_level = ~0u;  // LOD clamp (the virtual texture's last level, to compare alike)
 };
 

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "common/srgb.h"
+#include "scene/material_rules.h"
 
 namespace vt::render {
 namespace {
@@ -31,13 +32,20 @@ std::string where(const scene::Scene& s, int mesh, size_t prim) {
   return s.source_path + ": mesh '" + s.meshes[mesh].name + "' primitive " + std::to_string(prim);
 }
 
-float cutoff_of(const scene::Scene& s, const scene::Primitive& p) {
-  if (p.material < 0 || size_t(p.material) >= s.materials.size()) return -1.0f;
-  const scene::Material& m = s.materials[p.material];
-  return m.alpha_mode == scene::AlphaMode::kMask ? m.alpha_cutoff : -1.0f;
+const scene::Material* material_of(const scene::Scene& s, const scene::Primitive& p) {
+  return p.material >= 0 && size_t(p.material) < s.materials.size() ? &s.materials[p.material]
+                                                                    : nullptr;
 }
 
-// Flattens instances; `uv_of(prim)` gives the UV array to use (or an error).
+// Where a draw's UVs come from: a UV set, read through a texture slot's transform when `slot` is
+// set (the reference pass samples as the material does); no set gives UV (0, 0).
+struct UvSource {
+  const std::vector<scene::Vec2>* uvs = nullptr;
+  const scene::TextureRef* slot = nullptr;
+};
+
+// Flattens instances; `uv_of(prim)` gives the UV source to use (or an error). The reference
+// pass also takes the vertex colours (linear RGBA, alpha 1 for OPAQUE as scene::base_color).
 template <typename UvOf>
 Expected<SceneDraws> draws(const scene::Scene& s, UvOf uv_of, bool reference) {
   SceneDraws out;
@@ -48,7 +56,10 @@ Expected<SceneDraws> draws(const scene::Scene& s, UvOf uv_of, bool reference) {
     for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
       const scene::Primitive& p = mesh.primitives[pi];
       if (p.indices.empty()) continue;
-      VT_ASSIGN_OR_RETURN(const std::vector<scene::Vec2>* uvs, uv_of(inst.mesh, pi, p));
+      VT_ASSIGN_OR_RETURN(const UvSource src, uv_of(inst.mesh, pi, p));
+      const scene::Material* mat = material_of(s, p);
+      const bool colors = reference && p.colors.size() == p.positions.size();
+      const bool opaque = !mat || mat->alpha_mode == scene::AlphaMode::kOpaque;
       MeshData m;
       m.vertices.resize(p.positions.size());
       for (size_t v = 0; v < p.positions.size(); ++v) {
@@ -59,19 +70,28 @@ Expected<SceneDraws> draws(const scene::Scene& s, UvOf uv_of, bool reference) {
           return Error(ErrorCode::kCorrupt, where(s, inst.mesh, pi) + ": vertex " +
                                                 std::to_string(v) + " has a non-finite position");
         }
-        o.u = uvs ? (*uvs)[v][0] : 0.0f;
-        o.v = uvs ? (*uvs)[v][1] : 0.0f;
+        if (src.uvs) {
+          const scene::Vec2& uv = (*src.uvs)[v];
+          const auto t = src.slot ? scene::texture_uv(*src.slot, uv[0], uv[1])
+                                  : std::array<double, 2>{uv[0], uv[1]};
+          o.u = float(t[0]), o.v = float(t[1]);
+        } else {
+          o.u = o.v = 0.0f;
+        }
         if (!std::isfinite(o.u) || !std::isfinite(o.v)) {
           return Error(ErrorCode::kCorrupt, where(s, inst.mesh, pi) + ": vertex " +
                                                 std::to_string(v) + " has a non-finite UV");
         }
+        if (colors) {
+          const scene::Vec4& c = p.colors[v];
+          o.r = c[0], o.g = c[1], o.b = c[2], o.a = opaque ? 1.0f : c[3];
+        }
         b.add(o.x, o.y, o.z);
       }
       m.indices = p.indices;
-      m.alpha_cutoff = cutoff_of(s, p);
+      m.alpha_cutoff = mat ? scene::alpha_test_cutoff(*mat) : -1.0f;
       // Reference texture index = material index; the default material is the last texture.
-      m.reference_texture =
-          reference ? uint32_t(p.material >= 0 ? p.material : int(s.materials.size())) : 0;
+      m.reference_texture = reference ? uint32_t(mat ? p.material : int(s.materials.size())) : 0;
       out.meshes.push_back(std::move(m));
     }
   }
@@ -129,60 +149,65 @@ Expected<std::vector<uint8_t>> load_rgba8(const scene::Image& image, uint32_t* w
 Expected<SceneDraws> virtual_scene_draws(const scene::Scene& s, int uv_set) {
   return draws(
       s,
-      [&](int mesh, size_t pi,
-          const scene::Primitive& p) -> Expected<const std::vector<scene::Vec2>*> {
+      [&](int mesh, size_t pi, const scene::Primitive& p) -> Expected<UvSource> {
         int set = uv_set < 0 ? int(p.uvs.size()) - 1 : uv_set;
         if (set < 0 || size_t(set) >= p.uvs.size() || p.uvs[set].size() != p.positions.size()) {
           return Error(ErrorCode::kInvalidArgument, where(s, mesh, pi) + ": no atlas UV set " +
                                                         std::to_string(set) +
                                                         " (is this the unwrapped scene?)");
         }
-        return &p.uvs[set];
+        return UvSource{&p.uvs[set], nullptr};
       },
       false);
 }
+
+namespace {
+
+// The material's base colour texels through scene::base_color (factor; alpha 1 for OPAQUE), in
+// place: sRGB 8-bit in and out, the product taken in linear light.
+void apply_base_color(const scene::Material& m, std::vector<uint8_t>& texels) {
+  for (size_t i = 0; i + 3 < texels.size(); i += 4) {
+    scene::Vec4 t;
+    for (int c = 0; c < 3; ++c) t[c] = srgb_to_linear(texels[i + c] / 255.0f);
+    t[3] = texels[i + 3] / 255.0f;
+    const scene::Vec4 out = scene::base_color(m, t, {1, 1, 1, 1});
+    for (int c = 0; c < 3; ++c) texels[i + c] = linear_to_srgb8(out[c]);
+    texels[i + 3] = uint8_t(std::lround(std::clamp(out[3], 0.0f, 1.0f) * 255.0f));
+  }
+}
+
+}  // namespace
 
 Expected<SceneDraws> reference_scene_draws(const scene::Scene& s, uint32_t max_side) {
   VT_ASSIGN_OR_RETURN(
       SceneDraws out,
       draws(
           s,
-          [&](int mesh, size_t pi,
-              const scene::Primitive& p) -> Expected<const std::vector<scene::Vec2>*> {
-            if (p.material < 0 || size_t(p.material) >= s.materials.size()) return nullptr;
-            const scene::TextureRef& t = s.materials[p.material].base_color_texture;
-            if (!t.valid()) return nullptr;
-            if (size_t(t.texcoord) >= p.uvs.size() ||
-                p.uvs[t.texcoord].size() != p.positions.size()) {
+          [&](int mesh, size_t pi, const scene::Primitive& p) -> Expected<UvSource> {
+            const scene::Material* m = material_of(s, p);
+            if (!m || !m->base_color_texture.valid()) return UvSource{};
+            const scene::TextureRef& t = m->base_color_texture;
+            const std::vector<scene::Vec2>* uvs = scene::texture_uv_set(p, t);
+            if (!uvs) {
               return Error(ErrorCode::kCorrupt, where(s, mesh, pi) + ": base colour reads UV set " +
                                                     std::to_string(t.texcoord) +
                                                     " which it does not have");
             }
-            return &p.uvs[t.texcoord];
+            return UvSource{uvs, &t};
           },
           true));
   // One texture per material plus the default material's.
   for (size_t mi = 0; mi <= s.materials.size(); ++mi) {
     ReferenceTexture tex;
-    scene::Vec4 factor = {1, 1, 1, 1};
     std::vector<uint8_t> texels = {255, 255, 255, 255};
     tex.width = tex.height = 1;
-    if (mi < s.materials.size()) {
-      const scene::Material& m = s.materials[mi];
-      factor = m.base_color_factor;
-      const scene::TextureRef& t = m.base_color_texture;
-      if (t.valid() && size_t(t.image) < s.images.size()) {
-        VT_ASSIGN_OR_RETURN(texels, load_rgba8(s.images[t.image], &tex.width, &tex.height));
-        tex.address_mode =
-            t.wrap_s == scene::WrapMode::kClampToEdge ? AddressMode::kClamp : AddressMode::kWrap;
-      }
+    const scene::Material m = mi < s.materials.size() ? s.materials[mi] : scene::Material{};
+    const scene::TextureRef& t = m.base_color_texture;
+    if (t.valid() && size_t(t.image) < s.images.size()) {
+      VT_ASSIGN_OR_RETURN(texels, load_rgba8(s.images[t.image], &tex.width, &tex.height));
+      tex.sampler = TextureSampler{t.wrap_s, t.wrap_t, t.mag_filter};
     }
-    for (size_t i = 0; i + 3 < texels.size(); i += 4) {
-      for (int c = 0; c < 3; ++c) {
-        texels[i + c] = linear_to_srgb8(srgb_to_linear(texels[i + c] / 255.0f) * factor[c]);
-      }
-      texels[i + 3] = uint8_t(std::lround(std::clamp(texels[i + 3] * factor[3], 0.0f, 255.0f)));
-    }
+    apply_base_color(m, texels);
     tex.levels = box_mip_chain(texels.data(), tex.width, tex.height);
     // Too large for the device or memory: drop the finest levels.
     uint32_t drop = 0;

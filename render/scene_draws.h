@@ -24,11 +24,14 @@ struct SceneDraws {
 // cutoff. Errors name the mesh and primitive lacking the set.
 Expected<SceneDraws> virtual_scene_draws(const scene::Scene& scene, int uv_set = -1);
 
-// The original scene for the reference pass: one reference texture per material, its base
-// colour image (OpenImageIO; float images are taken as linear, others as sRGB) multiplied by
-// base_color_factor in linear light and stored as sRGB 8-bit, with a full mip chain; a material
-// without an image gets a 1 x 1 texture of its factor. Images larger than `max_texture_side`
-// are box-reduced to fit. Vertex colours are not applied.
+// The original scene for the reference pass, under the bake's material rules
+// (scene/material_rules.h): one reference texture per material, its base colour image
+// (OpenImageIO; float images are taken as linear, others as sRGB) multiplied by
+// base_color_factor in linear light and stored as sRGB 8-bit, with a full mip chain and the
+// texture's sampler (wrap per axis, magFilter); a material without an image gets a 1 x 1 texture
+// of its factor. Images larger than `max_texture_side` are box-reduced to fit. Each vertex's UV
+// is the slot's texCoord set through its KHR_texture_transform (exact: the transform is affine)
+// and its colour the primitive's COLOR_0 (alpha 1 for OPAQUE materials); MASK keeps its cutoff.
 Expected<SceneDraws> reference_scene_draws(const scene::Scene& scene,
                                            uint32_t max_texture_side = 4096);
 

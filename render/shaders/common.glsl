@@ -10,7 +10,8 @@ layout(push_constant) uniform Push {
   vec4 tex;
   // x: level count, y: page payload, z: page border, w: page size (payload + 2 * border).
   ivec4 vt;
-  // x: frame index (feedback tap rotation), y: address mode (0 clamp, 1 wrap), z: max LOD.
+  // x: frame index (feedback tap rotation), y: address mode (0 clamp, 1 wrap, 2 the sampler's:
+  // taps are left as they are, for material samplers with per-axis modes), z: max LOD.
   ivec4 misc;
 }
 pc;
@@ -42,6 +43,7 @@ Footprint footprint(vec2 uv, float deriv_scale) {
 
 vec2 tap_uv(vec2 uv, Footprint f, int i) {
   vec2 u = uv + f.step * (float(i) - 0.5 * float(kTaps - 1));
+  if (pc.misc.y == 2) return u;
   return pc.misc.y == 1 ? fract(u) : clamp(u, 0.0, 1.0);
 }
 #endif  // VT_VERTEX_STAGE

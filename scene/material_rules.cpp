@@ -1,0 +1,52 @@
+#include "scene/material_rules.h"
+
+#include <cmath>
+
+namespace vt::scene {
+
+const std::vector<Vec2>* texture_uv_set(const Primitive& p, const TextureRef& ref) {
+  if (ref.texcoord < 0 || size_t(ref.texcoord) >= p.uvs.size()) return nullptr;
+  const std::vector<Vec2>& set = p.uvs[ref.texcoord];
+  return set.size() == p.positions.size() ? &set : nullptr;
+}
+
+std::array<double, 2> texture_uv(const TextureRef& ref, double u, double v) {
+  return ref.transform.apply(u, v);
+}
+
+std::array<double, 4> texture_uv_derivatives(const TextureRef& ref, std::array<double, 4> d) {
+  if (ref.transform.identity()) return d;
+  const auto m = ref.transform.matrix();
+  for (int k = 0; k < 4; k += 2) {
+    const double du = d[k], dv = d[k + 1];
+    d[k] = m[0] * du + m[2] * dv, d[k + 1] = m[1] * du + m[3] * dv;
+  }
+  return d;
+}
+
+double wrap_coordinate(WrapMode mode, double x) {
+  switch (mode) {
+    case WrapMode::kClampToEdge:
+      return std::fmin(std::fmax(x, 0.0), 1.0);
+    case WrapMode::kMirroredRepeat: {
+      const double period = x - 2.0 * std::floor(x * 0.5);  // [0, 2)
+      return period <= 1.0 ? period : 2.0 - period;
+    }
+    case WrapMode::kRepeat:
+      break;
+  }
+  return x - std::floor(x);
+}
+
+Vec4 base_color(const Material& m, const Vec4& texture, const Vec4& vertex_color) {
+  Vec4 c;
+  for (int i = 0; i < 4; ++i) c[i] = texture[i] * m.base_color_factor[i] * vertex_color[i];
+  if (m.alpha_mode == AlphaMode::kOpaque) c[3] = 1;
+  return c;
+}
+
+float alpha_test_cutoff(const Material& m) {
+  return m.alpha_mode == AlphaMode::kMask ? m.alpha_cutoff : -1.0f;
+}
+
+}  // namespace vt::scene
