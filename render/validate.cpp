@@ -8,6 +8,7 @@
 #include "codec/metrics.h"
 #include "format/page_file.h"
 #include "format/runtime_format.h"
+#include "render/coverage_tolerance.h"
 #include "render/report.h"
 #include "render/scene_draws.h"
 #include "runtime/page_source.h"
@@ -111,8 +112,8 @@ Expected<ConvergeResult> converge_view(Renderer& renderer, Streamer& streamer, c
   return result;
 }
 
-Expected<ViewMetrics> compare_view(const ReferenceFrame& reference_frame,
-                                   const VirtualFrame& frame) {
+Expected<ViewMetrics> compare_view(const ReferenceFrame& reference_frame, const VirtualFrame& frame,
+                                   std::span<const float> cutoffs) {
   const Rgba8Image& reference = reference_frame.color;
   const Rgba8Image& test = frame.color;
   const size_t n = size_t(test.width) * test.height;
@@ -126,7 +127,7 @@ Expected<ViewMetrics> compare_view(const ReferenceFrame& reference_frame,
   // (alpha-test decisions that flip on a rounding difference, or a broken alpha channel) are
   // counted apart, so a background colour never enters the PSNR.
   std::vector<uint8_t> ref_px, test_px;
-  uint64_t covered = 0, coarser = 0, either = 0, mismatch = 0;
+  uint64_t covered = 0, coarser = 0;
   constexpr uint32_t kTile = 16;
   const uint32_t tiles_x = (test.width + kTile - 1) / kTile;
   const uint32_t tiles_y = (test.height + kTile - 1) / kTile;
@@ -144,8 +145,6 @@ Expected<ViewMetrics> compare_view(const ReferenceFrame& reference_frame,
         if (sampled == 31) ++m.unresident_pixels;
         if (sampled > wanted) ++coarser;
       }
-      if (vcov || rcov) ++either;
-      if (vcov != rcov) ++mismatch;
       if (!(vcov && rcov)) continue;
       const uint8_t* r = &reference.texels[i * 4];
       const uint8_t* t = &test.texels[i * 4];
@@ -157,7 +156,9 @@ Expected<ViewMetrics> compare_view(const ReferenceFrame& reference_frame,
     }
   }
   m.pixels = ref_px.size() / 4;
-  m.coverage_mismatch_share = either ? double(mismatch) / double(either) : 0.0;
+  const CoverageMismatch cm = classify_coverage(reference_frame, frame, cutoffs);
+  m.coverage_mismatch_share = cm.either ? double(cm.unexplained) / double(cm.either) : 0.0;
+  m.alpha_edge_pixels = cm.explained;
   m.worst_tile_psnr = kPsnrIdentical;
   for (size_t k = 0; k < sse.size(); ++k) {
     if (count[k] < 32) continue;
@@ -263,7 +264,7 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
     t0 = std::chrono::steady_clock::now();
     VT_ASSIGN_OR_RETURN(ReferenceFrame reference, renderer.render_reference(cameras[v]));
     view.reference_ms = ms_since(t0);
-    VT_ASSIGN_OR_RETURN(view.metrics, compare_view(reference, frame));
+    VT_ASSIGN_OR_RETURN(view.metrics, compare_view(reference, frame, options.alpha_cutoffs));
     view.failures = check_view(view.metrics, report.thresholds);
     if (!view.converge.converged) {
       view.failures.push_back("did not converge in " + std::to_string(converge.max_frames) +
@@ -388,6 +389,12 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
   vopt.converge.max_frames = o.max_frames;
   vopt.thresholds = o.thresholds;
   vopt.out_dir = out_dir;
+  for (const MeshData& m : in.reference.meshes) {
+    if (m.alpha_cutoff >= 0) vopt.alpha_cutoffs.push_back(m.alpha_cutoff);
+  }
+  std::sort(vopt.alpha_cutoffs.begin(), vopt.alpha_cutoffs.end());
+  vopt.alpha_cutoffs.erase(std::unique(vopt.alpha_cutoffs.begin(), vopt.alpha_cutoffs.end()),
+                           vopt.alpha_cutoffs.end());
 
   VT_ASSIGN_OR_RETURN(
       ValidationReport report,

@@ -61,11 +61,15 @@ struct ViewMetrics {
   double ssim = 0;           // whole image, channels 0-2
   double coarser_share = 0;  // share of covered pixels whose fine taps read a coarser level
   uint64_t unresident_pixels = 0;
-  // Share of the pixels either render drew that only one of them drew (alpha-test decisions).
-  double coverage_mismatch_share = 0;  // pixels that found no valid page-table entry at all
+  // Share of the pixels either render drew that only one of them drew and no alpha cutoff
+  // explains (render/coverage_tolerance.h).
+  double coverage_mismatch_share = 0;
+  uint64_t alpha_edge_pixels = 0;  // drawn by one render only, explained by an alpha cutoff
 };
 
-Expected<ViewMetrics> compare_view(const ReferenceFrame& reference, const VirtualFrame& frame);
+// `alpha_cutoffs`: the scene's MASK cutoffs, which explain pixels drawn by one render only.
+Expected<ViewMetrics> compare_view(const ReferenceFrame& reference, const VirtualFrame& frame,
+                                   std::span<const float> alpha_cutoffs = {});
 
 // Pass/fail bounds of one view. Measured on the synthetic bake (docs/BENCHMARKS.md): correct
 // bakes score >= 55 dB whole view and per tile with an uncompressed cache, >= 35.6 / 34.1 dB
@@ -124,6 +128,7 @@ struct ValidateOptions {
   std::optional<Thresholds> thresholds;  // default_thresholds(cache format) when unset
   std::string
       out_dir;  // where PNGs go (view_<i>_{reference,virtual,diff,residency}.png); "" = none
+  std::vector<float> alpha_cutoffs;  // the scene's MASK cutoffs (compare_view)
 };
 
 // Validates one layer over `cameras`: per view a cold streamer over `source`, the loop to
