@@ -63,6 +63,9 @@ Status write_png(const std::string& path, const Rgba8Image& image) {
   auto out = OIIO::ImageOutput::create(path);
   if (!out) return Error(ErrorCode::kIo, path + ": cannot create image: " + OIIO::geterror());
   OIIO::ImageSpec spec(int(image.width), int(image.height), 3, OIIO::TypeDesc::UINT8);
+  // zlib level 1: a third of the default's encode time for ~10% more bytes; validate writes
+  // four 1280x720 images per view (docs/BENCHMARKS.md).
+  spec.attribute("png:compressionLevel", 1);
   if (!out->open(path, spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) ||
       !out->close()) {
     return Error(ErrorCode::kIo, path + ": " + out->geterror());
