@@ -55,7 +55,16 @@ void print_text(const vt::render::ValidationReport& r) {
   }
   std::printf("  bounds: PSNR >= %.1f dB, worst tile >= %.1f dB; images and report in %s\n",
               r.thresholds.min_psnr, r.thresholds.min_tile_psnr, r.out_dir.c_str());
+  std::printf("  contact sheet: %s\n", r.contact_sheet.c_str());
   std::printf("%s\n", r.passed() ? "PASS" : "FAIL");
+}
+
+// On stderr whatever --json and --quiet say: what a build log must show.
+void print_warnings_and_failures(const vt::render::ValidationReport& r) {
+  for (const std::string& w : r.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  for (const std::string& f : vt::render::failure_lines(r)) {
+    std::fprintf(stderr, "vtbake validate: %s\n", f.c_str());
+  }
 }
 
 int run(ValidateArgs& a, const vt::cli::GlobalOptions& global) {
@@ -72,6 +81,7 @@ int run(ValidateArgs& a, const vt::cli::GlobalOptions& global) {
   } else if (!global.quiet) {
     print_text(*report);
   }
+  print_warnings_and_failures(*report);
   return report->passed() ? vt::cli::kExitOk : vt::cli::kExitFailure;
 }
 
@@ -126,9 +136,12 @@ vt::cli::CommandRunner make_validate(CLI::App& app) {
       "eye and target are required; up defaults to [0, 1, 0], fov_y_deg (vertical, in (0, 180))\n"
       "to 50, near and far to 1/100 and 100 times the eye-target distance. 1-256 cameras;\n"
       "unknown keys, non-finite numbers, eye == target and up parallel to the view are errors.\n"
+      "Writes per view its images, the atlas heat maps, contact_sheet.png (every image on one\n"
+      "sheet, failures outlined in red) and report.json into --out; --json prints the report.\n"
       "Exit status: 0 every view and every page passes, 1 a view or a page (atlas check: each\n"
-      "page of each layer against the original materials) fails its bounds or a write fails,\n"
-      "2 bad input or no Vulkan device.");
+      "page of each layer against the original materials) fails its bounds or a write fails\n"
+      "(stderr names the failing views with their reasons, and the layers with their worst\n"
+      "pages as (level, x, y)), 2 bad input or no Vulkan device.");
   return [args](const vt::cli::GlobalOptions& global) { return run(*args, global); };
 }
 

@@ -63,11 +63,40 @@ Status write_png(const std::string& path, const Rgba8Image& image) {
   auto out = OIIO::ImageOutput::create(path);
   if (!out) return Error(ErrorCode::kIo, path + ": cannot create image: " + OIIO::geterror());
   OIIO::ImageSpec spec(int(image.width), int(image.height), 3, OIIO::TypeDesc::UINT8);
+  // zlib level 1: a third of the default's encode time for ~10% more bytes; validate writes
+  // four 1280x720 images per view (docs/BENCHMARKS.md).
+  spec.attribute("png:compressionLevel", 1);
   if (!out->open(path, spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) ||
       !out->close()) {
     return Error(ErrorCode::kIo, path + ": " + out->geterror());
   }
   return Status::Ok();
+}
+
+Expected<Rgba8Image> read_png(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) return Error(ErrorCode::kIo, path + ": cannot read image: " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  const int channels = spec.nchannels;
+  if (spec.width <= 0 || spec.height <= 0 || channels <= 0 || spec.width > 65536 ||
+      spec.height > 65536) {
+    return Error(ErrorCode::kCorrupt, path + ": unusable image size");
+  }
+  std::vector<uint8_t> pixels(size_t(spec.width) * spec.height * channels);
+  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, pixels.data())) {
+    return Error(ErrorCode::kIo, path + ": " + in->geterror());
+  }
+  Rgba8Image image;
+  image.width = uint32_t(spec.width);
+  image.height = uint32_t(spec.height);
+  image.texels.resize(size_t(image.width) * image.height * 4);
+  for (size_t i = 0, n = size_t(image.width) * image.height; i < n; ++i) {
+    const uint8_t* s = &pixels[i * channels];
+    uint8_t* d = &image.texels[i * 4];
+    for (int c = 0; c < 3; ++c) d[c] = s[channels >= 3 ? c : 0];
+    d[3] = channels == 2 ? s[1] : channels >= 4 ? s[3] : 255;
+  }
+  return image;
 }
 
 bool ValidationReport::passed() const {
@@ -79,12 +108,46 @@ bool ValidationReport::passed() const {
   return true;
 }
 
+std::vector<std::string> failure_lines(const ValidationReport& r) {
+  std::vector<std::string> lines;
+  if (r.passed()) return lines;
+  std::string views, layers;
+  for (const ViewReport& v : r.views) {
+    if (v.failures.empty()) continue;
+    views += (views.empty() ? "" : ", ") + std::to_string(v.view);
+    std::string line = "view " + std::to_string(v.view) + ": ";
+    for (size_t i = 0; i < v.failures.size(); ++i) line += (i ? "; " : "") + v.failures[i];
+    lines.push_back(line);
+  }
+  for (const AtlasLayerReport& l : r.atlas.layers) {
+    if (l.pages_failed > 0) layers += (layers.empty() ? "" : ", ") + l.name;
+  }
+  // The atlas check's own lines name each failing layer's worst pages.
+  for (const std::string& f : r.atlas.failures) lines.push_back("layer " + f);
+  std::string summary = "FAIL:";
+  if (!views.empty()) summary += " views " + views;
+  if (!layers.empty()) {
+    summary +=
+        (views.empty() ? "" : ";") + std::string(" layers ") + layers + " (pages as (level, x, y))";
+  }
+  if (views.empty() && layers.empty())
+    summary += " the atlas check did not run and no view was rendered";
+  lines.insert(lines.begin(), summary);
+  return lines;
+}
+
 namespace {
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
+}
+
+double sum(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return s;
 }
 
 }  // namespace
@@ -114,6 +177,7 @@ std::string report_json(const ValidationReport& r) {
                      {"thrashing", v.converge.thrashing},
                      {"feedback_ms_median", median(v.converge.feedback_ms)},
                      {"stream_ms_median", median(v.converge.stream_ms)},
+                     {"converge_ms", sum(v.converge.feedback_ms) + sum(v.converge.stream_ms)},
                      {"virtual_ms", v.virtual_ms},
                      {"reference_ms", v.reference_ms},
                      {"images", v.images}});
@@ -131,7 +195,16 @@ std::string report_json(const ValidationReport& r) {
                 {"max_coverage_mismatch", r.thresholds.max_coverage_mismatch}}},
               {"passed", r.passed()},
               {"views", views},
-              {"atlas", to_json(r.atlas)}};
+              {"atlas", to_json(r.atlas)},
+              {"warnings", r.warnings},
+              {"contact_sheet", r.contact_sheet},
+              {"seconds",
+               {{"load", r.seconds.load},
+                {"atlas_check", r.seconds.atlas_check},
+                {"setup", r.seconds.setup},
+                {"views", r.seconds.views},
+                {"contact_sheet", r.seconds.contact_sheet},
+                {"total", r.seconds.total}}}};
   return doc.dump(2);
 }
 

@@ -20,6 +20,15 @@ Rgba8Image residency_heat_map(const VirtualFrame& frame);
 // Writes RGB (alpha dropped: renders clear to transparent black) PNG. Errors name the file.
 Status write_png(const std::string& path, const Rgba8Image& image);
 
+// Reads an image file (PNG or any format OpenImageIO reads) as RGBA8: grey is spread over RGB,
+// a missing alpha is opaque. Errors name the file.
+Expected<Rgba8Image> read_png(const std::string& path);
+
+// Why a report has not passed, one line each: a summary naming the failing views and layers,
+// then per failing view its reasons, then per failing atlas layer its worst pages as
+// (level, x, y). Empty when it passed.
+std::vector<std::string> failure_lines(const ValidationReport& report);
+
 // The report as JSON (docs/REPORTS.md): what report.json holds and `vtbake validate --json` prints.
 std::string report_json(const ValidationReport& report);
 Status write_report_json(const std::string& path, const ValidationReport& report);

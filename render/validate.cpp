@@ -8,6 +8,7 @@
 #include "codec/metrics.h"
 #include "format/page_file.h"
 #include "format/runtime_format.h"
+#include "render/contact_sheet.h"
 #include "render/coverage_tolerance.h"
 #include "render/report.h"
 #include "render/scene_draws.h"
@@ -297,6 +298,7 @@ struct BakeInputs {
   std::vector<Camera> cameras;  // from the camera file; empty = automatic views
   std::shared_ptr<const PageFileReader> reader;
   scene::Scene original, baked;  // for the atlas check
+  std::string unwrapped;         // the baked scene's path
   SceneDraws reference, virt;
   uint32_t layer = 0;
 };
@@ -324,12 +326,12 @@ Expected<BakeInputs> read_bake_inputs(const BakeValidationOptions& o) {
     VT_ASSIGN_OR_RETURN(in.cameras,
                         load_cameras_json(o.cameras_file, float(o.width) / float(o.height)));
   }
-  const std::string unwrapped =
-      o.unwrapped.empty() ? std::filesystem::path(o.page_file).replace_extension(".glb").string()
-                          : o.unwrapped;
+  in.unwrapped = o.unwrapped.empty()
+                     ? std::filesystem::path(o.page_file).replace_extension(".glb").string()
+                     : o.unwrapped;
   VT_ASSIGN_OR_RETURN(in.reader, PageFileReader::open(o.page_file));
   VT_ASSIGN_OR_RETURN(in.original, scene::load_scene(o.scene));
-  VT_ASSIGN_OR_RETURN(in.baked, scene::load_scene(unwrapped));
+  VT_ASSIGN_OR_RETURN(in.baked, scene::load_scene(in.unwrapped));
   VT_ASSIGN_OR_RETURN(in.reference, reference_scene_draws(in.original));
   VT_ASSIGN_OR_RETURN(in.virt, virtual_scene_draws(in.baked));
   if (in.reference.meshes.empty() || in.virt.meshes.empty()) {
@@ -339,10 +341,46 @@ Expected<BakeInputs> read_bake_inputs(const BakeValidationOptions& o) {
   return in;
 }
 
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return ms_since(t0) / 1000.0;
+}
+
+// The importers' warnings of a scene, each naming the file.
+void add_scene_warnings(const scene::Scene& scene, const std::string& path,
+                        std::vector<std::string>& out) {
+  for (const std::string& w : scene.warnings)
+    out.push_back(w.rfind(path, 0) == 0 ? w : path + ": " + w);
+}
+
+// Fills the warnings and the stage times, writes the contact sheet and report.json.
+Status finish_report(const BakeInputs& in, const BakeValidationOptions& o, double load_seconds,
+                     std::chrono::steady_clock::time_point start, ValidationReport& report) {
+  add_scene_warnings(in.original, o.scene, report.warnings);
+  add_scene_warnings(in.baked, in.unwrapped, report.warnings);
+  for (const AtlasLayerReport& l : report.atlas.layers) {
+    if (!l.note.empty()) report.warnings.push_back("atlas check: layer " + l.name + ": " + l.note);
+  }
+  if (!report.atlas.ran && report.atlas.note != "disabled") {
+    report.warnings.push_back("atlas check " + report.atlas.note);
+  }
+  report.seconds.load = load_seconds;
+  report.seconds.atlas_check = report.atlas.seconds;
+  const auto t0 = std::chrono::steady_clock::now();
+  ContactSheetOptions cs;
+  cs.geometry = in.reader->geometry();
+  report.contact_sheet = report.out_dir + "/contact_sheet.png";
+  VT_RETURN_IF_ERROR(write_contact_sheet(report.contact_sheet, report, cs));
+  report.seconds.contact_sheet = seconds_since(t0);
+  report.seconds.total = seconds_since(start);
+  return write_report_json(report.out_dir + "/report.json", report);
+}
+
 }  // namespace
 
 Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
   VT_ASSIGN_OR_RETURN(BakeInputs in, read_bake_inputs(o));
+  const double load_seconds = seconds_since(start);
   const std::string out_dir =
       o.out_dir.empty() ? std::filesystem::path(o.page_file).replace_extension(".validate").string()
                         : o.out_dir;
@@ -359,9 +397,10 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
     report.layer = in.layer;
     report.out_dir = out_dir;
     report.atlas = std::move(atlas);
-    VT_RETURN_IF_ERROR(write_report_json(out_dir + "/report.json", report));
+    VT_RETURN_IF_ERROR(finish_report(in, o, load_seconds, start, report));
     return report;
   }
+  const auto setup_start = std::chrono::steady_clock::now();
   VulkanOptions vo;
   vo.prefer_hardware = o.prefer_hardware;
   VT_ASSIGN_OR_RETURN(std::unique_ptr<VulkanContext> ctx, VulkanContext::create(vo));
@@ -396,6 +435,8 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
   vopt.alpha_cutoffs.erase(std::unique(vopt.alpha_cutoffs.begin(), vopt.alpha_cutoffs.end()),
                            vopt.alpha_cutoffs.end());
 
+  const double setup_seconds = seconds_since(setup_start);
+  const auto views_start = std::chrono::steady_clock::now();
   VT_ASSIGN_OR_RETURN(
       ValidationReport report,
       validate_views(*renderer, std::shared_ptr<const PageSource>(std::move(source)), cameras,
@@ -403,7 +444,9 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
   report.page_file = o.page_file;
   report.device = ctx->device_name();
   report.atlas = std::move(atlas);
-  VT_RETURN_IF_ERROR(write_report_json(vopt.out_dir + "/report.json", report));
+  report.seconds.setup = setup_seconds;
+  report.seconds.views = seconds_since(views_start);
+  VT_RETURN_IF_ERROR(finish_report(in, o, load_seconds, start, report));
   return report;
 }
 

@@ -115,6 +115,15 @@ struct ValidationReport {
   std::vector<ViewReport> views;
   std::string out_dir;     // where the PNGs (and, from validate_bake, report.json) went; "" = none
   AtlasCheckReport atlas;  // validate_bake's atlas-space page check (atlas.ran: it ran)
+  // What the run could not take into account: the importers' warnings of both scenes (each
+  // naming its file), atlas layers left unchecked and why.
+  std::vector<std::string> warnings;
+  std::string contact_sheet;  // validate_bake's one-glance PNG (render/contact_sheet.h)
+  // validate_bake's wall clock per stage, seconds: reading the camera file, the page file and
+  // both scenes; the atlas check; Vulkan and renderer set-up; every view; the contact sheet.
+  struct Seconds {
+    double load = 0, atlas_check = 0, setup = 0, views = 0, contact_sheet = 0, total = 0;
+  } seconds;
   // Every view passes and the atlas check found no failing page; with no views, the atlas check
   // ran and passed.
   bool passed() const;

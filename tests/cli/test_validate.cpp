@@ -1,6 +1,8 @@
 // End-to-end: `vtbake sample-scene` -> `vtbake bake` -> `vtbake validate` through the binary.
 // A correct bake must pass from automatic views and from a camera file; the same bake with its
-// pages shuffled (a wrong page in the index, checksums valid) must fail. Skips without Vulkan.
+// pages shuffled (a wrong page in the index, checksums valid) must fail with exit status 1,
+// naming the failing view and layer and its pages on stderr. Every run leaves a contact sheet;
+// --json prints report.json. Skips without Vulkan.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -12,6 +14,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
+
+#include <OpenImageIO/imageio.h>
 
 #include "format/page_file.h"
 #include "tests/cli/cli_test_util.h"
@@ -35,6 +39,13 @@ nlohmann::json read_json(const std::string& path) {
 
 void write_text(const std::string& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
+}
+
+// Width and height of an image file; {0, 0} when it cannot be read.
+std::pair<int, int> image_size(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) return {0, 0};
+  return {in->spec().width, in->spec().height};
 }
 
 // Copies a page file, giving each stored page of `layer` the stored bytes of the next stored
@@ -131,10 +142,37 @@ TEST_F(ValidateCli, BakedSampleScenePassesFromAutomaticViews) {
     EXPECT_GT(v["pixels_compared"].get<uint64_t>(), 320u * 180u / 10) << v.dump();
     EXPECT_GE(v["psnr_rgb"].get<double>(), report["thresholds"]["min_psnr"].get<double>());
     EXPECT_GT(v["pages_uploaded"].get<uint64_t>(), 0u);
+    ASSERT_EQ(v["images"].size(), 4u);  // reference, virtual, difference, residency
     for (const auto& image : v["images"]) {
       EXPECT_TRUE(std::filesystem::exists(image.get<std::string>())) << image;
     }
   }
+  // One sheet: two view rows of four 320-wide thumbnails (no larger than the renders), and
+  // the heat maps.
+  EXPECT_EQ(report["contact_sheet"], out + "/contact_sheet.png");
+  const auto [w, h] = image_size(out + "/contact_sheet.png");
+  EXPECT_GE(w, 4 * 320);
+  EXPECT_GE(h, 2 * 180 + 64);
+  EXPECT_TRUE(report["warnings"].is_array());
+  for (const char* k : {"load", "atlas_check", "setup", "views", "contact_sheet", "total"}) {
+    EXPECT_GT(report["seconds"][k].get<double>(), 0.0) << k;
+  }
+  EXPECT_GE(report["seconds"]["total"].get<double>(),
+            report["seconds"]["views"].get<double>() + report["seconds"]["load"].get<double>());
+}
+
+TEST_F(ValidateCli, JsonPrintsTheReportOnStdout) {
+  const std::string out = dir_ + "/json";
+  RunResult r =
+      vt::testing::run_vtbake("validate " + dir_ + "/scene.gltf " + dir_ +
+                                  "/bake.vtpf --views 1 --size 160x90 --json --out " + out,
+                              /*merge_stderr=*/false);
+  if (r.exit_code == 2) GTEST_SKIP() << "no Vulkan device (or bad input): " << r.out;
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const nlohmann::json printed = nlohmann::json::parse(r.out, nullptr, false);
+  ASSERT_TRUE(printed.is_object()) << r.out;
+  EXPECT_EQ(printed, read_json(out + "/report.json"));
+  EXPECT_EQ(printed["views"].size(), 1u);
 }
 
 TEST_F(ValidateCli, CameraFileViewPassesAndAShuffledBakeFails) {
@@ -175,6 +213,13 @@ TEST_F(ValidateCli, CameraFileViewPassesAndAShuffledBakeFails) {
       run("validate " + scene + " " + shuffled + args + " --out " + dir_ + "/cam_shuffled");
   EXPECT_EQ(bad.exit_code, 1) << bad.out;
   EXPECT_TRUE(contains(bad.out, "FAIL")) << bad.out;
+  // stderr names the view with its reason, the layer and its pages.
+  EXPECT_TRUE(contains(bad.out, "vtbake validate: FAIL: views 0; layers albedo")) << bad.out;
+  EXPECT_TRUE(contains(bad.out, "vtbake validate: view 0: ")) << bad.out;
+  EXPECT_TRUE(contains(bad.out, "worst tile PSNR")) << bad.out;
+  EXPECT_TRUE(contains(bad.out, "vtbake validate: layer albedo: ")) << bad.out;
+  EXPECT_TRUE(contains(bad.out, " pages fail (")) << bad.out;
+  EXPECT_TRUE(std::filesystem::exists(dir_ + "/cam_shuffled/contact_sheet.png"));
   report = read_json(dir_ + "/cam_shuffled/report.json");
   ASSERT_EQ(report["views"].size(), 1u);
   EXPECT_EQ(report["passed"], false);
@@ -191,6 +236,48 @@ TEST_F(ValidateCli, CameraLookingAwayFromTheSceneFails) {
   if (no_vulkan(r)) GTEST_SKIP() << "no Vulkan device: " << r.out;
   EXPECT_EQ(r.exit_code, 1) << r.out;
   EXPECT_TRUE(contains(r.out, "no pixel drawn by both renders")) << r.out;
+}
+
+// The atlas check alone needs no Vulkan: a shuffled bake fails it (exit 1, the layer and its pages
+// on stderr), the contact sheet holds the heat maps, and the importer's warnings of the original
+// scene are printed and in the report.
+TEST_F(ValidateCli, AtlasOnlyFailsNamingPagesAndReportsSceneWarnings) {
+  auto reader = PageFileReader::open(dir_ + "/bake.vtpf");
+  ASSERT_TRUE(reader.ok()) << reader.status().message();
+  uint32_t albedo = 0;
+  while ((*reader)->layers()[albedo].semantic != LayerSemantic::kAlbedo) ++albedo;
+  const std::string shuffled = dir_ + "/atlas_shuffled.vtpf";
+  Status s = rewrite_page_file(dir_ + "/bake.vtpf", shuffled, albedo, /*rotate=*/true);
+  ASSERT_TRUE(s.ok()) << s.message();
+  std::filesystem::copy_file(dir_ + "/bake.glb", dir_ + "/atlas_shuffled.glb",
+                             std::filesystem::copy_options::overwrite_existing);
+  // The same scene with no asset.version: the glTF importer warns and reads it as 2.0.
+  nlohmann::json gltf = read_json(dir_ + "/scene.gltf");
+  ASSERT_TRUE(gltf.is_object());
+  gltf["asset"].erase("version");
+  const std::string scene = dir_ + "/scene_noversion.gltf";
+  write_text(scene, gltf.dump());
+
+  const std::string out = dir_ + "/atlas_only";
+  RunResult r = run("validate " + scene + " " + shuffled + " --atlas-only --out " + out);
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_TRUE(contains(r.out, "vtbake validate: FAIL: layers albedo (pages as (level, x, y))"))
+      << r.out;
+  EXPECT_TRUE(contains(r.out, "vtbake validate: layer albedo: ")) << r.out;
+  EXPECT_TRUE(contains(r.out, "warning: " + scene + ": asset.version is missing")) << r.out;
+  nlohmann::json report = read_json(out + "/report.json");
+  ASSERT_TRUE(report.is_object());
+  EXPECT_EQ(report["passed"], false);
+  ASSERT_EQ(report["warnings"].size(), 1u) << report["warnings"].dump();
+  EXPECT_TRUE(contains(report["warnings"][0].get<std::string>(), "asset.version is missing"));
+  const auto [w, h] = image_size(out + "/contact_sheet.png");
+  EXPECT_GT(w, 0);
+  EXPECT_GT(h, 0);
+
+  // The bake itself passes the atlas check: exit 0, nothing on stderr but the warning.
+  r = run("validate " + scene + " " + dir_ + "/bake.vtpf --atlas-only --quiet --out " + out);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_FALSE(contains(r.out, "FAIL")) << r.out;
 }
 
 // These fail before any scene, page file or Vulkan work, so they run everywhere.
@@ -219,6 +306,11 @@ TEST(ValidateCliArgs, BadCameraFilesAreBadInputNamingTheFile) {
   r = run("validate none.gltf none.vtpf --views 2 --cameras " + cams);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(contains(r.out, "excludes")) << r.out;
+
+  // A scene that does not exist is bad input too, named.
+  r = run("validate " + dir + "/none.gltf " + dir + "/none.vtpf");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(contains(r.out, dir + "/none.vtpf")) << r.out;
 
   r = run("validate --help");
   EXPECT_EQ(r.exit_code, 0);
