@@ -131,7 +131,8 @@ std::string report_json(const ValidationReport& r) {
                 {"max_coverage_mismatch", r.thresholds.max_coverage_mismatch}}},
               {"passed", r.passed()},
               {"views", views},
-              {"atlas", to_json(r.atlas)}};
+              {"atlas", to_json(r.atlas)},
+              {"exact", to_json(r.exact)}};
   return doc.dump(2);
 }
 
