@@ -184,7 +184,8 @@ class StreamingCheck : public ::testing::Test {
   // validate_bake's setup around validate_views, with `edit` applied to what the cache (and
   // the level texture: both read the same source) receives.
   Expected<ValidationReport> validate(const std::string& codec, const EditedSource::Edit& edit) {
-    VT_ASSIGN_OR_RETURN(auto reader, PageFileReader::open(dir_ + "/" + codec + ".vtpf"));
+    VT_ASSIGN_OR_RETURN(std::shared_ptr<const PageFileReader> reader,
+                        PageFileReader::open(dir_ + "/" + codec + ".vtpf"));
     VT_ASSIGN_OR_RETURN(scene::Scene original, scene::load_scene(dir_ + "/scene/scene.gltf"));
     VT_ASSIGN_OR_RETURN(scene::Scene baked, scene::load_scene(dir_ + "/" + codec + ".glb"));
     VT_ASSIGN_OR_RETURN(SceneDraws ref, reference_scene_draws(original));
@@ -267,11 +268,12 @@ TEST_F(StreamingCheck, CorrectBakesAgreeWithTheirLevelsToRounding) {
 TEST_F(StreamingCheck, ZeroedBordersInTheCacheFail) {
   // Every page of levels 0 and 1 reaches the cache with its border zeroed (RGBA8 texels or, for
   // BC, the border's blocks: the 4-texel border is exactly one block row or column).
-  auto reader = PageFileReader::open(dir_ + "/raw.vtpf");
-  ASSERT_TRUE(reader.ok());
-  auto plain = make_page_file_source(*reader, {});
+  auto opened = PageFileReader::open(dir_ + "/raw.vtpf");
+  ASSERT_TRUE(opened.ok());
+  std::shared_ptr<const PageFileReader> reader = std::move(*opened);
+  auto plain = make_page_file_source(reader, {});
   ASSERT_TRUE(plain.ok());
-  const uint32_t layer = albedo(**reader);
+  const uint32_t layer = albedo(*reader);
   const RuntimeFormat format = (*plain)->upload_format(layer);
   const bool as_rgba8 = ctx_->is_lavapipe() && format == RuntimeFormat::kBc7;
   auto r = validate("raw", [&](const PageId& id, uint32_t l, std::span<uint8_t> bytes) {
@@ -289,19 +291,21 @@ TEST_F(StreamingCheck, ZeroedBordersInTheCacheFail) {
 TEST_F(StreamingCheck, APageReplacedByItsNeighbourFails) {
   // The cache receives page (x + 1, y) for every level-0 page (x, y) with x even: payload and
   // borders from the neighbour, so every seam between the two reads the wrong texels.
-  auto reader = PageFileReader::open(dir_ + "/raw.vtpf");
-  ASSERT_TRUE(reader.ok());
+  auto opened = PageFileReader::open(dir_ + "/raw.vtpf");
+  ASSERT_TRUE(opened.ok());
+  std::shared_ptr<const PageFileReader> reader = std::move(*opened);
   PageFileSourceOptions so;
   so.bc7_as_rgba8 = ctx_->is_lavapipe();
-  auto plain = make_page_file_source(*reader, so);
+  auto plain = make_page_file_source(reader, so);
   ASSERT_TRUE(plain.ok());
   const PageSource& truth = **plain;
-  const uint32_t layer = albedo(**reader);
+  const uint32_t layer = albedo(*reader);
   auto r = validate("raw", [&](const PageId& id, uint32_t l, std::span<uint8_t> bytes) {
     const PageId next{0, id.x + 1, id.y};
     if (id.level != 0 || id.x % 2 != 0 || l != layer) return;
-    if (truth.geometry().contains(next) && truth.present(next))
+    if (truth.geometry().contains(next) && truth.present(next)) {
       EXPECT_TRUE(truth.load(next, l, bytes).ok());
+    }
   });
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_TRUE(exact_failed(*r)) << failures(*r);
