@@ -195,13 +195,13 @@ class StreamingCheck : public ::testing::Test {
     VT_ASSIGN_OR_RETURN(std::unique_ptr<PageSource> inner, make_page_file_source(reader, so));
     auto source = std::make_shared<EditedSource>(std::move(inner), edit);
     RenderOptions ro;
-    ro.width = 640;
-    ro.height = 360;
+    ro.width = 1280;
+    ro.height = 720;
     VT_ASSIGN_OR_RETURN(std::unique_ptr<Renderer> renderer, Renderer::create(*ctx_, ro));
     VT_RETURN_IF_ERROR(renderer->set_meshes(virt.meshes));
     VT_RETURN_IF_ERROR(renderer->set_reference_meshes(ref.meshes));
     VT_RETURN_IF_ERROR(renderer->set_reference_textures(ref.textures));
-    const auto cameras = orbit_views(ref.bounds_min, ref.bounds_max, 3, 640.0f / 360.0f);
+    const auto cameras = orbit_views(ref.bounds_min, ref.bounds_max, 3, 1280.0f / 720.0f);
     ValidateOptions vo;
     vo.layer = albedo(*reader);
     vo.address_mode = reader->layers()[vo.layer].address_mode;
@@ -251,7 +251,7 @@ TEST_F(StreamingCheck, CorrectBakesAgreeWithTheirLevelsToRounding) {
     EXPECT_EQ(r->exact.first_level, 0u);
     ASSERT_EQ(r->exact.views.size(), 3u);
     for (const StreamingViewResult& v : r->exact.views) {
-      EXPECT_GT(v.metrics.pixels, 10000u) << codec;
+      EXPECT_GT(v.metrics.pixels, 5000u) << codec;
       EXPECT_LE(v.metrics.max_abs, r->exact.bounds.max_abs) << codec;
       std::printf("%s: %s %llu px, max %d, %.2f dB, beyond %.4f%%, tile %.2f dB, %.1f ms\n", codec,
                   r->cache_format.c_str(), (unsigned long long)v.metrics.pixels, v.metrics.max_abs,
@@ -289,8 +289,8 @@ TEST_F(StreamingCheck, ZeroedBordersInTheCacheFail) {
 }
 
 TEST_F(StreamingCheck, APageReplacedByItsNeighbourFails) {
-  // The cache receives page (x + 1, y) for every level-0 page (x, y) with x even: payload and
-  // borders from the neighbour, so every seam between the two reads the wrong texels.
+  // The cache receives level-0 page (2, 1) in place of (1, 1): payload and borders from the
+  // neighbour, so every seam around the page reads the wrong texels.
   auto opened = PageFileReader::open(dir_ + "/raw.vtpf");
   ASSERT_TRUE(opened.ok());
   std::shared_ptr<const PageFileReader> reader = std::move(*opened);
@@ -302,7 +302,7 @@ TEST_F(StreamingCheck, APageReplacedByItsNeighbourFails) {
   const uint32_t layer = albedo(*reader);
   auto r = validate("raw", [&](const PageId& id, uint32_t l, std::span<uint8_t> bytes) {
     const PageId next{0, id.x + 1, id.y};
-    if (id.level != 0 || id.x % 2 != 0 || l != layer) return;
+    if (!(id == PageId{0, 1, 1}) || l != layer) return;
     if (truth.geometry().contains(next) && truth.present(next)) {
       EXPECT_TRUE(truth.load(next, l, bytes).ok());
     }
@@ -310,7 +310,7 @@ TEST_F(StreamingCheck, APageReplacedByItsNeighbourFails) {
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_TRUE(exact_failed(*r)) << failures(*r);
   for (const ViewReport& v : r->views)
-    std::printf("neighbour pages, view %u: loose %.2f dB / tile %.2f dB, exact max %d, %.2f dB\n",
+    std::printf("neighbour page, view %u: loose %.2f dB / tile %.2f dB, exact max %d, %.2f dB\n",
                 v.view, v.metrics.psnr_rgb, v.metrics.worst_tile_psnr,
                 r->exact.views[v.view].metrics.max_abs, r->exact.views[v.view].metrics.psnr);
 }
