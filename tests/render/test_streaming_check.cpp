@@ -242,6 +242,16 @@ bool exact_failed(const ValidationReport& r) {
   return false;
 }
 
+// Both checks per view, for docs/BENCHMARKS.md.
+void print_views(const char* what, const ValidationReport& r) {
+  for (const ViewReport& v : r.views) {
+    const StreamingViewMetrics& e = r.exact.views[v.view].metrics;
+    std::printf("%s, view %u: loose %.2f dB / tile %.2f dB, exact max %d, %.2f dB, beyond %.4f%%\n",
+                what, v.view, v.metrics.psnr_rgb, v.metrics.worst_tile_psnr, e.max_abs, e.psnr,
+                100 * e.share_beyond);
+  }
+}
+
 TEST_F(StreamingCheck, CorrectBakesAgreeWithTheirLevelsToRounding) {
   for (const char* codec : {"dct", "bc", "raw"}) {
     auto r = validate(codec, kNoEdit);
@@ -283,13 +293,7 @@ TEST_F(StreamingCheck, ZeroedBordersInTheCacheFail) {
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_FALSE(r->passed());
   EXPECT_TRUE(exact_failed(*r)) << failures(*r);
-  for (const ViewReport& v : r->views)
-    std::printf(
-        "zeroed borders, view %u: loose %.2f dB / tile %.2f dB, exact max %d, %.2f dB, beyond "
-        "%.4f%%\n",
-        v.view, v.metrics.psnr_rgb, v.metrics.worst_tile_psnr,
-        r->exact.views[v.view].metrics.max_abs, r->exact.views[v.view].metrics.psnr,
-        100 * r->exact.views[v.view].metrics.share_beyond);
+  print_views("zeroed borders", *r);
 }
 
 TEST_F(StreamingCheck, APageReplacedByItsNeighbourFails) {
@@ -313,13 +317,7 @@ TEST_F(StreamingCheck, APageReplacedByItsNeighbourFails) {
   });
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_TRUE(exact_failed(*r)) << failures(*r);
-  for (const ViewReport& v : r->views)
-    std::printf(
-        "neighbour page, view %u: loose %.2f dB / tile %.2f dB, exact max %d, %.2f dB, beyond "
-        "%.4f%%\n",
-        v.view, v.metrics.psnr_rgb, v.metrics.worst_tile_psnr,
-        r->exact.views[v.view].metrics.max_abs, r->exact.views[v.view].metrics.psnr,
-        100 * r->exact.views[v.view].metrics.share_beyond);
+  print_views("neighbour page", *r);
 }
 
 }  // namespace
