@@ -127,6 +127,10 @@ vt::cli::CommandRunner make_validate(CLI::App& app) {
          "--no-atlas-check", [&f](int64_t) { f.atlas.enabled = false; },
          "Skip the atlas-space page check")
       ->excludes(atlas_only);
+  app.add_flag(
+         "--no-exact-check", [&f](int64_t) { f.exact.enabled = false; },
+         "Skip the exact streaming check (virtual render against the baked levels as a texture)")
+      ->excludes(atlas_only);
   app.add_option("--out", f.out_dir,
                  "Folder for the PNGs and report.json (default PAGE_FILE.validate)");
   app.footer(

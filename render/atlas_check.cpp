@@ -142,26 +142,6 @@ void store_reference(const ReferenceLayer& r, float* t, size_t n, uint8_t* out) 
   for (size_t i = 0; i < n * wc; ++i) out[i] = q(t[i]);
 }
 
-// What the runtime uploads for a page, as stored texels: BC blocks decoded (channels as stored),
-// 8-bit uploads narrowed to the stored channels, float uploads as they are.
-Status uploaded_texels(const PageSource& source, const LayerSpec& spec, const PageId& id,
-                       uint32_t layer, std::vector<uint8_t>& upload, uint8_t* out) {
-  upload.resize(source.upload_bytes(layer));
-  VT_RETURN_IF_ERROR(source.load(id, layer, upload));
-  const int ps = int(source.geometry().page_size());
-  const RuntimeFormatInfo& info = *runtime_format_info(source.upload_format(layer));
-  if (info.bc) return bc_decode_image(*info.bc, upload.data(), ps, ps, spec.channels, out);
-  if (info.is_float) {
-    std::memcpy(out, upload.data(), size_t(ps) * ps * spec.texel_bytes());
-    return Status::Ok();
-  }
-  const size_t n = size_t(ps) * ps;
-  for (size_t t = 0; t < n; ++t)
-    for (uint32_t c = 0; c < spec.channels; ++c)
-      out[t * spec.channels + c] = c < info.channels ? upload[t * info.channels + c] : 0;
-  return Status::Ok();
-}
-
 // PSNR of float pages with 1.0 as the peak (HDR values count as they are).
 double float_psnr(const float* a, const float* b, size_t n, int* max_abs) {
   double sse = 0, worst = 0;
@@ -390,6 +370,24 @@ void finish_layer(LayerRun& run, uint32_t keep, std::vector<std::string>& failur
 }
 
 }  // namespace
+
+Status uploaded_texels(const PageSource& source, const LayerSpec& spec, const PageId& id,
+                       uint32_t layer, std::vector<uint8_t>& upload, uint8_t* out) {
+  upload.resize(source.upload_bytes(layer));
+  VT_RETURN_IF_ERROR(source.load(id, layer, upload));
+  const int ps = int(source.geometry().page_size());
+  const RuntimeFormatInfo& info = *runtime_format_info(source.upload_format(layer));
+  if (info.bc) return bc_decode_image(*info.bc, upload.data(), ps, ps, spec.channels, out);
+  if (info.is_float) {
+    std::memcpy(out, upload.data(), size_t(ps) * ps * spec.texel_bytes());
+    return Status::Ok();
+  }
+  const size_t n = size_t(ps) * ps;
+  for (size_t t = 0; t < n; ++t)
+    for (uint32_t c = 0; c < spec.channels; ++c)
+      out[t * spec.channels + c] = c < info.channels ? upload[t * info.channels + c] : 0;
+  return Status::Ok();
+}
 
 AtlasLayerBounds default_atlas_bounds(const LayerSpec& layer) {
   // Worst page on the sample scene (vtbake sample-scene; bake --codec dct | bc | raw), dB:

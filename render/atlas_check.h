@@ -17,6 +17,10 @@
 #include "format/page_file.h"
 #include "scene/scene.h"
 
+namespace vt {
+class PageSource;
+}
+
 namespace vt::render {
 
 // What a page of one layer must meet. Colour, ORM and custom layers: PSNR over every channel
@@ -95,6 +99,12 @@ Expected<AtlasCheckReport> check_atlas_pages(std::shared_ptr<const PageFileReade
                                              const scene::Scene& original,
                                              const scene::Scene& unwrapped,
                                              const AtlasCheckOptions& options);
+
+// What the runtime uploads for page `id` of `layer`, as the layer's stored channels: BC blocks
+// decoded as the GPU decodes them, 8-bit uploads narrowed to spec.channels, float uploads as they
+// are. `upload` is scratch; `out` takes page_size^2 texels of spec.texel_bytes().
+Status uploaded_texels(const PageSource& source, const LayerSpec& spec, const PageId& id,
+                       uint32_t layer, std::vector<uint8_t>& upload, uint8_t* out);
 
 // The report as report.json's "atlas" object (docs/REPORTS.md).
 nlohmann::json to_json(const AtlasCheckReport& report);

@@ -204,7 +204,8 @@ std::string report_json(const ValidationReport& r) {
                 {"setup", r.seconds.setup},
                 {"views", r.seconds.views},
                 {"contact_sheet", r.seconds.contact_sheet},
-                {"total", r.seconds.total}}}};
+                {"total", r.seconds.total}}},
+              {"exact", to_json(r.exact)}};
   return doc.dump(2);
 }
 

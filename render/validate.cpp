@@ -245,6 +245,8 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
   report.out_dir = options.out_dir;
   ConvergeOptions converge = options.converge;
   converge.layer = options.layer;
+  const bool exact = options.exact.enabled && !options.exact_meshes.empty();
+  std::vector<VirtualFrame> frames;  // kept for the exact check
   for (uint32_t v = 0; v < cameras.size(); ++v) {
     // A cold cache per view: frames-to-converge then measures the view alone.
     VT_ASSIGN_OR_RETURN(std::unique_ptr<Streamer> streamer,
@@ -287,6 +289,16 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
       }
     }
     report.views.push_back(std::move(view));
+    if (exact) frames.push_back(std::move(frame));
+  }
+  if (exact) {
+    VT_ASSIGN_OR_RETURN(report.exact,
+                        run_streaming_check(renderer, *source, options.layer, options.address_mode,
+                                            options.exact_meshes, cameras, frames, options.exact));
+    for (size_t v = 0; v < report.exact.views.size(); ++v) {
+      const auto& why = report.exact.views[v].failures;
+      report.views[v].failures.insert(report.views[v].failures.end(), why.begin(), why.end());
+    }
   }
   return report;
 }
@@ -434,6 +446,8 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
   std::sort(vopt.alpha_cutoffs.begin(), vopt.alpha_cutoffs.end());
   vopt.alpha_cutoffs.erase(std::unique(vopt.alpha_cutoffs.begin(), vopt.alpha_cutoffs.end()),
                            vopt.alpha_cutoffs.end());
+  vopt.exact = o.exact;
+  vopt.exact_meshes = in.virt.meshes;
 
   const double setup_seconds = seconds_since(setup_start);
   const auto views_start = std::chrono::steady_clock::now();

@@ -15,6 +15,7 @@
 #include "render/atlas_check.h"
 #include "render/camera.h"
 #include "render/renderer.h"
+#include "render/streaming_check.h"
 #include "runtime/streamer.h"
 
 namespace vt::render {
@@ -124,6 +125,7 @@ struct ValidationReport {
   struct Seconds {
     double load = 0, atlas_check = 0, setup = 0, views = 0, contact_sheet = 0, total = 0;
   } seconds;
+  StreamingCheckReport exact;  // the exact streaming check (exact.ran: it ran)
   // Every view passes and the atlas check found no failing page; with no views, the atlas check
   // ran and passed.
   bool passed() const;
@@ -138,6 +140,10 @@ struct ValidateOptions {
   std::string
       out_dir;  // where PNGs go (view_<i>_{reference,virtual,diff,residency}.png); "" = none
   std::vector<float> alpha_cutoffs;  // the scene's MASK cutoffs (compare_view)
+  // The exact streaming check runs after the views when `exact_meshes` (the meshes set_meshes
+  // was given) is not empty; it leaves the renderer's reference set to the baked levels.
+  StreamingCheckOptions exact;
+  std::span<const MeshData> exact_meshes;
 };
 
 // Validates one layer over `cameras`: per view a cold streamer over `source`, the loop to
@@ -163,6 +169,7 @@ struct BakeValidationOptions {
   uint32_t max_frames = 48;      // per view, before giving up converging
   bool prefer_hardware = false;  // a hardware Vulkan device rather than lavapipe
   AtlasCheckOptions atlas;       // out_dir is set to out_dir
+  StreamingCheckOptions exact;   // the virtual render against the baked levels
   bool render_views = true;      // false: the atlas check alone (no Vulkan needed)
 };
 

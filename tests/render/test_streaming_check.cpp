@@ -1,0 +1,324 @@
+// The exact streaming check: the level texture assembly on a hand-made page source (payloads
+// tiled, borders ignored, absent pages from their ancestor, fine levels dropped over the side
+// limit), then on bakes of the procedural sample scene: a correct bake agrees with its baked
+// levels to rounding, and a cache fed wrong borders or a wrong page fails.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+
+#include "bake/scene_bake.h"
+#include "format/runtime_format.h"
+#include "render/scene_draws.h"
+#include "render/streaming_check.h"
+#include "render/validate.h"
+#include "render/vulkan_context.h"
+#include "samples/sample_scene.h"
+
+namespace vt::render {
+namespace {
+
+// RGBA8 or RG8 pages whose payload texel (x, y) of page (px, py) at level L reads
+// (16 L + 4 py + px, x * 16 + y, 7, 9) and whose border reads 0xEE; page (1, 0) of level 0 is
+// absent.
+class HandMadeSource : public PageSource {
+ public:
+  // Width 6: level 0 is 6 x 8 (two pages across, the second cut), level 1 3 x 4.
+  explicit HandMadeSource(RuntimeFormat format, uint32_t width = 6) : format_(format) {
+    g_.width = width;
+    g_.height = 8;
+    g_.payload = 4;
+    g_.border = 2;
+  }
+  const PageGeometry& geometry() const override { return g_; }
+  uint32_t layer_count() const override { return 1; }
+  RuntimeFormat upload_format(uint32_t) const override { return format_; }
+  size_t upload_bytes(uint32_t) const override {
+    return runtime_format_page_bytes(format_, g_.page_size());
+  }
+  bool present(const PageId& id) const override {
+    return !(id.level == 0 && id.x == 1 && id.y == 0);
+  }
+  Status load(const PageId& id, uint32_t, std::span<uint8_t> out) const override {
+    const uint32_t S = g_.page_size(), B = g_.border, ch = channels();
+    for (uint32_t y = 0; y < S; ++y)
+      for (uint32_t x = 0; x < S; ++x) {
+        uint8_t* p = &out[(size_t(y) * S + x) * ch];
+        const bool payload = x >= B && y >= B && x < B + g_.payload && y < B + g_.payload;
+        const uint8_t v[4] = {uint8_t(16 * id.level + 4 * id.y + id.x),
+                              uint8_t((x - B) * 16 + (y - B)), 7, 9};
+        for (uint32_t c = 0; c < ch; ++c) p[c] = payload ? v[c] : 0xEE;
+      }
+    return Status::Ok();
+  }
+  uint32_t channels() const { return format_ == RuntimeFormat::kRg8 ? 2 : 4; }
+
+ private:
+  PageGeometry g_;
+  RuntimeFormat format_;
+};
+
+TEST(LevelTexture, TilesPayloadsIgnoringBordersAndFillsAbsentPagesFromTheirAncestor) {
+  HandMadeSource source(RuntimeFormat::kRgba8);
+  ASSERT_TRUE(source.geometry().validate().ok());
+  auto t = assemble_level_texture(source, 0, AddressMode::kWrap);
+  ASSERT_TRUE(t.ok()) << t.status().message();
+  EXPECT_EQ(t->first_level, 0u);
+  EXPECT_EQ(t->level_count, 2u);
+  EXPECT_EQ(t->absent_pages, 1u);
+  ASSERT_EQ(t->texture.levels.size(), 2u);
+  EXPECT_EQ(t->texture.width, 6u);
+  EXPECT_EQ(t->texture.height, 8u);
+  EXPECT_EQ(t->texture.max_level, 1u);
+  EXPECT_EQ(t->texture.address_mode, AddressMode::kWrap);
+  const auto& l0 = t->texture.levels[0];
+  const auto& l1 = t->texture.levels[1];
+  ASSERT_EQ(l0.size(), 6u * 8 * 4);
+  ASSERT_EQ(l1.size(), 3u * 4 * 4);
+  auto at = [](const std::vector<uint8_t>& l, uint32_t w, uint32_t x, uint32_t y) {
+    const uint8_t* p = &l[(size_t(y) * w + x) * 4];
+    return std::array<int, 4>{p[0], p[1], p[2], p[3]};
+  };
+  // Page (0, 1) of level 0, texel (3, 2) of its payload at level texel (3, 6).
+  EXPECT_EQ(at(l0, 6, 3, 6), (std::array<int, 4>{4, 3 * 16 + 2, 7, 9}));
+  EXPECT_EQ(at(l0, 6, 0, 0), (std::array<int, 4>{0, 0, 7, 9}));
+  EXPECT_EQ(at(l0, 6, 5, 7), (std::array<int, 4>{5, 1 * 16 + 3, 7, 9}));  // the cut page (1, 1)
+  // Level 0's absent page (1, 0) covers texels x 4-5, y 0-3: level 1 texel (x / 2, y / 2).
+  EXPECT_EQ(at(l0, 6, 5, 3), at(l1, 3, 2, 1));
+  EXPECT_EQ(at(l1, 3, 2, 1), (std::array<int, 4>{16, 2 * 16 + 1, 7, 9}));
+  for (size_t i = 0; i < l0.size(); ++i) ASSERT_NE(l0[i], 0xEE) << "border texel at byte " << i;
+}
+
+TEST(LevelTexture, MissingChannelsReadAsTheGpuReadsThemAndFineLevelsDropOverTheLimit) {
+  HandMadeSource source(RuntimeFormat::kRg8);
+  auto t = assemble_level_texture(source, 0, AddressMode::kClamp, /*max_side=*/4);
+  ASSERT_TRUE(t.ok()) << t.status().message();
+  EXPECT_EQ(t->first_level, 1u);  // level 0 is 6 x 8
+  ASSERT_EQ(t->texture.levels.size(), 1u);
+  EXPECT_EQ(t->texture.width, 3u);
+  const uint8_t* p = &t->texture.levels[0][(1 * 3 + 2) * 4];
+  EXPECT_EQ(int(p[0]), 16);
+  EXPECT_EQ(int(p[1]), 2 * 16 + 1);
+  EXPECT_EQ(int(p[2]), 0);
+  EXPECT_EQ(int(p[3]), 255);
+}
+
+TEST(LevelTexture, CoarseLevelsThatDoNotHalveAsVulkanMipsAreDropped) {
+  // 7 wide: level 1 is ceil(7 / 2) = 4 texels, a Vulkan mip of 7 is 3.
+  HandMadeSource source(RuntimeFormat::kRgba8, 7);
+  auto t = assemble_level_texture(source, 0, AddressMode::kClamp);
+  ASSERT_TRUE(t.ok());
+  EXPECT_EQ(t->first_level, 0u);
+  EXPECT_EQ(t->level_count, 2u);
+  EXPECT_EQ(t->texture.levels.size(), 1u);
+  EXPECT_EQ(t->texture.max_level, 0u);
+}
+
+// A page source that passes another one through, except for what `edit` changes in an upload.
+class EditedSource : public PageSource {
+ public:
+  using Edit = std::function<void(const PageId&, uint32_t layer, std::span<uint8_t>)>;
+  EditedSource(std::shared_ptr<const PageSource> inner, Edit edit)
+      : inner_(std::move(inner)), edit_(std::move(edit)) {}
+  const PageGeometry& geometry() const override { return inner_->geometry(); }
+  uint32_t layer_count() const override { return inner_->layer_count(); }
+  RuntimeFormat upload_format(uint32_t l) const override { return inner_->upload_format(l); }
+  size_t upload_bytes(uint32_t l) const override { return inner_->upload_bytes(l); }
+  bool present(const PageId& id) const override { return inner_->present(id); }
+  Status load(const PageId& id, uint32_t layer, std::span<uint8_t> out) const override {
+    VT_RETURN_IF_ERROR(inner_->load(id, layer, out));
+    edit_(id, layer, out);
+    return Status::Ok();
+  }
+  const PageSource& inner() const { return *inner_; }
+
+ private:
+  std::shared_ptr<const PageSource> inner_;
+  Edit edit_;
+};
+
+class StreamingCheck : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = (std::filesystem::temp_directory_path() /
+            ("vt_streaming_check_" + std::to_string(::getpid())))
+               .string();
+    std::filesystem::remove_all(dir_);
+    SampleSceneOptions so;
+    so.ground_cells = 4;
+    so.sphere_segments = 12;
+    so.texture_size = 128;
+    Status s = write_sample_scene(dir_ + "/scene", so);
+    for (const char* codec : {"dct", "bc", "raw"}) {
+      if (!s.ok()) break;
+      SceneBakeOptions o;
+      o.build.output = dir_ + "/" + codec + ".vtpf";
+      const std::string c = codec;
+      o.build.codec.codec = c == "raw"  ? CodecKind::kRaw
+                            : c == "bc" ? CodecKind::kBc
+                                        : CodecKind::kDct;
+      o.unwrap.size_pages = 4;
+      auto baked = bake_scene(dir_ + "/scene/scene.gltf", o);
+      if (!baked.ok()) s = baked.status();
+    }
+    if (!s.ok()) setup_error_ = s.message();
+  }
+  static void TearDownTestSuite() { std::filesystem::remove_all(dir_); }
+  void SetUp() override {
+    ASSERT_TRUE(setup_error_.empty()) << setup_error_;
+    auto ctx = VulkanContext::create();
+    if (!ctx.ok()) GTEST_SKIP() << "no Vulkan device: " << ctx.status().message();
+    ctx_ = std::move(*ctx);
+  }
+
+  static uint32_t albedo(const PageFileReader& reader) {
+    for (uint32_t l = 0; l < reader.layers().size(); ++l)
+      if (reader.layers()[l].semantic == LayerSemantic::kAlbedo) return l;
+    return 0;
+  }
+
+  // validate_bake's setup around validate_views, with `edit` applied to what the cache (and
+  // the level texture: both read the same source) receives.
+  Expected<ValidationReport> validate(const std::string& codec, const EditedSource::Edit& edit) {
+    VT_ASSIGN_OR_RETURN(std::shared_ptr<const PageFileReader> reader,
+                        PageFileReader::open(dir_ + "/" + codec + ".vtpf"));
+    VT_ASSIGN_OR_RETURN(scene::Scene original, scene::load_scene(dir_ + "/scene/scene.gltf"));
+    VT_ASSIGN_OR_RETURN(scene::Scene baked, scene::load_scene(dir_ + "/" + codec + ".glb"));
+    VT_ASSIGN_OR_RETURN(SceneDraws ref, reference_scene_draws(original));
+    VT_ASSIGN_OR_RETURN(SceneDraws virt, virtual_scene_draws(baked));
+    PageFileSourceOptions so;
+    so.bc7_as_rgba8 = ctx_->is_lavapipe();
+    VT_ASSIGN_OR_RETURN(std::unique_ptr<PageSource> inner, make_page_file_source(reader, so));
+    auto source = std::make_shared<EditedSource>(std::move(inner), edit);
+    RenderOptions ro;
+    ro.width = 1280;
+    ro.height = 720;
+    VT_ASSIGN_OR_RETURN(std::unique_ptr<Renderer> renderer, Renderer::create(*ctx_, ro));
+    VT_RETURN_IF_ERROR(renderer->set_meshes(virt.meshes));
+    VT_RETURN_IF_ERROR(renderer->set_reference_meshes(ref.meshes));
+    VT_RETURN_IF_ERROR(renderer->set_reference_textures(ref.textures));
+    const auto cameras = orbit_views(ref.bounds_min, ref.bounds_max, 3, 1280.0f / 720.0f);
+    ValidateOptions vo;
+    vo.layer = albedo(*reader);
+    vo.address_mode = reader->layers()[vo.layer].address_mode;
+    vo.thresholds = scene_thresholds();
+    vo.exact_meshes = virt.meshes;
+    return validate_views(*renderer, source, cameras, vo);
+  }
+
+  static std::string dir_, setup_error_;
+  std::unique_ptr<VulkanContext> ctx_;
+};
+std::string StreamingCheck::dir_, StreamingCheck::setup_error_;
+
+const EditedSource::Edit kNoEdit = [](const PageId&, uint32_t, std::span<uint8_t>) {};
+
+// Zeroes the 4-texel border of a 128 x 128 upload: texels, or for BC the outer ring of blocks.
+void zero_border(std::span<uint8_t> bytes, RuntimeFormat format) {
+  constexpr uint32_t S = 128, B = 4;
+  const RuntimeFormatInfo& info = *runtime_format_info(format);
+  const uint32_t unit = info.bc ? 4 : 1, n = S / unit, ring = B / unit;
+  const size_t bpu = bytes.size() / (size_t(n) * n);
+  for (uint32_t y = 0; y < n; ++y)
+    for (uint32_t x = 0; x < n; ++x)
+      if (x < ring || y < ring || x >= n - ring || y >= n - ring)
+        std::memset(&bytes[(size_t(y) * n + x) * bpu], 0, bpu);
+}
+
+std::string failures(const ValidationReport& r) {
+  std::string s;
+  for (const ViewReport& v : r.views)
+    for (const std::string& f : v.failures) s += "view " + std::to_string(v.view) + ": " + f + "\n";
+  return s;
+}
+
+bool exact_failed(const ValidationReport& r) {
+  for (const StreamingViewResult& v : r.exact.views)
+    if (!v.failures.empty()) return true;
+  return false;
+}
+
+// Both checks per view, for docs/BENCHMARKS.md.
+void print_views(const char* what, const ValidationReport& r) {
+  for (const ViewReport& v : r.views) {
+    const StreamingViewMetrics& e = r.exact.views[v.view].metrics;
+    std::printf("%s, view %u: loose %.2f dB / tile %.2f dB, exact max %d, %.2f dB, beyond %.4f%%\n",
+                what, v.view, v.metrics.psnr_rgb, v.metrics.worst_tile_psnr, e.max_abs, e.psnr,
+                100 * e.share_beyond);
+  }
+}
+
+TEST_F(StreamingCheck, CorrectBakesAgreeWithTheirLevelsToRounding) {
+  for (const char* codec : {"dct", "bc", "raw"}) {
+    auto r = validate(codec, kNoEdit);
+    ASSERT_TRUE(r.ok()) << codec << ": " << r.status().message();
+    EXPECT_TRUE(r->passed()) << codec << ":\n" << failures(*r);
+    ASSERT_TRUE(r->exact.ran) << r->exact.note;
+    EXPECT_EQ(r->exact.first_level, 0u);
+    ASSERT_EQ(r->exact.views.size(), 3u);
+    for (const StreamingViewResult& v : r->exact.views) {
+      EXPECT_GT(v.metrics.pixels, 5000u) << codec;
+      EXPECT_LE(v.metrics.share_beyond, r->exact.bounds.max_share_beyond) << codec;
+      EXPECT_GE(v.metrics.psnr, 55.0) << codec;
+      std::printf("%s: %s %llu px, max %d, %.2f dB, beyond %.4f%%, tile %.2f dB, %.1f ms\n", codec,
+                  r->cache_format.c_str(), (unsigned long long)v.metrics.pixels, v.metrics.max_abs,
+                  v.metrics.psnr, 100 * v.metrics.share_beyond, v.metrics.worst_tile_psnr,
+                  v.render_ms + v.compare_ms);
+    }
+    const nlohmann::json j = to_json(r->exact);
+    EXPECT_TRUE(j["ran"].get<bool>());
+    EXPECT_EQ(j["views"].size(), 3u);
+    EXPECT_TRUE(j["views"][0]["passed"].get<bool>());
+  }
+}
+
+TEST_F(StreamingCheck, ZeroedBordersInTheCacheFail) {
+  // Every page of levels 0 and 1 reaches the cache with its border zeroed (RGBA8 texels or, for
+  // BC, the border's blocks: the 4-texel border is exactly one block row or column).
+  auto opened = PageFileReader::open(dir_ + "/raw.vtpf");
+  ASSERT_TRUE(opened.ok());
+  std::shared_ptr<const PageFileReader> reader = std::move(*opened);
+  auto plain = make_page_file_source(reader, {});
+  ASSERT_TRUE(plain.ok());
+  const uint32_t layer = albedo(*reader);
+  const RuntimeFormat format = (*plain)->upload_format(layer);
+  const bool as_rgba8 = ctx_->is_lavapipe() && format == RuntimeFormat::kBc7;
+  auto r = validate("raw", [&](const PageId& id, uint32_t l, std::span<uint8_t> bytes) {
+    if (id.level <= 1 && l == layer) zero_border(bytes, as_rgba8 ? RuntimeFormat::kRgba8 : format);
+  });
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_FALSE(r->passed());
+  EXPECT_TRUE(exact_failed(*r)) << failures(*r);
+  print_views("zeroed borders", *r);
+}
+
+TEST_F(StreamingCheck, APageReplacedByItsNeighbourFails) {
+  // The cache receives level-0 page (2, 1) in place of (1, 1): payload and borders from the
+  // neighbour, so every seam around the page reads the wrong texels.
+  auto opened = PageFileReader::open(dir_ + "/raw.vtpf");
+  ASSERT_TRUE(opened.ok());
+  std::shared_ptr<const PageFileReader> reader = std::move(*opened);
+  PageFileSourceOptions so;
+  so.bc7_as_rgba8 = ctx_->is_lavapipe();
+  auto plain = make_page_file_source(reader, so);
+  ASSERT_TRUE(plain.ok());
+  const PageSource& truth = **plain;
+  const uint32_t layer = albedo(*reader);
+  auto r = validate("raw", [&](const PageId& id, uint32_t l, std::span<uint8_t> bytes) {
+    const PageId next{0, id.x + 1, id.y};
+    if (!(id == PageId{0, 1, 1}) || l != layer) return;
+    if (truth.geometry().contains(next) && truth.present(next)) {
+      EXPECT_TRUE(truth.load(next, l, bytes).ok());
+    }
+  });
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_TRUE(exact_failed(*r)) << failures(*r);
+  print_views("neighbour page", *r);
+}
+
+}  // namespace
+}  // namespace vt::render
