@@ -8,6 +8,7 @@
 
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/scene_load_flags.h"
 #include "render/report.h"
 #include "render/validate.h"
 
@@ -117,6 +118,7 @@ vt::cli::CommandRunner make_validate(CLI::App& app) {
          "--no-atlas-check", [&f](int64_t) { f.atlas.enabled = false; },
          "Skip the atlas-space page check")
       ->excludes(atlas_only);
+  vt::cli::add_scene_load_flags(app, f.load);
   app.add_option("--out", f.out_dir,
                  "Folder for the PNGs and report.json (default PAGE_FILE.validate)");
   app.footer(

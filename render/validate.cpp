@@ -327,7 +327,7 @@ Expected<BakeInputs> read_bake_inputs(const BakeValidationOptions& o) {
       o.unwrapped.empty() ? std::filesystem::path(o.page_file).replace_extension(".glb").string()
                           : o.unwrapped;
   VT_ASSIGN_OR_RETURN(in.reader, PageFileReader::open(o.page_file));
-  VT_ASSIGN_OR_RETURN(in.original, scene::load_scene(o.scene));
+  VT_ASSIGN_OR_RETURN(in.original, scene::load_scene(o.scene, o.load));
   VT_ASSIGN_OR_RETURN(in.baked, scene::load_scene(unwrapped));
   VT_ASSIGN_OR_RETURN(in.reference, reference_scene_draws(in.original));
   VT_ASSIGN_OR_RETURN(in.virt, virtual_scene_draws(in.baked));

@@ -150,6 +150,7 @@ struct BakeValidationOptions {
   bool prefer_hardware = false;  // a hardware Vulkan device rather than lavapipe
   AtlasCheckOptions atlas;       // out_dir is set to out_dir
   bool render_views = true;      // false: the atlas check alone (no Vulkan needed)
+  scene::SceneLoadOptions load;  // how the original scene is read
 };
 
 // Reads the camera file (first, so that a bad one fails fast), the page file and both scenes,
