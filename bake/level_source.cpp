@@ -38,8 +38,8 @@ struct Conversion {
 class Level0Converter {
  public:
   // `origin` names the source file for messages ("" when the texels are not a file's).
-  Level0Converter(const LayerPlan& plan, const std::string& origin, uint32_t width,
-                  uint32_t height, NonFinitePolicy policy, int threads)
+  Level0Converter(const LayerPlan& plan, const std::string& origin, uint32_t width, uint32_t height,
+                  NonFinitePolicy policy, int threads)
       : conv_(plan),
         where_((origin.empty() ? "" : origin + ": ") + "layer '" + plan.spec.name + "'"),
         width_(width),
@@ -166,8 +166,8 @@ class StreamedLevel0 final : public LevelSource {
   StreamedLevel0(std::shared_ptr<ImageSource> source, const LayerPlan& plan, NonFinitePolicy policy,
                  int threads, bool count)
       : source_(std::move(source)),
-        converter_(plan, source_->origin(), source_->info().width, source_->info().height,
-                   policy, threads),
+        converter_(plan, source_->origin(), source_->info().width, source_->info().height, policy,
+                   threads),
         count_(count) {}
 
   uint32_t width() const override { return source_->info().width; }

@@ -10,8 +10,8 @@
 #include "cli/cli_util.h"
 #include "cli/command.h"
 #include "cli/scene_load_flags.h"
-#include "format/atomic_output.h"
 #include "cli/unwrap_flags.h"
+#include "format/atomic_output.h"
 #include "scene/scene.h"
 
 namespace {

@@ -72,8 +72,8 @@ void warn_about_degenerate_geometry(Scene* scene) {
     for (const Primitive& p : mesh.primitives) total += p.triangle_count();
   if (zero == 0) return;
   scene->warnings.push_back(file + ": " + std::to_string(zero) + " of " + std::to_string(total) +
-                            " triangles have zero area and get no texels (first in " +
-                            first_zero + ")");
+                            " triangles have zero area and get no texels (first in " + first_zero +
+                            ")");
   if (empty_prims > 0)
     scene->warnings.push_back(
         file + ": " + std::to_string(empty_prims) +

@@ -141,8 +141,8 @@ Status ObjReader::load_library(const std::string& written) {
   std::string note;
   std::string file = resolve_written_path(folder_, written, &note);
   if (!libraries_.insert(file).second) return Status::Ok();
-  VT_RETURN_IF_ERROR(check_inside_scene_tree(path_, file, "line " + std::to_string(line) +
-                                                              ": mtllib", options_));
+  VT_RETURN_IF_ERROR(
+      check_inside_scene_tree(path_, file, "line " + std::to_string(line) + ": mtllib", options_));
   if (!note.empty()) scene_.warnings.push_back(where() + ": mtllib " + note);
   Status s = load_mtl(file, &scene_, &materials_);
   if (s.ok()) return Status::Ok();

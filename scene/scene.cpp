@@ -122,10 +122,9 @@ Status validate_geometry(const Scene& scene) {
       for (size_t set = 0; set < p.uvs.size(); ++set)
         for (size_t v = 0; v < p.uvs[set].size(); ++v)
           if (!std::isfinite(p.uvs[set][v][0]) || !std::isfinite(p.uvs[set][v][1]))
-            return Error(ErrorCode::kCorrupt, where + ": vertex " + std::to_string(v) +
-                                                  " has a non-finite TEXCOORD_" +
-                                                  std::to_string(set) +
-                                                  " (it would sample nothing: fix the UVs)");
+            return Error(ErrorCode::kCorrupt,
+                         where + ": vertex " + std::to_string(v) + " has a non-finite TEXCOORD_" +
+                             std::to_string(set) + " (it would sample nothing: fix the UVs)");
     }
   }
   return Status::Ok();

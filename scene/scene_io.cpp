@@ -260,7 +260,6 @@ bool is_gltf1(const std::string& path) {
   return v.is_string() && v.get<std::string>().rfind("1", 0) == 0;
 }
 
-
 // "material 'Body' baseColorTexture image 2 'brick'": the first material slot using the
 // image, for error messages.
 std::string image_user(const Scene& scene, size_t image) {
@@ -314,7 +313,7 @@ Expected<Scene> load_scene(const std::string& path, const SceneLoadOptions& opti
     if (!scene.images[i].embedded())
       VT_RETURN_IF_ERROR(detail::check_inside_scene_tree(path, scene.images[i].path,
                                                          image_user(scene, i), options));
-  warn_about_degenerate_geometry(&scene);
+  detail::warn_about_degenerate_geometry(&scene);
   return scene;
 }
 

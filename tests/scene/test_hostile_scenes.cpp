@@ -43,8 +43,7 @@ std::string gltf_with_image(const std::string& uri) {
          R"({"baseColorTexture":{"index":0}}}]})";
 }
 
-Expected<scene::Scene> load_gltf_naming(const Tree& t, const std::string& uri,
-                                        bool allow = false) {
+Expected<scene::Scene> load_gltf_naming(const Tree& t, const std::string& uri, bool allow = false) {
   Tree::write(t.car + "car.gltf", gltf_with_image(uri));
   scene::SceneLoadOptions options;
   options.allow_outside_paths = allow;
@@ -68,8 +67,8 @@ TEST(HostileScenes, AnEscapeAboveTheTreeNamesTheSceneMaterialImageAndPath) {
   EXPECT_EQ(s.status().code(), ErrorCode::kInvalidArgument);
   EXPECT_EQ(s.status().message(),
             t.car + "car.gltf: material 'Body' baseColorTexture image 0 'paint': '" + t.car +
-                "../../secret.png' is " + t.secret + ", outside the scene's folder tree " +
-                t.root + "assets (a scene may name files in its folder, below it or in a " +
+                "../../secret.png' is " + t.secret + ", outside the scene's folder tree " + t.root +
+                "assets (a scene may name files in its folder, below it or in a " +
                 "sibling folder; --allow-outside-paths reads it anyway)");
   EXPECT_TRUE(load_gltf_naming(t, "../../secret.png", true).ok());
 }
@@ -91,8 +90,9 @@ TEST(HostileScenes, AbsolutePathsAndSymlinksOutsideAreRefused) {
 TEST(HostileScenes, GltfBufferOutsideIsRefusedBeforeItIsRead) {
   Tree t;
   Tree::write(t.root + "data.bin", std::string(12, '\0'));
-  Tree::write(t.car + "car.gltf",
-              R"({"asset":{"version":"2.0"},"buffers":[{"uri":"../../data.bin","byteLength":12}]})");
+  Tree::write(
+      t.car + "car.gltf",
+      R"({"asset":{"version":"2.0"},"buffers":[{"uri":"../../data.bin","byteLength":12}]})");
   auto s = scene::load_scene(t.car + "car.gltf");
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.status().code(), ErrorCode::kInvalidArgument);
@@ -158,19 +158,19 @@ TEST(HostileScenes, DegenerateGeometryIsAWarningWithCounts) {
   // primitive 1: only a zero-area triangle.
   Tree::write(t.car + "flat.obj",
               "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\n"
-              "g good\nf 1 2 3\nf 1 1 2\nf 1 2 4\n");
+              "f 1 2 3\nf 1 1 2\nf 1 2 4\n");
   auto s = scene::load_scene(t.car + "flat.obj");
   ASSERT_TRUE(s.ok()) << s.status().message();
   ASSERT_EQ(s->warnings.size(), 1u);
   EXPECT_EQ(s->warnings[0], t.car + "flat.obj: 2 of 3 triangles have zero area and get no " +
-                                "texels (first in mesh 'flat' primitive 0)");
+                                "texels (first in mesh 'obj' primitive 0)");
 
   Tree::write(t.car + "line.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\nf 3 2 1\n");
   auto line = scene::load_scene(t.car + "line.obj");
   ASSERT_TRUE(line.ok()) << line.status().message();
   ASSERT_EQ(line->warnings.size(), 2u);
   EXPECT_EQ(line->warnings[1], t.car + "line.obj: 1 primitive has no area at all and will not " +
-                                   "appear in the bake: mesh 'line' primitive 0");
+                                   "appear in the bake: mesh 'obj' primitive 0");
 }
 
 }  // namespace
