@@ -115,7 +115,7 @@ Expected<SceneBakeSummary> bake_scene(const std::string& scene_path,
   if (options.progress) options.progress({"load", 0.0});
   auto loaded = scene::load_scene(scene_path, options.load);
   if (!loaded.ok()) return loaded.status();
-  VT_RETURN_IF_ERROR(scene::validate_geometry(*loaded).with_context(scene_path));
+  VT_RETURN_IF_ERROR(scene::validate_geometry(*loaded));  // its messages name the file
   double load_seconds = seconds_since(t0);
   auto summary = bake_scene(*loaded, options);
   if (!summary.ok()) return summary.status().with_context(scene_path);

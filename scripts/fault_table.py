@@ -65,6 +65,8 @@ def run(vtbake, args, timeout=TIMEOUT, limit_as=4 << 30, preexec=None):
         return "ok", 0, err
     # A clear error names the problem in one vtbake line; an internal error, bad_alloc or a
     # library's stray line is not clear.
+    if p.returncode == 1 and not err.strip():
+        return "error", 1, err  # a finished run whose own checks failed (unwrap's atlas check)
     bad = ("internal error", "bad_alloc", "PNG library error", "terminate called")
     return ("unclear" if any(b in err for b in bad) or "vtbake" not in err else "error",
             p.returncode, err)

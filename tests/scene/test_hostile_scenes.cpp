@@ -75,7 +75,12 @@ TEST(HostileScenes, AnEscapeAboveTheTreeNamesTheSceneMaterialImageAndPath) {
 
 TEST(HostileScenes, AbsolutePathsAndSymlinksOutsideAreRefused) {
   Tree t;
-  auto abs = load_gltf_naming(t, t.secret);
+  // A glTF uri is always relative to the scene's folder ("/x" is "<folder>//x"); OBJ/MTL,
+  // assimp and the resolver read absolute paths as they are.
+  Tree::write(t.car + "abs.mtl", "newmtl paint\nmap_Kd " + t.secret + "\n");
+  Tree::write(t.car + "abs.obj",
+              "mtllib abs.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl paint\nf 1 2 3\n");
+  auto abs = scene::load_scene(t.car + "abs.obj");
   ASSERT_FALSE(abs.ok());
   EXPECT_NE(abs.status().message().find("outside the scene's folder tree"), std::string::npos);
   // A percent-encoded escape is the same escape.
