@@ -79,8 +79,8 @@ TEST(CliHostileInputs, TextureAboveTheSceneTreeIsRefusedUnlessAllowed) {
 
 TEST(CliHostileInputs, NanUvIsAnErrorNamingTheVertex) {
   const std::string dir = fresh_dir("nan_uv");
-  write_png(dir + "/car/tex.png");
   const std::string obj = quad(dir, "tex.png", "nan");
+  write_png(dir + "/car/tex.png");
   auto r = run_vtbake("bake " + obj + " -o " + dir + "/q.vtpf --size 1 --unwrapped -", true);
   EXPECT_EQ(r.exit_code, 2) << r.out;
   EXPECT_NE(r.out.find("primitive 0: vertex 0 has a non-finite TEXCOORD_0"), std::string::npos)
