@@ -425,14 +425,15 @@ def kill_class(vtbake, work, rng, n, classes):
     bake = lambda scene: [vtbake, "-q", "--threads", "1", "bake", scene, "-o", vtpf, "--size",
                           "6"]
     pairs = {}
+    quiet = dict(check=True, stdout=subprocess.DEVNULL)
     for name, scene in (("a", a), ("b", b)):
         t0 = time.time()
-        subprocess.run(bake(scene), check=True)
+        subprocess.run(bake(scene), **quiet)
         pairs[name] = (digest(vtpf), digest(glb), time.time() - t0)
     duration = pairs["b"][2]
     c = Counts("SIGKILL mid-bake (pair replaced together?)")
     for i in range(n):
-        subprocess.run(bake(a), check=True)
+        subprocess.run(bake(a), **quiet)
         p = subprocess.Popen(bake(b), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         time.sleep(rng.uniform(0, duration * 1.1))
         p.send_signal(signal.SIGKILL)
