@@ -29,6 +29,28 @@ Expected<uint64_t> hash_file(const std::string& path) {
   return XXH3_64bits_digest(&state);
 }
 
+// A failed decode of a file that opened: the file is corrupt or truncated (kCorrupt, exit 2).
+// OpenImageIO's message is one line per error it collected; libpng's adds a bare "PNG library
+// error" line that says nothing, and the same cause often comes twice: both are dropped.
+Status decode_error(const std::string& path, const std::string& oiio_message) {
+  std::vector<std::string> lines;
+  size_t start = 0;
+  while (start < oiio_message.size()) {
+    size_t end = std::min(oiio_message.find('\n', start), oiio_message.size());
+    std::string line = oiio_message.substr(start, end - start);
+    start = end + 1;
+    if (line.empty() || line == "PNG library error") continue;
+    bool repeated = false;
+    for (const std::string& l : lines)
+      repeated |= l.find(line) != std::string::npos || line.find(l) != std::string::npos;
+    if (!repeated) lines.push_back(std::move(line));
+  }
+  std::string text;
+  for (const std::string& l : lines) text += (text.empty() ? "" : "; ") + l;
+  if (text.empty()) text = "cannot decode the image";
+  return Error(ErrorCode::kCorrupt, path + ": " + text);
+}
+
 class FileImageSource final : public ImageSource {
  public:
   FileImageSource(std::string path, std::unique_ptr<OIIO::ImageInput> in, ImageInfo info,
@@ -46,6 +68,7 @@ class FileImageSource final : public ImageSource {
 
   // The file's bytes decide its texels; hashing them is far cheaper than decoding.
   Expected<uint64_t> content_hash() override { return hash_file(path_); }
+  std::string origin() const override { return path_; }
 
   Status read_rows(uint32_t y0, uint32_t y1, float* out) override {
     if (y0 > y1 || y1 > info_.height) {
@@ -57,7 +80,7 @@ class FileImageSource final : public ImageSource {
     if (tile_w_ == 0) {
       bool ok = in_->read_scanlines(0, 0, spec.y + int(y0), spec.y + int(y1), spec.z, 0,
                                     int(info_.channels), OIIO::TypeDesc::FLOAT, out);
-      if (!ok) return Error(ErrorCode::kIo, path_ + ": " + in_->geterror());
+      if (!ok) return decode_error(path_, in_->geterror());
       return Status::Ok();
     }
     // Tiled: read whole tile rows covering [y0, y1) and copy the rows asked for.
@@ -69,7 +92,7 @@ class FileImageSource final : public ImageSource {
     bool ok = in_->read_tiles(0, 0, spec.x, spec.x + int(xend), spec.y + int(ty0),
                               spec.y + int(ty1), spec.z, spec.z + 1, 0, int(info_.channels),
                               OIIO::TypeDesc::FLOAT, tile_buf_.data());
-    if (!ok) return Error(ErrorCode::kIo, path_ + ": " + in_->geterror());
+    if (!ok) return decode_error(path_, in_->geterror());
     std::memcpy(out, tile_buf_.data() + size_t(y0 - ty0) * row_floats,
                 size_t(y1 - y0) * row_floats * sizeof(float));
     return Status::Ok();

@@ -38,6 +38,8 @@ class ImageSource {
   // memory, leaving the source empty, so that a build can convert it in place rather than copy
   // it; empty when the source cannot.
   virtual std::vector<float> release_texels() { return {}; }
+  // The file the texels come from, for messages; "" for generated or in-memory texels.
+  virtual std::string origin() const { return ""; }
 };
 
 // Opens an image file OpenImageIO can read (first subimage, level 0). Errors name the file.

@@ -37,9 +37,15 @@ struct Conversion {
 // per texel), colour converted to linear, alpha premultiplied, normals decoded and renormalised.
 class Level0Converter {
  public:
-  Level0Converter(const LayerPlan& plan, uint32_t width, uint32_t height, NonFinitePolicy policy,
-                  int threads)
-      : conv_(plan), width_(width), policy_(policy), threads_(threads), counted_(height, false) {}
+  // `origin` names the source file for messages ("" when the texels are not a file's).
+  Level0Converter(const LayerPlan& plan, const std::string& origin, uint32_t width, uint32_t height,
+                  NonFinitePolicy policy, int threads)
+      : conv_(plan),
+        where_((origin.empty() ? "" : origin + ": ") + "layer '" + plan.spec.name + "'"),
+        width_(width),
+        policy_(policy),
+        threads_(threads),
+        counted_(height, false) {}
 
   const NonFiniteReport& report() const { return report_; }
   const Conversion& conversion() const { return conv_; }
@@ -67,12 +73,14 @@ class Level0Converter {
       }
     }
     if (policy_ == NonFinitePolicy::kError && report_.any()) {
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "%s value %g at texel (%u, %u) channel %u",
+      char buf[256];
+      std::snprintf(buf, sizeof buf,
+                    ": %s value %g at texel (%u, %u) channel %u (--fix-nonfinite error; black "
+                    "or clamp repairs it)",
                     std::isfinite(report_.first_value) ? "negative" : "non-finite",
                     double(report_.first_value), report_.first_x, report_.first_y,
                     report_.first_channel);
-      return Error(ErrorCode::kInvalidArgument, buf);
+      return Error(ErrorCode::kInvalidArgument, where_ + buf);
     }
     return Status::Ok();
   }
@@ -144,6 +152,7 @@ class Level0Converter {
   }
 
   const Conversion conv_;
+  const std::string where_;
   uint32_t width_;
   NonFinitePolicy policy_;
   int threads_;
@@ -157,7 +166,8 @@ class StreamedLevel0 final : public LevelSource {
   StreamedLevel0(std::shared_ptr<ImageSource> source, const LayerPlan& plan, NonFinitePolicy policy,
                  int threads, bool count)
       : source_(std::move(source)),
-        converter_(plan, source_->info().width, source_->info().height, policy, threads),
+        converter_(plan, source_->origin(), source_->info().width, source_->info().height, policy,
+                   threads),
         count_(count) {}
 
   uint32_t width() const override { return source_->info().width; }
@@ -211,7 +221,8 @@ Expected<std::shared_ptr<LevelSource>> hold_level0(const LayerInput& input, cons
                   plan.spec.name + ": a layer with a coverage mask keeps its levels in memory; " +
                       std::to_string(bytes >> 20) + " MiB per level does not fit the memory limit");
   }
-  Level0Converter converter(plan, w, h, options.non_finite, thread_count(options.threads));
+  Level0Converter converter(plan, input.source->origin(), w, h, options.non_finite,
+                            thread_count(options.threads));
   const size_t in_row = size_t(w) * plan.source_channels, out_row = size_t(w) * wc;
   // Scene bakes hand over their transfer buffers: converted in place, level 0 costs no copy.
   std::vector<float> texels;

@@ -113,9 +113,9 @@ Expected<SceneBakeSummary> bake_scene(const std::string& scene_path,
                                       const SceneBakeOptions& options) {
   auto t0 = Clock::now();
   if (options.progress) options.progress({"load", 0.0});
-  auto loaded = scene::load_scene(scene_path);
+  auto loaded = scene::load_scene(scene_path, options.load);
   if (!loaded.ok()) return loaded.status();
-  VT_RETURN_IF_ERROR(scene::validate_geometry(*loaded).with_context(scene_path));
+  VT_RETURN_IF_ERROR(scene::validate_geometry(*loaded));  // its messages name the file
   double load_seconds = seconds_since(t0);
   auto summary = bake_scene(*loaded, options);
   if (!summary.ok()) return summary.status().with_context(scene_path);
@@ -166,6 +166,16 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   if (!unwrapped.ok()) return unwrapped.status().with_context("unwrap");
   summary.unwrap = unwrapped->stats;
   summary.triangles = uint64_t(unwrapped->stats.faces);
+  // Charts that cover almost nothing (degenerate or needle geometry, one huge chart beside
+  // specks) leave the atlas empty: every texel baked is then wasted on background.
+  if (constexpr double kLowUtilisation = 0.05; summary.unwrap.utilisation < kLowUtilisation) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "atlas utilisation %.4f: the charts cover %.2f%% of the atlas's texels "
+                  "(degenerate or needle-thin geometry?)",
+                  summary.unwrap.utilisation, 100.0 * summary.unwrap.utilisation);
+    summary.warnings.push_back(text);
+  }
   summary.stages.push_back({"unwrap", seconds_since(t0)});
   report("unwrap", 1.0);
 

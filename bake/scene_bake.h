@@ -33,6 +33,7 @@ struct SceneBakeOptions {
   unwrap::UnwrapOptions unwrap;  // page_payload and threads are taken from `build`
   int supersample = 1;           // 1, 4 or 16 transfer samples per texel
   MissingTextures missing_textures = MissingTextures::kError;  // see TransferOptions
+  scene::SceneLoadOptions load;  // how the scene file is read (bake_scene(path, ...) only)
   std::function<void(const SceneBakeProgress&)> progress;
 
   // A scene bake holds the transfer's buffers too: 8 GiB by default rather than the build's 2.

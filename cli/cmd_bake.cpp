@@ -12,6 +12,7 @@
 #include "cli/build_flags.h"
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/scene_load_flags.h"
 #include "cli/unwrap_flags.h"
 #include "format/atomic_output.h"
 
@@ -72,6 +73,7 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
          "A texture that cannot be read: error (default: fail naming the material, slot and "
          "path) or warn (bake the slot from its factor alone and list the miss)")
       ->default_str("error");
+  vt::cli::add_scene_load_flags(app, o.load);
   vt::cli::add_unwrap_flags(app, o.unwrap);
   vt::cli::add_build_flags(app, o.build);
   return [args](const vt::cli::GlobalOptions& global) -> int {

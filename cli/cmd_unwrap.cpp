@@ -9,7 +9,9 @@
 #include "bake/unwrap/unwrap.h"
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/scene_load_flags.h"
 #include "cli/unwrap_flags.h"
+#include "format/atomic_output.h"
 #include "scene/scene.h"
 
 namespace {
@@ -17,6 +19,7 @@ namespace {
 struct Args {
   std::string input, output, report, picture;
   vt::unwrap::UnwrapOptions options;
+  vt::scene::SceneLoadOptions load;
 };
 
 std::string stem(const std::string& path) {
@@ -33,6 +36,7 @@ vt::cli::CommandRunner make_unwrap(CLI::App& sub) {
   sub.add_option("-o,--output", args->output, "Output .glb with the atlas UV set added")
       ->required();
   vt::cli::add_unwrap_flags(sub, args->options);
+  vt::cli::add_scene_load_flags(sub, args->load);
   sub.add_option("--report", args->report, "Report JSON path (default OUT.report.json)");
   sub.add_option("--picture", args->picture, "Atlas PNG path (default OUT.atlas.png)");
   return [args](const vt::cli::GlobalOptions& global) -> int {
@@ -43,7 +47,9 @@ vt::cli::CommandRunner make_unwrap(CLI::App& sub) {
     if (a.picture.empty()) a.picture = stem(a.output) + ".atlas.png";
 
     auto t0 = Clock::now();
-    auto scene = vt::scene::load_scene(a.input);
+    if (vt::Status in = vt::check_input_file(a.input); !in.ok())
+      return vt::cli::report_error("unwrap", in);
+    auto scene = vt::scene::load_scene(a.input, a.load);
     if (!scene.ok()) return vt::cli::report_error("unwrap", scene.status());
     double load_s = std::chrono::duration<double>(Clock::now() - t0).count();
     for (const std::string& w : scene->warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());

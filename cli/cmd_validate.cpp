@@ -8,6 +8,7 @@
 
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/scene_load_flags.h"
 #include "render/report.h"
 #include "render/validate.h"
 
@@ -131,6 +132,7 @@ vt::cli::CommandRunner make_validate(CLI::App& app) {
          "--no-exact-check", [&f](int64_t) { f.exact.enabled = false; },
          "Skip the exact streaming check (virtual render against the baked levels as a texture)")
       ->excludes(atlas_only);
+  vt::cli::add_scene_load_flags(app, f.load);
   app.add_option("--out", f.out_dir,
                  "Folder for the PNGs and report.json (default PAGE_FILE.validate)");
   app.footer(

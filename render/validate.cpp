@@ -342,8 +342,10 @@ Expected<BakeInputs> read_bake_inputs(const BakeValidationOptions& o) {
                      ? std::filesystem::path(o.page_file).replace_extension(".glb").string()
                      : o.unwrapped;
   VT_ASSIGN_OR_RETURN(in.reader, PageFileReader::open(o.page_file));
-  VT_ASSIGN_OR_RETURN(in.original, scene::load_scene(o.scene));
-  VT_ASSIGN_OR_RETURN(in.baked, scene::load_scene(in.unwrapped));
+  VT_ASSIGN_OR_RETURN(in.original, scene::load_scene(o.scene, o.load));
+  // The bake's own output: its image uris point back at the original scene's files (checked
+  // above), from wherever the bake was written.
+  VT_ASSIGN_OR_RETURN(in.baked, scene::load_scene(in.unwrapped, {.allow_outside_paths = true}));
   VT_ASSIGN_OR_RETURN(in.reference, reference_scene_draws(in.original));
   VT_ASSIGN_OR_RETURN(in.virt, virtual_scene_draws(in.baked));
   if (in.reference.meshes.empty() || in.virt.meshes.empty()) {

@@ -171,6 +171,7 @@ struct BakeValidationOptions {
   AtlasCheckOptions atlas;       // out_dir is set to out_dir
   StreamingCheckOptions exact;   // the virtual render against the baked levels
   bool render_views = true;      // false: the atlas check alone (no Vulkan needed)
+  scene::SceneLoadOptions load;  // how the original scene is read
 };
 
 // Reads the camera file (first, so that a bad one fails fast), the page file and both scenes,

@@ -53,7 +53,10 @@ Status load_buffers(Gltf* g, std::vector<uint8_t>* glb_bin) {
       if (!data.ok()) return data.status().with_context(g->path);
       g->buffers.push_back(std::move(data).value());
     } else {
-      auto data = read_file(folder + percent_decode(uri));
+      const std::string file = folder + percent_decode(uri);
+      VT_RETURN_IF_ERROR(
+          check_inside_scene_tree(g->path, file, "buffer " + std::to_string(i), g->options));
+      auto data = read_file(file);
       if (!data.ok()) return data.status().with_context(g->path + ": buffer");
       g->buffers.push_back(std::move(data).value());
     }

@@ -19,6 +19,7 @@ namespace vt::scene::detail {
 
 struct Gltf {
   std::string path;
+  SceneLoadOptions options;
   nlohmann::json doc;
   std::vector<std::vector<uint8_t>> buffers;  // a placeholder buffer (no uri) is empty
   // bufferView index -> its bytes decoded from EXT_meshopt_compression.

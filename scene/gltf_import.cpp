@@ -126,10 +126,11 @@ Expected<Scene> load_document(Gltf& g, std::vector<uint8_t>* glb_bin) {
 
 }  // namespace
 
-Expected<Scene> load_gltf(const std::string& path) {
+Expected<Scene> load_gltf(const std::string& path, const SceneLoadOptions& options) {
   VT_ASSIGN_OR_RETURN(auto bytes, read_file(path));
   Gltf g;
   g.path = path;
+  g.options = options;
   std::vector<uint8_t> bin;
   bool glb = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
   try {

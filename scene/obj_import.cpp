@@ -35,7 +35,8 @@ struct Builder {
 
 class ObjReader {
  public:
-  explicit ObjReader(const std::string& path) : path_(path), folder_(parent_folder(path)) {
+  ObjReader(const std::string& path, const SceneLoadOptions& options)
+      : path_(path), folder_(parent_folder(path)), options_(options) {
     scene_.source_path = path;
   }
   Status statement(const std::string& key, LineCursor* c);
@@ -47,12 +48,13 @@ class ObjReader {
   std::string where() const { return path_ + ":" + std::to_string(line); }
   Status vertex(LineCursor* c);
   Status face(LineCursor* c);
-  void mtllib(const std::string& rest);
-  void load_library(const std::string& written);
+  Status mtllib(const std::string& rest);
+  Status load_library(const std::string& written);
   int material_index(const std::string& name);
   void fill_colors(Builder* b) const;
 
   std::string path_, folder_;
+  SceneLoadOptions options_;
   Scene scene_;
   std::map<std::string, int> materials_;
   std::set<std::string> libraries_;  // loaded, by resolved path
@@ -135,13 +137,15 @@ Status ObjReader::face(LineCursor* c) {
   return Status::Ok();
 }
 
-void ObjReader::load_library(const std::string& written) {
+Status ObjReader::load_library(const std::string& written) {
   std::string note;
   std::string file = resolve_written_path(folder_, written, &note);
-  if (!libraries_.insert(file).second) return;
+  if (!libraries_.insert(file).second) return Status::Ok();
+  VT_RETURN_IF_ERROR(
+      check_inside_scene_tree(path_, file, "line " + std::to_string(line) + ": mtllib", options_));
   if (!note.empty()) scene_.warnings.push_back(where() + ": mtllib " + note);
   Status s = load_mtl(file, &scene_, &materials_);
-  if (s.ok()) return;
+  if (s.ok()) return Status::Ok();
   // As assimp does: a library that is not there is often the OBJ's own name with .mtl.
   std::string own = path_.substr(0, path_.size() - lower_extension(path_).size()) + "mtl";
   std::error_code ec;
@@ -149,25 +153,24 @@ void ObjReader::load_library(const std::string& written) {
       libraries_.insert(own).second && load_mtl(own, &scene_, &materials_).ok()) {
     scene_.warnings.push_back(where() + ": mtllib '" + written + "' not found; using '" + own +
                               "' (the OBJ's name)");
-    return;
+    return Status::Ok();
   }
   library_missing_ = true;
   scene_.warnings.push_back(where() + ": mtllib '" + written + "': " + s.message() +
                             "; its materials are defaults");
+  return Status::Ok();
 }
 
 // One library whose name has spaces, or several separated by blanks (both are written).
-void ObjReader::mtllib(const std::string& rest) {
+Status ObjReader::mtllib(const std::string& rest) {
   std::vector<Token> tokens = split_tokens(rest);
   std::string note;
   std::error_code ec;
   bool whole = tokens.size() > 1 && rest.front() != '"' &&
                std::filesystem::is_regular_file(resolve_written_path(folder_, rest, &note), ec);
-  if (whole || tokens.size() == 1) {
-    load_library(whole ? rest : tokens[0].text);
-    return;
-  }
-  for (const auto& t : tokens) load_library(t.text);
+  if (whole || tokens.size() == 1) return load_library(whole ? rest : tokens[0].text);
+  for (const auto& t : tokens) VT_RETURN_IF_ERROR(load_library(t.text));
+  return Status::Ok();
 }
 
 Status ObjReader::statement(const std::string& key, LineCursor* c) {
@@ -187,7 +190,7 @@ Status ObjReader::statement(const std::string& key, LineCursor* c) {
     current_ = c->rest_of_line();
   } else if (key == "mtllib") {
     std::string rest = c->rest_of_line();
-    if (!rest.empty()) mtllib(rest);
+    if (!rest.empty()) VT_RETURN_IF_ERROR(mtllib(rest));
   } else if (key == "l" || key == "p" || key == "curv" || key == "curv2" || key == "surf") {
     ++ignored_elements_;
   }
@@ -250,12 +253,12 @@ Scene ObjReader::finish() && {
 
 }  // namespace
 
-Expected<Scene> load_obj(const std::string& path) {
+Expected<Scene> load_obj(const std::string& path, const SceneLoadOptions& options) {
   VT_ASSIGN_OR_RETURN(auto bytes, read_file(path));
   std::string note;
   VT_ASSIGN_OR_RETURN(std::string text, decode_text(bytes, path, &note));
   bytes = {};
-  ObjReader reader(path);
+  ObjReader reader(path, options);
   if (!note.empty()) reader.warn(path + ": " + note);
   LineCursor c{text.data(), text.data() + text.size()};
   while (c.p < c.end) {

@@ -119,6 +119,12 @@ Status validate_geometry(const Scene& scene) {
       VT_RETURN_IF_ERROR(check(p.tangents.size(), "TANGENT"));
       VT_RETURN_IF_ERROR(check(p.colors.size(), "COLOR_0"));
       for (const auto& uv : p.uvs) VT_RETURN_IF_ERROR(check(uv.size(), "TEXCOORD"));
+      for (size_t set = 0; set < p.uvs.size(); ++set)
+        for (size_t v = 0; v < p.uvs[set].size(); ++v)
+          if (!std::isfinite(p.uvs[set][v][0]) || !std::isfinite(p.uvs[set][v][1]))
+            return Error(ErrorCode::kCorrupt,
+                         where + ": vertex " + std::to_string(v) + " has a non-finite TEXCOORD_" +
+                             std::to_string(set) + " (it would sample nothing: fix the UVs)");
     }
   }
   return Status::Ok();

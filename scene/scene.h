@@ -137,13 +137,24 @@ struct Scene {
   size_t triangle_count() const;  // over meshes (not instances)
 };
 
+struct SceneLoadOptions {
+  // Files the scene names (images, glTF buffers) must lie in the scene's folder tree: the
+  // folder holding the scene's folder and everything below it (so "../textures/x.png" from
+  // a sibling folder is fine, "../../x" and absolute paths elsewhere are not), symlinks
+  // resolved. A file outside is an error naming the scene, the image and the path; true
+  // reads it anyway (--allow-outside-paths). Missing files are reported as before.
+  bool allow_outside_paths = false;
+};
+
 // Loads .gltf, .glb, .obj, .ply or .drc (chosen by extension, case-insensitive). OBJ, PLY and
 // DRC give one mesh under one root node. Non-finite positions are kept; callers that need
-// finite geometry check it (see validate_geometry).
-Expected<Scene> load_scene(const std::string& path);
+// finite geometry check it (see validate_geometry). Degenerate geometry (zero-area triangles,
+// primitives with no area at all) is a warning with counts in Scene::warnings.
+Expected<Scene> load_scene(const std::string& path, const SceneLoadOptions& options = {});
 
-// Checks indices are in range and positions finite. The error names the mesh, primitive and
-// vertex or triangle, e.g. "mesh 'Body' primitive 0: vertex 17 has a non-finite position".
+// Checks indices are in range and positions and UVs finite. The error names the mesh,
+// primitive and vertex or triangle, e.g. "mesh 'Body' primitive 0: vertex 17 has a non-finite
+// position" (a NaN UV would bake as black texels, so it is an error, never repaired).
 Status validate_geometry(const Scene& scene);
 
 // Writes the scene as glTF 2.0 binary. Embedded images are stored in the .glb; file images

@@ -14,7 +14,17 @@
 namespace vt::scene {
 namespace detail {
 
+Status check_regular_file(const std::string& path) {
+  // Never open what is not a regular file: a FIFO blocks the open, a device never ends.
+  std::error_code ec;
+  auto status = std::filesystem::status(path, ec);
+  if (!ec && status.type() != std::filesystem::file_type::regular)
+    return Error(ErrorCode::kInvalidArgument, path + ": not a regular file to read");
+  return Status::Ok();
+}
+
 Expected<std::vector<uint8_t>> read_file(const std::string& path) {
+  VT_RETURN_IF_ERROR(check_regular_file(path));
   std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
   if (!f) return Error(ErrorCode::kNotFound, path + ": cannot open file");
   if (std::fseek(f.get(), 0, SEEK_END) != 0) return Error(ErrorCode::kIo, path + ": cannot seek");
@@ -187,6 +197,29 @@ std::string resolve_written_path(const std::string& folder, const std::string& w
   return windows_absolute ? folder + base : as_written;
 }
 
+std::string scene_folder_tree(const std::string& scene_path) {
+  std::error_code ec;
+  std::filesystem::path folder = std::filesystem::absolute(scene_path, ec).parent_path();
+  folder = std::filesystem::weakly_canonical(folder, ec);
+  return folder.parent_path().string();
+}
+
+Status check_inside_scene_tree(const std::string& scene_path, const std::string& file,
+                               const std::string& what, const SceneLoadOptions& options) {
+  std::error_code ec;
+  if (options.allow_outside_paths || !std::filesystem::exists(file, ec)) return Status::Ok();
+  const std::filesystem::path real = std::filesystem::canonical(file, ec);
+  if (ec) return Error(ErrorCode::kIo, scene_path + ": " + what + ": cannot resolve " + file);
+  const std::filesystem::path root = scene_folder_tree(scene_path);
+  auto [r, f] = std::mismatch(root.begin(), root.end(), real.begin(), real.end());
+  if (r == root.end()) return Status::Ok();
+  return Error(ErrorCode::kInvalidArgument,
+               scene_path + ": " + what + ": '" + file + "' is " + real.string() +
+                   ", outside the scene's folder tree " + root.string() +
+                   " (a scene may name files in its folder, below it or in a sibling folder; "
+                   "--allow-outside-paths reads it anyway)");
+}
+
 Scene single_mesh_scene(const std::string& path, std::string name, std::vector<Primitive> prims,
                         std::vector<Material> materials) {
   Scene scene;
@@ -227,9 +260,28 @@ bool is_gltf1(const std::string& path) {
   return v.is_string() && v.get<std::string>().rfind("1", 0) == 0;
 }
 
-}  // namespace
+// "material 'Body' baseColorTexture image 2 'brick'": the first material slot using the
+// image, for error messages.
+std::string image_user(const Scene& scene, size_t image) {
+  std::string name = "image " + std::to_string(image);
+  if (!scene.images[image].name.empty()) name += " '" + scene.images[image].name + "'";
+  for (size_t m = 0; m < scene.materials.size(); ++m) {
+    const Material& mat = scene.materials[m];
+    const std::pair<const TextureRef*, const char*> slots[] = {
+        {&mat.base_color_texture, "baseColorTexture"},
+        {&mat.metallic_roughness_texture, "metallicRoughnessTexture"},
+        {&mat.normal_texture, "normalTexture"},
+        {&mat.occlusion_texture, "occlusionTexture"},
+        {&mat.emissive_texture, "emissiveTexture"}};
+    for (const auto& [ref, slot] : slots)
+      if (ref->image == static_cast<int>(image))
+        return "material '" + (mat.name.empty() ? std::to_string(m) : mat.name) + "' " + slot +
+               " " + name;
+  }
+  return name;
+}
 
-Expected<Scene> load_scene(const std::string& path) {
+Expected<Scene> load_by_extension(const std::string& path, const SceneLoadOptions& options) {
   std::string ext = detail::lower_extension(path);
   if (ext == "gltf" || ext == "glb") {
     // glTF 1.0 goes through assimp; should assimp fail too, the own importer says why not.
@@ -240,9 +292,9 @@ Expected<Scene> load_scene(const std::string& path) {
         return scene;
       }
     }
-    return detail::load_gltf(path);
+    return detail::load_gltf(path, options);
   }
-  if (ext == "obj") return detail::load_obj(path);
+  if (ext == "obj") return detail::load_obj(path, options);
   if (ext == "ply") return detail::load_ply(path);
   if (ext == "drc") return detail::load_drc(path);
   if (detail::assimp_reads(ext)) return detail::load_assimp(path);
@@ -250,6 +302,19 @@ Expected<Scene> load_scene(const std::string& path) {
                path +
                    ": unknown scene format (expected .gltf, .glb, .obj, .ply, .drc or a format "
                    "assimp reads: .fbx, .dae, .3ds, .blend, ...)");
+}
+
+}  // namespace
+
+Expected<Scene> load_scene(const std::string& path, const SceneLoadOptions& options) {
+  VT_RETURN_IF_ERROR(detail::check_regular_file(path));
+  VT_ASSIGN_OR_RETURN(Scene scene, load_by_extension(path, options));
+  for (size_t i = 0; i < scene.images.size(); ++i)
+    if (!scene.images[i].embedded())
+      VT_RETURN_IF_ERROR(detail::check_inside_scene_tree(path, scene.images[i].path,
+                                                         image_user(scene, i), options));
+  detail::warn_about_degenerate_geometry(&scene);
+  return scene;
 }
 
 }  // namespace vt::scene

@@ -10,6 +10,10 @@
 
 namespace vt::scene::detail {
 
+// kInvalidArgument when something other than a regular file is at `path` (never opened: a
+// FIFO would block); Ok when it is a file or nothing is there (opening reports that).
+Status check_regular_file(const std::string& path);
+// The whole file; refuses what is not a regular file.
 Expected<std::vector<uint8_t>> read_file(const std::string& path);
 std::string lower_extension(const std::string& path);
 std::string parent_folder(const std::string& path);  // "" or ends with '/'
@@ -27,8 +31,20 @@ std::string percent_decode(const std::string& uri);
 std::string resolve_written_path(const std::string& folder, const std::string& written,
                                  std::string* note);
 
-Expected<Scene> load_gltf(const std::string& path);
-Expected<Scene> load_obj(const std::string& path);
+// The folder holding the scene's folder (absolute, symlinks resolved): the tree a scene's
+// files must lie in (SceneLoadOptions::allow_outside_paths).
+std::string scene_folder_tree(const std::string& scene_path);
+// Ok when `file` is missing, inside scene_folder_tree(scene_path) after resolving symlinks, or
+// options allow outside paths; else kInvalidArgument naming the scene, `what` (the image or
+// buffer) and the path.
+Status check_inside_scene_tree(const std::string& scene_path, const std::string& file,
+                               const std::string& what, const SceneLoadOptions& options);
+// Appends one warning per kind of degenerate geometry with counts: zero-area triangles,
+// primitives with no area at all (they get no texels).
+void warn_about_degenerate_geometry(Scene* scene);
+
+Expected<Scene> load_gltf(const std::string& path, const SceneLoadOptions& options);
+Expected<Scene> load_obj(const std::string& path, const SceneLoadOptions& options);
 Expected<Scene> load_ply(const std::string& path);
 Expected<Scene> load_drc(const std::string& path);
 // Any other format assimp reads (FBX, COLLADA, 3DS, ...; glTF 1.0).

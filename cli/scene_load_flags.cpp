@@ -1,0 +1,13 @@
+// The scene loading flags (see scene_load_flags.h).
+#include "cli/scene_load_flags.h"
+
+namespace vt::cli {
+
+void add_scene_load_flags(CLI::App& app, scene::SceneLoadOptions& o) {
+  app.add_flag("--allow-outside-paths", o.allow_outside_paths,
+               "Read images and buffers the scene names outside its folder tree (by default a "
+               "scene may name files in its own folder, below it or in a sibling folder: at "
+               "most one '..', symlinks resolved; absolute paths elsewhere are refused)");
+}
+
+}  // namespace vt::cli
