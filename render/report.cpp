@@ -116,7 +116,9 @@ std::string report_json(const ValidationReport& r) {
                      {"stream_ms_median", median(v.converge.stream_ms)},
                      {"virtual_ms", v.virtual_ms},
                      {"reference_ms", v.reference_ms},
-                     {"images", v.images}});
+                     {"images", v.images},
+                     {"framing", v.framing},
+                     {"density", to_json(v.density)}});
   }
   json doc = {{"page_file", r.page_file},
               {"layer", r.layer},
@@ -128,10 +130,12 @@ std::string report_json(const ValidationReport& r) {
                {{"min_psnr", r.thresholds.min_psnr},
                 {"min_tile_psnr", r.thresholds.min_tile_psnr},
                 {"max_coarser_share", r.thresholds.max_coarser_share},
-                {"max_coverage_mismatch", r.thresholds.max_coverage_mismatch}}},
+                {"max_coverage_mismatch", r.thresholds.max_coverage_mismatch},
+                {"min_density", r.thresholds.min_density}}},
               {"passed", r.passed()},
               {"views", views},
-              {"atlas", to_json(r.atlas)}};
+              {"atlas", to_json(r.atlas)},
+              {"view_plan", to_json(r.view_plan)}};
   return doc.dump(2);
 }
 
