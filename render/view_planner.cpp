@@ -159,9 +159,12 @@ bool segment_hits(Vec3d a, Vec3d b, const SurfaceTriangle& t) {
   return s > 1e-4 && s < 0.995;  // the target's own surface is not an occluder
 }
 
-bool occluded(const ViewSurfaces& s, Vec3d eye, Vec3d target) {
+// Whether a surface outside cluster `framed` lies between the eye and the target (the framed
+// cluster's own curvature does not count: its centroid may lie behind its surface).
+bool occluded(const ViewSurfaces& s, const std::vector<int>& cluster_of_chart, int framed,
+              Vec3d eye, Vec3d target) {
   for (const SurfaceTriangle& t : s.triangles)
-    if (segment_hits(eye, target, t)) return true;
+    if (cluster_of_chart[t.chart] != framed && segment_hits(eye, target, t)) return true;
   return false;
 }
 
@@ -182,8 +185,10 @@ Vec3d lean(Vec3d n, Vec3d toward, double deg, double spin) {
 struct Context {
   const ViewSurfaces& s;
   const ViewPlanOptions& o;
+  std::vector<int> cluster_of_chart;
   Vec3d up, h1, h2;
   double aspect = 1, diameter = 1;
+  double atlas_total = 0;
   double half_fov_min = 0.45;  // half of the smaller of the two fields of view
 };
 
@@ -208,8 +213,8 @@ Expected<PlannedView> make_view(const Context& c, ViewKind kind, Vec3d eye, Vec3
 // A view of `target` from distance `dist` along `n` leaned by `tilt_deg`: the first of a few
 // leaning directions (then shorter distances, when `may_approach`) from which no surface hides
 // the target.
-Expected<PlannedView> framed_view(const Context& c, ViewKind kind, Vec3d target, Vec3d n,
-                                  double dist, double tilt_deg, bool may_approach) {
+Expected<PlannedView> framed_view(const Context& c, ViewKind kind, int cluster, Vec3d target,
+                                  Vec3d n, double dist, double tilt_deg, bool may_approach) {
   const double spins[] = {0, kPi / 2, -kPi / 2, kPi};
   const double scales[] = {1.0, 0.5, 0.25};
   Vec3d eye = target + lean(n, c.up, tilt_deg, 0) * dist;
@@ -217,7 +222,7 @@ Expected<PlannedView> framed_view(const Context& c, ViewKind kind, Vec3d target,
   for (double scale : scales) {
     for (double spin : spins) {
       const Vec3d e = target + lean(n, c.up, tilt_deg, spin) * (dist * scale);
-      if (!occluded(c.s, e, target)) {
+      if (!occluded(c.s, c.cluster_of_chart, cluster, e, target)) {
         eye = e, clear = true;
         break;
       }
@@ -226,6 +231,7 @@ Expected<PlannedView> framed_view(const Context& c, ViewKind kind, Vec3d target,
   }
   VT_ASSIGN_OR_RETURN(PlannedView v, make_view(c, kind, eye, target, dist * 0.02));
   v.occluded = !clear;
+  v.cluster = cluster;
   v.angle_deg = std::acos(std::clamp(dot(unit(eye - target, n), n), -1.0, 1.0)) / kDeg;
   return v;
 }
@@ -263,10 +269,41 @@ size_t anchor_triangle(const ViewSurfaces& s, const std::vector<int>& cluster_of
   return best;
 }
 
-std::string percent(double share) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.0f%%", 100.0 * share);
-  return buf;
+// Cluster k framed whole along its mean normal.
+Expected<PlannedView> surface_view(const Context& c, const Cluster& cl, int k) {
+  const double dist = std::max(cl.radius, 1e-3) / std::sin(c.half_fov_min) * 1.05;
+  VT_ASSIGN_OR_RETURN(PlannedView v, framed_view(c, ViewKind::kSurface, k, cl.centroid, cl.normal,
+                                                 dist, kSurfaceTiltDeg, true));
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "surface %d (%.0f%% of the texels), %.0f deg from its normal", k,
+                100.0 * cl.atlas / c.atlas_total, v.angle_deg);
+  v.description = buf;
+  return v;
+}
+
+// A point on cluster k, nearly face-on, at one baked texel per pixel: a pixel at distance d
+// spans d * 2 tan(fov / 2) / height units, a texel 1 / (its chart's texels per unit).
+Expected<PlannedView> texel_view(const Context& c, const Cluster& cl, int k) {
+  const ViewSurfaces& s = c.s;
+  const SurfaceTriangle& t = s.triangles[anchor_triangle(s, c.cluster_of_chart, k, cl.centroid)];
+  double chart_atlas = 0, chart_area = 0;
+  for (const SurfaceTriangle& u : s.triangles)
+    if (u.chart == t.chart) chart_atlas += u.atlas_texels, chart_area += u.world_area;
+  const double texels_per_unit = std::sqrt(chart_atlas / std::max(chart_area, 1e-30));
+  Vec3d n = d3(t.normal);
+  if (dot(n, cl.normal) < 0) n = n * -1.0;
+  const double pixel_per_unit_distance = 2.0 * std::tan(0.5 * c.o.fov_y) / c.o.height;
+  const double dist = 1.0 / (pixel_per_unit_distance * std::max(texels_per_unit, 1e-30));
+  const Vec3d target = (d3(t.p[0]) + d3(t.p[1]) + d3(t.p[2])) / 3.0;
+  VT_ASSIGN_OR_RETURN(PlannedView v,
+                      framed_view(c, ViewKind::kTexel, k, target, n, dist, kTexelTiltDeg, false));
+  v.pixels_per_texel =
+      1.0 / (pixel_per_unit_distance * length(d3(v.spec.eye) - target) * texels_per_unit);
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "texels of surface %d at %.2f pixels per texel, %.0f deg", k,
+                v.pixels_per_texel, v.angle_deg);
+  v.description = buf;
+  return v;
 }
 
 }  // namespace
@@ -385,9 +422,8 @@ Expected<ViewPlan> plan_views(const ViewSurfaces& s, const ViewPlanOptions& o) {
       "overview from " + std::to_string(int(std::lround(overview_elev))) + " deg above the horizon";
   plan.views.push_back(overview);
 
-  std::vector<int> cluster_of_chart;
-  std::vector<Cluster> clusters = cluster_charts(s, &cluster_of_chart);
-  double atlas_total = 0;
+  std::vector<Cluster> clusters = cluster_charts(s, &c.cluster_of_chart);
+  double& atlas_total = c.atlas_total;
   for (const Cluster& cl : clusters) atlas_total += cl.atlas;
   size_t usable = 0;
   while (usable < clusters.size() && atlas_total > 0 &&
@@ -401,38 +437,13 @@ Expected<ViewPlan> plan_views(const ViewSurfaces& s, const ViewPlanOptions& o) {
     const Cluster& cl = clusters[k];
     const double share = cl.atlas / atlas_total;
     if (k < surfaces) {
-      const double dist = std::max(cl.radius, 1e-3) / std::sin(c.half_fov_min) * 1.05;
-      VT_ASSIGN_OR_RETURN(PlannedView v, framed_view(c, ViewKind::kSurface, cl.centroid, cl.normal,
-                                                     dist, kSurfaceTiltDeg, true));
-      v.cluster = int(k), v.cluster_share = share;
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "surface %zu (%s of the texels), %.0f deg from its normal", k,
-                    percent(share).c_str(), v.angle_deg);
-      v.description = buf;
+      VT_ASSIGN_OR_RETURN(PlannedView v, surface_view(c, cl, int(k)));
+      v.cluster_share = share;
       plan.views.push_back(v);
     }
     if (k < texels && plan.views.size() < o.views) {
-      const SurfaceTriangle& t =
-          s.triangles[anchor_triangle(s, cluster_of_chart, int(k), cl.centroid)];
-      double chart_atlas = 0, chart_area = 0;
-      for (const SurfaceTriangle& u : s.triangles)
-        if (u.chart == t.chart) chart_atlas += u.atlas_texels, chart_area += u.world_area;
-      const double texels_per_unit = std::sqrt(chart_atlas / std::max(chart_area, 1e-30));
-      Vec3d n = d3(t.normal);
-      if (dot(n, cl.normal) < 0) n = n * -1.0;
-      // One texel per pixel: a pixel at distance d spans d * 2 tan(fov / 2) / height units.
-      const double dist = double(o.height) / (2.0 * std::tan(0.5 * o.fov_y) * texels_per_unit);
-      const Vec3d target = (d3(t.p[0]) + d3(t.p[1]) + d3(t.p[2])) / 3.0;
-      VT_ASSIGN_OR_RETURN(PlannedView v,
-                          framed_view(c, ViewKind::kTexel, target, n, dist, kTexelTiltDeg, false));
-      v.cluster = int(k), v.cluster_share = share;
-      v.pixels_per_texel = double(o.height) /
-                           (2.0 * std::tan(0.5 * o.fov_y) * length(d3(v.spec.eye) - target)) /
-                           texels_per_unit;
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "texels of surface %zu at %.2f pixels per texel, %.0f deg", k,
-                    v.pixels_per_texel, v.angle_deg);
-      v.description = buf;
+      VT_ASSIGN_OR_RETURN(PlannedView v, texel_view(c, cl, int(k)));
+      v.cluster_share = share;
       plan.views.push_back(v);
     }
   }
