@@ -54,10 +54,9 @@ Vec3d axis_vector(UpAxis a) {
 
 // Two horizontal axes for `up`, fixed by up alone.
 void horizontal_frame(Vec3d up, Vec3d* h1, Vec3d* h2) {
-  const Vec3d ref = std::abs(up.y) < 0.9 ? Vec3d{0, 1, 0} : Vec3d{0, 0, 1};
-  // For +Y up this gives h1 = +X-ish, h2 = +Z-ish, the orbit the old views used.
-  *h1 = unit(cross(ref, up), {1, 0, 0});
-  if (std::abs(up.y) >= 0.9) *h1 = unit(cross(up, Vec3d{0, 0, 1}), {1, 0, 0});
+  // For +Y up: h1 = +X, h2 = +Z, the orbit the old views used.
+  *h1 = std::abs(up.y) < 0.9 ? unit(cross(Vec3d{0, 1, 0}, up), {1, 0, 0})
+                             : unit(cross(up, Vec3d{0, 0, 1}), {1, 0, 0});
   *h2 = cross(*h1, up);
 }
 
