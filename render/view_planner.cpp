@@ -424,24 +424,29 @@ Expected<ViewPlan> plan_views(const ViewSurfaces& s, const ViewPlanOptions& o) {
   std::vector<Cluster> clusters = cluster_charts(s, &c.cluster_of_chart);
   double& atlas_total = c.atlas_total;
   for (const Cluster& cl : clusters) atlas_total += cl.atlas;
-  size_t usable = 0;
-  while (usable < clusters.size() && atlas_total > 0 &&
-         clusters[usable].atlas >= kMinClusterShare * atlas_total)
-    ++usable;
+  // Clusters worth a view, largest first; undersides (box bottoms resting on the ground, a
+  // ground's back) only when nothing else is left.
+  std::vector<int> chosen, undersides;
+  for (size_t k = 0; k < clusters.size(); ++k) {
+    if (!(atlas_total > 0) || clusters[k].atlas < kMinClusterShare * atlas_total) break;
+    (dot(clusters[k].normal, c.up) < -0.7 ? undersides : chosen).push_back(int(k));
+  }
+  if (chosen.empty()) chosen = undersides;
   plan.clusters = uint32_t(clusters.size());
   const uint32_t rest = o.views - 1;
-  const size_t surfaces = std::min<size_t>((rest + 1) / 2, usable);
-  const size_t texels = std::min<size_t>(rest / 2, usable);
-  for (size_t k = 0; plan.views.size() < o.views && k < std::max(surfaces, texels); ++k) {
+  const size_t surfaces = std::min<size_t>((rest + 1) / 2, chosen.size());
+  const size_t texels = std::min<size_t>(rest / 2, chosen.size());
+  for (size_t i = 0; plan.views.size() < o.views && i < std::max(surfaces, texels); ++i) {
+    const int k = chosen[i];
     const Cluster& cl = clusters[k];
     const double share = cl.atlas / atlas_total;
-    if (k < surfaces) {
-      VT_ASSIGN_OR_RETURN(PlannedView v, surface_view(c, cl, int(k)));
+    if (i < surfaces) {
+      VT_ASSIGN_OR_RETURN(PlannedView v, surface_view(c, cl, k));
       v.cluster_share = share;
       plan.views.push_back(v);
     }
-    if (k < texels && plan.views.size() < o.views) {
-      VT_ASSIGN_OR_RETURN(PlannedView v, texel_view(c, cl, int(k)));
+    if (i < texels && plan.views.size() < o.views) {
+      VT_ASSIGN_OR_RETURN(PlannedView v, texel_view(c, cl, k));
       v.cluster_share = share;
       plan.views.push_back(v);
     }
