@@ -16,6 +16,7 @@ namespace {
 
 struct ValidateArgs {
   std::string size = "1280x720";  // parsed into options.width and height
+  std::string up = "auto";        // parsed into options.up
   vt::render::BakeValidationOptions options;
 };
 
@@ -75,6 +76,9 @@ int run(ValidateArgs& a, const vt::cli::GlobalOptions& global) {
     return vt::cli::bad_usage("validate",
                               "--size must be WxH (at most 8192x8192), got '" + a.size + "'");
   }
+  auto up = vt::render::parse_up_axis(a.up);
+  if (!up.ok()) return vt::cli::bad_usage("validate", "--up: " + up.status().message());
+  o.up = *up;
   auto report = vt::render::validate_bake(o);
   if (!report.ok()) return vt::cli::report_error("validate", report.status());
   if (global.json) {
@@ -94,9 +98,19 @@ vt::cli::CommandRunner make_validate(CLI::App& app) {
   app.add_option("page_file", f.page_file, "The baked page file (.vtpf)")->required();
   app.add_option("--unwrapped", f.unwrapped,
                  "The unwrapped scene `vtbake bake` wrote (default: PAGE_FILE with .glb)");
-  auto* views = app.add_option("--views", f.views, "Automatic camera views around the scene")
+  auto* views = app.add_option("--views", f.views,
+                               "Automatic views: an overview, then views framed on the surfaces "
+                               "with the most texels and views at one baked texel per pixel")
                     ->check(CLI::Range(1, 64))
                     ->capture_default_str();
+  app.add_option("--up", args->up,
+                 "The scene's up axis for automatic views: auto (from the data), x, y, z, -x, -y, "
+                 "-z")
+      ->capture_default_str();
+  app.add_option("--min-density", f.thresholds.min_density,
+                 "Fail a view whose baked texels per source texel (median in view) is below this")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
   auto* cameras = app.add_option("--cameras", f.cameras_file,
                                  "Camera file (JSON, format below) instead of automatic views");
   views->excludes(cameras);

@@ -30,8 +30,10 @@ struct Camera {
   Mat4 view_proj = Mat4::identity();
 };
 
-// Views around an axis-aligned box: a frontal view, close-ups (fine levels), grazing views
-// (anisotropic footprints) and a distant view (coarse levels). Deterministic.
+// Views around an axis-aligned box, +Y up: a frontal view, close-ups (fine levels), grazing
+// views (anisotropic footprints) and a distant view (coarse levels). Deterministic. For the
+// renderer's own tests; scenes get render/view_planner.h (up axis from the data, views framed on
+// the surfaces).
 std::vector<Camera> orbit_views(Vec3f bounds_min, Vec3f bounds_max, int count, float aspect);
 
 // Camera file (`vtbake validate --cameras FILE.json`), in the scene's world units:

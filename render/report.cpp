@@ -180,7 +180,9 @@ std::string report_json(const ValidationReport& r) {
                      {"converge_ms", sum(v.converge.feedback_ms) + sum(v.converge.stream_ms)},
                      {"virtual_ms", v.virtual_ms},
                      {"reference_ms", v.reference_ms},
-                     {"images", v.images}});
+                     {"images", v.images},
+                     {"framing", v.framing},
+                     {"density", to_json(v.density)}});
   }
   json doc = {{"page_file", r.page_file},
               {"layer", r.layer},
@@ -192,7 +194,8 @@ std::string report_json(const ValidationReport& r) {
                {{"min_psnr", r.thresholds.min_psnr},
                 {"min_tile_psnr", r.thresholds.min_tile_psnr},
                 {"max_coarser_share", r.thresholds.max_coarser_share},
-                {"max_coverage_mismatch", r.thresholds.max_coverage_mismatch}}},
+                {"max_coverage_mismatch", r.thresholds.max_coverage_mismatch},
+                {"min_density", r.thresholds.min_density}}},
               {"passed", r.passed()},
               {"views", views},
               {"atlas", to_json(r.atlas)},
@@ -205,7 +208,8 @@ std::string report_json(const ValidationReport& r) {
                 {"views", r.seconds.views},
                 {"contact_sheet", r.seconds.contact_sheet},
                 {"total", r.seconds.total}}},
-              {"exact", to_json(r.exact)}};
+              {"exact", to_json(r.exact)},
+              {"view_plan", to_json(r.view_plan)}};
   return doc.dump(2);
 }
 

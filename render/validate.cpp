@@ -394,6 +394,20 @@ Status finish_report(const BakeInputs& in, const BakeValidationOptions& o, doubl
 Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   VT_ASSIGN_OR_RETURN(BakeInputs in, read_bake_inputs(o));
+  // The surfaces and the planned views before the long atlas check, so bad input fails fast.
+  ViewSurfaces surfaces;
+  ViewPlan plan;
+  std::vector<Camera> cameras = in.cameras;
+  if (o.render_views) {
+    const PageGeometry& g = in.reader->geometry();
+    VT_ASSIGN_OR_RETURN(surfaces, gather_view_surfaces(in.baked, g.width, g.height));
+    if (cameras.empty()) {
+      ViewPlanOptions po;
+      po.views = o.views, po.up = o.up, po.width = o.width, po.height = o.height;
+      VT_ASSIGN_OR_RETURN(plan, plan_views(surfaces, po));
+      for (const PlannedView& v : plan.views) cameras.push_back(v.camera);
+    }
+  }
   const double load_seconds = seconds_since(start);
   const std::string out_dir =
       o.out_dir.empty() ? std::filesystem::path(o.page_file).replace_extension(".validate").string()
@@ -430,11 +444,6 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
   VT_RETURN_IF_ERROR(renderer->set_reference_meshes(in.reference.meshes));
   VT_RETURN_IF_ERROR(renderer->set_reference_textures(in.reference.textures));
 
-  const float aspect = float(o.width) / float(o.height);
-  const std::vector<Camera> cameras =
-      !in.cameras.empty()
-          ? in.cameras
-          : orbit_views(in.reference.bounds_min, in.reference.bounds_max, int(o.views), aspect);
   ValidateOptions vopt;
   vopt.layer = in.layer;
   vopt.address_mode = in.reader->layers()[in.layer].address_mode;
@@ -457,6 +466,14 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
       ValidationReport report,
       validate_views(*renderer, std::shared_ptr<const PageSource>(std::move(source)), cameras,
                      vopt));
+  for (size_t v = 0; v < report.views.size(); ++v) {
+    ViewReport& view = report.views[v];
+    view.density = measure_view_density(surfaces, cameras[v], o.width, o.height);
+    std::string why = check_view_density(view.density, report.thresholds.min_density);
+    if (!why.empty()) view.failures.push_back(std::move(why));
+    if (v < plan.views.size()) view.framing = plan.views[v].description;
+  }
+  report.view_plan = std::move(plan);
   report.page_file = o.page_file;
   report.device = ctx->device_name();
   report.atlas = std::move(atlas);

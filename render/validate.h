@@ -16,6 +16,8 @@
 #include "render/camera.h"
 #include "render/renderer.h"
 #include "render/streaming_check.h"
+#include "render/view_density.h"
+#include "render/view_planner.h"
 #include "runtime/streamer.h"
 
 namespace vt::render {
@@ -82,6 +84,9 @@ struct Thresholds {
   double max_coarser_share = 0.05;  // after convergence
   // Alpha-tested edges flip on rounding differences between the two paths' filtering.
   double max_coverage_mismatch = 0.01;
+  // validate_bake: a view whose density (view_density.h) is below this fails; 0.5 = the bake is
+  // 2x coarser than its sources where the view looks.
+  double min_density = 0.5;
 };
 // Defaults for a cache format: 40 dB for uncompressed caches, 30 dB for BC caches (BC1 alone
 // costs ~36 dB on photographs, ../shared/ANCHORS.md).
@@ -104,6 +109,8 @@ struct ViewReport {
   double virtual_ms = 0;              // one final pass with read back
   std::vector<std::string> failures;  // check_view(); empty when the view passes
   std::vector<std::string> images;    // files written for this view
+  ViewDensity density;                // validate_bake: baked texels per source texel in view
+  std::string framing;                // an automatic view: what it frames (PlannedView)
 };
 
 struct ValidationReport {
@@ -126,6 +133,7 @@ struct ValidationReport {
     double load = 0, atlas_check = 0, setup = 0, views = 0, contact_sheet = 0, total = 0;
   } seconds;
   StreamingCheckReport exact;  // the exact streaming check (exact.ran: it ran)
+  ViewPlan view_plan;      // validate_bake's automatic views (none with a camera file)
   // Every view passes and the atlas check found no failing page; with no views, the atlas check
   // ran and passed.
   bool passed() const;
@@ -161,8 +169,9 @@ struct BakeValidationOptions {
   std::string unwrapped;  // the unwrapped scene the bake wrote; "" = page_file with .glb
   std::string out_dir;    // PNGs and report.json; "" = page_file with .validate
   std::string layer;      // the layer's name; "" = the albedo layer (the only one with a reference)
-  std::string cameras_file;  // a camera file (camera.h); "" = `views` automatic orbit views
-  uint32_t views = 6;
+  std::string cameras_file;  // a camera file (camera.h); "" = `views` planned views
+  uint32_t views = 6;        // planned views (view_planner.h): overview, surfaces, texels
+  UpAxis up = UpAxis::kAuto;
   uint32_t width = 1280, height = 720;
   Thresholds thresholds = scene_thresholds();
   uint32_t slots = 32;           // physical cache slots per side
