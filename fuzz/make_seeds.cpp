@@ -14,6 +14,7 @@
 #include "fuzz/fuzz_obj.h"
 #include "scene/gltf_export.h"
 #include "scene/scene.h"
+#include "scene/scene_io_util.h"
 
 namespace vt::fuzz {
 namespace {
@@ -152,31 +153,13 @@ scene::Scene quad_scene() {
   scene::Image image;
   image.name = "albedo";
   image.uri = image.path = "albedo.png";
-  scene::Scene s;
-  s.meshes.push_back({"quad", {p}});
-  s.materials.push_back(m);
+  scene::Scene s = scene::detail::single_mesh_scene("quad.gltf", "quad", {p}, {m});
   s.images.push_back(image);
-  scene::Node node;
-  node.name = "quad";
-  node.mesh = 0;
-  s.nodes.push_back(node);
-  s.roots.push_back(0);
   return s;
 }
 
-std::string base64(const std::string& bytes) {
-  static const char* kTable = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (size_t i = 0; i < bytes.size(); i += 3) {
-    uint32_t v = uint32_t(uint8_t(bytes[i])) << 16;
-    if (i + 1 < bytes.size()) v |= uint32_t(uint8_t(bytes[i + 1])) << 8;
-    if (i + 2 < bytes.size()) v |= uint8_t(bytes[i + 2]);
-    out += kTable[(v >> 18) & 63];
-    out += kTable[(v >> 12) & 63];
-    out += i + 1 < bytes.size() ? kTable[(v >> 6) & 63] : '=';
-    out += i + 2 < bytes.size() ? kTable[v & 63] : '=';
-  }
-  return out;
+std::string base64_of(const std::string& bytes) {
+  return scene::detail::base64_encode(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
 }
 
 void gltf_seeds(const fs::path& dir, const fs::path& scratch) {
@@ -191,7 +174,7 @@ void gltf_seeds(const fs::path& dir, const fs::path& scratch) {
   if (at == std::string::npos) fail("quad.gltf does not name quad.bin");
   json.replace(
       at, uri.size(),
-      "\"data:application/octet-stream;base64," + base64(read(scratch / "quad.bin")) + "\"");
+      "\"data:application/octet-stream;base64," + base64_of(read(scratch / "quad.bin")) + "\"");
   write(dir / "quad.gltf", json);
 }
 
