@@ -17,18 +17,22 @@
 
 namespace vt::fuzz {
 
-// The process's scratch folder, removed at exit.
+// The process's scratch folder, removed at exit. Held in a buffer that is never destroyed: the
+// exit handler runs after function-local statics are gone.
 inline const std::string& scratch_dir() {
-  static const std::string dir = [] {
+  static const std::string& dir = *new std::string([] {
     const char* base = std::filesystem::is_directory("/dev/shm") ? "/dev/shm" : "/tmp";
     std::string tmpl = std::string(base) + "/vtbake_fuzz_XXXXXX";
     if (!::mkdtemp(tmpl.data())) std::abort();
-    std::atexit([] {
-      std::error_code ec;
-      std::filesystem::remove_all(scratch_dir(), ec);
-    });
     return tmpl + "/";
+  }());
+  static const bool cleanup = [] {
+    return std::atexit([] {
+             std::error_code ec;
+             std::filesystem::remove_all(scratch_dir(), ec);
+           }) == 0;
   }();
+  (void)cleanup;
   return dir;
 }
 

@@ -187,6 +187,10 @@ Status check_budget(const std::string& path, const Header& h, size_t file_size) 
     for (const Property& p : e.props)
       unit += h.format == 0 ? 2 : (p.count_type ? p.count_type->size : p.type->size);
     std::string what = path + ": PLY element " + e.name;
+    // Entries without properties occupy no bytes, so no file size bounds their count.
+    if (e.count > 0 && e.props.empty())
+      return corrupt(path, "element " + e.name + " has " + std::to_string(e.count) +
+                               " entries but no properties");
     VT_RETURN_IF_ERROR(check_backed(what, e.count, unit, "the rest of the file", left));
     if (e.is_vertex()) VT_RETURN_IF_ERROR(check_ceiling(what, e.count, kMaxVertices, "vertices"));
     if (e.is_faces()) VT_RETURN_IF_ERROR(check_ceiling(what, e.count, kMaxIndices / 3, "faces"));

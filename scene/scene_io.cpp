@@ -15,6 +15,10 @@ namespace vt::scene {
 namespace detail {
 
 Expected<std::vector<uint8_t>> read_file(const std::string& path) {
+  // A directory opens and reports a size of 2^63 - 1; a FIFO would block in fopen.
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    return Error(ErrorCode::kInvalidArgument, path + ": not a regular file");
   std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
   if (!f) return Error(ErrorCode::kNotFound, path + ": cannot open file");
   if (std::fseek(f.get(), 0, SEEK_END) != 0) return Error(ErrorCode::kIo, path + ": cannot seek");

@@ -164,5 +164,20 @@ TEST(Ply, IndicesOutsideTheVerticesAreNamed) {
       << s.status().message();
 }
 
+// Fuzz finding (fuzz/fuzz_ply.cpp): an element without properties occupies no bytes, so the
+// budget passed any count and 200,000,000 vertices made a 2.4 GiB allocation. Refused now.
+TEST(Ply, ElementWithoutPropertiesIsRefusedBeforeAllocating) {
+  const std::string path = write("no_properties.ply",
+                                 "ply\nformat ascii 1.0\nelement vertex 200000000\nelement face 1\n"
+                                 "property list uchar int vertex_indices\nend_header\n3 0 1 2\n");
+  std::optional<Expected<scene::Scene>> s;
+  const size_t largest = largest_allocation_during([&] { s.emplace(scene::load_scene(path)); });
+  ASSERT_FALSE(s->ok());
+  EXPECT_EQ(s->status().code(), ErrorCode::kCorrupt);
+  EXPECT_EQ(s->status().message(),
+            path + ": PLY: element vertex has 200000000 entries but no properties");
+  EXPECT_LT(largest, size_t{64} << 10);
+}
+
 }  // namespace
 }  // namespace vt::test
