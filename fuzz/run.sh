@@ -46,9 +46,10 @@ run_one() {
     "$bin/vt_fuzz_$name" "${args[@]}" "$out" "$bin/seeds/$seeds" >"$log" 2>&1
   local rc=$?
   local runs rate rss cov ft
-  runs=$(grep -o 'stat::number_of_executed_units: [0-9]*' "$log" | grep -o '[0-9]*$')
-  rate=$(grep -o 'stat::average_exec_per_sec: [0-9]*' "$log" | grep -o '[0-9]*$')
-  rss=$(grep -o 'stat::peak_rss_mb: [0-9]*' "$log" | grep -o '[0-9]*$')
+  stat() { awk -v k="stat::$1:" '$1 == k { v = $2 } END { print v }' "$log"; }
+  runs=$(stat number_of_executed_units)
+  rate=$(stat average_exec_per_sec)
+  rss=$(stat peak_rss_mb)
   cov=$(grep -oE 'cov: [0-9]+' "$log" | tail -1 | grep -oE '[0-9]+')
   ft=$(grep -oE 'ft: [0-9]+' "$log" | tail -1 | grep -oE '[0-9]+')
   local files
