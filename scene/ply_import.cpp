@@ -12,6 +12,7 @@
 // glTF's COLOR_0). Alpha stays as written.
 #include <algorithm>
 #include <charconv>
+#include <cstdint>
 #include <cstring>
 #include <new>
 #include <sstream>
@@ -187,6 +188,10 @@ Status check_budget(const std::string& path, const Header& h, size_t file_size) 
     for (const Property& p : e.props)
       unit += h.format == 0 ? 2 : (p.count_type ? p.count_type->size : p.type->size);
     std::string what = path + ": PLY element " + e.name;
+    // Entries without properties occupy no bytes, so no file size bounds their count.
+    if (e.count > 0 && e.props.empty())
+      return corrupt(path, "element " + e.name + " has " + std::to_string(e.count) +
+                               " entries but no properties");
     VT_RETURN_IF_ERROR(check_backed(what, e.count, unit, "the rest of the file", left));
     if (e.is_vertex()) VT_RETURN_IF_ERROR(check_ceiling(what, e.count, kMaxVertices, "vertices"));
     if (e.is_faces()) VT_RETURN_IF_ERROR(check_ceiling(what, e.count, kMaxIndices / 3, "faces"));
@@ -275,6 +280,21 @@ struct VertexSink {
 };
 
 // Appends the triangles of one face or strip list, each index checked against the vertices.
+// An ASCII value as written ("1e+30", "nan"): shortest round-trip form.
+std::string number_text(double v) {
+  char buf[32];
+  auto r = std::to_chars(buf, buf + sizeof(buf), v);
+  return std::string(buf, r.ptr);
+}
+
+// A list entry as an integer; values outside int64 (and NaN) saturate, so that add_triangles
+// refuses them as out-of-range vertices instead of the conversion being undefined.
+int64_t saturated_int(double v) {
+  if (v >= 9.2e18) return INT64_MAX;
+  if (!(v > -9.2e18)) return INT64_MIN;
+  return static_cast<int64_t>(v);
+}
+
 Status add_triangles(const std::string& path, const Element& e, uint64_t entry,
                      const std::vector<int64_t>& list, size_t vertices,
                      std::vector<uint32_t>* out) {
@@ -323,12 +343,12 @@ Status read_elements(const std::string& path, const Header& h, const std::vector
         }
         double n = r.value(pr.count_type);
         size_t least = h.format == 0 ? 2 : pr.type->size;
-        if (n < 0 || n > static_cast<double>(r.bytes_left() / least + 1))
-          return corrupt(path, e.name + " " + std::to_string(i) + ": a list of " +
-                                   std::to_string(static_cast<int64_t>(n)) +
+        // Written so that NaN fails too; the count is printed as read (it may not fit an int).
+        if (!(n >= 0 && n <= static_cast<double>(r.bytes_left() / least + 1)))
+          return corrupt(path, e.name + " " + std::to_string(i) + ": a list of " + number_text(n) +
                                    " entries runs past the end of the file");
         list.resize(static_cast<size_t>(n));
-        for (int64_t& v : list) v = static_cast<int64_t>(r.value(pr.type));
+        for (int64_t& v : list) v = saturated_int(r.value(pr.type));
         if (r.ok && is_index_list(e, pr))
           VT_RETURN_IF_ERROR(add_triangles(path, e, i, list, vertices, &prim->indices));
       }

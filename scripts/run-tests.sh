@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Sets up a Debian 12 machine, builds vtbake and runs the whole test suite: the runtime side
-# (codec, format, runtime) under ASan/UBSan, then everything in Release. Ends with ctest's summary.
+# (codec, format, runtime) under ASan/UBSan, then every fuzz target for a bounded time (clang,
+# libFuzzer, ASan/UBSan; any finding fails), then everything in Release. Ends with ctest's summary.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -9,6 +10,10 @@ jobs=$(nproc)
 cmake --preset asan-runtime >/dev/null
 cmake --build --preset asan-runtime -j "$jobs"
 ctest --preset asan-runtime -j "$jobs"
+
+cmake --preset fuzz >/dev/null
+cmake --build --preset fuzz -j "$jobs"
+fuzz/run.sh --build build/fuzz --seconds "${VTBAKE_FUZZ_SECONDS:-20}" --jobs "$jobs"
 
 cmake --preset release >/dev/null
 cmake --build --preset release -j "$jobs"

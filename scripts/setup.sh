@@ -12,6 +12,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libvulkan-dev glslc mesa-vulkan-drivers
   libjpeg62-turbo-dev libstb-dev
+  clang libclang-rt-14-dev
 )
 
 missing=()

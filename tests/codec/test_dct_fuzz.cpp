@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "common/hash.h"
-#include "fuzz_dct.cpp"
+#include "fuzz/fuzz_dct.cpp"
 
 namespace vt {
 namespace {

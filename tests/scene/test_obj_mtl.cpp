@@ -6,9 +6,11 @@
 
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include "common/srgb.h"
 #include "scene/scene.h"
+#include "tests/scene/alloc_probe.h"
 
 namespace vt::test {
 namespace {
@@ -374,6 +376,27 @@ TEST(ObjMtl, Latin1NamesAndMalformedNumberTails) {
   EXPECT_FLOAT_EQ(s.meshes[0].primitives[0].positions[2][2], 3.1f);
   EXPECT_EQ(warnings_with(s, {"a.mtl: not UTF-8: read as Latin-1"}), 1);
   EXPECT_EQ(warnings_with(s, {"a.obj: not UTF-8: read as Latin-1"}), 1);
+}
+
+// Fuzz finding (fuzz/fuzz_obj.cpp): an mtllib naming a folder made read_file ask for 2^63 bytes
+// (a folder opens and reports that size). It is refused as not a regular file; the OBJ keeps
+// its default material. An OBJ path that is a folder is refused the same way.
+TEST(ObjMtl, LibraryThatIsAFolderIsRefusedBeforeAllocating) {
+  const std::string dir = folder("mtl_folder");
+  fs::create_directories(dir + "lib.mtl");
+  write_file(dir + "a.obj", "mtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  std::optional<Expected<scene::Scene>> s;
+  const size_t largest =
+      largest_allocation_during([&] { s.emplace(scene::load_scene(dir + "a.obj")); });
+  ASSERT_TRUE(s->ok()) << s->status().message();
+  EXPECT_EQ((*s)->meshes[0].primitives[0].indices, (std::vector<uint32_t>{0, 1, 2}));
+  EXPECT_LT(largest, size_t{1} << 20);
+
+  fs::create_directories(dir + "b.obj");
+  auto folder_obj = scene::load_scene(dir + "b.obj");
+  ASSERT_FALSE(folder_obj.ok());
+  EXPECT_EQ(folder_obj.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(folder_obj.status().message(), dir + "b.obj: not a regular file");
 }
 
 }  // namespace

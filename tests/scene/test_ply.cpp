@@ -164,5 +164,44 @@ TEST(Ply, IndicesOutsideTheVerticesAreNamed) {
       << s.status().message();
 }
 
+// Fuzz finding (fuzz/fuzz_ply.cpp): an element without properties occupies no bytes, so the
+// budget passed any count and 200,000,000 vertices made a 2.4 GiB allocation. Refused now.
+TEST(Ply, ElementWithoutPropertiesIsRefusedBeforeAllocating) {
+  const std::string path = write("no_properties.ply",
+                                 "ply\nformat ascii 1.0\nelement vertex 200000000\nelement face 1\n"
+                                 "property list uchar int vertex_indices\nend_header\n3 0 1 2\n");
+  std::optional<Expected<scene::Scene>> s;
+  const size_t largest = largest_allocation_during([&] { s.emplace(scene::load_scene(path)); });
+  ASSERT_FALSE(s->ok());
+  EXPECT_EQ(s->status().code(), ErrorCode::kCorrupt);
+  EXPECT_EQ(s->status().message(),
+            path + ": PLY: element vertex has 200000000 entries but no properties");
+  EXPECT_LT(largest, size_t{64} << 10);
+}
+
+// Fuzz finding (fuzz/fuzz_ply.cpp, UBSan): a list count or an index beyond int64 in an ASCII
+// file was converted to an integer (undefined); a NaN count passed the check. All are refused.
+TEST(Ply, ListCountsAndIndicesBeyondIntegersAreRefused) {
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n";
+  const std::string huge = write("huge_list.ply", head + "1.4e19 0 1 2\n");
+  auto a = scene::load_scene(huge);
+  ASSERT_FALSE(a.ok());
+  EXPECT_EQ(a.status().message(),
+            huge + ": PLY: face 0: a list of 1.4e+19 entries runs past the end of the file");
+  const std::string nan = write("nan_list.ply", head + "nan 0 1 2\n");
+  auto b = scene::load_scene(nan);
+  ASSERT_FALSE(b.ok());
+  EXPECT_EQ(b.status().message(),
+            nan + ": PLY: face 0: a list of nan entries runs past the end of the file");
+  const std::string index = write("huge_index.ply", head + "3 0 1 1e30\n");
+  auto c = scene::load_scene(index);
+  ASSERT_FALSE(c.ok());
+  EXPECT_EQ(c.status().message(),
+            index + ": PLY: face 0 uses vertex 9223372036854775807 but there are 3");
+}
+
 }  // namespace
 }  // namespace vt::test

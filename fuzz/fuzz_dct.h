@@ -1,15 +1,15 @@
-// libFuzzer entry for the page DCT decoder and tables parser. Build alone with
-// -fsanitize=fuzzer, or as a plain function: test_dct_fuzz.cpp includes this file and drives it
-// with random and mutated inputs under the sanitizers.
+// The DCT fuzz target's input layout, shared by the target (fuzz_dct.cpp) and the seed writer.
 //
 // Input: byte 0 selects the target (bit 0: tables parser; else page decoder, bits 1-3 the
 // channel layout, bit 4 trained tables), byte 1 the quality, byte 2 the page size; the rest is
 // the data under test.
+#pragma once
+
 #include <array>
 #include <cstdint>
 #include <cstdlib>
-#include <cstring>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "codec/dct.h"
@@ -60,31 +60,3 @@ inline DctTablesPtr tables_for(const Setup& s) {
 }
 
 }  // namespace vt::dct_fuzz
-
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  using namespace vt;
-  if (size < dct_fuzz::kHeaderBytes) return 0;
-  const std::span<const uint8_t> body(data + dct_fuzz::kHeaderBytes, size - dct_fuzz::kHeaderBytes);
-  if (data[0] & 1) {
-    auto tables = dct_parse_tables(body);
-    if (tables.ok()) {
-      // Whatever parses must serialise back to bytes that parse to the same tables.
-      const auto bytes = dct_serialize_tables(**tables);
-      auto again = dct_parse_tables(bytes);
-      if (!again.ok() || dct_serialize_tables(**again) != bytes) std::abort();
-    }
-    return 0;
-  }
-  const dct_fuzz::Setup setup = dct_fuzz::setup_from(data);
-  const DctTablesPtr tables = dct_fuzz::tables_for(setup);
-  const size_t texels = size_t(setup.width) * setup.height * setup.settings.channels;
-  std::vector<uint8_t> a(texels, 0x11), b(texels, 0x22);
-  const Status sa = dct_decode_page(*tables, body, setup.width, setup.height, a.data());
-  if (!sa.ok() && sa.code() != ErrorCode::kCorrupt) std::abort();
-  if (sa.ok()) {
-    // Every texel written, and the same bytes decode to the same texels.
-    const Status sb = dct_decode_page(*tables, body, setup.width, setup.height, b.data());
-    if (!sb.ok() || a != b) std::abort();
-  }
-  return 0;
-}
