@@ -117,6 +117,7 @@ std::string report_json(const ValidationReport& r) {
                      {"virtual_ms", v.virtual_ms},
                      {"reference_ms", v.reference_ms},
                      {"images", v.images}});
+    if (v.lit) views.back()["lit"] = to_json(*v.lit);
   }
   json doc = {{"page_file", r.page_file},
               {"layer", r.layer},
@@ -129,6 +130,11 @@ std::string report_json(const ValidationReport& r) {
                 {"min_tile_psnr", r.thresholds.min_tile_psnr},
                 {"max_coarser_share", r.thresholds.max_coarser_share},
                 {"max_coverage_mismatch", r.thresholds.max_coverage_mismatch}}},
+              {"lit",
+               {{"layers", r.lit_layers},
+                {"skipped", r.lit_skipped},
+                {"min_psnr", r.lit_thresholds.min_psnr},
+                {"min_tile_psnr", r.lit_thresholds.min_tile_psnr}}},
               {"passed", r.passed()},
               {"views", views},
               {"atlas", to_json(r.atlas)}};
