@@ -232,6 +232,9 @@ Expected<LitLayers> find_lit_layers(std::span<const LayerSpec> layers,
       break;
     }
   }
+  if (named && !out.any() && !out.skipped.empty()) {
+    return Error(ErrorCode::kUnsupported, "layer " + out.skipped[0]);
+  }
   if (!out.layer[0]) out.layer = {};  // no albedo to shade: no lit pass
   return out;
 }

@@ -134,7 +134,7 @@ struct LitFrameOptions {
   float eye[3] = {0, 0, 0};
   float key_dir[3] = {0, 0, 1};   // towards the key light
   float fill_dir[3] = {0, 0, 1};  // towards the fill light
-  float key = 2.2f, fill = 0.7f, ambient = 0.12f;
+  float key = 1.4f, fill = 0.45f, ambient = 0.1f;
   uint32_t inputs = 0;
 };
 
