@@ -1,6 +1,7 @@
 #include "render/renderer.h"
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <functional>
 #include <utility>
@@ -38,6 +39,44 @@ uint32_t mip_count(uint32_t w, uint32_t h) {
   while ((w >> n) > 0 || (h >> n) > 0) ++n;
   return n;
 }
+
+// The lit passes' Vulkan objects, made on first use (no lit pass, no cost).
+struct LitState {
+  VkDevice dev = VK_NULL_HANDLE;
+  VkDescriptorSetLayout ref_set_layout = VK_NULL_HANDLE;
+  VkDescriptorSetLayout vt_set_layout = VK_NULL_HANDLE;
+  VkPipelineLayout ref_layout = VK_NULL_HANDLE;
+  VkPipelineLayout vt_layout = VK_NULL_HANDLE;
+  VkPipeline ref_pipe = VK_NULL_HANDLE;
+  VkPipeline vt_pipe = VK_NULL_HANDLE;
+  VkDescriptorPool ref_pool = VK_NULL_HANDLE;
+  VkDescriptorPool vt_pool = VK_NULL_HANDLE;
+  VkDescriptorSet vt_set = VK_NULL_HANDLE;
+  Buffer frame;  // the LitFrame uniform block (shaders/lit.glsl), host-visible
+  Image blank;   // 1 x 1 white: what an unused cache binding reads
+  struct Material {
+    Image normal, orm, emissive;
+    VkDescriptorSet set = VK_NULL_HANDLE;
+    float emissive_scale[3] = {0, 0, 0};
+    float normal_scale = 1.0f;
+    int32_t flags = 0;  // bit 0 normal map, bit 1 two-channel normal map
+  };
+  std::vector<Material> materials;
+  std::array<Image, kLitInputCount> caches;
+  std::array<std::optional<RuntimeFormat>, kLitInputCount> formats;
+  bool ready() const { return ref_pipe != VK_NULL_HANDLE; }
+  ~LitState() {
+    if (!dev) return;
+    for (VkPipeline p : {ref_pipe, vt_pipe})
+      if (p) vkDestroyPipeline(dev, p, nullptr);
+    for (VkPipelineLayout l : {ref_layout, vt_layout})
+      if (l) vkDestroyPipelineLayout(dev, l, nullptr);
+    for (VkDescriptorSetLayout l : {ref_set_layout, vt_set_layout})
+      if (l) vkDestroyDescriptorSetLayout(dev, l, nullptr);
+    for (VkDescriptorPool p : {ref_pool, vt_pool})
+      if (p) vkDestroyDescriptorPool(dev, p, nullptr);
+  }
+};
 
 }  // namespace
 
@@ -178,6 +217,14 @@ struct Renderer::Impl {
   // A pool of `sets` descriptor sets of `descriptors` combined image samplers in all.
   Expected<VkDescriptorPool> make_pool(uint32_t sets, uint32_t descriptors);
   Expected<VkDescriptorSet> allocate_set(VkDescriptorPool pool, VkDescriptorSetLayout layout);
+
+  // Lit passes (after the other members: destroyed first).
+  LitState lit;
+  Status init_lit();
+  Expected<Image> upload_texture(const ReferenceTexture& tex, const std::string& name);
+  VkSampler sampler_for(AddressMode mode) const {
+    return mode == AddressMode::kWrap ? trilinear_repeat : trilinear_clamp;
+  }
 };
 
 Renderer::Impl::~Impl() {
@@ -896,6 +943,344 @@ Expected<VirtualFrame> Renderer::render_virtual(const Camera& camera) {
       p.tex[2] = 1.0f;
       p.tex[3] = m.alpha_cutoff;
       draw_mesh(cmd, s.vt_layout, p, m);
+    }
+  }));
+  VirtualFrame out;
+  out.color = s.read_color(w, h);
+  out.status = read_u32(s.status_rb, size_t(w) * h);
+  return out;
+}
+
+// ---- Lit passes ----
+
+namespace {
+
+// Mirrors `LitFrame` in shaders/lit.glsl (std140: three vec4).
+struct LitFrameBlock {
+  float eye[4];
+  float key[4];
+  float fill[4];
+};
+
+int32_t float_bits(float f) {
+  int32_t i;
+  std::memcpy(&i, &f, sizeof(i));
+  return i;
+}
+
+void fill_lit_frame(const Buffer& frame, const LitFrameOptions& o) {
+  LitFrameBlock b{};
+  for (int c = 0; c < 3; ++c)
+    b.eye[c] = o.eye[c], b.key[c] = o.key_dir[c], b.fill[c] = o.fill_dir[c];
+  b.eye[3] = o.ambient;
+  b.key[3] = o.key;
+  b.fill[3] = o.fill;
+  std::memcpy(frame.mapped(), &b, sizeof(b));
+}
+
+// The shader's input bits (lit.glsl kLitNormal, kLitOrm, kLitEmissive) from LitFrameOptions'.
+int32_t lit_input_bits(uint32_t inputs) {
+  auto has = [&](LitInput i) { return (inputs >> uint32_t(i)) & 1u; };
+  return int32_t(has(LitInput::kNormal) | has(LitInput::kOrm) << 1 | has(LitInput::kEmissive) << 2);
+}
+
+}  // namespace
+
+Expected<Image> Renderer::Impl::upload_texture(const ReferenceTexture& tex,
+                                               const std::string& name) {
+  if (tex.width == 0 || tex.height == 0 || tex.levels.empty()) {
+    return Error(ErrorCode::kInvalidArgument, name + " is empty");
+  }
+  const uint32_t levels =
+      std::min<uint32_t>(uint32_t(tex.levels.size()), mip_count(tex.width, tex.height));
+  std::vector<ImageCopy> copies;
+  std::vector<uint8_t> staging;
+  for (uint32_t l = 0; l < levels; ++l) {
+    uint32_t w = std::max(1u, tex.width >> l), h = std::max(1u, tex.height >> l);
+    if (tex.levels[l].size() != size_t(w) * h * 4) {
+      return Error(ErrorCode::kInvalidArgument,
+                   name + " level " + std::to_string(l) + " has the wrong byte count");
+    }
+    copies.push_back({staging.size(), l, 0, 0, w, h});
+    staging.insert(staging.end(), tex.levels[l].begin(), tex.levels[l].end());
+  }
+  ImageDesc d;
+  d.width = tex.width;
+  d.height = tex.height;
+  d.mip_levels = levels;
+  VT_ASSIGN_OR_RETURN(Image image, ctx.create_image(d));
+  VT_RETURN_IF_ERROR(upload_image(image, staging, copies, VK_IMAGE_LAYOUT_UNDEFINED));
+  return image;
+}
+
+Status Renderer::Impl::init_lit() {
+  if (lit.ready()) return Status::Ok();
+  lit.dev = dev;
+  // Reference: albedo, normal, ORM, emissive, LitFrame. Virtual: page table, the four caches,
+  // LitFrame.
+  auto set_layout = [&](uint32_t samplers, VkDescriptorSetLayout* out) -> Status {
+    std::vector<VkDescriptorSetLayoutBinding> b(samplers + 1);
+    for (uint32_t i = 0; i <= samplers; ++i) {
+      b[i].binding = i;
+      b[i].descriptorType = i < samplers ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER
+                                         : VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+      b[i].descriptorCount = 1;
+      b[i].stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT;
+    }
+    VkDescriptorSetLayoutCreateInfo ci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    ci.bindingCount = uint32_t(b.size());
+    ci.pBindings = b.data();
+    VT_VK(vkCreateDescriptorSetLayout(dev, &ci, nullptr, out));
+    return Status::Ok();
+  };
+  VT_RETURN_IF_ERROR(set_layout(4, &lit.ref_set_layout));
+  VT_RETURN_IF_ERROR(set_layout(5, &lit.vt_set_layout));
+  VkPushConstantRange push{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                           sizeof(Push)};
+  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pl.pushConstantRangeCount = 1;
+  pl.pPushConstantRanges = &push;
+  pl.setLayoutCount = 1;
+  pl.pSetLayouts = &lit.ref_set_layout;
+  VT_VK(vkCreatePipelineLayout(dev, &pl, nullptr, &lit.ref_layout));
+  pl.pSetLayouts = &lit.vt_set_layout;
+  VT_VK(vkCreatePipelineLayout(dev, &pl, nullptr, &lit.vt_layout));
+  const VkFormat formats[] = {kColorFormat, kUintFormat};
+  VT_ASSIGN_OR_RETURN(lit.vt_pipe, make_pipeline(lit.vt_layout, spirv_lit_virtual_frag(), formats));
+  VT_ASSIGN_OR_RETURN(lit.frame, ctx.create_buffer(sizeof(LitFrameBlock),
+                                                   VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true));
+  ReferenceTexture white;
+  white.width = white.height = 1;
+  white.levels = {{255, 255, 255, 255}};
+  VT_ASSIGN_OR_RETURN(lit.blank, upload_texture(white, "render: lit blank texture"));
+  // Last: ready() means everything above exists.
+  VT_ASSIGN_OR_RETURN(lit.ref_pipe,
+                      make_pipeline(lit.ref_layout, spirv_lit_reference_frag(), formats));
+  return Status::Ok();
+}
+
+namespace {
+
+// A pool of `sets` sets with `samplers` combined image samplers and one uniform buffer each.
+Expected<VkDescriptorPool> make_lit_pool(VkDevice dev, uint32_t sets, uint32_t samplers) {
+  VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, sets * samplers},
+                                   {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, sets}};
+  VkDescriptorPoolCreateInfo ci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  ci.maxSets = sets;
+  ci.poolSizeCount = 2;
+  ci.pPoolSizes = sizes;
+  VkDescriptorPool pool;
+  VT_VK(vkCreateDescriptorPool(dev, &ci, nullptr, &pool));
+  return pool;
+}
+
+// Writes `images` to bindings 0.. of `set` and the lit frame buffer to the binding after them.
+void write_lit_set(VkDevice dev, VkDescriptorSet set, std::span<const VkDescriptorImageInfo> images,
+                   const Buffer& frame) {
+  std::vector<VkWriteDescriptorSet> w(images.size() + 1, {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET});
+  VkDescriptorBufferInfo bi{frame.handle(), 0, sizeof(LitFrameBlock)};
+  for (uint32_t i = 0; i < w.size(); ++i) {
+    w[i].dstSet = set;
+    w[i].dstBinding = i;
+    w[i].descriptorCount = 1;
+    if (i < images.size()) {
+      w[i].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+      w[i].pImageInfo = &images[i];
+    } else {
+      w[i].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+      w[i].pBufferInfo = &bi;
+    }
+  }
+  vkUpdateDescriptorSets(dev, uint32_t(w.size()), w.data(), 0, nullptr);
+}
+
+}  // namespace
+
+Status Renderer::set_lit_materials(std::span<const LitMaterial> materials) {
+  Impl& s = *impl_;
+  if (materials.size() != s.textures.size()) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "render: " + std::to_string(materials.size()) + " lit materials for " +
+                     std::to_string(s.textures.size()) + " reference textures");
+  }
+  VT_RETURN_IF_ERROR(s.init_lit());
+  vkDeviceWaitIdle(s.dev);
+  s.lit.materials.clear();
+  if (s.lit.ref_pool) vkDestroyDescriptorPool(s.dev, s.lit.ref_pool, nullptr);
+  s.lit.ref_pool = VK_NULL_HANDLE;
+  if (materials.empty()) return Status::Ok();
+  VT_ASSIGN_OR_RETURN(s.lit.ref_pool, make_lit_pool(s.dev, uint32_t(materials.size()), 4));
+  for (size_t i = 0; i < materials.size(); ++i) {
+    const LitMaterial& m = materials[i];
+    const std::string name = "render: lit material " + std::to_string(i);
+    LitState::Material g;
+    VT_ASSIGN_OR_RETURN(g.normal, s.upload_texture(m.normal, name + " normal map"));
+    VT_ASSIGN_OR_RETURN(g.orm, s.upload_texture(m.orm, name + " ORM"));
+    VT_ASSIGN_OR_RETURN(g.emissive, s.upload_texture(m.emissive, name + " emissive"));
+    for (int c = 0; c < 3; ++c) g.emissive_scale[c] = m.emissive_scale[c];
+    g.normal_scale = m.normal_scale;
+    g.flags = (m.has_normal_map ? 1 : 0) | (m.two_channel_normal ? 2 : 0);
+    VT_ASSIGN_OR_RETURN(g.set, s.allocate_set(s.lit.ref_pool, s.lit.ref_set_layout));
+    const Impl::GpuTexture& albedo = s.textures[i];
+    const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    const VkDescriptorImageInfo images[4] = {
+        {s.sampler_for(albedo.mode), albedo.image.view(), ro},
+        {s.sampler_for(m.normal.address_mode), g.normal.view(), ro},
+        {s.sampler_for(m.orm.address_mode), g.orm.view(), ro},
+        {s.sampler_for(m.emissive.address_mode), g.emissive.view(), ro}};
+    write_lit_set(s.dev, g.set, images, s.lit.frame);
+    s.lit.materials.push_back(std::move(g));
+  }
+  return Status::Ok();
+}
+
+Status Renderer::set_lit_caches(
+    std::span<const std::optional<RuntimeFormat>, kLitInputCount> formats) {
+  Impl& s = *impl_;
+  if (!s.has_vt) return Error(ErrorCode::kInvalidArgument, "render: no virtual texture set");
+  // The albedo cache's size addresses every cache in the shader.
+  if (!formats[0]) {
+    return Error(ErrorCode::kInvalidArgument, "render: the lit caches need an albedo cache");
+  }
+  VT_RETURN_IF_ERROR(s.init_lit());
+  vkDeviceWaitIdle(s.dev);
+  const uint32_t ps = s.vt.geometry.page_size();
+  for (uint32_t i = 0; i < kLitInputCount; ++i) {
+    if (!formats[i]) {
+      s.lit.caches[i].reset();
+      s.lit.formats[i].reset();
+      continue;
+    }
+    const VkFormat f = cache_vk_format(*formats[i]);
+    if (f == VK_FORMAT_UNDEFINED || !s.ctx.supports_sampled_linear(f)) {
+      return Error(ErrorCode::kUnsupported, std::string("render: cannot sample a ") +
+                                                to_string(*formats[i]) +
+                                                " lit cache with linear filtering");
+    }
+    const ImageDesc& have = s.lit.caches[i].desc();
+    if (!s.lit.caches[i].handle() || s.lit.formats[i] != formats[i] ||
+        have.width != s.vt.slots_x * ps || have.height != s.vt.slots_y * ps) {
+      ImageDesc cd;
+      cd.width = s.vt.slots_x * ps;
+      cd.height = s.vt.slots_y * ps;
+      cd.format = f;
+      VT_ASSIGN_OR_RETURN(s.lit.caches[i], s.ctx.create_image(cd));
+      VT_RETURN_IF_ERROR(s.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+        VulkanContext::transition(cmd, s.lit.caches[i], VK_IMAGE_LAYOUT_UNDEFINED,
+                                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+      }));
+      s.lit.formats[i] = formats[i];
+    }
+  }
+  if (!s.lit.vt_pool) {
+    VT_ASSIGN_OR_RETURN(s.lit.vt_pool, make_lit_pool(s.dev, 1, 5));
+    VT_ASSIGN_OR_RETURN(s.lit.vt_set, s.allocate_set(s.lit.vt_pool, s.lit.vt_set_layout));
+  }
+  // The page table is made anew by every set_virtual_texture: bind the current one.
+  const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  VkDescriptorImageInfo images[5] = {{s.table_sampler, s.table.view(), ro}};
+  for (uint32_t i = 0; i < kLitInputCount; ++i) {
+    // An unused input reads the blank image (the shader ignores it).
+    const Image& img = s.lit.caches[i].handle() ? s.lit.caches[i] : s.lit.blank;
+    images[i + 1] = {s.cache_sampler, img.view(), ro};
+  }
+  write_lit_set(s.dev, s.lit.vt_set, images, s.lit.frame);
+  return Status::Ok();
+}
+
+Status Renderer::upload_lit_slots(LitInput input, std::span<const SlotUpload> pages) {
+  Impl& s = *impl_;
+  const uint32_t i = uint32_t(input);
+  if (i >= kLitInputCount || !s.lit.formats[i]) {
+    return Error(ErrorCode::kInvalidArgument, "render: no lit cache for that input");
+  }
+  if (pages.empty()) return Status::Ok();
+  const uint32_t ps = s.vt.geometry.page_size();
+  const size_t bytes = cache_page_bytes(*s.lit.formats[i], ps);
+  std::vector<uint8_t> staging;
+  staging.reserve(bytes * pages.size());
+  std::vector<ImageCopy> copies;
+  for (const SlotUpload& p : pages) {
+    if (p.slot_x >= s.vt.slots_x || p.slot_y >= s.vt.slots_y || p.bytes.size() != bytes) {
+      return Error(ErrorCode::kInvalidArgument,
+                   "render: lit page upload to slot (" + std::to_string(p.slot_x) + ", " +
+                       std::to_string(p.slot_y) + ") has a bad slot or " +
+                       std::to_string(p.bytes.size()) + " bytes instead of " +
+                       std::to_string(bytes));
+    }
+    copies.push_back({staging.size(), 0, int32_t(p.slot_x * ps), int32_t(p.slot_y * ps), ps, ps});
+    staging.insert(staging.end(), p.bytes.begin(), p.bytes.end());
+  }
+  return s.upload_image(s.lit.caches[i], staging, copies, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+}
+
+Expected<ReferenceFrame> Renderer::render_lit_reference(const Camera& camera,
+                                                        const LitFrameOptions& o) {
+  Impl& s = *impl_;
+  if (s.lit.materials.size() != s.textures.size() || s.textures.empty()) {
+    return Error(ErrorCode::kInvalidArgument, "render: no lit materials set");
+  }
+  for (const auto& m : s.reference_meshes()) {
+    if (m.texture >= s.lit.materials.size()) {
+      return Error(ErrorCode::kInvalidArgument,
+                   "render: a mesh names material " + std::to_string(m.texture) + " but only " +
+                       std::to_string(s.lit.materials.size()) + " are set");
+    }
+  }
+  fill_lit_frame(s.lit.frame, o);
+  const uint32_t w = options_.width, h = options_.height;
+  VT_RETURN_IF_ERROR(s.run_color_pass(w, h, s.lit.ref_pipe, [&](VkCommandBuffer cmd) {
+    for (const auto& m : s.reference_meshes()) {
+      const auto& t = s.textures[m.texture];
+      const LitState::Material& lm = s.lit.materials[m.texture];
+      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.lit.ref_layout, 0, 1, &lm.set,
+                              0, nullptr);
+      Push p{};
+      std::memcpy(p.mvp, camera.view_proj.m.data(), sizeof(p.mvp));
+      p.tex[0] = float(t.width);
+      p.tex[1] = float(t.height);
+      p.tex[2] = 1.0f;
+      p.tex[3] = m.alpha_cutoff;
+      for (int c = 0; c < 3; ++c) p.vt[c] = float_bits(lm.emissive_scale[c]);
+      p.vt[3] = float_bits(lm.normal_scale);
+      p.misc[0] = lm.flags;
+      p.misc[1] = t.mode == AddressMode::kWrap ? 1 : 0;
+      p.misc[2] = int32_t(t.max_level);
+      p.misc[3] = lit_input_bits(o.inputs);
+      draw_mesh(cmd, s.lit.ref_layout, p, m);
+    }
+  }));
+  ReferenceFrame out;
+  out.color = s.read_color(w, h);
+  out.covered = read_u32(s.status_rb, size_t(w) * h);
+  return out;
+}
+
+Expected<VirtualFrame> Renderer::render_lit_virtual(const Camera& camera,
+                                                    const LitFrameOptions& o) {
+  Impl& s = *impl_;
+  if (!s.has_vt || !s.lit.vt_set) {
+    return Error(ErrorCode::kInvalidArgument, "render: no lit caches set");
+  }
+  for (uint32_t i = 0; i < kLitInputCount; ++i) {
+    if (((o.inputs >> i) & 1u) && !s.lit.formats[i]) {
+      return Error(ErrorCode::kInvalidArgument,
+                   "render: lit input " + std::to_string(i) + " has no cache");
+    }
+  }
+  fill_lit_frame(s.lit.frame, o);
+  const uint32_t w = options_.width, h = options_.height;
+  VT_RETURN_IF_ERROR(s.run_color_pass(w, h, s.lit.vt_pipe, [&](VkCommandBuffer cmd) {
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.lit.vt_layout, 0, 1,
+                            &s.lit.vt_set, 0, nullptr);
+    for (const auto& m : s.meshes) {
+      Push p{};
+      std::memcpy(p.mvp, camera.view_proj.m.data(), sizeof(p.mvp));
+      fill_vt_push(p, s.vt);
+      p.tex[2] = 1.0f;
+      p.tex[3] = m.alpha_cutoff;
+      p.misc[3] = lit_input_bits(o.inputs);
+      draw_mesh(cmd, s.lit.vt_layout, p, m);
     }
   }));
   VirtualFrame out;

@@ -121,6 +121,34 @@ struct VirtualFrame {
   std::vector<uint32_t> status;
 };
 
+// Lit passes (shaders/lit.glsl): metal-roughness shading with a key and a fill light fixed
+// relative to the camera, ambient, emissive added. The inputs, in cache order.
+enum class LitInput : uint32_t { kAlbedo, kNormal, kOrm, kEmissive };
+inline constexpr uint32_t kLitInputCount = 4;
+
+// One material's extra textures for the lit reference pass, beside its reference texture (the
+// albedo). Each a ReferenceTexture (RGBA8 mip chain); a 1 x 1 one where the material has none.
+struct LitMaterial {
+  ReferenceTexture normal;    // tangent-space normal map as stored (n * 0.5 + 0.5)
+  ReferenceTexture orm;       // occlusion, roughness, metallic, the material's factors applied
+  ReferenceTexture emissive;  // sRGB; times emissive_scale (linear)
+  float emissive_scale[3] = {0, 0, 0};
+  float normal_scale = 1.0f;
+  bool has_normal_map = false;
+  bool two_channel_normal = false;  // z reconstructed from x and y
+};
+
+// What one lit frame is lit with (world space) and which inputs it takes from the materials
+// or layers: a bit (1 << LitInput) per input; inputs left out take fixed values on both passes
+// (vertex normal; occlusion 1, roughness 0.5, metallic 0; no emission). Albedo is always used.
+struct LitFrameOptions {
+  float eye[3] = {0, 0, 0};
+  float key_dir[3] = {0, 0, 1};   // towards the key light
+  float fill_dir[3] = {0, 0, 1};  // towards the fill light
+  float key = 1.4f, fill = 0.45f, ambient = 0.1f;
+  uint32_t inputs = 0;
+};
+
 class Renderer {
  public:
   // `ctx` must outlive the renderer.
@@ -149,6 +177,16 @@ class Renderer {
   // `frame` rotates which tap each pixel reports and jitters the sub-pixel position.
   Expected<FeedbackImage> render_feedback(const Camera& camera, uint32_t frame);
   Expected<VirtualFrame> render_virtual(const Camera& camera);
+
+  // Lit passes. set_lit_materials: one per reference texture, after set_reference_textures.
+  // set_lit_caches: a physical cache per lit input that has a format (the others unused), sharing
+  // set_virtual_texture's page table and slots; call after each set_virtual_texture.
+  Status set_lit_materials(std::span<const LitMaterial> materials);
+  Status set_lit_caches(std::span<const std::optional<RuntimeFormat>, kLitInputCount> formats);
+  Status upload_lit_slots(LitInput input, std::span<const SlotUpload> pages);
+  Expected<ReferenceFrame> render_lit_reference(const Camera& camera,
+                                                const LitFrameOptions& options);
+  Expected<VirtualFrame> render_lit_virtual(const Camera& camera, const LitFrameOptions& options);
 
  private:
   struct Impl;

@@ -183,6 +183,7 @@ std::string report_json(const ValidationReport& r) {
                      {"images", v.images},
                      {"framing", v.framing},
                      {"density", to_json(v.density)}});
+    if (v.lit) views.back()["lit"] = to_json(*v.lit);
   }
   json doc = {{"page_file", r.page_file},
               {"layer", r.layer},
@@ -196,6 +197,11 @@ std::string report_json(const ValidationReport& r) {
                 {"max_coarser_share", r.thresholds.max_coarser_share},
                 {"max_coverage_mismatch", r.thresholds.max_coverage_mismatch},
                 {"min_density", r.thresholds.min_density}}},
+              {"lit",
+               {{"layers", r.lit_layers},
+                {"skipped", r.lit_skipped},
+                {"min_psnr", r.lit_thresholds.min_psnr},
+                {"min_tile_psnr", r.lit_thresholds.min_tile_psnr}}},
               {"passed", r.passed()},
               {"views", views},
               {"atlas", to_json(r.atlas)},

@@ -15,6 +15,12 @@ const uint32_t kFeedbackFrag[] =
 const uint32_t kVirtualFrag[] =
 #include "spirv/virtual.frag.inc"
     ;
+const uint32_t kLitReferenceFrag[] =
+#include "spirv/lit_reference.frag.inc"
+    ;
+const uint32_t kLitVirtualFrag[] =
+#include "spirv/lit_virtual.frag.inc"
+    ;
 
 }  // namespace
 
@@ -29,6 +35,12 @@ std::span<const uint32_t> spirv_feedback_frag() {
 }
 std::span<const uint32_t> spirv_virtual_frag() {
   return kVirtualFrag;
+}
+std::span<const uint32_t> spirv_lit_reference_frag() {
+  return kLitReferenceFrag;
+}
+std::span<const uint32_t> spirv_lit_virtual_frag() {
+  return kLitVirtualFrag;
 }
 
 }  // namespace vt::render

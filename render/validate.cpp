@@ -22,7 +22,7 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-Status upload_frame(Renderer& renderer, Streamer& streamer, uint32_t layer,
+Status upload_frame(Renderer& renderer, Streamer& streamer, uint32_t layer, const LitLayers& lit,
                     std::vector<PageUpload>& uploads) {
   if (!uploads.empty()) {
     std::vector<SlotUpload> slots;
@@ -34,6 +34,7 @@ Status upload_frame(Renderer& renderer, Streamer& streamer, uint32_t layer,
       slots.push_back({u.slot_x, u.slot_y, u.layers[layer]});
     }
     VT_RETURN_IF_ERROR(renderer.upload_slots(slots));
+    VT_RETURN_IF_ERROR(upload_lit_pages(renderer, lit, uploads));
   }
   // The whole table is a few KiB; uploading it all keeps the GPU copy trivially in sync.
   PageTable table = streamer.page_table();
@@ -80,7 +81,7 @@ Expected<ConvergeResult> converge_view(Renderer& renderer, Streamer& streamer, c
   {
     std::vector<PageUpload> first = streamer.take_uploads();
     result.pages_uploaded += uint32_t(first.size());
-    VT_RETURN_IF_ERROR(upload_frame(renderer, streamer, options.layer, first));
+    VT_RETURN_IF_ERROR(upload_frame(renderer, streamer, options.layer, options.lit, first));
   }
   for (uint32_t frame = 0; frame < options.max_frames; ++frame) {
     auto t0 = std::chrono::steady_clock::now();
@@ -97,7 +98,7 @@ Expected<ConvergeResult> converge_view(Renderer& renderer, Streamer& streamer, c
     result.pages_uploaded += uint32_t(uploads.size());
     result.load_errors += a.load_errors + b.load_errors;
     result.thrashing = result.thrashing || a.thrashing || b.thrashing;
-    VT_RETURN_IF_ERROR(upload_frame(renderer, streamer, options.layer, uploads));
+    VT_RETURN_IF_ERROR(upload_frame(renderer, streamer, options.layer, options.lit, uploads));
     result.stream_ms.push_back(ms_since(t0));
     result.frames_rendered = frame + 1;
 
@@ -200,6 +201,15 @@ Thresholds scene_thresholds() {
   return t;
 }
 
+Thresholds lit_scene_thresholds() {
+  Thresholds t;
+  t.min_psnr = 30.0;
+  t.min_tile_psnr = 20.0;
+  t.max_coarser_share = 1.0;  // residency and coverage are the view's own checks
+  t.max_coverage_mismatch = 1.0;
+  return t;
+}
+
 std::vector<std::string> check_view(const ViewMetrics& m, const Thresholds& t) {
   std::vector<std::string> why;
   char line[160];
@@ -247,6 +257,8 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
   converge.layer = options.layer;
   const bool exact = options.exact.enabled && !options.exact_meshes.empty();
   std::vector<VirtualFrame> frames;  // kept for the exact check
+  converge.lit = options.lit;
+  report.lit_thresholds = options.lit_thresholds;
   for (uint32_t v = 0; v < cameras.size(); ++v) {
     // A cold cache per view: frames-to-converge then measures the view alone.
     VT_ASSIGN_OR_RETURN(std::unique_ptr<Streamer> streamer,
@@ -258,6 +270,7 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
       report.thresholds = options.thresholds.value_or(default_thresholds(setup.cache_format));
     }
     VT_RETURN_IF_ERROR(renderer.set_virtual_texture(setup));
+    if (options.lit.any()) VT_RETURN_IF_ERROR(set_lit_caches_for(renderer, options.lit));
     ViewReport view;
     view.view = v;
     VT_ASSIGN_OR_RETURN(view.converge, converge_view(renderer, *streamer, cameras[v], converge));
@@ -276,6 +289,14 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
     if (view.converge.load_errors > 0) {
       view.failures.push_back(std::to_string(view.converge.load_errors) + " pages failed to load");
     }
+    std::optional<LitFrames> lit;
+    if (options.lit.any()) {
+      VT_ASSIGN_OR_RETURN(lit, render_lit_view(renderer, cameras[v], options.lit));
+      VT_ASSIGN_OR_RETURN(ViewMetrics lm, compare_view(lit->reference, lit->virt));
+      for (const std::string& why : check_view(lm, options.lit_thresholds))
+        view.failures.push_back("lit: " + why);
+      view.lit = LitViewReport{lm, lit->reference_ms, lit->virtual_ms};
+    }
     if (!options.out_dir.empty()) {
       const std::string base = options.out_dir + "/view_" + std::to_string(v) + "_";
       const std::pair<const char*, Rgba8Image> images[] = {
@@ -286,6 +307,13 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
       for (const auto& [name, image] : images) {
         VT_RETURN_IF_ERROR(write_png(base + name, image));
         view.images.push_back(base + name);
+      }
+      if (lit) {
+        for (const auto& [name, image] : {std::pair{"lit_reference.png", &lit->reference.color},
+                                          std::pair{"lit_virtual.png", &lit->virt.color}}) {
+          VT_RETURN_IF_ERROR(write_png(base + name, *image));
+          view.images.push_back(base + name);
+        }
       }
     }
     report.views.push_back(std::move(view));
@@ -315,15 +343,23 @@ struct BakeInputs {
   uint32_t layer = 0;
 };
 
-// The layer to validate: by name, or the albedo layer; only albedo has a reference render.
+// The layer to validate: by name, or the albedo layer; only albedo has a reference render of its
+// own (a normal, ORM or emissive layer is validated by the lit check, beside albedo's).
 Expected<uint32_t> find_layer(const PageFileReader& reader, const BakeValidationOptions& o) {
   for (uint32_t i = 0; i < reader.layers().size(); ++i) {
     const LayerSpec& l = reader.layers()[i];
     if (!(o.layer.empty() ? l.semantic == LayerSemantic::kAlbedo : l.name == o.layer)) continue;
+    if (l.semantic == LayerSemantic::kNormal || l.semantic == LayerSemantic::kOrm ||
+        l.semantic == LayerSemantic::kEmissive) {
+      BakeValidationOptions albedo = o;
+      albedo.layer.clear();
+      return find_layer(reader, albedo);
+    }
     if (l.semantic != LayerSemantic::kAlbedo) {
       return Error(ErrorCode::kInvalidArgument, "layer '" + o.layer +
                                                     "' is not albedo: only albedo has a "
-                                                    "reference render");
+                                                    "reference render, and normal, orm and "
+                                                    "emissive layers a lit one");
     }
     return i;
   }
@@ -389,6 +425,27 @@ Status finish_report(const BakeInputs& in, const BakeValidationOptions& o, doubl
   return write_report_json(report.out_dir + "/report.json", report);
 }
 
+// The lit check's layers and materials; the draws get their shading frames when it runs.
+struct LitInputs {
+  LitLayers layers;
+  std::vector<LitMaterial> materials;
+};
+
+Expected<LitInputs> lit_inputs_for(const PageSource& source, BakeInputs& in,
+                                   const BakeValidationOptions& o) {
+  LitInputs lit;
+  const std::vector<LayerSpec>& specs = in.reader->layers();
+  if (!o.layer.empty() && specs[in.layer].name == o.layer) return lit;  // albedo named: no lit
+  std::vector<RuntimeFormat> formats;
+  for (uint32_t l = 0; l < source.layer_count(); ++l) formats.push_back(source.upload_format(l));
+  VT_ASSIGN_OR_RETURN(lit.layers, find_lit_layers(specs, formats, o.layer));
+  if (!lit.layers.any()) return lit;
+  VT_RETURN_IF_ERROR(add_shading_frames(in.original, in.reference, true));
+  VT_RETURN_IF_ERROR(add_shading_frames(in.baked, in.virt, false));
+  VT_ASSIGN_OR_RETURN(lit.materials, lit_materials(in.original));
+  return lit;
+}
+
 }  // namespace
 
 Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
@@ -435,6 +492,7 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
   PageFileSourceOptions so;
   so.bc7_as_rgba8 = ctx->is_lavapipe();  // lavapipe samples BC7 15-25x slower than BC1
   VT_ASSIGN_OR_RETURN(std::unique_ptr<PageSource> source, make_page_file_source(in.reader, so));
+  VT_ASSIGN_OR_RETURN(LitInputs lit, lit_inputs_for(*source, in, o));
 
   RenderOptions ro;
   ro.width = o.width;
@@ -443,6 +501,7 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
   VT_RETURN_IF_ERROR(renderer->set_meshes(in.virt.meshes));
   VT_RETURN_IF_ERROR(renderer->set_reference_meshes(in.reference.meshes));
   VT_RETURN_IF_ERROR(renderer->set_reference_textures(in.reference.textures));
+  if (lit.layers.any()) VT_RETURN_IF_ERROR(renderer->set_lit_materials(lit.materials));
 
   ValidateOptions vopt;
   vopt.layer = in.layer;
@@ -459,6 +518,8 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
                            vopt.alpha_cutoffs.end());
   vopt.exact = o.exact;
   vopt.exact_meshes = in.virt.meshes;
+  vopt.lit = lit.layers;
+  vopt.lit_thresholds = o.lit_thresholds;
 
   const double setup_seconds = seconds_since(setup_start);
   const auto views_start = std::chrono::steady_clock::now();
@@ -476,6 +537,9 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
   report.view_plan = std::move(plan);
   report.page_file = o.page_file;
   report.device = ctx->device_name();
+  for (const auto& l : lit.layers.layer)
+    if (l) report.lit_layers.push_back(in.reader->layers()[*l].name);
+  report.lit_skipped = lit.layers.skipped;
   report.atlas = std::move(atlas);
   report.seconds.setup = setup_seconds;
   report.seconds.views = seconds_since(views_start);

@@ -14,6 +14,7 @@
 #include "common/status.h"
 #include "render/atlas_check.h"
 #include "render/camera.h"
+#include "render/lit_pass.h"
 #include "render/renderer.h"
 #include "render/streaming_check.h"
 #include "render/view_density.h"
@@ -33,6 +34,7 @@ struct ConvergeOptions {
   // Consecutive frames that must map nothing new: one cycle of the feedback pass's tap rotation
   // and jitter, so every tap of every pixel has asked once.
   uint32_t quiet_frames = 4;
+  LitLayers lit;  // layers uploaded into the renderer's lit caches beside `layer`
 };
 
 struct ConvergeResult {
@@ -101,6 +103,17 @@ Thresholds scene_thresholds();
 // passes.
 std::vector<std::string> check_view(const ViewMetrics& metrics, const Thresholds& thresholds);
 
+// Bounds of the lit comparison against the original materials (lit_pass.h), on top of the
+// view's own: measured on the sample scene (docs/BENCHMARKS.md).
+Thresholds lit_scene_thresholds();
+
+struct LitViewReport {
+  ViewMetrics metrics;  // the lit virtual render against the lit reference
+  double reference_ms = 0, virtual_ms = 0;
+};
+// A view's "lit" object in report.json (docs/REPORTS.md).
+nlohmann::json to_json(const LitViewReport& lit);
+
 struct ViewReport {
   uint32_t view = 0;
   ViewMetrics metrics;
@@ -111,6 +124,9 @@ struct ViewReport {
   std::vector<std::string> images;    // files written for this view
   ViewDensity density;                // validate_bake: baked texels per source texel in view
   std::string framing;                // an automatic view: what it frames (PlannedView)
+  // The lit comparison, when the bake has a normal, ORM or emissive layer it can render; its
+  // failures are in `failures`, prefixed "lit: ".
+  std::optional<LitViewReport> lit;
 };
 
 struct ValidationReport {
@@ -120,6 +136,9 @@ struct ValidationReport {
   std::string device;
   uint32_t width = 0, height = 0;
   Thresholds thresholds;
+  Thresholds lit_thresholds;
+  std::vector<std::string> lit_layers;   // the layers the lit pass read (names); empty: no lit pass
+  std::vector<std::string> lit_skipped;  // layers it could not render, and why
   std::vector<ViewReport> views;
   std::string out_dir;     // where the PNGs (and, from validate_bake, report.json) went; "" = none
   AtlasCheckReport atlas;  // validate_bake's atlas-space page check (atlas.ran: it ran)
@@ -145,6 +164,8 @@ struct ValidateOptions {
   StreamerOptions streamer;
   ConvergeOptions converge;              // its layer is set from `layer`
   std::optional<Thresholds> thresholds;  // default_thresholds(cache format) when unset
+  LitLayers lit;                         // lit pass inputs; none set: no lit pass
+  Thresholds lit_thresholds = lit_scene_thresholds();
   std::string
       out_dir;  // where PNGs go (view_<i>_{reference,virtual,diff,residency}.png); "" = none
   std::vector<float> alpha_cutoffs;  // the scene's MASK cutoffs (compare_view)
@@ -168,12 +189,15 @@ struct BakeValidationOptions {
   std::string page_file;  // the bake (.vtpf)
   std::string unwrapped;  // the unwrapped scene the bake wrote; "" = page_file with .glb
   std::string out_dir;    // PNGs and report.json; "" = page_file with .validate
-  std::string layer;      // the layer's name; "" = the albedo layer (the only one with a reference)
+  // "" = the albedo layer, plus the lit check with every normal, ORM and emissive layer; a
+  // normal, ORM or emissive layer's name = the albedo check and the lit check with that layer.
+  std::string layer;
   std::string cameras_file;  // a camera file (camera.h); "" = `views` planned views
   uint32_t views = 6;        // planned views (view_planner.h): overview, surfaces, texels
   UpAxis up = UpAxis::kAuto;
   uint32_t width = 1280, height = 720;
   Thresholds thresholds = scene_thresholds();
+  Thresholds lit_thresholds = lit_scene_thresholds();
   uint32_t slots = 32;           // physical cache slots per side
   uint32_t max_frames = 48;      // per view, before giving up converging
   bool prefer_hardware = false;  // a hardware Vulkan device rather than lavapipe

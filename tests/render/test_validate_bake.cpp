@@ -76,12 +76,7 @@ TEST_F(ValidateBake, InputErrorsSayWhatIsWrong) {
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), ErrorCode::kNotFound);
   EXPECT_NE(r.status().message().find("'nope'"), std::string::npos);
-
-  o.layer = "normal";
-  r = validate_bake(o);
-  ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.status().code(), ErrorCode::kInvalidArgument);
-  EXPECT_NE(r.status().message().find("only albedo"), std::string::npos);
+  // A normal, ORM or emissive layer's name selects the lit check (tests/render/test_lit.cpp).
 }
 
 TEST_F(ValidateBake, PassesAndWritesItsReportBesideThePageFile) {

@@ -1,0 +1,74 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+#define LIT_FRAME_BINDING 4
+#include "lit.glsl"
+
+// Lit reference: the original materials. Albedo as reference.frag; the normal map decoded in the
+// mesh's tangent frame (the frame the bake's transfer decodes it in); ORM with the material's
+// factors applied; emissive texture times factor x strength.
+// Per draw: vt.xyz emissive factor x strength and vt.w normal scale (float bits); misc.x bit 0:
+// the material has a normal map, bit 1: a two-channel one (z reconstructed).
+layout(set = 0, binding = 0) uniform sampler2D u_albedo;
+layout(set = 0, binding = 1) uniform sampler2D u_normal;
+layout(set = 0, binding = 2) uniform sampler2D u_orm;
+layout(set = 0, binding = 3) uniform sampler2D u_emissive;
+
+layout(location = 0) in vec2 v_uv;
+layout(location = 2) in vec3 v_normal;
+layout(location = 3) in vec4 v_tangent;
+layout(location = 4) in vec3 v_world;
+layout(location = 0) out vec4 out_color;
+layout(location = 1) out uint out_covered;
+
+// The same 4x anisotropic taps as common.glsl's footprint, in the texture's own texel size.
+vec4 sample_taps(sampler2D t, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
+  vec2 size = vec2(textureSize(t, 0));
+  vec2 dx = duv_dx * size, dy = duv_dy * size;
+  float lx = length(dx), ly = length(dy);
+  vec2 major = lx >= ly ? dx : dy;
+  float lod = clamp(log2(max(max(max(lx, ly) / float(kTaps), min(lx, ly)), 1e-6)), 0.0,
+                    float(textureQueryLevels(t) - 1));
+  vec2 step = major / (size * float(kTaps));
+  vec4 c = vec4(0.0);
+  for (int i = 0; i < kTaps; ++i) {
+    c += textureLod(t, uv + step * (float(i) - 0.5 * float(kTaps - 1)), lod);
+  }
+  return c / float(kTaps);
+}
+
+void main() {
+  vec2 duv_dx = dFdx(v_uv), duv_dy = dFdy(v_uv);
+  Footprint f = footprint(v_uv, 1.0);
+  vec4 albedo = vec4(0.0);
+  for (int i = 0; i < kTaps; ++i) albedo += textureLod(u_albedo, tap_uv(v_uv, f, i), f.lod);
+  albedo /= float(kTaps);
+  if (pc.tex.w >= 0.0 && albedo.a < pc.tex.w) discard;
+  vec4 tn = sample_taps(u_normal, v_uv, duv_dx, duv_dy);
+  vec4 torm = sample_taps(u_orm, v_uv, duv_dx, duv_dy);
+  vec4 te = sample_taps(u_emissive, v_uv, duv_dx, duv_dy);
+
+  vec3 n = normalize(v_normal);
+  vec3 shading = n;
+  if ((pc.misc.w & kLitNormal) != 0 && (pc.misc.x & 1) != 0) {
+    vec3 t = v_tangent.xyz - n * dot(n, v_tangent.xyz);
+    t = dot(t, t) > 1e-12 ? normalize(t) : normalize(cross(abs(n.x) < 0.9 ? vec3(1, 0, 0) : vec3(0, 1, 0), n));
+    vec3 b = cross(n, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
+    float scale = intBitsToFloat(pc.vt.w);
+    vec2 xy = (tn.xy * 2.0 - 1.0) * scale;
+    float z = (pc.misc.x & 2) != 0 ? sqrt(max(0.0, 1.0 - dot(xy, xy))) : tn.z * 2.0 - 1.0;
+    vec3 w = t * xy.x + b * xy.y + n * z;
+    shading = dot(w, w) > 1e-12 ? normalize(w) : n;
+  }
+  // Back faces (open or two-sided surfaces) are lit as seen.
+  if (dot(n, lit.eye.xyz - v_world) < 0.0) shading = -shading;
+  vec3 orm = (pc.misc.w & kLitOrm) != 0 ? torm.rgb : kLitDefaultOrm;
+  vec3 emissive = vec3(0.0);
+  if ((pc.misc.w & kLitEmissive) != 0) {
+    emissive = srgb_to_linear3(te.rgb) *
+               vec3(intBitsToFloat(pc.vt.x), intBitsToFloat(pc.vt.y), intBitsToFloat(pc.vt.z));
+  }
+  vec3 c = shade(v_world, shading, srgb_to_linear3(albedo.rgb), orm, emissive);
+  out_color = vec4(linear_to_srgb3(c), 1.0);
+  out_covered = 1u;
+}

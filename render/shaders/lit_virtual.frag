@@ -1,0 +1,104 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+#define LIT_FRAME_BINDING 5
+#include "lit.glsl"
+
+// Lit virtual texture: albedo, normal, ORM and emissive from their layers' physical caches, all
+// addressed through the one page table (every layer shares the page grid and slots) with the
+// taps and trilinear blend of virtual.frag. The baked normal is in the atlas tangent frame
+// (bake/transfer.cpp): tangent along +u of the atlas, bitangent up the atlas image.
+layout(set = 0, binding = 0) uniform usampler2D u_page_table;
+layout(set = 0, binding = 1) uniform sampler2D u_albedo;
+layout(set = 0, binding = 2) uniform sampler2D u_normal;
+layout(set = 0, binding = 3) uniform sampler2D u_orm;
+layout(set = 0, binding = 4) uniform sampler2D u_emissive;
+
+layout(location = 0) in vec2 v_uv;
+layout(location = 2) in vec3 v_normal;
+layout(location = 4) in vec3 v_world;
+layout(location = 0) out vec4 out_color;
+layout(location = 1) out uint out_status;
+
+struct Inputs {
+  vec4 albedo, normal, orm, emissive;
+};
+
+ivec2 level_size(int level) {
+  return max(ivec2(1), (ivec2(pc.tex.xy) + (1 << level) - 1) >> level);
+}
+
+// One bilinear tap of every cache at `uv` in `level` (the resident ancestor where the page is
+// not in the cache).
+Inputs sample_level(vec2 uv, int level, inout int sampled) {
+  float payload = float(pc.vt.y);
+  ivec2 size = level_size(level);
+  ivec2 pages = (size + pc.vt.y - 1) / pc.vt.y;
+  ivec2 page = clamp(ivec2(floor(uv * vec2(size) / payload)), ivec2(0), pages - 1);
+  uvec4 e = texelFetch(u_page_table, page, level);
+  Inputs r;
+  if ((e.a & 1u) == 0u) {
+    sampled = 31;
+    r.albedo = r.emissive = vec4(1.0, 0.0, 1.0, 1.0);  // nothing resident at all: a loud colour
+    r.normal = r.orm = vec4(0.5);
+    return r;
+  }
+  int resident = int(e.b);
+  ivec2 rpage = page >> max(resident - level, 0);
+  vec2 local = uv * vec2(level_size(resident)) - vec2(rpage) * payload;
+  float lo = 0.5 - float(pc.vt.z);
+  local = clamp(local, vec2(lo), vec2(payload - lo));
+  vec2 phys = (vec2(e.rg) * float(pc.vt.w) + float(pc.vt.z) + local) /
+              vec2(textureSize(u_albedo, 0));
+  sampled = max(sampled, resident);
+  r.albedo = textureLod(u_albedo, phys, 0.0);
+  r.normal = textureLod(u_normal, phys, 0.0);
+  r.orm = textureLod(u_orm, phys, 0.0);
+  r.emissive = textureLod(u_emissive, phys, 0.0);
+  return r;
+}
+
+void main() {
+  // The atlas frame from the triangle's position and atlas-UV derivatives (flat per triangle,
+  // as the transfer's per-triangle gradients).
+  vec3 dpx = dFdx(v_world), dpy = dFdy(v_world);
+  vec2 dux = dFdx(v_uv), duy = dFdy(v_uv);
+  Footprint f = footprint(v_uv, 1.0);
+  int l0 = int(floor(f.lod));
+  int l1 = min(l0 + 1, pc.misc.z);
+  float blend = f.lod - float(l0);
+  int sampled = 0, ignored = 0;
+  Inputs c = Inputs(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
+  for (int i = 0; i < kTaps; ++i) {
+    vec2 uv = tap_uv(v_uv, f, i);
+    Inputs a = sample_level(uv, l0, sampled);
+    Inputs b = l1 != l0 ? sample_level(uv, l1, ignored) : a;
+    c.albedo += mix(a.albedo, b.albedo, blend);
+    c.normal += mix(a.normal, b.normal, blend);
+    c.orm += mix(a.orm, b.orm, blend);
+    c.emissive += mix(a.emissive, b.emissive, blend);
+  }
+  vec4 albedo = c.albedo / float(kTaps);
+  if (pc.tex.w >= 0.0 && albedo.a < pc.tex.w) discard;
+
+  vec3 n = normalize(v_normal);
+  vec3 shading = n;
+  if ((pc.misc.w & kLitNormal) != 0) {
+    float det = dux.x * duy.y - dux.y * duy.x;
+    vec3 dpdu = (dpx * duy.y - dpy * dux.y) * sign(det);
+    vec3 dpdv = (dpy * dux.x - dpx * duy.x) * sign(det);
+    vec3 t = dpdu - n * dot(n, dpdu);
+    t = dot(t, t) > 1e-20 ? normalize(t)
+                          : normalize(cross(abs(n.x) < 0.9 ? vec3(1, 0, 0) : vec3(0, 1, 0), n));
+    vec3 b = cross(n, t) * (dot(cross(n, t), dpdv) > 0.0 ? -1.0 : 1.0);
+    vec3 tn = decode_normal_xy(c.normal.xy / float(kTaps));
+    shading = normalize(t * tn.x + b * tn.y + n * tn.z);
+  }
+  if (dot(n, lit.eye.xyz - v_world) < 0.0) shading = -shading;
+  vec3 orm = (pc.misc.w & kLitOrm) != 0 ? c.orm.rgb / float(kTaps) : kLitDefaultOrm;
+  vec3 emissive =
+      (pc.misc.w & kLitEmissive) != 0 ? srgb_to_linear3(c.emissive.rgb / float(kTaps)) : vec3(0.0);
+  vec3 lin = shade(v_world, shading, srgb_to_linear3(albedo.rgb), orm, emissive);
+  out_color = vec4(linear_to_srgb3(lin), 1.0);
+  out_status = 0x80000000u | uint(l0) | (uint(sampled) << 8);
+}
