@@ -106,6 +106,10 @@ struct UnwrapResult {
 // and vertex), an atlas over max_atlas_texels, an invalid option.
 Expected<UnwrapResult> unwrap_scene(const scene::Scene& scene, const UnwrapOptions& options);
 
+// Writes the unwrapped scene as .glb with TANGENT in the atlas frame (the one the baked normal
+// layer is expressed in; gltf_export.h GltfWriteOptions::atlas_tangents).
+Status save_unwrapped_glb(const UnwrapResult& result, const std::string& path);
+
 // Texel-space checks of a laid-out atlas with the atlas rasteriser (atlas_raster.h; used by
 // unwrap_scene, exposed for tests): utilisation (texel centres covered), overlapping triangles
 // (texel centres two triangles own by the fill rule) and overlapping texels (texels two charts
