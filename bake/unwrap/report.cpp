@@ -45,6 +45,7 @@ nlohmann::json density_json(const UnwrapStats& s) {
     materials.push_back({{"name", m.name},
                          {"source", m.source},
                          {"requested", m.requested},
+                         {"requested_scale", m.requested_scale},
                          {"achieved", m.achieved}});
   return {{"texels_per_unit", s.texels_per_unit},
           {"source_texels_per_unit", s.source_texels_per_unit},

@@ -70,8 +70,9 @@ struct UnwrapStats {
   struct MaterialDensity {
     std::string name;
     double source = 0;     // texels per unit its textures give (area-weighted median), 0 = none
-    double requested = 0;  // its own density from the density file, 0 = none
-    double achieved = 0;   // texels per unit its charts got (area-weighted mean)
+    double requested = 0;  // its own texels per unit (density file or glTF extras), 0 = none
+    double requested_scale = 0;  // its own scale of the scene's density, 0 = none
+    double achieved = 0;         // texels per unit its charts got (area-weighted mean)
   };
   std::vector<MaterialDensity> materials;  // materials with a source or a requested density
   // E.g. the bake is more than 2x coarser than its sources, naming the worst materials.
