@@ -68,6 +68,16 @@ class TexelDensity : public ::testing::Test {
     return s;
   }
 
+  // Two 1 x 1 quads under node "Wall", materials "plaster" and "sign", both 128 x 128 texels.
+  Scene plaster_and_sign() {
+    Scene s = scene_of(std::vector<Primitive>{quad(1, 1, 0), quad(1, 1, 1, 1.0f, 2.0f)});
+    s.nodes[0].name = "Wall";
+    const std::string image = png(128, 128);
+    textured(s, "plaster", image);
+    textured(s, "sign", image);
+    return s;
+  }
+
   void write(const std::string& name, const std::string& text) {
     std::ofstream(dir_ / name) << text;
   }
@@ -140,16 +150,16 @@ TEST_F(TexelDensity, EmbeddedImagesAndMissingOnes) {
   EXPECT_NE(d.unreadable[0].find("nope.png"), std::string::npos) << d.unreadable[0];
 }
 
-TEST_F(TexelDensity, DefaultIsTheSourcesDensity) {
-  Scene s = textured_quad("wall", 256);
+TEST_F(TexelDensity, DefaultIsTwiceTheSourcesDensity) {
+  Scene s = textured_quad("wall", 128);
   auto o = options();
   o.min_size_pages = 1;
   auto r = unwrap::unwrap_scene(s, o);
   ASSERT_TRUE(r.ok()) << r.status().message();
   expect_valid(s, *r);
   EXPECT_EQ(r->stats.density_rule, "sources");
-  EXPECT_EQ(r->stats.texels_per_unit, 256.0);
-  EXPECT_EQ(r->stats.source_texels_per_unit, 256.0);
+  EXPECT_EQ(r->stats.texels_per_unit, 256.0);  // unwrap::kSourceOversample x 128
+  EXPECT_EQ(r->stats.source_texels_per_unit, 128.0);
   ASSERT_EQ(r->stats.materials.size(), 1u);
   EXPECT_EQ(r->stats.materials[0].name, "wall");
   EXPECT_DOUBLE_EQ(r->stats.materials[0].achieved, 256.0);
@@ -200,12 +210,7 @@ double atlas_area(const unwrap::UnwrapResult& r, size_t first, size_t count) {
 }
 
 TEST_F(TexelDensity, MaterialAndObjectDensitiesScaleTheirCharts) {
-  std::vector<Primitive> prims = {quad(1, 1, 0), quad(1, 1, 1, 1.0f, 2.0f)};
-  Scene s = scene_of(prims);
-  s.nodes[0].name = "Wall";
-  const std::string image = png(128, 128);
-  textured(s, "plaster", image);
-  textured(s, "sign", image);
+  Scene s = plaster_and_sign();
   write("d.json", R"({"texels_per_unit": 32, "materials": {"sign": 128}})");
   auto o = options();
   o.density_file = (dir_ / "d.json").string();
@@ -249,12 +254,7 @@ TEST_F(TexelDensity, MaterialAndObjectDensitiesScaleTheirCharts) {
 }
 
 TEST_F(TexelDensity, ScalesAndNodesAndGltfExtrasSetOwnDensities) {
-  std::vector<Primitive> prims = {quad(1, 1, 0), quad(1, 1, 1, 1.0f, 2.0f)};
-  Scene s = scene_of(prims);
-  s.nodes[0].name = "Wall";
-  const std::string image = png(128, 128);
-  textured(s, "plaster", image);
-  textured(s, "sign", image);
+  Scene s = plaster_and_sign();
   auto o = options();
   o.texels_per_unit = 32;
   // A scale multiplies the scene's density; {"texels_per_unit": D} is the same as D.
