@@ -65,9 +65,8 @@ Expected<Image> composite_image(const std::vector<ChannelSource>& channels,
   out.name = name;
   out.mime_type = "image/png";
   OIIO::Filesystem::IOVecOutput proxy(out.bytes);
-  auto writer = OIIO::ImageOutput::create("composite.png");
-  OIIO::ImageSpec spec(w, h, n, wide ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
-  spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+  auto writer = OIIO::ImageOutput::create("composite.png", &proxy);
+  const OIIO::ImageSpec spec(w, h, n, wide ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
   if (!writer || !writer->open("composite.png", spec) ||
       !writer->write_image(OIIO::TypeDesc::FLOAT, pixels.data()) || !writer->close())
     return Error(ErrorCode::kIo, name + ": cannot encode the packed map (" +

@@ -240,9 +240,7 @@ TEST(ObjMtl, OpacityFromDAndTr) {
 // The texels of an embedded PNG, as stored.
 std::vector<uint8_t> embedded_texels(const scene::Image& im, int* w, int* h, int* channels) {
   OIIO::Filesystem::IOMemReader proxy(im.bytes.data(), im.bytes.size());
-  OIIO::ImageSpec config;
-  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
-  auto in = OIIO::ImageInput::open("packed.png", &config);
+  auto in = OIIO::ImageInput::open("packed.png", nullptr, &proxy);
   EXPECT_TRUE(in) << OIIO::geterror();
   if (!in) return {};
   *w = in->spec().width, *h = in->spec().height, *channels = in->spec().nchannels;
