@@ -66,7 +66,9 @@ Expected<Image> composite_image(const std::vector<ChannelSource>& channels,
   out.mime_type = "image/png";
   OIIO::Filesystem::IOVecOutput proxy(out.bytes);
   auto writer = OIIO::ImageOutput::create("composite.png", &proxy);
-  const OIIO::ImageSpec spec(w, h, n, wide ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
+  OIIO::ImageSpec spec(w, h, n, wide ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
+  // Stored as given, like an artist's RGBA PNG: OpenImageIO would otherwise un-premultiply.
+  spec.attribute("oiio:UnassociatedAlpha", 1);
   if (!writer || !writer->open("composite.png", spec) ||
       !writer->write_image(OIIO::TypeDesc::FLOAT, pixels.data()) || !writer->close())
     return Error(ErrorCode::kIo, name + ": cannot encode the packed map (" +

@@ -240,7 +240,9 @@ TEST(ObjMtl, OpacityFromDAndTr) {
 // The texels of an embedded PNG, as stored.
 std::vector<uint8_t> embedded_texels(const scene::Image& im, int* w, int* h, int* channels) {
   OIIO::Filesystem::IOMemReader proxy(im.bytes.data(), im.bytes.size());
-  auto in = OIIO::ImageInput::open("packed.png", nullptr, &proxy);
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);  // the bytes as stored
+  auto in = OIIO::ImageInput::open("packed.png", &config, &proxy);
   EXPECT_TRUE(in) << OIIO::geterror();
   if (!in) return {};
   *w = in->spec().width, *h = in->spec().height, *channels = in->spec().nchannels;
