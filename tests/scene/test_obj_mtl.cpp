@@ -240,11 +240,12 @@ TEST(ObjMtl, OpacityFromDAndTr) {
 // The texels of an embedded PNG, as stored.
 std::vector<uint8_t> embedded_texels(const scene::Image& im, int* w, int* h, int* channels) {
   OIIO::Filesystem::IOMemReader proxy(im.bytes.data(), im.bytes.size());
-  OIIO::ImageSpec config;
+  OIIO::ImageSpec config, spec;
   config.attribute("oiio:UnassociatedAlpha", 1);  // the bytes as stored
-  auto in = OIIO::ImageInput::open("packed.png", &config, &proxy);
-  EXPECT_TRUE(in) << OIIO::geterror();
-  if (!in) return {};
+  auto in = OIIO::ImageInput::create("png");
+  const bool opened = in && in->set_ioproxy(&proxy) && in->open("packed.png", spec, config);
+  EXPECT_TRUE(opened) << OIIO::geterror();
+  if (!opened) return {};
   *w = in->spec().width, *h = in->spec().height, *channels = in->spec().nchannels;
   std::vector<uint8_t> px(size_t(*w) * *h * *channels);
   EXPECT_TRUE(in->read_image(0, 0, 0, *channels, OIIO::TypeDesc::UINT8, px.data()));
