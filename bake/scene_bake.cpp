@@ -242,7 +242,7 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
     t0 = Clock::now();
     report("write scene", 0.0);
     VT_RETURN_IF_ERROR(
-        scene::save_glb(unwrapped->scene, staged_scene).with_context(summary.unwrapped));
+        unwrap::save_unwrapped_glb(*unwrapped, staged_scene).with_context(summary.unwrapped));
     summary.stages.push_back({"write scene", seconds_since(t0)});
   }
   VT_RETURN_IF_ERROR(outputs.commit());

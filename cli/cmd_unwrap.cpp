@@ -58,7 +58,7 @@ vt::cli::CommandRunner make_unwrap(CLI::App& sub) {
                    scene->meshes.size(), scene->triangle_count(), load_s);
     auto result = vt::unwrap::unwrap_scene(*scene, a.options);
     if (!result.ok()) return vt::cli::report_error("unwrap", result.status().with_context(a.input));
-    vt::Status st = vt::scene::save_glb(result->scene, a.output);
+    vt::Status st = vt::unwrap::save_unwrapped_glb(*result, a.output);
     if (!st.ok()) return vt::cli::report_error("unwrap", st);
     std::string report = vt::unwrap::report_json(result->stats);
     std::ofstream(a.report) << report << "\n";

@@ -5,8 +5,8 @@ namespace vt::cli {
 
 void add_unwrap_flags(CLI::App& app, unwrap::UnwrapOptions& o) {
   auto* tpu = app.add_option("--texels-per-unit", o.texels_per_unit,
-                             "World texel density (default: the textures' density on the "
-                             "surfaces, 90th percentile by area, within --max-size)")
+                             "World texel density (default: twice the textures' density on "
+                             "the surfaces, 90th percentile by area, within --max-size)")
                   ->check(CLI::PositiveNumber);
   // 1024 pages is far past the atlas limit (UnwrapOptions::max_atlas_texels), which then
   // reports the size; the bound only keeps size * payload from overflowing.
@@ -21,9 +21,10 @@ void add_unwrap_flags(CLI::App& app, unwrap::UnwrapOptions& o) {
       ->check(CLI::Range(1, 1024))
       ->capture_default_str();
   app.add_option("--density", o.density_file,
-                 "Density file (JSON): {\"materials\": {NAME: texels per unit}, \"objects\": "
-                 "{NODE: ...}, \"texels_per_unit\" or \"size_pages\"}; default: "
-                 "SCENE.density.json beside the scene when it exists, '-' = none");
+                 "Density file (JSON): {\"materials\": {NAME: texels per unit or "
+                 "{\"scale\": K}}, \"objects\" (or \"nodes\"): {NODE: ...}, "
+                 "\"texels_per_unit\" or \"size_pages\"}; default: SCENE.density.json beside "
+                 "the scene when it exists, '-' = none");
   // The unwrapper's own bound.
   app.add_option("--padding", o.padding, "Empty texels between charts")
       ->check(CLI::Range(0, 1024))

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "scene/scene_io_util.h"
+#include "scene/tangent_frame.h"
 
 namespace vt::scene {
 namespace {
@@ -21,7 +22,7 @@ using json = nlohmann::json;
 
 constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;  // bufferView targets
 constexpr int kFloat = 5126, kUnsignedInt = 5125;                 // accessor component types
-constexpr int kLinear = 9729, kLinearMipmapLinear = 9987;         // sampler filters
+constexpr int kNearest = 9728, kLinear = 9729, kLinearMipmapLinear = 9987;  // sampler filters
 
 int wrap_code(WrapMode m) {
   return m == WrapMode::kClampToEdge ? 33071 : m == WrapMode::kMirroredRepeat ? 33648 : 10497;
@@ -128,8 +129,9 @@ class DocumentBuilder {
   // One texture per slot use; samplers shared by equal wrap modes.
   json texture(const TextureRef& ref) {
     json sampler = {{"wrapS", wrap_code(ref.wrap_s)}, {"wrapT", wrap_code(ref.wrap_t)}};
+    if (ref.mag_filter == FilterMode::kNearest) sampler["magFilter"] = kNearest;
     if (options_.sampler_filters) {
-      sampler["magFilter"] = kLinear;
+      if (ref.mag_filter != FilterMode::kNearest) sampler["magFilter"] = kLinear;
       sampler["minFilter"] = kLinearMipmapLinear;
     }
     size_t s = 0;
@@ -140,6 +142,13 @@ class DocumentBuilder {
     doc_["textures"].push_back({{"source", ref.image}, {"sampler", s}});
     json info = {{"index", doc_["textures"].size() - 1}};
     if (ref.texcoord || options_.write_texcoord_0) info["texCoord"] = ref.texcoord;
+    // `texcoord` is the set after the transform's override, so the extension names none.
+    if (!ref.transform.identity()) {
+      const TextureTransform& t = ref.transform;
+      info["extensions"]["KHR_texture_transform"] = {
+          {"offset", t.offset}, {"rotation", t.rotation}, {"scale", t.scale}};
+      use_extension("KHR_texture_transform");
+    }
     return info;
   }
 
@@ -164,6 +173,11 @@ class DocumentBuilder {
       }
       j["emissiveFactor"] = m.emissive_factor;
       if (m.emissive_texture.valid()) j["emissiveTexture"] = texture(m.emissive_texture);
+      if (m.emissive_strength != 1.0f) {
+        j["extensions"]["KHR_materials_emissive_strength"] = {
+            {"emissiveStrength", m.emissive_strength}};
+        use_extension("KHR_materials_emissive_strength");
+      }
       if (m.alpha_mode != AlphaMode::kOpaque || options_.write_opaque)
         j["alphaMode"] = m.alpha_mode == AlphaMode::kMask    ? "MASK"
                          : m.alpha_mode == AlphaMode::kBlend ? "BLEND"
@@ -199,8 +213,21 @@ class DocumentBuilder {
     const size_t n = p.positions.size();
     json attrs;
     attrs["POSITION"] = add_floats<3>(p.positions, true);
-    if (p.normals.size() == n && n) attrs["NORMAL"] = add_floats<3>(p.normals, false);
-    if (p.tangents.size() == n && n) attrs["TANGENT"] = add_floats<4>(p.tangents, false);
+    const bool atlas_frame =
+        options_.atlas_tangents && n && !p.uvs.empty() && p.uvs.back().size() == n;
+    // glTF ignores TANGENT without NORMAL: the atlas frame comes with the smooth normals the
+    // bake used.
+    std::vector<Vec3> computed;
+    if (atlas_frame && p.normals.size() != n) computed = compute_normals(p);
+    const std::vector<Vec3>& normals = computed.empty() ? p.normals : computed;
+    if (normals.size() == n && n) attrs["NORMAL"] = add_floats<3>(normals, false);
+    if (atlas_frame) {
+      const int atlas_set = static_cast<int>(p.uvs.size()) - 1;
+      attrs["TANGENT"] = add_floats<4>(compute_tangents(p, normals, atlas_set), false);
+      if (p.tangents.size() == n) attrs["_SOURCE_TANGENT"] = add_floats<4>(p.tangents, false);
+    } else if (p.tangents.size() == n && n) {
+      attrs["TANGENT"] = add_floats<4>(p.tangents, false);
+    }
     for (size_t k = 0; k < p.uvs.size(); ++k)
       attrs["TEXCOORD_" + std::to_string(k)] = add_floats<2>(p.uvs[k], false);
     if (p.colors.size() == n && n) attrs["COLOR_0"] = add_floats<4>(p.colors, false);
@@ -219,6 +246,13 @@ class DocumentBuilder {
       if (!n.children.empty()) j["children"] = n.children;
       doc_["nodes"].push_back(j);
     }
+  }
+
+  void use_extension(const char* name) {
+    auto& used = doc_["extensionsUsed"];
+    for (const auto& e : used)
+      if (e == name) return;
+    used.push_back(name);
   }
 
   const GltfWriteOptions& options_;
@@ -255,7 +289,10 @@ Status write_file(const std::string& path, std::initializer_list<Bytes> parts) {
 }  // namespace
 
 Status save_glb(const Scene& scene, const std::string& path) {
-  const GltfWriteOptions options;
+  return save_glb(scene, path, GltfWriteOptions{});
+}
+
+Status save_glb(const Scene& scene, const std::string& path, const GltfWriteOptions& options) {
   DocumentBuilder builder(options, detail::parent_folder(path));
   VT_RETURN_IF_ERROR(builder.add(scene, path));
   auto [doc, bin] = std::move(builder).finish("");

@@ -18,6 +18,11 @@ struct GltfWriteOptions {
   bool write_single_sided = false;   // "doubleSided": false on materials (glTF's default)
   bool write_opaque = true;          // "alphaMode": "OPAQUE" on materials (glTF's default)
   bool sampler_filters = false;      // LINEAR magnification, LINEAR_MIPMAP_LINEAR minification
+  // TANGENT from each primitive's last UV set (the atlas set the unwrapper appends), in the
+  // frame the bake's normal layer is expressed in (compute_tangents on the atlas UVs), so an
+  // engine sampling the baked normal layer decodes it right. Tangents the primitive carried
+  // for its source normal map are kept as the application attribute _SOURCE_TANGENT.
+  bool atlas_tangents = false;
 };
 
 // Writes the document as glTF 2.0 text at PATH and its buffer at PATH's stem + ".bin" in the
@@ -25,5 +30,8 @@ struct GltfWriteOptions {
 // embedded images go into the buffer. Each file appears under its name only once complete.
 // save_glb (scene.h) writes the same document, with the default options, as one .glb.
 Status save_gltf(const Scene& scene, const std::string& path, const GltfWriteOptions& options = {});
+
+// save_glb (scene.h) with options: the unwrapped scene of a bake is written with atlas_tangents.
+Status save_glb(const Scene& scene, const std::string& path, const GltfWriteOptions& options);
 
 }  // namespace vt::scene

@@ -37,6 +37,10 @@ void check_mesh_fields(const JsonFields& root, Warnings* warnings);
 std::vector<Material> load_materials(const JsonFields& root, ExtensionUses* uses,
                                      Warnings* warnings);
 
+// extras.vtbake_texels_per_unit of a material or node: a positive number (else an error), 0
+// when absent. Extras that are not an object are application data of others: ignored.
+double density_extra(const JsonFields& object);
+
 // Nodes and the displayed scene's roots; the graph must be a forest.
 Status load_nodes(const JsonFields& root, Scene* scene);
 

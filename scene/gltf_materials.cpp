@@ -147,6 +147,7 @@ struct MaterialReader {
       m.fail("alphaMode", "'" + alpha + "' is not OPAQUE, MASK or BLEND");
     mat.alpha_cutoff = non_negative(m, "alphaCutoff", 0.5);
     mat.double_sided = m.boolean("doubleSided", false);
+    mat.texels_per_unit = density_extra(m);
 
     JsonFields ext = m.object("extensions");
     for (const std::string& name : ext.keys()) ++(*uses)[name];
@@ -159,6 +160,17 @@ struct MaterialReader {
 };
 
 }  // namespace
+
+double density_extra(const JsonFields& object) {
+  const auto& raw = object.raw();
+  if (!raw.is_object() || !raw.contains("extras") || !raw["extras"].is_object()) return 0;
+  JsonFields extras = object.object("extras");
+  if (!extras.has("vtbake_texels_per_unit")) return 0;
+  const double v = extras.number("vtbake_texels_per_unit", 0);
+  if (!(v > 0))
+    extras.fail("vtbake_texels_per_unit", "expected a positive number (texels per world unit)");
+  return std::max(v, 0.0);
+}
 
 std::vector<Material> load_materials(const JsonFields& root, ExtensionUses* uses,
                                      Warnings* warnings) {

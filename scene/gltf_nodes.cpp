@@ -87,6 +87,7 @@ Status load_nodes(const JsonFields& root, Scene* scene) {
     node.local = node_matrix(n);
     node.mesh = n.index("mesh", "meshes");
     node.children = n.indices("children", "nodes");
+    node.texels_per_unit = density_extra(n);
     n.index("skin", "skins");
     n.index("camera", "cameras");
     scene->nodes.push_back(std::move(node));

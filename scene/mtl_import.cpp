@@ -130,8 +130,8 @@ struct Draft {
   Material m;
   bool has_d = false, has_tr = false, has_ke = false, has_pm = false, has_map_d = false;
   float d = 1.0f, tr = 0.0f;
-  std::string map_d_path;
-  TextureRef map_pr, map_pm;
+  TextureRef map_d, map_pr, map_pm;
+  char map_d_chan = 0, map_pr_chan = 0, map_pm_chan = 0;  // their -imfchan
   std::vector<std::string> ignored;
   void ignore(const std::string& what) {
     if (std::find(ignored.begin(), ignored.end(), what) == ignored.end()) ignored.push_back(what);
@@ -157,6 +157,10 @@ class MtlReader {
   TextureRef texture(const std::string& key, const MapStatement& map, const std::string& path);
   void finish_opacity();
   void finish_metal_roughness();
+  // `base` with its image replaced by a packed one; an invalid ref (and a warning) on failure.
+  TextureRef packed(const TextureRef& base, const std::vector<ChannelSource>& channels,
+                    const std::string& what);
+  ChannelSource channel_of(const TextureRef& ref, char imfchan, int fallback) const;
 
   std::string path_, folder_;
   Scene* scene_;
@@ -249,11 +253,14 @@ void MtlReader::map_key(const std::string& key, const std::string& written,
     m.normal_scale = map.bump_multiplier;
   } else if (key == "map_d") {
     draft_->has_map_d = true;
-    draft_->map_d_path = path;
+    draft_->map_d = texture(written, map, path);
+    draft_->map_d_chan = map.imfchan;
   } else if (key == "map_pr") {
     draft_->map_pr = texture(written, map, path);
+    draft_->map_pr_chan = map.imfchan;
   } else {
     draft_->map_pm = texture(written, map, path);
+    draft_->map_pm_chan = map.imfchan;
   }
 }
 
@@ -302,29 +309,59 @@ void MtlReader::finish_opacity() {
   if (opacity <= 0.0f) warn("d 0 makes the material fully transparent");
   f.m.base_color_factor[3] = opacity;
   if (opacity < 1.0f || f.has_map_d) f.m.alpha_mode = AlphaMode::kBlend;
-  // Opacity comes from the base colour texture's alpha: a map_d that is another image is lost.
-  const auto& kd = f.m.base_color_texture;
-  if (f.has_map_d && (!kd.valid() || scene_->images[kd.image].path != f.map_d_path))
-    f.ignore("map_d (only the base colour texture's alpha is baked)");
+  // glTF's opacity is the base colour texture's alpha: a map_d in another image is packed
+  // into a copy of map_Kd (or into white) as its alpha.
+  auto& kd = f.m.base_color_texture;
+  if (!f.map_d.valid() || (kd.valid() && kd.image == f.map_d.image)) return;
+  std::vector<ChannelSource> rgba(4);
+  for (int c = 0; c < 3; ++c) rgba[c] = kd.valid() ? channel_of(kd, 0, c) : ChannelSource{};
+  rgba[3] = channel_of(f.map_d, f.map_d_chan, -1);
+  TextureRef base = packed(kd.valid() ? kd : f.map_d, rgba, "map_Kd + map_d");
+  if (base.valid()) kd = base;
 }
 
-// glTF packs roughness in G and metallic in B of one texture: map_Pr and map_Pm fit when they
-// are one image, or when map_Pr is alone and the material is not metallic (its B is unused).
+ChannelSource MtlReader::channel_of(const TextureRef& ref, char imfchan, int fallback) const {
+  ChannelSource s;
+  s.path = scene_->images[ref.image].path;
+  s.channel = imfchan == 'r' ? 0 : imfchan == 'g' ? 1 : imfchan == 'b' ? 2 : imfchan ? 0 : fallback;
+  return s;
+}
+
+TextureRef MtlReader::packed(const TextureRef& base, const std::vector<ChannelSource>& channels,
+                             const std::string& what) {
+  auto image = composite_image(channels, draft_->m.name + ": " + what);
+  if (!image.ok()) {
+    warn(what + " not packed into one texture, so the second map is not baked: " +
+         image.status().message());
+    return {};
+  }
+  scene_->images.push_back(std::move(image).value());
+  TextureRef ref = base;
+  ref.image = static_cast<int>(scene_->images.size()) - 1;
+  return ref;
+}
+
+// glTF packs roughness in G and metallic in B of one texture: map_Pr and map_Pm are used as
+// they are when they are one image, or when map_Pr is alone and the material is not metallic
+// (its B is unused); otherwise they are packed into G and B of a new texture (1 where a map is
+// absent, so that its factor alone applies).
 void MtlReader::finish_metal_roughness() {
   Draft& f = *draft_;
   Material& m = f.m;
   if (f.map_pm.valid() && !f.has_pm) m.metallic_factor = 1.0f;
-  if (f.map_pr.valid() && f.map_pm.valid() && f.map_pr.image != f.map_pm.image) {
+  const bool one_image = f.map_pr.valid() && f.map_pm.valid() && f.map_pr.image == f.map_pm.image;
+  if (one_image || (f.map_pr.valid() && !f.map_pm.valid() && m.metallic_factor == 0.0f)) {
     m.metallic_roughness_texture = f.map_pr;
-    f.ignore("map_Pm (a metallic map in another image than map_Pr)");
-  } else if (f.map_pr.valid()) {
-    m.metallic_roughness_texture = f.map_pr;
-    if (!f.map_pm.valid() && m.metallic_factor != 0.0f)
-      f.ignore("Pm with map_Pr alone (metallic would read the roughness map)");
-  } else if (f.map_pm.valid()) {
-    f.ignore("map_Pm without map_Pr (roughness would read the metallic map)");
-    if (!f.has_pm) m.metallic_factor = 0.0f;
+    return;
   }
+  if (!f.map_pr.valid() && !f.map_pm.valid()) return;
+  std::vector<ChannelSource> orm(3);
+  if (f.map_pr.valid()) orm[1] = channel_of(f.map_pr, f.map_pr_chan, 0);
+  if (f.map_pm.valid()) orm[2] = channel_of(f.map_pm, f.map_pm_chan, 0);
+  m.metallic_roughness_texture =
+      packed(f.map_pr.valid() ? f.map_pr : f.map_pm, orm, "map_Pr + map_Pm");
+  if (!m.metallic_roughness_texture.valid() && f.map_pm.valid() && !f.has_pm)
+    m.metallic_factor = 0.0f;
 }
 
 void MtlReader::finish() {

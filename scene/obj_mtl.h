@@ -41,6 +41,22 @@ struct Token {
 };
 std::vector<Token> split_tokens(const std::string& text);
 
+// One channel of a packed map: channel `channel` of the image at `path` (resampled to the
+// largest source's size; -1 = its alpha when it has one, else its first), or `constant` when
+// `path` is empty.
+struct ChannelSource {
+  std::string path;
+  int channel = 0;
+  float constant = 1.0f;
+};
+
+// An embedded PNG whose channels come from other images (8-bit, or 16-bit when a source has
+// more bits); values are copied as stored, with no colour conversion. For MTL maps that glTF
+// keeps in one texture: map_Kd + map_d as base colour + alpha, map_Pr + map_Pm as G and B of
+// the metallic-roughness texture. Errors name the image that could not be read.
+Expected<Image> composite_image(const std::vector<ChannelSource>& channels,
+                                const std::string& name);
+
 // An MTL library read into `scene->materials` (and the images they use into scene->images);
 // `by_name` maps material names to indices. Warnings name the MTL file; an error only when the
 // file cannot be read (the OBJ then keeps default materials).

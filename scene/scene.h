@@ -72,6 +72,9 @@ struct Material {
   AlphaMode alpha_mode = AlphaMode::kOpaque;
   float alpha_cutoff = 0.5f;
   bool double_sided = false;
+  // Its own atlas density, texels per world unit (glTF extras.vtbake_texels_per_unit); 0 = the
+  // scene's. A density file overrides it.
+  double texels_per_unit = 0;
 };
 
 // An image a material uses: either a file (uri, resolved relative to the scene file's folder
@@ -110,6 +113,8 @@ struct Node {
   Mat4 local = kIdentity;  // transform relative to the parent
   int mesh = -1;           // index into Scene::meshes, -1 = none
   std::vector<int> children;
+  // Atlas density of its subtree (glTF extras.vtbake_texels_per_unit); 0 = inherited.
+  double texels_per_unit = 0;
 };
 
 // One placement of a mesh in the world (a node with a mesh, after flattening the hierarchy).

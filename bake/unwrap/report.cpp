@@ -1,4 +1,4 @@
-// The unwrap report (JSON) and the atlas picture (PNG through OpenImageIO).
+// The unwrap report (JSON), the atlas picture (PNG through OpenImageIO) and the unwrapped .glb.
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -7,6 +7,7 @@
 
 #include "bake/unwrap/atlas_raster.h"
 #include "bake/unwrap/unwrap.h"
+#include "scene/gltf_export.h"
 
 namespace vt::unwrap {
 
@@ -44,6 +45,7 @@ nlohmann::json density_json(const UnwrapStats& s) {
     materials.push_back({{"name", m.name},
                          {"source", m.source},
                          {"requested", m.requested},
+                         {"requested_scale", m.requested_scale},
                          {"achieved", m.achieved}});
   return {{"texels_per_unit", s.texels_per_unit},
           {"source_texels_per_unit", s.source_texels_per_unit},
@@ -134,6 +136,12 @@ Status write_atlas_picture(const UnwrapResult& result, const std::string& path, 
   if (!out->write_image(OIIO::TypeDesc::UINT8, pixels.data()) || !out->close())
     return Error(ErrorCode::kIo, path + ": " + out->geterror());
   return Status::Ok();
+}
+
+Status save_unwrapped_glb(const UnwrapResult& result, const std::string& path) {
+  scene::GltfWriteOptions options;
+  options.atlas_tangents = true;
+  return scene::save_glb(result.scene, path, options);
 }
 
 }  // namespace vt::unwrap

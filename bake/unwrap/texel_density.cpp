@@ -62,17 +62,36 @@ double number(const nlohmann::json& j, const std::string& where, const std::stri
   return j.get<double>();
 }
 
+// A number (texels per unit) or {"texels_per_unit": D} or {"scale": K}.
+OwnDensity own_density(const nlohmann::json& j, const std::string& where, const std::string& path) {
+  OwnDensity d;
+  if (!j.is_object()) {
+    d.texels_per_unit = number(j, where, path);
+    return d;
+  }
+  if (j.size() != 1 || !(j.contains("texels_per_unit") || j.contains("scale")))
+    throw std::runtime_error(path + ": " + where +
+                             " must be a number (texels per unit), {\"texels_per_unit\": D} or "
+                             "{\"scale\": K}, not " +
+                             j.dump());
+  if (j.contains("scale"))
+    d.scale = number(j["scale"], where + " scale", path);
+  else
+    d.texels_per_unit = number(j["texels_per_unit"], where + " texels_per_unit", path);
+  return d;
+}
+
 // Resolves {"name": density} against the names in `names` (all entries with that name).
-std::vector<double> by_name(const nlohmann::json& j, const char* key, const char* what,
-                            const std::vector<std::string>& names, const std::string& path) {
-  std::vector<double> out(names.size(), 0.0);
+std::vector<OwnDensity> by_name(const nlohmann::json& j, const char* key, const char* what,
+                                const std::vector<std::string>& names, const std::string& path) {
+  std::vector<OwnDensity> out(names.size());
   if (!j.contains(key)) return out;
   const auto& table = j[key];
   if (!table.is_object())
     throw std::runtime_error(path + ": \"" + std::string(key) + "\" must be an object of " + what +
                              " names to texels per unit");
   for (const auto& [name, value] : table.items()) {
-    double d = number(value, std::string(what) + " '" + name + "'", path);
+    const OwnDensity d = own_density(value, std::string(what) + " '" + name + "'", path);
     bool found = false;
     for (size_t i = 0; i < names.size(); ++i)
       if (names[i] == name) out[i] = d, found = true;
@@ -84,23 +103,6 @@ std::vector<double> by_name(const nlohmann::json& j, const char* key, const char
       throw std::runtime_error(path + ": the scene has no " + what + " named '" + name + "'" +
                                (known.empty() ? "" : " (it has " + known + ")"));
     }
-  }
-  return out;
-}
-
-// A named node's density covers its subtree; the deepest named node wins.
-std::vector<double> spread_to_subtrees(const scene::Scene& scene, std::vector<double> named) {
-  std::vector<double> out(scene.nodes.size(), 0.0);
-  std::vector<char> visited(scene.nodes.size(), 0);
-  std::vector<std::pair<int, double>> stack;
-  for (int r : scene.roots) stack.push_back({r, 0.0});
-  while (!stack.empty()) {
-    auto [node, inherited] = stack.back();
-    stack.pop_back();
-    if (node < 0 || node >= static_cast<int>(scene.nodes.size()) || visited[node]) continue;
-    visited[node] = 1;
-    out[node] = named[node] > 0 ? named[node] : inherited;
-    for (int c : scene.nodes[node].children) stack.push_back({c, out[node]});
   }
   return out;
 }
@@ -227,9 +229,13 @@ Expected<DensityFile> load_density_file(const std::string& path, const scene::Sc
       throw std::runtime_error(path + ": a density file is a JSON object, not " +
                                std::string(j.type_name()));
     for (const auto& [key, value] : j.items())
-      if (key != "texels_per_unit" && key != "size_pages" && key != "materials" && key != "objects")
-        throw std::runtime_error(path + ": unknown key \"" + key +
-                                 "\" (known: texels_per_unit, size_pages, materials, objects)");
+      if (key != "texels_per_unit" && key != "size_pages" && key != "materials" &&
+          key != "objects" && key != "nodes")
+        throw std::runtime_error(
+            path + ": unknown key \"" + key +
+            "\" (known: texels_per_unit, size_pages, materials, objects or nodes)");
+    if (j.contains("objects") && j.contains("nodes"))
+      throw std::runtime_error(path + ": give \"objects\" or \"nodes\" (the same), not both");
     if (j.contains("texels_per_unit"))
       out.texels_per_unit = number(j["texels_per_unit"], "\"texels_per_unit\"", path);
     if (j.contains("texels_per_unit") && j.contains("size_pages"))
@@ -244,13 +250,30 @@ Expected<DensityFile> load_density_file(const std::string& path, const scene::Sc
     std::vector<std::string> materials, nodes;
     for (const auto& m : scene.materials) materials.push_back(m.name);
     for (const auto& n : scene.nodes) nodes.push_back(n.name);
-    out.material_texels_per_unit = by_name(j, "materials", "material", materials, path);
-    out.node_texels_per_unit =
-        spread_to_subtrees(scene, by_name(j, "objects", "object", nodes, path));
+    out.materials = by_name(j, "materials", "material", materials, path);
+    out.nodes = by_name(j, j.contains("nodes") ? "nodes" : "objects", "object", nodes, path);
   } catch (const nlohmann::json::exception& e) {
     return Error(ErrorCode::kInvalidArgument, path + ": malformed density JSON: " + e.what());
   } catch (const std::runtime_error& e) {
     return Error(ErrorCode::kInvalidArgument, e.what());
+  }
+  return out;
+}
+
+std::vector<OwnDensity> spread_to_subtrees(const scene::Scene& scene,
+                                           const std::vector<OwnDensity>& named) {
+  std::vector<OwnDensity> out(scene.nodes.size());
+  std::vector<char> visited(scene.nodes.size(), 0);
+  std::vector<std::pair<int, OwnDensity>> stack;
+  for (int r : scene.roots) stack.push_back({r, OwnDensity{}});
+  while (!stack.empty()) {
+    auto [node, inherited] = stack.back();
+    stack.pop_back();
+    if (node < 0 || node >= static_cast<int>(scene.nodes.size()) || visited[node]) continue;
+    visited[node] = 1;
+    out[node] =
+        node < static_cast<int>(named.size()) && named[node].set() ? named[node] : inherited;
+    for (int c : scene.nodes[node].children) stack.push_back({c, out[node]});
   }
   return out;
 }
@@ -269,13 +292,10 @@ int pages_within(double texels, int page_payload) {
 
 namespace detail {
 
-double DensityPlan::wanted(int material, int node) const {
-  if (node >= 0 && node < static_cast<int>(node_texels_per_unit.size()) &&
-      node_texels_per_unit[node] > 0)
-    return node_texels_per_unit[node];
-  if (material >= 0 && material < static_cast<int>(material_texels_per_unit.size()))
-    return material_texels_per_unit[material];
-  return 0;
+OwnDensity DensityPlan::wanted(int material, int node) const {
+  if (node >= 0 && node < static_cast<int>(nodes.size()) && nodes[node].set()) return nodes[node];
+  if (material >= 0 && material < static_cast<int>(materials.size())) return materials[material];
+  return {};
 }
 
 Expected<DensityPlan> plan_density(const scene::Scene& scene, const UnwrapOptions& opt) {
@@ -293,8 +313,17 @@ Expected<DensityPlan> plan_density(const scene::Scene& scene, const UnwrapOption
     file = std::move(loaded).value();
     plan.file = path;
   }
-  plan.material_texels_per_unit = file.material_texels_per_unit;
-  plan.node_texels_per_unit = file.node_texels_per_unit;
+  // glTF extras where the file names nothing.
+  plan.materials = file.materials;
+  plan.materials.resize(scene.materials.size());
+  for (size_t m = 0; m < scene.materials.size(); ++m)
+    if (!plan.materials[m].set())
+      plan.materials[m].texels_per_unit = scene.materials[m].texels_per_unit;
+  std::vector<OwnDensity> named = file.nodes;
+  named.resize(scene.nodes.size());
+  for (size_t n = 0; n < scene.nodes.size(); ++n)
+    if (!named[n].set()) named[n].texels_per_unit = scene.nodes[n].texels_per_unit;
+  plan.nodes = spread_to_subtrees(scene, named);
   plan.source = measure_source_density(scene, opt.share_instances);
   double tpu = opt.texels_per_unit;
   int size = opt.size_pages;
@@ -311,7 +340,8 @@ Expected<DensityPlan> plan_density(const scene::Scene& scene, const UnwrapOption
     plan.mode = DensityPlan::Mode::kFitPages, plan.pages = size, plan.rule = "size";
     plan.texels_per_unit = plan.source.scene;
   } else if (plan.source.scene > 0) {
-    plan.mode = DensityPlan::Mode::kBounded, plan.texels_per_unit = plan.source.scene;
+    plan.mode = DensityPlan::Mode::kBounded;
+    plan.texels_per_unit = plan.source.scene * kSourceOversample;
     plan.rule = "sources";
   } else {
     plan.mode = DensityPlan::Mode::kFitPages, plan.pages = kDefaultSizePages;
@@ -330,9 +360,12 @@ void report_density(const DensityPlan& plan, const scene::Scene& scene,
     d.name =
         scene.materials[m].name.empty() ? "material " + std::to_string(m) : scene.materials[m].name;
     d.source = m < plan.source.material.size() ? plan.source.material[m] : 0;
-    d.requested = m < plan.material_texels_per_unit.size() ? plan.material_texels_per_unit[m] : 0;
+    if (m < plan.materials.size()) {
+      d.requested = plan.materials[m].texels_per_unit;
+      d.requested_scale = plan.materials[m].scale;
+    }
     d.achieved = m < achieved.size() ? achieved[m] : 0;
-    if (d.source > 0 || d.requested > 0) st->materials.push_back(d);
+    if (d.source > 0 || d.requested > 0 || d.requested_scale > 0) st->materials.push_back(d);
   }
   // Materials baked at under half their sources' density, worst first.
   std::vector<const UnwrapStats::MaterialDensity*> coarse;

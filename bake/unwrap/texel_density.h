@@ -18,6 +18,13 @@ namespace vt::unwrap {
 // decal size the whole atlas.
 constexpr double kSourcePercentile = 0.9;
 
+// The default atlas density over that source density. The bake resamples its sources, and a
+// texel of the atlas at the source's own density lands between source texels: the bilinear
+// resample of a resample blurs, and close views' worst tiles reached only 16-20 dB against the
+// sources. Twice the density brought them over 20 dB on the corpus models measured (see
+// docs/BENCHMARKS.md) for 4x the level-0 texels, which --max-size and the memory limit bound.
+constexpr double kSourceOversample = 2.0;
+
 // One textured triangle: its linear source density (texels per world unit) and its world area.
 struct DensitySample {
   double texels_per_unit = 0;
@@ -52,24 +59,40 @@ struct SourceDensity {
 // the header of every image a drawn material uses.
 SourceDensity measure_source_density(const scene::Scene& scene, bool share_instances);
 
+// A surface's own density: texels per world unit, or a scale of the scene's density (2 = twice
+// as fine as the rest). Neither set = the scene's.
+struct OwnDensity {
+  double texels_per_unit = 0;
+  double scale = 0;
+  bool set() const { return texels_per_unit > 0 || scale > 0; }
+};
+
 // The density side file, JSON:
 //   {"texels_per_unit": 40, "size_pages": 16,
-//    "materials": {"Brick": 200}, "objects": {"Sign": 400}}
+//    "materials": {"Brick": 200, "Floor": {"scale": 0.5}},
+//    "objects": {"Sign": {"texels_per_unit": 400}}}
 // every key optional. "texels_per_unit" and "size_pages" are the scene's density or atlas size
 // (as --texels-per-unit and --size; the command line wins); "materials" name materials and
-// "objects" name nodes (a node's density covers its subtree; the deepest named node wins, and an
-// object's density wins over its material's). Densities are texels per world unit.
+// "objects" (or "nodes") name nodes (a node's density covers its subtree; the deepest named node
+// wins, and an object's density wins over its material's). A value is texels per world unit, or
+// {"texels_per_unit": D} or {"scale": K} (K times the scene's density). The same densities can
+// come from glTF: extras.vtbake_texels_per_unit on a material or node (the file wins).
 struct DensityFile {
   std::string path;
   double texels_per_unit = 0;
   int size_pages = 0;
-  std::vector<double> material_texels_per_unit;  // per material, 0 = not named
-  std::vector<double> node_texels_per_unit;      // per node, 0 = not named (subtrees applied)
+  std::vector<OwnDensity> materials;  // per material, unset = not named
+  std::vector<OwnDensity> nodes;      // per node as named (subtrees not applied)
 };
 
 // Reads and checks a side file against the scene: errors name the file and the problem (bad
 // JSON, a non-positive density, a material or object the scene does not have).
 Expected<DensityFile> load_density_file(const std::string& path, const scene::Scene& scene);
+
+// Per node: the own density that applies to it, the deepest named node of its path winning
+// (`named` per node; the scene's roots down).
+std::vector<OwnDensity> spread_to_subtrees(const scene::Scene& scene,
+                                           const std::vector<OwnDensity>& named);
 
 // The side file looked for beside a scene when none is named: "DIR/NAME.gltf" ->
 // "DIR/NAME.density.json". "" for a scene with no source path.

@@ -898,12 +898,13 @@ std::vector<double> chart_weights(const std::vector<Surface>& surfaces,
   double base = plan.texels_per_unit;
   for (size_t i = 0; i < charts.size(); ++i) {
     const Surface& s = surfaces[charts[i].surface];
-    double own = plan.wanted(s.material, s.node);
-    if (!(own > 0)) continue;
+    const OwnDensity own = plan.wanted(s.material, s.node);
+    if (own.scale > 0) weight[i] = own.scale;
+    if (!(own.texels_per_unit > 0)) continue;
     if (!(base > 0))
       base = first_density_guess(charts, std::vector<double>(charts.size(), 1.0),
                                  plan.pages * opt.page_payload);
-    weight[i] = own / base;
+    weight[i] = own.texels_per_unit / base;
   }
   return weight;
 }

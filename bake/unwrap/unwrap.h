@@ -70,8 +70,9 @@ struct UnwrapStats {
   struct MaterialDensity {
     std::string name;
     double source = 0;     // texels per unit its textures give (area-weighted median), 0 = none
-    double requested = 0;  // its own density from the density file, 0 = none
-    double achieved = 0;   // texels per unit its charts got (area-weighted mean)
+    double requested = 0;  // its own texels per unit (density file or glTF extras), 0 = none
+    double requested_scale = 0;  // its own scale of the scene's density, 0 = none
+    double achieved = 0;         // texels per unit its charts got (area-weighted mean)
   };
   std::vector<MaterialDensity> materials;  // materials with a source or a requested density
   // E.g. the bake is more than 2x coarser than its sources, naming the worst materials.
@@ -105,6 +106,10 @@ struct UnwrapResult {
 // mesh of its own in the output. Errors: non-finite positions or bad indices (naming the mesh
 // and vertex), an atlas over max_atlas_texels, an invalid option.
 Expected<UnwrapResult> unwrap_scene(const scene::Scene& scene, const UnwrapOptions& options);
+
+// Writes the unwrapped scene as .glb with TANGENT in the atlas frame (the one the baked normal
+// layer is expressed in; gltf_export.h GltfWriteOptions::atlas_tangents).
+Status save_unwrapped_glb(const UnwrapResult& result, const std::string& path);
 
 // Texel-space checks of a laid-out atlas with the atlas rasteriser (atlas_raster.h; used by
 // unwrap_scene, exposed for tests): utilisation (texel centres covered), overlapping triangles

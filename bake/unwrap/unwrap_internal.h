@@ -86,12 +86,13 @@ struct DensityPlan {
   double texels_per_unit = 0;  // the density of a chart with no density of its own; 0 = none
   int pages = 0;
   int min_pages = 0, max_pages = 0;
-  std::vector<double> material_texels_per_unit, node_texels_per_unit;  // 0 = none
+  // Own densities per material (density file, else glTF extras) and per node (subtrees applied).
+  std::vector<OwnDensity> materials, nodes;
   SourceDensity source;
   std::string rule, file;  // UnwrapStats::density_rule (before bounds) and density_file
 
-  // The density a surface of `material` under `node` asks for; 0 = the scene's.
-  double wanted(int material, int node) const;
+  // The density a surface of `material` under `node` asks for; unset = the scene's.
+  OwnDensity wanted(int material, int node) const;
 };
 Expected<DensityPlan> plan_density(const scene::Scene& scene, const UnwrapOptions& options);
 

@@ -10,6 +10,7 @@
 #include <tuple>
 
 #include "scene/gltf_export.h"
+#include "scene/tangent_frame.h"
 #include "tests/unwrap/mesh_gen.h"
 
 namespace vt::test {
@@ -164,6 +165,83 @@ TEST(GltfExport, BadIndexIsAnErrorAndLeavesNoFile) {
     EXPECT_FALSE(std::filesystem::exists(temp(name) + ".tmp"));
   }
   EXPECT_FALSE(std::filesystem::exists(temp("bad.bin")));
+}
+
+// A flat 2 x 1 grid in the XY plane with a source UV set and an atlas set (last) that maps +x
+// to +u (or -u, mirrored) and +y up the atlas image (v down, as in glTF).
+Scene atlas_grid(bool mirrored) {
+  Scene s = scene_of(flat_grid(2, 1, 2, 1), "grid");
+  auto& p = s.meshes[0].primitives[0];
+  p.uvs.assign(2, {});
+  for (const auto& v : p.positions) p.uvs[0].push_back({v[1], v[0]});  // a rotated source set
+  for (const auto& v : p.positions)
+    p.uvs[1].push_back({(mirrored ? 1 - v[0] : v[0]) * 0.5f, 0.5f - v[1] * 0.5f});
+  p.tangents.assign(p.positions.size(), {0, 1, 0, 1});  // the source set's frame
+  return s;
+}
+
+TEST(GltfExport, UnwrappedGlbCarriesTheAtlasTangentFrame) {
+  for (bool mirrored : {false, true}) {
+    const Scene s = atlas_grid(mirrored);
+    scene::GltfWriteOptions o;
+    o.atlas_tangents = true;
+    ASSERT_TRUE(scene::save_glb(s, temp("atlas.glb"), o).ok());
+    const json doc = glb_json(read_all(temp("atlas.glb")));
+    const json& attrs = doc["meshes"][0]["primitives"][0]["attributes"];
+    EXPECT_TRUE(attrs.contains("NORMAL"));  // glTF ignores TANGENT without NORMAL
+    EXPECT_TRUE(attrs.contains("_SOURCE_TANGENT"));
+    auto back = scene::load_scene(temp("atlas.glb"));
+    ASSERT_TRUE(back.ok()) << back.status().message();
+    const scene::Primitive& p = back->meshes[0].primitives[0];
+    ASSERT_EQ(p.tangents.size(), p.positions.size());
+    ASSERT_EQ(p.normals.size(), p.positions.size());
+    EXPECT_EQ(p.tangents,
+              scene::compute_tangents(s.meshes[0].primitives[0],
+                                      scene::compute_normals(s.meshes[0].primitives[0]), 1));
+    for (size_t i = 0; i < p.positions.size(); ++i) {
+      const auto& n = p.normals[i];
+      const auto& t = p.tangents[i];
+      // Tangent along +u of the atlas; bitangent = cross(n, t) * w up the atlas image (+y).
+      EXPECT_NEAR(t[0], mirrored ? -1 : 1, 1e-6);
+      EXPECT_NEAR(t[1], 0, 1e-6);
+      const float by = (n[2] * t[0] - n[0] * t[2]) * t[3];
+      EXPECT_NEAR(by, 1, 1e-6) << "vertex " << i << (mirrored ? " (mirrored)" : "");
+    }
+  }
+  // Without the option the primitive's own tangents are written.
+  ASSERT_TRUE(scene::save_glb(atlas_grid(false), temp("own.glb")).ok());
+  auto own = scene::load_scene(temp("own.glb"));
+  ASSERT_TRUE(own.ok());
+  EXPECT_EQ(own->meshes[0].primitives[0].tangents,
+            atlas_grid(false).meshes[0].primitives[0].tangents);
+}
+
+TEST(GltfExport, TextureTransformEmissiveStrengthAndNearestFilterRoundTrip) {
+  Scene s = textured_ball();
+  scene::Material& m = s.materials[1];
+  m.base_color_texture.transform.offset = {0.25f, -0.5f};
+  m.base_color_texture.transform.rotation = 0.5f;
+  m.base_color_texture.transform.scale = {2, 3};
+  m.base_color_texture.texcoord = 1;
+  m.base_color_texture.mag_filter = scene::FilterMode::kNearest;
+  m.emissive_factor = {1, 0.5f, 0};
+  m.emissive_strength = 8;
+  ASSERT_TRUE(scene::save_glb(s, temp("ext.glb")).ok());
+  const json doc = glb_json(read_all(temp("ext.glb")));
+  EXPECT_EQ(doc["extensionsUsed"],
+            json({"KHR_texture_transform", "KHR_materials_emissive_strength"}));
+  EXPECT_FALSE(doc.contains("extensionsRequired"));  // a reader without them still works
+  auto back = scene::load_scene(temp("ext.glb"));
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  const scene::TextureRef& t = back->materials[1].base_color_texture;
+  EXPECT_EQ(t.texcoord, 1);
+  EXPECT_EQ(t.transform.offset, m.base_color_texture.transform.offset);
+  EXPECT_EQ(t.transform.rotation, 0.5f);
+  EXPECT_EQ(t.transform.scale, m.base_color_texture.transform.scale);
+  EXPECT_EQ(t.mag_filter, scene::FilterMode::kNearest);
+  EXPECT_EQ(back->materials[1].emissive_strength, 8.0f);
+  EXPECT_TRUE(back->materials[0].base_color_texture.transform.identity());
+  EXPECT_EQ(back->materials[0].emissive_strength, 1.0f);
 }
 
 }  // namespace

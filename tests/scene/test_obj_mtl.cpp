@@ -2,6 +2,8 @@
 // folder of its own: paths (backslashes, quotes, spaces, Windows drives, letter case), map
 // options, the d/Tr rule, bump versus normal maps, PBR keys, vertex colours, missing MTLs and
 // materials, UTF-16 text.
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -235,6 +237,68 @@ TEST(ObjMtl, OpacityFromDAndTr) {
   EXPECT_EQ(s.materials[4].alpha_mode, scene::AlphaMode::kBlend);  // alpha from map_Kd's alpha
   EXPECT_FLOAT_EQ(s.materials[5].base_color_factor[3], 0.5f);
   EXPECT_EQ(s.warnings.size(), 3u);
+}
+
+// The texels of an embedded PNG, as stored.
+std::vector<uint8_t> embedded_texels(const scene::Image& im, int* w, int* h, int* channels) {
+  OIIO::Filesystem::IOMemReader proxy(im.bytes.data(), im.bytes.size());
+  OIIO::ImageSpec config, spec;
+  config.attribute("oiio:UnassociatedAlpha", 1);  // the bytes as stored
+  auto in = OIIO::ImageInput::create("png");
+  const bool opened = in && in->set_ioproxy(&proxy) && in->open("packed.png", spec, config);
+  EXPECT_TRUE(opened) << OIIO::geterror();
+  if (!opened) return {};
+  *w = in->spec().width, *h = in->spec().height, *channels = in->spec().nchannels;
+  std::vector<uint8_t> px(size_t(*w) * *h * *channels);
+  EXPECT_TRUE(in->read_image(0, 0, 0, *channels, OIIO::TypeDesc::UINT8, px.data()));
+  return px;
+}
+
+TEST(ObjMtl, SeparateOpacityRoughnessAndMetallicMapsArePacked) {
+  std::string dir = folder("packed");
+  write_file(dir + "kd.png", tiny_png(2, 2, 3, {10, 20, 30}));
+  write_file(dir + "mask.png", tiny_png(4, 4, 1, {200}));
+  write_file(dir + "rough.png", tiny_png(2, 2, 1, {100}));
+  write_file(dir + "metal.png", tiny_png(2, 2, 1, {50}));
+  scene::Scene s = load_material(dir,
+                                 "newmtl m\nmap_Kd -s 2 2 1 kd.png\nmap_d mask.png\n"
+                                 "newmtl alpha_only\nKd 1 0 0\nmap_d mask.png\n"
+                                 "newmtl pr_pm\nmap_Pr rough.png\nmap_Pm metal.png\n"
+                                 "newmtl pm\nPr 0.5\nmap_Pm metal.png\n"
+                                 "newmtl missing\nmap_Kd kd.png\nmap_d nothere.png\n");
+  ASSERT_EQ(s.materials.size(), 5u);
+  int w = 0, h = 0, c = 0;
+  // map_Kd's colour and map_d's grey as alpha, at the larger size; map_Kd's options kept.
+  const scene::Material& m = s.materials[0];
+  ASSERT_TRUE(m.base_color_texture.valid());
+  EXPECT_TRUE(s.images[m.base_color_texture.image].embedded());
+  EXPECT_EQ(m.base_color_texture.transform.scale, (scene::Vec2{2, 2}));
+  EXPECT_EQ(m.alpha_mode, scene::AlphaMode::kBlend);
+  auto px = embedded_texels(s.images[m.base_color_texture.image], &w, &h, &c);
+  ASSERT_EQ(w * h * c, 64);
+  EXPECT_EQ(std::vector<uint8_t>(px.begin(), px.begin() + 4),
+            (std::vector<uint8_t>{10, 20, 30, 200}));
+  EXPECT_EQ(std::vector<uint8_t>(px.end() - 4, px.end()), (std::vector<uint8_t>{10, 20, 30, 200}));
+  // map_d alone: white colour (Kd is the factor) with its alpha.
+  px = embedded_texels(s.images[s.materials[1].base_color_texture.image], &w, &h, &c);
+  ASSERT_EQ(c, 4);
+  EXPECT_EQ(std::vector<uint8_t>(px.begin(), px.begin() + 4),
+            (std::vector<uint8_t>{255, 255, 255, 200}));
+  EXPECT_FLOAT_EQ(s.materials[1].base_color_factor[0], 1.0f);
+  // map_Pr in G and map_Pm in B; a missing map is 1 so that its factor applies.
+  const scene::Material& pr = s.materials[2];
+  EXPECT_FLOAT_EQ(pr.metallic_factor, 1.0f);  // map_Pm without Pm
+  px = embedded_texels(s.images[pr.metallic_roughness_texture.image], &w, &h, &c);
+  ASSERT_EQ(c, 3);
+  EXPECT_EQ(std::vector<uint8_t>(px.begin(), px.begin() + 3), (std::vector<uint8_t>{255, 100, 50}));
+  const scene::Material& pm = s.materials[3];
+  EXPECT_FLOAT_EQ(pm.roughness_factor, 0.5f);
+  px = embedded_texels(s.images[pm.metallic_roughness_texture.image], &w, &h, &c);
+  EXPECT_EQ(std::vector<uint8_t>(px.begin(), px.begin() + 3), (std::vector<uint8_t>{255, 255, 50}));
+  // An unreadable map_d: map_Kd as it is, and a warning naming the file.
+  EXPECT_EQ(image_path(s, s.materials[4].base_color_texture), dir + "kd.png");
+  EXPECT_EQ(warnings_with(s, {"material 'missing'", "map_d", "nothere.png"}), 1);
+  EXPECT_EQ(s.warnings.size(), 1u) << s.warnings[0];
 }
 
 TEST(ObjMtl, MeshLabWritesTrAsOpacity) {

@@ -68,6 +68,16 @@ class TexelDensity : public ::testing::Test {
     return s;
   }
 
+  // Two 1 x 1 quads under node "Wall", materials "plaster" and "sign", both 128 x 128 texels.
+  Scene plaster_and_sign() {
+    Scene s = scene_of(std::vector<Primitive>{quad(1, 1, 0), quad(1, 1, 1, 1.0f, 2.0f)});
+    s.nodes[0].name = "Wall";
+    const std::string image = png(128, 128);
+    textured(s, "plaster", image);
+    textured(s, "sign", image);
+    return s;
+  }
+
   void write(const std::string& name, const std::string& text) {
     std::ofstream(dir_ / name) << text;
   }
@@ -140,16 +150,16 @@ TEST_F(TexelDensity, EmbeddedImagesAndMissingOnes) {
   EXPECT_NE(d.unreadable[0].find("nope.png"), std::string::npos) << d.unreadable[0];
 }
 
-TEST_F(TexelDensity, DefaultIsTheSourcesDensity) {
-  Scene s = textured_quad("wall", 256);
+TEST_F(TexelDensity, DefaultIsTwiceTheSourcesDensity) {
+  Scene s = textured_quad("wall", 128);
   auto o = options();
   o.min_size_pages = 1;
   auto r = unwrap::unwrap_scene(s, o);
   ASSERT_TRUE(r.ok()) << r.status().message();
   expect_valid(s, *r);
   EXPECT_EQ(r->stats.density_rule, "sources");
-  EXPECT_EQ(r->stats.texels_per_unit, 256.0);
-  EXPECT_EQ(r->stats.source_texels_per_unit, 256.0);
+  EXPECT_EQ(r->stats.texels_per_unit, 256.0);  // unwrap::kSourceOversample x 128
+  EXPECT_EQ(r->stats.source_texels_per_unit, 128.0);
   ASSERT_EQ(r->stats.materials.size(), 1u);
   EXPECT_EQ(r->stats.materials[0].name, "wall");
   EXPECT_DOUBLE_EQ(r->stats.materials[0].achieved, 256.0);
@@ -200,12 +210,7 @@ double atlas_area(const unwrap::UnwrapResult& r, size_t first, size_t count) {
 }
 
 TEST_F(TexelDensity, MaterialAndObjectDensitiesScaleTheirCharts) {
-  std::vector<Primitive> prims = {quad(1, 1, 0), quad(1, 1, 1, 1.0f, 2.0f)};
-  Scene s = scene_of(prims);
-  s.nodes[0].name = "Wall";
-  const std::string image = png(128, 128);
-  textured(s, "plaster", image);
-  textured(s, "sign", image);
+  Scene s = plaster_and_sign();
   write("d.json", R"({"texels_per_unit": 32, "materials": {"sign": 128}})");
   auto o = options();
   o.density_file = (dir_ / "d.json").string();
@@ -246,6 +251,71 @@ TEST_F(TexelDensity, MaterialAndObjectDensitiesScaleTheirCharts) {
   EXPECT_EQ(f->stats.density_rule, "size");
   EXPECT_EQ(f->stats.pages_x, 4);
   EXPECT_NEAR(f->stats.materials[1].achieved / f->stats.materials[0].achieved, 4.0, 1e-9);
+}
+
+TEST_F(TexelDensity, ScalesAndNodesAndGltfExtrasSetOwnDensities) {
+  Scene s = plaster_and_sign();
+  auto o = options();
+  o.texels_per_unit = 32;
+  // A scale multiplies the scene's density; {"texels_per_unit": D} is the same as D.
+  write("s.json", R"({"materials": {"plaster": {"scale": 0.5}, "sign": {"texels_per_unit": 96}}})");
+  o.density_file = (dir_ / "s.json").string();
+  auto r = unwrap::unwrap_scene(s, o);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  expect_valid(s, *r);
+  ASSERT_EQ(r->stats.materials.size(), 2u);
+  EXPECT_DOUBLE_EQ(r->stats.materials[0].achieved, 16.0);
+  EXPECT_EQ(r->stats.materials[0].requested_scale, 0.5);
+  EXPECT_DOUBLE_EQ(r->stats.materials[1].achieved, 96.0);
+  EXPECT_EQ(r->stats.materials[1].requested, 96.0);
+  // "nodes" is "objects" by another name.
+  write("n.json", R"({"nodes": {"Wall": {"scale": 2}}})");
+  o.density_file = (dir_ / "n.json").string();
+  auto n = unwrap::unwrap_scene(s, o);
+  ASSERT_TRUE(n.ok()) << n.status().message();
+  EXPECT_DOUBLE_EQ(n->stats.materials[0].achieved, 64.0);
+  EXPECT_DOUBLE_EQ(n->stats.materials[1].achieved, 64.0);
+
+  // glTF extras (read by the importer into the scene model) act like the file, which wins.
+  s.materials[1].texels_per_unit = 128;
+  o.density_file = "-";
+  auto e = unwrap::unwrap_scene(s, o);
+  ASSERT_TRUE(e.ok()) << e.status().message();
+  EXPECT_DOUBLE_EQ(e->stats.materials[0].achieved, 32.0);
+  EXPECT_DOUBLE_EQ(e->stats.materials[1].achieved, 128.0);
+  EXPECT_EQ(e->stats.materials[1].requested, 128.0);
+  o.density_file = (dir_ / "s.json").string();
+  EXPECT_DOUBLE_EQ(unwrap::unwrap_scene(s, o)->stats.materials[1].achieved, 96.0);
+  s.materials[1].texels_per_unit = 0;
+  s.nodes[0].texels_per_unit = 48;  // a node's extras cover its mesh
+  o.density_file = "-";
+  auto ne = unwrap::unwrap_scene(s, o);
+  ASSERT_TRUE(ne.ok());
+  EXPECT_DOUBLE_EQ(ne->stats.materials[0].achieved, 48.0);
+  EXPECT_DOUBLE_EQ(ne->stats.materials[1].achieved, 48.0);
+}
+
+TEST_F(TexelDensity, GltfExtrasAreReadFromMaterialsAndNodes) {
+  write("x.gltf", R"({"asset": {"version": "2.0"},
+    "materials": [{"name": "a", "extras": {"vtbake_texels_per_unit": 250}},
+                  {"name": "b", "extras": "someone else's"}, {"name": "c"}],
+    "nodes": [{"name": "n", "extras": {"vtbake_texels_per_unit": 12.5}}, {"name": "m"}],
+    "scenes": [{"nodes": [0, 1]}], "scene": 0})");
+  auto s = scene::load_scene((dir_ / "x.gltf").string());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  EXPECT_EQ(s->materials[0].texels_per_unit, 250.0);
+  EXPECT_EQ(s->materials[1].texels_per_unit, 0.0);
+  EXPECT_EQ(s->materials[2].texels_per_unit, 0.0);
+  EXPECT_EQ(s->nodes[0].texels_per_unit, 12.5);
+  EXPECT_EQ(s->nodes[1].texels_per_unit, 0.0);
+  write("bad.gltf", R"({"asset": {"version": "2.0"},
+    "materials": [{"name": "a", "extras": {"vtbake_texels_per_unit": -3}}]})");
+  auto bad = scene::load_scene((dir_ / "bad.gltf").string());
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find(
+                "materials[0] 'a'.extras.vtbake_texels_per_unit: expected a positive number"),
+            std::string::npos)
+      << bad.status().message();
 }
 
 TEST_F(TexelDensity, ExplicitDensityCoarserThanSourcesWarns) {
@@ -292,6 +362,10 @@ TEST_F(TexelDensity, BadDensityFilesNameTheFileAndTheProblem) {
       {R"({"texels_per_unit": 4, "size_pages": 2})", "not both"},
       {R"({"size_pages": 0.5})", "\"size_pages\" must be a whole number"},
       {R"({"density": 4})", "unknown key \"density\""},
+      {R"({"materials": {"wall": {"scale": 0}}})", "material 'wall' scale must be a positive"},
+      {R"({"materials": {"wall": {"size": 2}}})", "{\"scale\": K}, not {\"size\":2}"},
+      {R"({"objects": {"House": 2}, "nodes": {"House": 2}})", "not both"},
+      {R"({"nodes": {"Hose": 10}})", "no object named 'Hose'"},
       {R"([1, 2])", "a density file is a JSON object"},
       {R"({"materials": )", "malformed density JSON"},
   };
