@@ -171,7 +171,8 @@ struct Renderer::Impl {
     VkDescriptorSet set = VK_NULL_HANDLE;
     uint32_t width = 0, height = 0, max_level = 0;
     AddressMode mode = AddressMode::kClamp;
-    bool sampler_addressing = false;  // a material sampler addresses the taps
+    bool sampler_addressing = false;     // a material sampler addresses the taps
+    VkSampler sampler = VK_NULL_HANDLE;  // reference_sampler(); owned by Impl
   };
   std::vector<GpuTexture> textures;
   // Material samplers (trilinear, per-axis addressing, magFilter), made once per distinct kind.
@@ -659,6 +660,7 @@ Status Renderer::set_reference_textures(std::span<const ReferenceTexture> textur
     g.mode = tex.address_mode;
     g.sampler_addressing = tex.sampler.has_value();
     VT_ASSIGN_OR_RETURN(VkSampler sampler, s.reference_sampler(tex));
+    g.sampler = sampler;
     ImageDesc d;
     d.width = tex.width;
     d.height = tex.height;
@@ -1124,7 +1126,7 @@ Status Renderer::set_lit_materials(std::span<const LitMaterial> materials) {
     const Impl::GpuTexture& albedo = s.textures[i];
     const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     const VkDescriptorImageInfo images[4] = {
-        {s.sampler_for(albedo.mode), albedo.image.view(), ro},
+        {albedo.sampler, albedo.image.view(), ro},
         {s.sampler_for(m.normal.address_mode), g.normal.view(), ro},
         {s.sampler_for(m.orm.address_mode), g.orm.view(), ro},
         {s.sampler_for(m.emissive.address_mode), g.emissive.view(), ro}};
@@ -1244,7 +1246,7 @@ Expected<ReferenceFrame> Renderer::render_lit_reference(const Camera& camera,
       for (int c = 0; c < 3; ++c) p.vt[c] = float_bits(lm.emissive_scale[c]);
       p.vt[3] = float_bits(lm.normal_scale);
       p.misc[0] = lm.flags;
-      p.misc[1] = t.mode == AddressMode::kWrap ? 1 : 0;
+      p.misc[1] = t.sampler_addressing ? 2 : t.mode == AddressMode::kWrap ? 1 : 0;
       p.misc[2] = int32_t(t.max_level);
       p.misc[3] = lit_input_bits(o.inputs);
       draw_mesh(cmd, s.lit.ref_layout, p, m);

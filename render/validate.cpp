@@ -202,9 +202,12 @@ Thresholds scene_thresholds() {
 }
 
 Thresholds lit_scene_thresholds() {
+  // Provisional. Correct sample-scene bakes, six planned views at 640x360: lit 26-33 dB whole
+  // view, worst tile down to 19.6 dB (specular on the normal-mapped floor, seen close); a
+  // green-flipped normal layer sinks the whole view below 30 dB.
   Thresholds t;
   t.min_psnr = 30.0;
-  t.min_tile_psnr = 20.0;
+  t.min_tile_psnr = 17.0;
   t.max_coarser_share = 1.0;  // residency and coverage are the view's own checks
   t.max_coverage_mismatch = 1.0;
   return t;

@@ -201,7 +201,11 @@ class DocumentBuilder {
             return Error(ErrorCode::kInvalidArgument,
                          path + ": mesh " + std::to_string(mi) + " primitive " +
                              std::to_string(pi) + ": index " + std::to_string(i) + " out of range");
-        jm["primitives"].push_back(primitive(p));
+        const int normal_set = p.material >= 0 && size_t(p.material) < scene.materials.size() &&
+                                       scene.materials[p.material].normal_texture.valid()
+                                   ? scene.materials[p.material].normal_texture.texcoord
+                                   : -1;
+        jm["primitives"].push_back(primitive(p, normal_set));
       }
       doc_["meshes"].push_back(jm);
     }
@@ -209,7 +213,8 @@ class DocumentBuilder {
   }
 
   // Attributes whose count differs from the positions' are left out, as glTF requires.
-  json primitive(const Primitive& p) {
+  // `normal_set`: the UV set the material's normal map reads (-1: none).
+  json primitive(const Primitive& p, int normal_set) {
     const size_t n = p.positions.size();
     json attrs;
     attrs["POSITION"] = add_floats<3>(p.positions, true);
@@ -224,7 +229,14 @@ class DocumentBuilder {
     if (atlas_frame) {
       const int atlas_set = static_cast<int>(p.uvs.size()) - 1;
       attrs["TANGENT"] = add_floats<4>(compute_tangents(p, normals, atlas_set), false);
-      if (p.tangents.size() == n) attrs["_SOURCE_TANGENT"] = add_floats<4>(p.tangents, false);
+      // The frame the source normal map is decoded in (given, or derived as the transfer
+      // derives it), so that the glb re-imports -- for validation or a re-bake -- with the
+      // material's own frame; TANGENT is the atlas frame for engines.
+      if (p.tangents.size() == n) {
+        attrs["_SOURCE_TANGENT"] = add_floats<4>(p.tangents, false);
+      } else if (normal_set >= 0 && size_t(normal_set) + 1 < p.uvs.size()) {
+        attrs["_SOURCE_TANGENT"] = add_floats<4>(compute_tangents(p, normals, normal_set), false);
+      }
     } else if (p.tangents.size() == n && n) {
       attrs["TANGENT"] = add_floats<4>(p.tangents, false);
     }

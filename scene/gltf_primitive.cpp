@@ -161,6 +161,11 @@ Expected<Primitive> read_primitive(const Gltf& g, const json& p, const std::stri
         load_attribute(g, attrs, "NORMAL", kDirectionRule3, n, where, &prim.normals));
     VT_RETURN_IF_ERROR(
         load_attribute(g, attrs, "TANGENT", kDirectionRule4, n, where, &prim.tangents));
+    // vtbake's unwrapped glb: TANGENT is the atlas frame, the material's normal maps need this.
+    if (attrs.contains("_SOURCE_TANGENT")) {
+      VT_RETURN_IF_ERROR(
+          load_attribute(g, attrs, "_SOURCE_TANGENT", kDirectionRule4, n, where, &prim.tangents));
+    }
     int color_components = 4;
     VT_RETURN_IF_ERROR(
         load_attribute(g, attrs, "COLOR_0", kColorRule, n, where, &prim.colors, &color_components));

@@ -15,6 +15,7 @@ layout(set = 0, binding = 2) uniform sampler2D u_orm;
 layout(set = 0, binding = 3) uniform sampler2D u_emissive;
 
 layout(location = 0) in vec2 v_uv;
+layout(location = 1) in vec4 v_color;  // vertex colour (linear), as reference.frag applies it
 layout(location = 2) in vec3 v_normal;
 layout(location = 3) in vec4 v_tangent;
 layout(location = 4) in vec3 v_world;
@@ -43,6 +44,7 @@ void main() {
   vec4 albedo = vec4(0.0);
   for (int i = 0; i < kTaps; ++i) albedo += textureLod(u_albedo, tap_uv(v_uv, f, i), f.lod);
   albedo /= float(kTaps);
+  albedo.a *= v_color.a;
   if (pc.tex.w >= 0.0 && albedo.a < pc.tex.w) discard;
   vec4 tn = sample_taps(u_normal, v_uv, duv_dx, duv_dy);
   vec4 torm = sample_taps(u_orm, v_uv, duv_dx, duv_dy);
@@ -68,7 +70,7 @@ void main() {
     emissive = srgb_to_linear3(te.rgb) *
                vec3(intBitsToFloat(pc.vt.x), intBitsToFloat(pc.vt.y), intBitsToFloat(pc.vt.z));
   }
-  vec3 c = shade(v_world, shading, srgb_to_linear3(albedo.rgb), orm, emissive);
+  vec3 c = shade(v_world, shading, srgb_to_linear3(albedo.rgb) * v_color.rgb, orm, emissive);
   out_color = vec4(linear_to_srgb3(c), 1.0);
   out_covered = 1u;
 }

@@ -142,16 +142,18 @@ TEST_F(ValidateCli, BakedSampleScenePassesFromAutomaticViews) {
     EXPECT_GT(v["pixels_compared"].get<uint64_t>(), 320u * 180u / 10) << v.dump();
     EXPECT_GE(v["psnr_rgb"].get<double>(), report["thresholds"]["min_psnr"].get<double>());
     EXPECT_GT(v["pages_uploaded"].get<uint64_t>(), 0u);
-    ASSERT_EQ(v["images"].size(), 4u);  // reference, virtual, difference, residency
+    // reference, virtual, difference, residency; the lit pair (the bake has normal, ORM and
+    // emissive layers)
+    ASSERT_EQ(v["images"].size(), 6u);
     for (const auto& image : v["images"]) {
       EXPECT_TRUE(std::filesystem::exists(image.get<std::string>())) << image;
     }
   }
-  // One sheet: two view rows of four 320-wide thumbnails (no larger than the renders), and
+  // One sheet: two view rows of six 320-wide thumbnails (no larger than the renders), and
   // the heat maps.
   EXPECT_EQ(report["contact_sheet"], out + "/contact_sheet.png");
   const auto [w, h] = image_size(out + "/contact_sheet.png");
-  EXPECT_GE(w, 4 * 320);
+  EXPECT_GE(w, 6 * 320);
   EXPECT_GE(h, 2 * 180 + 64);
   EXPECT_TRUE(report["warnings"].is_array());
   for (const char* k : {"load", "atlas_check", "setup", "views", "contact_sheet", "total"}) {

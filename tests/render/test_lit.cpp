@@ -184,6 +184,9 @@ class LitCheck : public ::testing::Test {
     o.width = 320;
     o.height = 180;
     o.atlas.enabled = false;  // the atlas check has its own tests
+    // The 4-page bake is coarser than its 256-texel sources on purpose (fast); density has its
+    // own tests (test_view_planner.cpp).
+    o.thresholds.min_density = 0;
     return validate_bake(o);
   }
 

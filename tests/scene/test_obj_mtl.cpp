@@ -460,7 +460,7 @@ TEST(ObjMtl, LibraryThatIsAFolderIsRefusedBeforeAllocating) {
   auto folder_obj = scene::load_scene(dir + "b.obj");
   ASSERT_FALSE(folder_obj.ok());
   EXPECT_EQ(folder_obj.status().code(), ErrorCode::kInvalidArgument);
-  EXPECT_EQ(folder_obj.status().message(), dir + "b.obj: not a regular file");
+  EXPECT_EQ(folder_obj.status().message(), dir + "b.obj: not a regular file to read");
 }
 
 }  // namespace
