@@ -20,7 +20,9 @@ namespace fs = std::filesystem;
 struct Tree {
   std::string root, car, shared, secret;
   Tree() {
-    root = fs::weakly_canonical(::testing::TempDir()).string() + "/vt_hostile/";
+    // One tree per test: ctest runs the tests of this file in parallel processes.
+    root = fs::weakly_canonical(::testing::TempDir()).string() + "/vt_hostile_" +
+           ::testing::UnitTest::GetInstance()->current_test_info()->name() + "/";
     fs::remove_all(root);
     car = root + "assets/car/";
     shared = root + "assets/shared/";
@@ -30,6 +32,10 @@ struct Tree {
     write(secret, "not an image");
     write(shared + "tex.png", "not an image");
     write(car + "tex.png", "not an image");
+  }
+  ~Tree() {
+    std::error_code ec;
+    fs::remove_all(root, ec);
   }
   static void write(const std::string& path, const std::string& text) {
     std::ofstream(path, std::ios::binary) << text;
