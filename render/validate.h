@@ -152,7 +152,7 @@ struct ValidationReport {
     double load = 0, atlas_check = 0, setup = 0, views = 0, contact_sheet = 0, total = 0;
   } seconds;
   StreamingCheckReport exact;  // the exact streaming check (exact.ran: it ran)
-  ViewPlan view_plan;      // validate_bake's automatic views (none with a camera file)
+  ViewPlan view_plan;          // validate_bake's automatic views (none with a camera file)
   // Every view passes and the atlas check found no failing page; with no views, the atlas check
   // ran and passed.
   bool passed() const;
