@@ -178,6 +178,9 @@ struct Renderer::Impl {
   // Material samplers (trilinear, per-axis addressing, magFilter), made once per distinct kind.
   std::vector<std::pair<uint32_t, VkSampler>> material_samplers;
   Expected<VkSampler> material_sampler(const TextureSampler& sampler);
+  // Copies pages in `format` into their slots of a physical cache (`what` names them in errors).
+  Status upload_pages(Image& cache, RuntimeFormat format, std::span<const SlotUpload> pages,
+                      const char* what);
   Expected<VkSampler> reference_sampler(const ReferenceTexture& tex);
 
   bool has_vt = false;
@@ -282,6 +285,27 @@ Expected<VkSampler> Renderer::Impl::material_sampler(const TextureSampler& m) {
   VT_VK(vkCreateSampler(dev, &ci, nullptr, &s));
   material_samplers.emplace_back(kind, s);
   return s;
+}
+
+Status Renderer::Impl::upload_pages(Image& cache, RuntimeFormat format,
+                                    std::span<const SlotUpload> pages, const char* what) {
+  const uint32_t ps = vt.geometry.page_size();
+  const size_t bytes = cache_page_bytes(format, ps);
+  std::vector<uint8_t> staging;
+  staging.reserve(bytes * pages.size());
+  std::vector<ImageCopy> copies;
+  for (const SlotUpload& p : pages) {
+    if (p.slot_x >= vt.slots_x || p.slot_y >= vt.slots_y || p.bytes.size() != bytes) {
+      return Error(ErrorCode::kInvalidArgument,
+                   std::string("render: ") + what + " upload to slot (" + std::to_string(p.slot_x) +
+                       ", " + std::to_string(p.slot_y) + ") has a bad slot or " +
+                       std::to_string(p.bytes.size()) + " bytes instead of " +
+                       std::to_string(bytes));
+    }
+    copies.push_back({staging.size(), 0, int32_t(p.slot_x * ps), int32_t(p.slot_y * ps), ps, ps});
+    staging.insert(staging.end(), p.bytes.begin(), p.bytes.end());
+  }
+  return upload_image(cache, staging, copies, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
 }
 
 Expected<VkSampler> Renderer::Impl::reference_sampler(const ReferenceTexture& tex) {
@@ -760,23 +784,7 @@ Status Renderer::upload_slots(std::span<const SlotUpload> pages) {
   Impl& s = *impl_;
   if (!s.has_vt) return Error(ErrorCode::kInvalidArgument, "render: no virtual texture set");
   if (pages.empty()) return Status::Ok();
-  const uint32_t ps = s.vt.geometry.page_size();
-  const size_t bytes = cache_page_bytes(s.vt.cache_format, ps);
-  std::vector<uint8_t> staging;
-  staging.reserve(bytes * pages.size());
-  std::vector<ImageCopy> copies;
-  for (const SlotUpload& p : pages) {
-    if (p.slot_x >= s.vt.slots_x || p.slot_y >= s.vt.slots_y || p.bytes.size() != bytes) {
-      return Error(ErrorCode::kInvalidArgument,
-                   "render: page upload to slot (" + std::to_string(p.slot_x) + ", " +
-                       std::to_string(p.slot_y) + ") has a bad slot or " +
-                       std::to_string(p.bytes.size()) + " bytes instead of " +
-                       std::to_string(bytes));
-    }
-    copies.push_back({staging.size(), 0, int32_t(p.slot_x * ps), int32_t(p.slot_y * ps), ps, ps});
-    staging.insert(staging.end(), p.bytes.begin(), p.bytes.end());
-  }
-  return s.upload_image(s.cache, staging, copies, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  return s.upload_pages(s.cache, s.vt.cache_format, pages, "page");
 }
 
 Status Renderer::upload_page_table(const PageTableLevels& table) {
@@ -1197,23 +1205,7 @@ Status Renderer::upload_lit_slots(LitInput input, std::span<const SlotUpload> pa
     return Error(ErrorCode::kInvalidArgument, "render: no lit cache for that input");
   }
   if (pages.empty()) return Status::Ok();
-  const uint32_t ps = s.vt.geometry.page_size();
-  const size_t bytes = cache_page_bytes(*s.lit.formats[i], ps);
-  std::vector<uint8_t> staging;
-  staging.reserve(bytes * pages.size());
-  std::vector<ImageCopy> copies;
-  for (const SlotUpload& p : pages) {
-    if (p.slot_x >= s.vt.slots_x || p.slot_y >= s.vt.slots_y || p.bytes.size() != bytes) {
-      return Error(ErrorCode::kInvalidArgument,
-                   "render: lit page upload to slot (" + std::to_string(p.slot_x) + ", " +
-                       std::to_string(p.slot_y) + ") has a bad slot or " +
-                       std::to_string(p.bytes.size()) + " bytes instead of " +
-                       std::to_string(bytes));
-    }
-    copies.push_back({staging.size(), 0, int32_t(p.slot_x * ps), int32_t(p.slot_y * ps), ps, ps});
-    staging.insert(staging.end(), p.bytes.begin(), p.bytes.end());
-  }
-  return s.upload_image(s.lit.caches[i], staging, copies, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  return s.upload_pages(s.lit.caches[i], *s.lit.formats[i], pages, "lit page");
 }
 
 Expected<ReferenceFrame> Renderer::render_lit_reference(const Camera& camera,
