@@ -56,6 +56,11 @@ constexpr ExtensionRule kExtensions[] = {
     {"KHR_materials_variants", Support::kIgnored, "only the default materials are baked"},
     {"KHR_techniques_webgl", Support::kIgnored,
      "shaders are ignored; the metallic-roughness material is baked"},
+    // The pre-release draft: its materials are glTF 1.0 technique values, with no
+    // metallic-roughness block to fall back on (glTF2/BoxTextured-glTF-techniqueWebGL).
+    {"KHR_technique_webgl", Support::kIgnored,
+     "its materials are shader-technique values with no metallic-roughness block; export the "
+     "file again as glTF 2.0 with pbrMetallicRoughness materials"},
     {"KHR_materials_cmnBlinnPhong", Support::kIgnored,
      "Blinn-Phong is ignored; the metallic-roughness material is baked"},
     {"KHR_texture_basisu", Support::kIgnored,

@@ -121,7 +121,10 @@ def select(corpus, only):
                     continue
                 mats = doc.get("materials")
                 if mats:  # a list (2.0) or an object (1.0) with entries
-                    picked.append((path, fmt, gltf_features(doc)))
+                    feats = gltf_features(doc)
+                    if entries(doc.get("textures")):
+                        feats = sorted(feats + ["textured"])
+                    picked.append((path, fmt, feats))
                 continue
             with open(path, "rb") as f:
                 data = f.read()
@@ -171,7 +174,10 @@ def one_model(args, path, index):
     rec["warnings"] = warnings_of(err)
     if rc != 0:
         if rc == 2:
-            rec["result"], rec["why"] = "refused", last_error(err)
+            rec["why"] = last_error(err)
+            # An unsupported feature is vtbake's gap; anything else is a defect of the input.
+            rec["result"] = "refused"
+            rec["refusal"] = "unsupported" if "not supported" in rec["why"] else "invalid file"
         else:
             rec["result"] = "FAIL"
             rec["why"] = ("exit %s: " % rc if rc is not None else "") + last_error(err)
@@ -187,54 +193,126 @@ def one_model(args, path, index):
     rec["validate_s"] = secs
     try:
         report = json.loads(out)
-        rec["views"] = ["%.1f" % v["psnr_rgb"] for v in report.get("views", [])]
-        failures = [f for v in report.get("views", []) for f in v.get("failures", [])]
     except ValueError:
-        report, failures = None, []
+        report = None
+    failures = layer_results(rec, report) if isinstance(report, dict) else []
     if rc == 0:
         rec["result"] = "pass"
     else:
         rec["result"] = "FAIL"
-        rec["why"] = "validate exit %s: %s" % (rc, failures[0] if failures else last_error(err))
+        why = "; ".join(failures[:3]) or last_error(err) or "(validate printed no reason)"
+        rec["why"] = "validate exit %s: %s" % (rc, why)
     return rec
 
 
-def write_table(args, rows):
+def psnr_range(values):
+    values = [v for v in values if v is not None]
+    if not values:
+        return ""
+    lo, hi = min(values), max(values)
+    return "%.1f" % lo if abs(hi - lo) < 0.05 else "%.1f-%.1f" % (lo, hi)
+
+
+def layer_results(rec, report):
+    """Fills rec's per-layer cells from validate's report.json; returns every failure line."""
+    views = [v for v in report.get("views", []) if isinstance(v, dict)]
+    failures = ["view %s: %s" % (v.get("view"), f) for v in views for f in v.get("failures", [])]
+    rec["views"] = ["%.1f" % v["psnr_rgb"] for v in views if "psnr_rgb" in v]
+    rec["albedo"] = "%s (tile >= %s)" % (
+        psnr_range([v.get("psnr_rgb") for v in views]),
+        psnr_range([min(v.get("worst_tile_psnr", 100) for v in views)])) if views else ""
+    lit = report.get("lit", {}) or {}
+    lit_views = [v["lit"] for v in views if isinstance(v.get("lit"), dict)]
+    lit_layers = [l for l in lit.get("layers", []) if l != "albedo"]
+    if lit_views:
+        rec["lit"] = "%s: %s (tile >= %s)" % (
+            " ".join(lit_layers) or "albedo only", psnr_range([v.get("psnr_rgb") for v in lit_views]),
+            psnr_range([min(v.get("worst_tile_psnr", 100) for v in lit_views)]))
+    else:
+        rec["lit"] = "not run" + (": " + "; ".join(lit.get("skipped", [])) if lit.get("skipped") else "")
+    exact = report.get("exact", {}) or {}
+    if exact.get("ran"):
+        ev = [v for v in exact.get("views", []) if v.get("pixels_compared")]
+        ok = all(v.get("passed", False) for v in exact.get("views", []))
+        rec["exact"] = "%s %s (%d of %d views compared)" % (
+            "pass" if ok else "FAIL", psnr_range([v.get("psnr") for v in ev]), len(ev),
+            len(exact.get("views", [])))
+    else:
+        rec["exact"] = exact.get("note", "") or "not run"
+    atlas = report.get("atlas", {}) or {}
+    if atlas.get("ran"):
+        rec["atlas_check"] = " ".join(
+            "%s %s %.1f" % (l.get("name"), "pass" if l.get("passed") else "FAIL",
+                            l.get("min_psnr", 0)) for l in atlas.get("layers", []))
+        failures += ["atlas check: " + f for f in atlas.get("failures", [])]
+    else:
+        rec["atlas_check"] = atlas.get("note", "") or "not run"
+    return failures
+
+
+def valid_gltf2(row):
+    """A glTF 2.0 model that is not refused for a defect of the file."""
+    _, fmt, feats, rec = row
+    return (fmt == "glTF" and "glTF 1.0" not in feats and "not readable as glTF JSON" not in feats
+            and rec.get("refusal") != "invalid file")
+
+
+def totals_line(rows):
     counts = {}
     for _, _, _, rec in rows:
-        counts[rec["result"]] = counts.get(rec["result"], 0) + 1
-    gl = [r for r in rows if r[1] == "glTF"]
-    gl_pass = sum(1 for r in gl if r[3]["result"] == "pass")
+        key = rec["result"] + (" (%s)" % rec["refusal"] if "refusal" in rec else "")
+        counts[key] = counts.get(key, 0) + 1
+    fails = counts.get("FAIL", 0)
+    gl = [r for r in rows if valid_gltf2(r)]
+    gl_tex = [r for r in gl if "textured" in r[2]]
+    passed = lambda rs: sum(1 for r in rs if r[3]["result"] == "pass")
+    line = "Totals: %d models; %s; %d FAIL. Valid glTF 2.0 models passing: %d of %d (%.0f%%); " \
+        "textured ones: %d of %d (%.0f%%)." % (
+            len(rows), ", ".join("%d %s" % (n, k) for k, n in sorted(counts.items()) if k != "FAIL"),
+            fails, passed(gl), len(gl), 100.0 * passed(gl) / max(1, len(gl)), passed(gl_tex),
+            len(gl_tex), 100.0 * passed(gl_tex) / max(1, len(gl_tex)))
+    return line, counts
+
+
+def write_table(args, rows):
+    totals, counts = totals_line(rows)
     lines = [
         "# Conformance: Debian's assimp-testmodels",
         "",
         "Written by `scripts/conformance.sh` (do not edit by hand): every model of the",
         "`assimp-testmodels` package that has a material (glTF) or names a texture (OBJ, FBX,",
         "COLLADA, PLY, 3DS), baked with default flags and validated with default bounds.",
-        "**pass**: baked and every view validated; **refused**: exit 2 with the message shown;",
-        "**FAIL**: a crash, a timeout, exit 1, or a bake that does not validate.",
-        "PSNR is per validation view (albedo layer, dB). Times are wall-clock seconds on the",
-        "machine that ran it (load average at the start: %s)." % args.load,
+        "**pass**: baked and validate passed every check on every layer; **refused**: exit 2 with",
+        "the message shown, either for a feature vtbake does not support (*unsupported*) or for a",
+        "defect of the file (*invalid file*: it breaks the glTF schema or spec, or names a file the",
+        "package lacks); **FAIL**: a crash, a timeout, exit 1, or a bake that does not validate.",
+        "Validation columns, from validate's report.json: *albedo* is the PSNR range over the views",
+        "(dB) and the worst 16x16 tile; *lit* the lit pass (the layers it shades with, PSNR range,",
+        "worst tile); *exact* the streaming check against the baked levels; *atlas* the per-layer",
+        "atlas check (worst page PSNR). Valid glTF 2.0 models are the glTF 2.0 files not refused as",
+        "invalid. Times are wall-clock seconds on the machine that ran it (load average at the",
+        "start: %s)." % args.load,
         "",
-        "Totals: %s. glTF models passing: %d of %d (%.0f%%)." % (
-            ", ".join("%d %s" % (n, k) for k, n in sorted(counts.items())), gl_pass, len(gl),
-            100.0 * gl_pass / max(1, len(gl))),
+        totals,
         "",
-        "| model | format | features | result | bake s | layers | validate PSNR per view | note |",
-        "| --- | --- | --- | --- | ---: | --- | --- | --- |",
+        "| model | format | features | result | bake s | layers | albedo | lit | exact | atlas "
+        "| note |",
+        "| --- | --- | --- | --- | ---: | --- | --- | --- | --- | --- | --- |",
     ]
     for path, fmt, feats, rec in rows:
         note = rec.get("why", "")
         if not note and rec["warnings"]:
             note = "warning: " + "; ".join(rec["warnings"][:2])
         note = note.replace("|", "\\|").replace(args.corpus + "/", "")
-        lines.append("| %s | %s | %s | %s | %.1f | %s | %s | %s |" % (
-            os.path.relpath(path, args.corpus), fmt, ", ".join(feats).replace("|", "/"),
-            rec["result"], rec["bake_s"], " ".join(rec["layers"]), " / ".join(rec["views"]),
-            note))
+        result = rec["result"] + (" (%s)" % rec["refusal"] if "refusal" in rec else "")
+        cells = [os.path.relpath(path, args.corpus), fmt, ", ".join(feats).replace("|", "/"),
+                 result, "%.1f" % rec["bake_s"], " ".join(rec["layers"]), rec.get("albedo", ""),
+                 rec.get("lit", ""), rec.get("exact", ""), rec.get("atlas_check", ""), note]
+        lines.append("| " + " | ".join(c.replace("|", "/") if i < 10 else c
+                                       for i, c in enumerate(cells)) + " |")
     with open(args.out, "w") as f:
         f.write("\n".join(lines) + "\n")
-    return counts
+    return totals, counts
 
 
 def main():
@@ -253,8 +331,8 @@ def main():
         print("[%d/%d] %-8s %6.1f s  %s  %s" % (i + 1, len(models), rec["result"], rec["bake_s"],
                                                 os.path.relpath(path, args.corpus),
                                                 rec.get("why", "")), flush=True)
-    counts = write_table(args, rows)
-    print("conformance: %s; table in %s" % (counts, args.out))
+    totals, counts = write_table(args, rows)
+    print("conformance: %s Table in %s" % (totals, args.out))
     return 1 if counts.get("FAIL") else 0
 
 
