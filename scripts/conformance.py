@@ -293,6 +293,13 @@ def write_table(args, rows):
         "invalid. Times are wall-clock seconds on the machine that ran it (load average at the",
         "start: %s)." % args.load,
         "",
+        "Rules behind some rows: a material that reads a UV set its primitive lacks is refused",
+        "(glTF 2.0 requires the set to exist; baking the factor alone would hide a texture the",
+        "author meant, so `issue_3269/texcoord_crash.gltf` is an invalid file). A COLLADA material",
+        "with opacity 0 is read as opaque with a warning (3ds Max writes `<transparency>`",
+        "inverted). The draft `KHR_technique_webgl` (not `KHR_techniques_webgl`) carries only",
+        "shader-technique values, no metallic-roughness block, so a file requiring it is refused.",
+        "",
         totals,
         "",
         "| model | format | features | result | bake s | layers | albedo | lit | exact | atlas "

@@ -183,5 +183,29 @@ TEST(AssimpImport, Gltf1IsReadThroughAssimp) {
   EXPECT_TRUE(noted);
 }
 
+// 3ds Max's COLLADA exporter writes <transparency> inverted: opacity 0 would hide the whole
+// material, so it is read as opaque with a warning (Collada/earthCylindrical.DAE).
+TEST(AssimpImport, ColladaOpacityZeroIsReadAsOpaque) {
+  fs::path d = fresh_dir("dae_opacity");
+  write_text(d / "wall.png", "not read by the importer");
+  std::string dae = collada_quad("wall.png");
+  const std::string diffuse = "<diffuse><texture texture=\"samp\" texcoord=\"UV0\"/></diffuse>";
+  ASSERT_NE(dae.find(diffuse), std::string::npos);
+  dae.replace(dae.find(diffuse), diffuse.size(),
+              diffuse +
+                  "<transparent opaque=\"A_ONE\"><color>1 1 1 1</color></transparent>"
+                  "<transparency><float>0</float></transparency>");
+  write_text(d / "quad.dae", dae);
+  auto s = scene::load_scene((d / "quad.dae").string());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  ASSERT_EQ(s->materials.size(), 1u);
+  const scene::Material& m = s->materials[0];
+  EXPECT_EQ(m.alpha_mode, scene::AlphaMode::kOpaque);
+  EXPECT_FLOAT_EQ(m.base_color_factor[3], 1.0f);
+  bool warned = false;
+  for (const std::string& w : s->warnings) warned |= w.find("opacity 0") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
 }  // namespace
 }  // namespace vt::test

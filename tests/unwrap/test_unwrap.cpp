@@ -182,5 +182,22 @@ TEST(Unwrap, ReportAndPicture) {
   EXPECT_EQ(sig[2], 'N');
 }
 
+// Fitting to a size searches the density: at every size the charts fill the square alike, so
+// the density follows the side (the step sizing from the last trial must not stop short).
+TEST(Unwrap, FittedDensityFollowsTheAtlasSide) {
+  Scene s = scene_of(sphere(32, 16));
+  double tpu[2] = {0, 0};
+  const int sizes[2] = {4, 16};
+  for (int i = 0; i < 2; ++i) {
+    auto r = unwrap::unwrap_scene(s, small_options(sizes[i]));
+    ASSERT_TRUE(r.ok()) << r.status().message();
+    EXPECT_EQ(r->stats.pages_x, sizes[i]);
+    EXPECT_EQ(r->stats.pages_y, sizes[i]);
+    EXPECT_GT(r->stats.utilisation, 0.35);
+    tpu[i] = r->stats.texels_per_unit;
+  }
+  EXPECT_NEAR(tpu[1] / tpu[0], 4.0, 0.4);
+}
+
 }  // namespace
 }  // namespace vt::test
