@@ -118,6 +118,18 @@ TEST(LevelTexture, CoarseLevelsThatDoNotHalveAsVulkanMipsAreDropped) {
   EXPECT_EQ(t->texture.max_level, 0u);
 }
 
+// A close view of a large atlas wants only levels finer than the check holds: that view says
+// nothing about the bake (3DS/test1.3ds); a view with nothing drawn and nothing excluded fails.
+TEST(StreamingBoundsCheck, AViewWantingOnlyDroppedLevelsIsNotAFailure) {
+  const StreamingBounds b = default_streaming_bounds(RuntimeFormat::kBc3);
+  StreamingViewMetrics close_view;
+  close_view.excluded_fine = 921600;
+  EXPECT_TRUE(check_streaming(close_view, b).empty());
+  const std::vector<std::string> why = check_streaming(StreamingViewMetrics{}, b);
+  ASSERT_EQ(why.size(), 1u);
+  EXPECT_EQ(why[0], "exact check: no pixel to compare");
+}
+
 // A page source that passes another one through, except for what `edit` changes in an upload.
 class EditedSource : public PageSource {
  public:
