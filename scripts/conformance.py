@@ -335,6 +335,7 @@ def main():
     for i, (path, fmt, feats) in enumerate(models):
         rec = one_model(args, path, i)
         rows.append((path, fmt, feats, rec))
+        write_table(args, rows)  # a stopped run still leaves the rows it has
         print("[%d/%d] %-8s %6.1f s  %s  %s" % (i + 1, len(models), rec["result"], rec["bake_s"],
                                                 os.path.relpath(path, args.corpus),
                                                 rec.get("why", "")), flush=True)
