@@ -180,6 +180,11 @@ TEST(GltfMaterials, UnsupportedRequiredExtensionIsRefusedByName) {
   doc["extensionsRequired"] = {"KHR_materials_clearcoat"};
   expect_error(load("required2.gltf", doc), "required2.gltf", ErrorCode::kUnsupported,
                "required extension KHR_materials_clearcoat is not supported");
+  // The pre-release draft's materials are technique values: the refusal says why.
+  doc["extensionsRequired"] = {"KHR_technique_webgl"};
+  expect_error(load("required3.gltf", doc), "required3.gltf", ErrorCode::kUnsupported,
+               "required extension KHR_technique_webgl is not supported (its materials are "
+               "shader-technique values with no metallic-roughness block");
 }
 
 TEST(GltfMaterials, UsedAppearanceExtensionsWarnOnceEach) {
