@@ -60,8 +60,9 @@ StreamingBounds default_streaming_bounds(RuntimeFormat cache_format);
 struct StreamingViewMetrics {
   uint64_t pixels = 0;         // compared: drawn by both renders, wanting a level the texture holds
   uint64_t excluded_fine = 0;  // wanted a dropped fine level
-  uint64_t excluded_coarse = 0;    // wanted a dropped coarse level
-  uint64_t excluded_fallback = 0;  // sampled a coarser level than wanted (page not resident)
+  uint64_t excluded_coarse = 0;      // wanted a dropped coarse level
+  uint64_t excluded_fallback = 0;    // sampled a coarser level than wanted (page not resident)
+  uint64_t excluded_alpha_edge = 0;  // alpha-tested, alpha a few steps above the cutoff
   uint64_t coverage_mismatch = 0;
   int max_abs = 0;
   double psnr = 0;

@@ -95,6 +95,7 @@ TEST(LitMaterials, FactorsAndDefaultsAsTheBakeAppliesThem) {
   EXPECT_EQ(a.emissive_scale[1], 0.5f);
   EXPECT_EQ(a.emissive_scale[2], 2.0f);
   EXPECT_EQ(a.normal.levels[0], (std::vector<uint8_t>{128, 128, 255, 255}));
+  EXPECT_EQ(a.occlusion.levels[0], (std::vector<uint8_t>{255, 255, 255, 255}));
   // glTF's default material: fully rough, fully metallic, no emission.
   EXPECT_EQ((*lit)[1].orm.levels[0], (std::vector<uint8_t>{255, 255, 255, 255}));
   EXPECT_EQ((*lit)[1].emissive_scale[0], 0.0f);
@@ -116,7 +117,7 @@ TEST(LitShadingFrames, NormalsTangentsAndUvsInWorldSpace) {
   p.indices = {0, 1, 2};
   p.material = 0;
   scene::Material m;
-  m.normal_texture.image = 0;  // no base colour texture: the reference takes the normal map's UVs
+  m.normal_texture.image = 0;  // read through its own slot (tex_uv), the draw's UV left alone
   s.materials = {m};
   scene::Mesh mesh;
   mesh.primitives = {p};
@@ -136,8 +137,9 @@ TEST(LitShadingFrames, NormalsTangentsAndUvsInWorldSpace) {
   EXPECT_FLOAT_EQ(v.nz, 1.0f);  // counter-clockwise in xy: +z
   EXPECT_FLOAT_EQ(v.tx, 1.0f);  // u grows along +x
   EXPECT_FLOAT_EQ(v.tw, 1.0f);
-  EXPECT_FLOAT_EQ(v.u, 1.0f);
-  EXPECT_FLOAT_EQ(v.v, 1.0f);
+  EXPECT_FLOAT_EQ(v.tex_uv[kLitNormalUv][0], 1.0f);
+  EXPECT_FLOAT_EQ(v.tex_uv[kLitNormalUv][1], 1.0f);
+  EXPECT_FLOAT_EQ(v.u, 0.0f);
   draws.meshes.push_back(md);  // a draw the scene does not have
   EXPECT_FALSE(add_shading_frames(s, draws, true).ok());
 }
