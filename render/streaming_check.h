@@ -48,8 +48,8 @@ struct StreamingBounds {
   int max_abs = 0;              // largest channel difference, 8-bit steps
   int steps = 0;                // a pixel "differs" when a channel is off by more than this
   double max_share_beyond = 0;  // share of compared pixels that differ
-  // ...or at most this many of them, whichever is more: small views and boards show a few
-  // isolated outliers (the open fault noted in streaming_check.cpp) that a share cannot absorb.
+  // ...or at most this many of them, whichever is more: a share of a small view rounds to no
+  // pixel at all.
   uint64_t max_pixels_beyond = 0;
   double min_psnr = 0;               // channels 0-2, whole view
   double min_tile_psnr = 0;          // worst 16 x 16 tile with at least 32 compared pixels

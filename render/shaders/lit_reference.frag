@@ -50,10 +50,12 @@ void main() {
   albedo /= float(kTaps);
   albedo.a *= v_color.a;
   if (pc.tex.w >= 0.0 && albedo.a < pc.tex.w) discard;
-  vec4 tn = sample_taps(u_normal, v_tex_uv01.xy);
-  float occlusion = sample_taps(u_occlusion, v_tex_uv01.zw).r;
-  vec4 tmr = sample_taps(u_orm, v_tex_uv23.xy);
-  vec4 te = sample_taps(u_emissive, v_tex_uv23.zw);
+  // Only the inputs this frame shades with (uniform branches).
+  const bool normal_in = (pc.misc.w & kLitNormal) != 0, orm_in = (pc.misc.w & kLitOrm) != 0;
+  vec4 tn = normal_in ? sample_taps(u_normal, v_tex_uv01.xy) : vec4(0.5, 0.5, 1.0, 1.0);
+  float occlusion = orm_in ? sample_taps(u_occlusion, v_tex_uv01.zw).r : 1.0;
+  vec4 tmr = orm_in ? sample_taps(u_orm, v_tex_uv23.xy) : vec4(0.0);
+  vec4 te = (pc.misc.w & kLitEmissive) != 0 ? sample_taps(u_emissive, v_tex_uv23.zw) : vec4(0.0);
 
   vec3 n = normalize(v_normal);
   vec3 shading = n;

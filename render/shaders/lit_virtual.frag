@@ -37,10 +37,12 @@ Inputs sample_level(vec2 uv, int level, inout int sampled) {
     return r;
   }
   phys /= vec2(textureSize(u_albedo, 0));
+  // Only the inputs this frame shades with (uniform branches): the emissive-only frame reads two
+  // caches of four.
   r.albedo = textureLod(u_albedo, phys, 0.0);
-  r.normal = textureLod(u_normal, phys, 0.0);
-  r.orm = textureLod(u_orm, phys, 0.0);
-  r.emissive = textureLod(u_emissive, phys, 0.0);
+  r.normal = (pc.misc.w & kLitNormal) != 0 ? textureLod(u_normal, phys, 0.0) : vec4(0.5);
+  r.orm = (pc.misc.w & kLitOrm) != 0 ? textureLod(u_orm, phys, 0.0) : vec4(0.0);
+  r.emissive = (pc.misc.w & kLitEmissive) != 0 ? textureLod(u_emissive, phys, 0.0) : vec4(0.0);
   return r;
 }
 

@@ -98,9 +98,8 @@ TEST(LitReferenceRules, EachTextureReadsItsOwnUvSetAndTransform) {
   m.emissive_texture.image = 0;
   m.emissive_texture.texcoord = 1;
   m.emissive_texture.transform.rotation = 0.5f;
-  auto draws = reference_scene_draws(sc)  // no base colour image: nothing to read;
-               ASSERT_TRUE(draws.ok())
-               << draws.status().message();
+  auto draws = reference_scene_draws(sc);  // no base colour image: nothing to read
+  ASSERT_TRUE(draws.ok()) << draws.status().message();
   ASSERT_TRUE(add_shading_frames(sc, *draws, true).ok());
   const scene::Primitive& p = sc.meshes[0].primitives[0];
   const std::vector<Vertex>& v = draws->meshes[0].vertices;
