@@ -19,6 +19,7 @@
 #include "render/vulkan_context.h"
 #include "scene/material_rules.h"
 #include "scene/scene.h"
+#include "tests/render/one_primitive_scene.h"
 
 namespace vt::render {
 namespace {
@@ -67,24 +68,7 @@ scene::Primitive screen_quad(double u0, double v0, double span) {
 }
 
 scene::Scene quad_scene(const scene::Material& m, const std::string& png) {
-  scene::Scene sc;
-  sc.source_path = "test.gltf";
-  scene::Primitive p = screen_quad(-0.5, -0.5, 2.0);
-  p.material = 0;
-  scene::Mesh mesh;
-  mesh.name = "quad";
-  mesh.primitives.push_back(std::move(p));
-  sc.meshes.push_back(std::move(mesh));
-  sc.materials.push_back(m);
-  scene::Image image;
-  image.uri = "occlusion.png";
-  image.path = png;
-  sc.images.push_back(image);
-  scene::Node node;
-  node.mesh = 0;
-  sc.nodes.push_back(node);
-  sc.roots = {0};
-  return sc;
+  return one_primitive_scene(screen_quad(-0.5, -0.5, 2.0), m, png);
 }
 
 TEST(LitReferenceRules, EachTextureReadsItsOwnUvSetAndTransform) {

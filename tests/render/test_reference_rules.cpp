@@ -26,6 +26,7 @@
 #include "scene/gltf_export.h"
 #include "scene/material_rules.h"
 #include "scene/scene.h"
+#include "tests/render/one_primitive_scene.h"
 
 namespace vt::render {
 namespace {
@@ -87,28 +88,6 @@ std::string write_png(const std::string& dir, const TexelFn& texel) {
 
 std::string cell_png(const std::string& name, bool alpha = false) {
   return write_png(test_dir(name), [alpha](int x, int y) { return cell_texel(x, y, alpha); });
-}
-
-// One primitive in one node, its material reading the image at `png`.
-scene::Scene one_primitive_scene(scene::Primitive p, const scene::Material& m,
-                                 const std::string& png) {
-  scene::Scene sc;
-  sc.source_path = "test.gltf";
-  p.material = 0;
-  scene::Mesh mesh;
-  mesh.name = "mesh";
-  mesh.primitives.push_back(std::move(p));
-  sc.meshes.push_back(std::move(mesh));
-  sc.materials.push_back(m);
-  scene::Image image;
-  image.uri = "tex.png";
-  image.path = png;
-  sc.images.push_back(image);
-  scene::Node node;
-  node.mesh = 0;
-  sc.nodes.push_back(node);
-  sc.roots = {0};
-  return sc;
 }
 
 // A quad over the whole clip space (identity camera); mesh UV (u0, v0) at the top-left corner
