@@ -1,8 +1,5 @@
 #include "render/lit_pass.h"
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -10,7 +7,9 @@
 
 #include "common/srgb.h"
 #include "common/vec.h"
+#include "render/image_load.h"
 #include "render/validate.h"
+#include "scene/material_rules.h"
 #include "scene/tangent_frame.h"
 
 namespace vt::render {
@@ -19,74 +18,18 @@ namespace {
 constexpr LayerSemantic kLitSemantics[kLitInputCount] = {
     LayerSemantic::kAlbedo, LayerSemantic::kNormal, LayerSemantic::kOrm, LayerSemantic::kEmissive};
 
-// An image's texels as float RGBA with the transfer's channel rules (bake/transfer.cpp
-// sample_texture): grey -> (g, g, g, 1), grey + alpha -> (g, g, g, a), RGB -> alpha 1.
-struct FloatImage {
-  uint32_t width = 0, height = 0;
-  uint32_t channels = 0;  // in the file
-  bool is_float = false;
-  std::vector<float> rgba;
-  const float* at(uint32_t x, uint32_t y) const { return &rgba[(size_t(y) * width + x) * 4]; }
-  // The texel nearest to the centre of texel (x, y) of a w x h image over the same UV square.
-  const float* nearest(uint32_t x, uint32_t y, uint32_t w, uint32_t h) const {
-    return at(std::min(width - 1, uint32_t((x + 0.5) * width / w)),
-              std::min(height - 1, uint32_t((y + 0.5) * height / h)));
-  }
-};
-
-Expected<FloatImage> load_image(const scene::Image& image) {
-  OIIO::Filesystem::IOMemReader mem(image.bytes.data(), image.bytes.size());
-  const std::string name = image.embedded()
-                               ? (image.mime_type == "image/jpeg" ? "embedded.jpg" : "embedded.png")
-                               : image.path;
-  std::unique_ptr<OIIO::ImageInput> in =
-      image.embedded() ? OIIO::ImageInput::open(name, nullptr, &mem) : OIIO::ImageInput::open(name);
-  if (!in) {
-    return Error(ErrorCode::kNotFound,
-                 "render: cannot open image '" + name + "': " + OIIO::geterror());
-  }
-  const OIIO::ImageSpec& spec = in->spec();
-  const int ch = spec.nchannels;
-  if (spec.width <= 0 || spec.height <= 0 || ch <= 0 || spec.width > 65536 || spec.height > 65536) {
-    return Error(ErrorCode::kCorrupt, "render: image '" + name + "' has a bad size");
-  }
-  std::vector<float> px(size_t(spec.width) * spec.height * ch);
-  if (!in->read_image(0, 0, 0, ch, OIIO::TypeDesc::FLOAT, px.data())) {
-    return Error(ErrorCode::kCorrupt,
-                 "render: cannot read image '" + name + "': " + in->geterror());
-  }
-  FloatImage out;
-  out.width = uint32_t(spec.width);
-  out.height = uint32_t(spec.height);
-  out.channels = uint32_t(ch);
-  out.is_float = spec.format.is_floating_point();
-  out.rgba.resize(size_t(out.width) * out.height * 4);
-  for (size_t i = 0, n = size_t(out.width) * out.height; i < n; ++i) {
-    const float* s = &px[i * ch];
-    float* d = &out.rgba[i * 4];
-    d[0] = s[0];
-    d[1] = ch >= 3 ? s[1] : s[0];
-    d[2] = ch >= 3 ? s[2] : s[0];
-    d[3] = ch == 2 ? s[1] : ch >= 4 ? s[3] : 1.0f;
-  }
-  return out;
-}
-
 uint8_t unorm8(float v) {
   return uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
 }
 
-AddressMode address_of(const scene::TextureRef& t) {
-  return t.wrap_s == scene::WrapMode::kClampToEdge ? AddressMode::kClamp : AddressMode::kWrap;
-}
-
-// A ReferenceTexture from level-0 RGBA8 texels: full box mip chain, reduced to `max_side`.
-ReferenceTexture make_texture(std::vector<uint8_t> texels, uint32_t w, uint32_t h, AddressMode mode,
-                              uint32_t max_side) {
+// A ReferenceTexture from level-0 RGBA8 texels: full box mip chain, reduced to `max_side`, sampled
+// with `ref`'s sampler (wrap per axis, magFilter) when given.
+ReferenceTexture make_texture(std::vector<uint8_t> texels, uint32_t w, uint32_t h,
+                              const scene::TextureRef* ref, uint32_t max_side) {
   ReferenceTexture tex;
   tex.width = w;
   tex.height = h;
-  tex.address_mode = mode;
+  if (ref) tex.sampler = TextureSampler{ref->wrap_s, ref->wrap_t, ref->mag_filter};
   tex.levels = box_mip_chain(texels.data(), w, h);
   uint32_t drop = 0;
   while (std::max(w >> drop, h >> drop) > max_side) ++drop;
@@ -99,7 +42,7 @@ ReferenceTexture make_texture(std::vector<uint8_t> texels, uint32_t w, uint32_t 
 }
 
 ReferenceTexture constant_texture(uint8_t r, uint8_t g, uint8_t b) {
-  return make_texture({r, g, b, 255}, 1, 1, AddressMode::kClamp, 1);
+  return make_texture({r, g, b, 255}, 1, 1, nullptr, 1);
 }
 
 // Loads each image once, on first use.
@@ -110,7 +53,7 @@ class ImageCache {
   Expected<const FloatImage*> get(const scene::TextureRef& t) {
     if (!t.valid() || size_t(t.image) >= images_.size()) return nullptr;
     if (!images_[t.image]) {
-      VT_ASSIGN_OR_RETURN(FloatImage img, load_image(scene_.images[t.image]));
+      VT_ASSIGN_OR_RETURN(FloatImage img, load_float_image(scene_.images[t.image]));
       images_[t.image] = std::move(img);
     }
     return &*images_[t.image];
@@ -121,26 +64,36 @@ class ImageCache {
   std::vector<std::optional<FloatImage>> images_;
 };
 
-// ORM as the bake's transfer computes it: occlusion 1 + strength (R - 1), roughness and
-// metallic the factors times G and B of the metallic-roughness texture. One texture at the
-// metallic-roughness image's size (else the occlusion image's); a separate occlusion image is
-// read at the nearest texel.
-ReferenceTexture orm_texture(const scene::Material& m, const FloatImage* occ, const FloatImage* mr,
-                             uint32_t max_side) {
-  const FloatImage* base = mr ? mr : occ;
-  const uint32_t w = base ? base->width : 1, h = base ? base->height : 1;
+// ORM as the bake's transfer computes it, each factor applied per texel (filtering commutes with
+// it): roughness and metallic the factors times G and B of the metallic-roughness texture (R 1),
+// and apart, on its own UV set and sampler, occlusion 1 + strength (R - 1).
+ReferenceTexture metal_rough_texture(const scene::Material& m, const FloatImage* mr,
+                                     uint32_t max_side) {
+  const uint32_t w = mr ? mr->width : 1, h = mr ? mr->height : 1;
   std::vector<uint8_t> texels(size_t(w) * h * 4);
   for (uint32_t y = 0; y < h; ++y)
     for (uint32_t x = 0; x < w; ++x) {
-      float o = occ ? 1.0f + m.occlusion_strength * (occ->nearest(x, y, w, h)[0] - 1.0f) : 1.0f;
-      float r = m.roughness_factor * (mr ? mr->at(x, y)[1] : 1.0f);
-      float t = m.metallic_factor * (mr ? mr->at(x, y)[2] : 1.0f);
       uint8_t* d = &texels[(size_t(y) * w + x) * 4];
-      d[0] = unorm8(o), d[1] = unorm8(r), d[2] = unorm8(t), d[3] = 255;
+      d[0] = 255;
+      d[1] = unorm8(m.roughness_factor * (mr ? mr->at(x, y)[1] : 1.0f));
+      d[2] = unorm8(m.metallic_factor * (mr ? mr->at(x, y)[2] : 1.0f));
+      d[3] = 255;
     }
-  const scene::TextureRef& ref =
-      m.metallic_roughness_texture.valid() ? m.metallic_roughness_texture : m.occlusion_texture;
-  return make_texture(std::move(texels), w, h, address_of(ref), max_side);
+  return make_texture(std::move(texels), w, h, mr ? &m.metallic_roughness_texture : nullptr,
+                      max_side);
+}
+
+ReferenceTexture occlusion_texture(const scene::Material& m, const FloatImage* occ,
+                                   uint32_t max_side) {
+  if (!occ) return constant_texture(255, 255, 255);
+  std::vector<uint8_t> texels(size_t(occ->width) * occ->height * 4, 255);
+  for (uint32_t y = 0; y < occ->height; ++y)
+    for (uint32_t x = 0; x < occ->width; ++x) {
+      const uint8_t o = unorm8(1.0f + m.occlusion_strength * (occ->at(x, y)[0] - 1.0f));
+      uint8_t* d = &texels[(size_t(y) * occ->width + x) * 4];
+      d[0] = d[1] = d[2] = o;
+    }
+  return make_texture(std::move(texels), occ->width, occ->height, &m.occlusion_texture, max_side);
 }
 
 // A data (raw) or colour (sRGB-encoded) 8-bit texture of an image.
@@ -153,7 +106,7 @@ ReferenceTexture image_texture(const FloatImage& img, bool colour, const scene::
     texels[i] = colour && img.is_float && i % 4 != 3 ? unorm8(linear_to_srgb(std::max(0.0f, v)))
                                                      : unorm8(v);
   }
-  return make_texture(std::move(texels), img.width, img.height, address_of(ref), max_side);
+  return make_texture(std::move(texels), img.width, img.height, &ref, max_side);
 }
 
 Expected<LitMaterial> lit_material(const scene::Material& m, ImageCache& images,
@@ -170,7 +123,8 @@ Expected<LitMaterial> lit_material(const scene::Material& m, ImageCache& images,
   }
   VT_ASSIGN_OR_RETURN(const FloatImage* occ, images.get(m.occlusion_texture));
   VT_ASSIGN_OR_RETURN(const FloatImage* mr, images.get(m.metallic_roughness_texture));
-  out.orm = orm_texture(m, occ, mr, max_side);
+  out.orm = metal_rough_texture(m, mr, max_side);
+  out.occlusion = occlusion_texture(m, occ, max_side);
   VT_ASSIGN_OR_RETURN(const FloatImage* emissive, images.get(m.emissive_texture));
   out.emissive = emissive ? image_texture(*emissive, true, m.emissive_texture, max_side)
                           : constant_texture(255, 255, 255);
@@ -180,16 +134,6 @@ Expected<LitMaterial> lit_material(const scene::Material& m, ImageCache& images,
 
 Vec3d to_d(const std::array<double, 3>& a) {
   return {a[0], a[1], a[2]};
-}
-
-// The UV set the lit reference reads for `m` when it has no base colour texture: the set of its
-// normal, metallic-roughness, occlusion or emissive texture; -1 when it has none.
-int lit_uv_set(const scene::Material& m) {
-  for (const scene::TextureRef* t : {&m.normal_texture, &m.metallic_roughness_texture,
-                                     &m.occlusion_texture, &m.emissive_texture}) {
-    if (t->valid()) return t->texcoord;
-  }
-  return -1;
 }
 
 }  // namespace
@@ -311,9 +255,12 @@ Status add_shading_frames(const scene::Scene& s, SceneDraws& draws, bool referen
                        ? p.tangents
                        : scene::compute_tangents(p, normals, m.normal_texture.texcoord);
       }
-      const int uv_set = reference && !m.base_color_texture.valid() ? lit_uv_set(m) : -1;
-      const bool take_uv = uv_set >= 0 && size_t(uv_set) < p.uvs.size() &&
-                           p.uvs[uv_set].size() == p.positions.size();
+      // The lit reference reads each texture on its own UV set through its own transform.
+      const scene::TextureRef* slots[4] = {&m.normal_texture, &m.occlusion_texture,
+                                           &m.metallic_roughness_texture, &m.emissive_texture};
+      const std::vector<scene::Vec2>* slot_uvs[4] = {};
+      for (int k = 0; k < 4 && reference; ++k)
+        if (slots[k]->valid()) slot_uvs[k] = scene::texture_uv_set(p, *slots[k]);
       for (size_t v = 0; v < p.positions.size(); ++v) {
         Vertex& out = md.vertices[v];
         const auto n = scene::transform_direction(inst.world, normals[v]);
@@ -326,7 +273,12 @@ Status add_shading_frames(const scene::Scene& s, SceneDraws& draws, bool referen
           out.tx = float(wt.x), out.ty = float(wt.y), out.tz = float(wt.z);
           out.tw = (t[3] < 0 ? -1.0f : 1.0f) * flip;
         }
-        if (take_uv) out.u = p.uvs[uv_set][v][0], out.v = p.uvs[uv_set][v][1];
+        for (int k = 0; k < 4; ++k) {
+          if (!slot_uvs[k]) continue;
+          const scene::Vec2& uv = (*slot_uvs[k])[v];
+          const auto t = scene::texture_uv(*slots[k], uv[0], uv[1]);
+          out.tex_uv[k][0] = float(t[0]), out.tex_uv[k][1] = float(t[1]);
+        }
       }
     }
   }
@@ -372,18 +324,36 @@ Expected<LitFrames> render_lit_view(Renderer& renderer, const Camera& camera,
   auto t2 = std::chrono::steady_clock::now();
   out.virtual_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
   out.reference_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
+  if (lit.layer[uint32_t(LitInput::kEmissive)]) {
+    const LitFrameOptions e = emissive_frame_for(camera);
+    VT_ASSIGN_OR_RETURN(out.emissive_virtual, renderer.render_lit_virtual(camera, e));
+    VT_ASSIGN_OR_RETURN(out.emissive_reference, renderer.render_lit_reference(camera, e));
+    out.emissive_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t2).count();
+  }
   return out;
+}
+
+LitFrameOptions emissive_frame_for(const Camera& camera) {
+  LitFrameOptions o = lit_frame_for(camera, 1u << uint32_t(LitInput::kEmissive));
+  o.key = o.fill = o.ambient = 0.0f;
+  return o;
 }
 
 nlohmann::json to_json(const LitViewReport& lit) {
   const ViewMetrics& m = lit.metrics;
-  return {{"psnr_rgb", m.psnr_rgb},
-          {"worst_tile_psnr", m.worst_tile_psnr},
-          {"ssim", m.ssim},
-          {"max_abs_error", m.max_abs},
-          {"pixels_compared", m.pixels},
-          {"reference_ms", lit.reference_ms},
-          {"virtual_ms", lit.virtual_ms}};
+  nlohmann::json j = {{"psnr_rgb", m.psnr_rgb},
+                      {"worst_tile_psnr", m.worst_tile_psnr},
+                      {"ssim", m.ssim},
+                      {"max_abs_error", m.max_abs},
+                      {"pixels_compared", m.pixels},
+                      {"reference_ms", lit.reference_ms},
+                      {"virtual_ms", lit.virtual_ms}};
+  if (lit.emissive) {
+    j["emissive"] = to_json(*lit.emissive);
+    j["emissive"]["ms"] = lit.emissive_ms;
+  }
+  return j;
 }
 
 }  // namespace vt::render

@@ -55,8 +55,8 @@ Expected<std::vector<LitMaterial>> lit_materials(const scene::Scene& scene,
 // Fills the vertex normals and tangents of `draws` (made by reference_scene_draws or
 // virtual_scene_draws from `scene`, same order) in world space: the primitive's own, else
 // scene/tangent_frame.h's, as the bake's transfer derives them. For the reference draws
-// (`reference`), a mesh whose material has no base colour texture takes its UVs from the set
-// its normal, ORM or emissive texture reads.
+// (`reference`), also each vertex's tex_uv: the normal, occlusion, metallic-roughness and emissive
+// slots' UV sets through their KHR_texture_transform (scene/material_rules.h).
 Status add_shading_frames(const scene::Scene& scene, SceneDraws& draws, bool reference);
 
 // The renderer's lit caches for `lit`, in the streamer's slots (after set_virtual_texture).
@@ -65,12 +65,21 @@ Status set_lit_caches_for(Renderer& renderer, const LitLayers& lit);
 Status upload_lit_pages(Renderer& renderer, const LitLayers& lit,
                         std::span<const PageUpload> uploads);
 
+// The lights of an emissive-only frame: every light off and only the emissive input, so both
+// passes shade to the emissive contribution alone (black elsewhere).
+LitFrameOptions emissive_frame_for(const Camera& camera);
+
 struct LitFrames {
   ReferenceFrame reference;
   VirtualFrame virt;
   double reference_ms = 0, virtual_ms = 0;  // each pass with read back
+  // With an emissive layer: the emissive-only pair (emissive_frame_for), both passes' time.
+  std::optional<ReferenceFrame> emissive_reference;
+  std::optional<VirtualFrame> emissive_virtual;
+  double emissive_ms = 0;
 };
-// Both lit passes of one view (the streamer converged, the caches uploaded).
+// Both lit passes of one view (the streamer converged, the caches uploaded), and the
+// emissive-only pair when `lit` has an emissive layer.
 Expected<LitFrames> render_lit_view(Renderer& renderer, const Camera& camera, const LitLayers& lit);
 
 }  // namespace vt::render

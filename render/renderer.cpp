@@ -55,7 +55,7 @@ struct LitState {
   Buffer frame;  // the LitFrame uniform block (shaders/lit.glsl), host-visible
   Image blank;   // 1 x 1 white: what an unused cache binding reads
   struct Material {
-    Image normal, orm, emissive;
+    Image normal, orm, emissive, occlusion;
     VkDescriptorSet set = VK_NULL_HANDLE;
     float emissive_scale[3] = {0, 0, 0};
     float normal_scale = 1.0f;
@@ -141,7 +141,6 @@ struct Renderer::Impl {
   VkDescriptorSetLayout ref_set_layout = VK_NULL_HANDLE;
   VkDescriptorSetLayout vt_set_layout = VK_NULL_HANDLE;
   VkPipelineLayout ref_layout = VK_NULL_HANDLE;
-  VkPipelineLayout fb_layout = VK_NULL_HANDLE;
   VkPipelineLayout vt_layout = VK_NULL_HANDLE;
   VkPipeline ref_pipe = VK_NULL_HANDLE;
   VkPipeline fb_pipe = VK_NULL_HANDLE;
@@ -226,9 +225,6 @@ struct Renderer::Impl {
   LitState lit;
   Status init_lit();
   Expected<Image> upload_texture(const ReferenceTexture& tex, const std::string& name);
-  VkSampler sampler_for(AddressMode mode) const {
-    return mode == AddressMode::kWrap ? trilinear_repeat : trilinear_clamp;
-  }
 };
 
 Renderer::Impl::~Impl() {
@@ -237,7 +233,7 @@ Renderer::Impl::~Impl() {
   for (VkPipeline p : {ref_pipe, fb_pipe, vt_pipe}) {
     if (p) vkDestroyPipeline(dev, p, nullptr);
   }
-  for (VkPipelineLayout l : {ref_layout, fb_layout, vt_layout}) {
+  for (VkPipelineLayout l : {ref_layout, vt_layout}) {
     if (l) vkDestroyPipelineLayout(dev, l, nullptr);
   }
   for (VkDescriptorSetLayout l : {ref_set_layout, vt_set_layout}) {
@@ -364,17 +360,19 @@ Expected<VkPipeline> Renderer::Impl::make_pipeline(VkPipelineLayout layout,
   stages[1].pName = "main";
 
   VkVertexInputBindingDescription binding{0, sizeof(Vertex), VK_VERTEX_INPUT_RATE_VERTEX};
-  VkVertexInputAttributeDescription attrs[5] = {
+  VkVertexInputAttributeDescription attrs[7] = {
       {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, x)},
       {1, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, u)},
       {2, 0, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(Vertex, r)},
       {3, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, nx)},
-      {4, 0, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(Vertex, tx)}};
+      {4, 0, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(Vertex, tx)},
+      {5, 0, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(Vertex, tex_uv[0])},
+      {6, 0, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(Vertex, tex_uv[2])}};
   VkPipelineVertexInputStateCreateInfo vi{
       VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
   vi.vertexBindingDescriptionCount = 1;
   vi.pVertexBindingDescriptions = &binding;
-  vi.vertexAttributeDescriptionCount = 5;
+  vi.vertexAttributeDescriptionCount = uint32_t(std::size(attrs));
   vi.pVertexAttributeDescriptions = attrs;
   VkPipelineInputAssemblyStateCreateInfo ia{
       VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
@@ -460,7 +458,6 @@ Status Renderer::Impl::init(const RenderOptions& o) {
   VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
   pl.pushConstantRangeCount = 1;
   pl.pPushConstantRanges = &push;
-  VT_VK(vkCreatePipelineLayout(dev, &pl, nullptr, &fb_layout));
   pl.setLayoutCount = 1;
   pl.pSetLayouts = &ref_set_layout;
   VT_VK(vkCreatePipelineLayout(dev, &pl, nullptr, &ref_layout));
@@ -471,7 +468,7 @@ Status Renderer::Impl::init(const RenderOptions& o) {
   const VkFormat fb_formats[] = {kUintFormat};
   const VkFormat vt_formats[] = {kColorFormat, kUintFormat};
   VT_ASSIGN_OR_RETURN(ref_pipe, make_pipeline(ref_layout, spirv_reference_frag(), ref_formats));
-  VT_ASSIGN_OR_RETURN(fb_pipe, make_pipeline(fb_layout, spirv_feedback_frag(), fb_formats));
+  VT_ASSIGN_OR_RETURN(fb_pipe, make_pipeline(vt_layout, spirv_feedback_frag(), fb_formats));
   VT_ASSIGN_OR_RETURN(vt_pipe, make_pipeline(vt_layout, spirv_virtual_frag(), vt_formats));
 
   uint32_t fw = std::max(1u, o.width / o.feedback_divisor);
@@ -922,14 +919,17 @@ Expected<FeedbackImage> Renderer::render_feedback(const Camera& camera, uint32_t
   const VkClearColorValue clears[] = {clear};
   VT_RETURN_IF_ERROR(s.run_pass({targets, readbacks, &s.fb_depth, w, h, clears}, s.fb_pipe,
                                 [&](VkCommandBuffer cmd) {
+                                  // The alpha test reads the cache as the virtual pass does.
+                                  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS,
+                                                          s.vt_layout, 0, 1, &s.vt_set, 0, nullptr);
                                   for (const auto& m : s.meshes) {
                                     Push p{};
                                     std::memcpy(p.mvp, mvp.m.data(), sizeof(p.mvp));
                                     fill_vt_push(p, s.vt);
                                     p.tex[2] = float(w) / float(options_.width);
-                                    p.tex[3] = -1.0f;
+                                    p.tex[3] = m.alpha_cutoff;
                                     p.misc[0] = int32_t(frame & 3);
-                                    draw_mesh(cmd, s.fb_layout, p, m);
+                                    draw_mesh(cmd, s.vt_layout, p, m);
                                   }
                                 }));
   FeedbackImage out;
@@ -1026,8 +1026,8 @@ Expected<Image> Renderer::Impl::upload_texture(const ReferenceTexture& tex,
 Status Renderer::Impl::init_lit() {
   if (lit.ready()) return Status::Ok();
   lit.dev = dev;
-  // Reference: albedo, normal, ORM, emissive, LitFrame. Virtual: page table, the four caches,
-  // LitFrame.
+  // Reference: albedo, normal, metallic-roughness, emissive, occlusion, LitFrame. Virtual: page
+  // table, the four caches, LitFrame.
   auto set_layout = [&](uint32_t samplers, VkDescriptorSetLayout* out) -> Status {
     std::vector<VkDescriptorSetLayoutBinding> b(samplers + 1);
     for (uint32_t i = 0; i <= samplers; ++i) {
@@ -1043,7 +1043,7 @@ Status Renderer::Impl::init_lit() {
     VT_VK(vkCreateDescriptorSetLayout(dev, &ci, nullptr, out));
     return Status::Ok();
   };
-  VT_RETURN_IF_ERROR(set_layout(4, &lit.ref_set_layout));
+  VT_RETURN_IF_ERROR(set_layout(5, &lit.ref_set_layout));
   VT_RETURN_IF_ERROR(set_layout(5, &lit.vt_set_layout));
   VkPushConstantRange push{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
                            sizeof(Push)};
@@ -1119,7 +1119,7 @@ Status Renderer::set_lit_materials(std::span<const LitMaterial> materials) {
   if (s.lit.ref_pool) vkDestroyDescriptorPool(s.dev, s.lit.ref_pool, nullptr);
   s.lit.ref_pool = VK_NULL_HANDLE;
   if (materials.empty()) return Status::Ok();
-  VT_ASSIGN_OR_RETURN(s.lit.ref_pool, make_lit_pool(s.dev, uint32_t(materials.size()), 4));
+  VT_ASSIGN_OR_RETURN(s.lit.ref_pool, make_lit_pool(s.dev, uint32_t(materials.size()), 5));
   for (size_t i = 0; i < materials.size(); ++i) {
     const LitMaterial& m = materials[i];
     const std::string name = "render: lit material " + std::to_string(i);
@@ -1127,17 +1127,22 @@ Status Renderer::set_lit_materials(std::span<const LitMaterial> materials) {
     VT_ASSIGN_OR_RETURN(g.normal, s.upload_texture(m.normal, name + " normal map"));
     VT_ASSIGN_OR_RETURN(g.orm, s.upload_texture(m.orm, name + " ORM"));
     VT_ASSIGN_OR_RETURN(g.emissive, s.upload_texture(m.emissive, name + " emissive"));
+    VT_ASSIGN_OR_RETURN(g.occlusion, s.upload_texture(m.occlusion, name + " occlusion"));
+    VT_ASSIGN_OR_RETURN(const VkSampler normal_sampler, s.reference_sampler(m.normal));
+    VT_ASSIGN_OR_RETURN(const VkSampler orm_sampler, s.reference_sampler(m.orm));
+    VT_ASSIGN_OR_RETURN(const VkSampler emissive_sampler, s.reference_sampler(m.emissive));
+    VT_ASSIGN_OR_RETURN(const VkSampler occlusion_sampler, s.reference_sampler(m.occlusion));
     for (int c = 0; c < 3; ++c) g.emissive_scale[c] = m.emissive_scale[c];
     g.normal_scale = m.normal_scale;
     g.flags = (m.has_normal_map ? 1 : 0) | (m.two_channel_normal ? 2 : 0);
     VT_ASSIGN_OR_RETURN(g.set, s.allocate_set(s.lit.ref_pool, s.lit.ref_set_layout));
     const Impl::GpuTexture& albedo = s.textures[i];
     const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-    const VkDescriptorImageInfo images[4] = {
-        {albedo.sampler, albedo.image.view(), ro},
-        {s.sampler_for(m.normal.address_mode), g.normal.view(), ro},
-        {s.sampler_for(m.orm.address_mode), g.orm.view(), ro},
-        {s.sampler_for(m.emissive.address_mode), g.emissive.view(), ro}};
+    const VkDescriptorImageInfo images[5] = {{albedo.sampler, albedo.image.view(), ro},
+                                             {normal_sampler, g.normal.view(), ro},
+                                             {orm_sampler, g.orm.view(), ro},
+                                             {emissive_sampler, g.emissive.view(), ro},
+                                             {occlusion_sampler, g.occlusion.view(), ro}};
     write_lit_set(s.dev, g.set, images, s.lit.frame);
     s.lit.materials.push_back(std::move(g));
   }

@@ -1,7 +1,8 @@
 // The validation renderer's three passes over one set of meshes, headless, read back to the CPU:
 //  - reference: each mesh's own mip-mapped texture, trilinear sampler, 4x anisotropic taps;
 //  - feedback: one uint32 page request per pixel at reduced resolution (runtime/ format:
-//    bits 0-11 page x, 12-23 page y, 24-28 level; 0xFFFFFFFF where nothing was drawn);
+//    bits 0-11 page x, 12-23 page y, 24-28 level; 0xFFFFFFFF where nothing was drawn), alpha-
+//    tested against what the cache holds;
 //  - virtual: page-table lookup and bordered physical-cache sampling with the same filtering.
 // Unlit; alpha test where a mesh asks for it. Output is deterministic on lavapipe.
 #pragma once
@@ -30,7 +31,11 @@ struct Vertex {
   float r = 1, g = 1, b = 1, a = 1;
   float nx = 0, ny = 0, nz = 1;
   float tx = 1, ty = 0, tz = 0, tw = 1;
+  // The lit reference's UVs of the normal, occlusion, metallic-roughness and emissive textures
+  // (kLitTexture*), each through its slot's texCoord and KHR_texture_transform.
+  float tex_uv[4][2] = {};
 };
+enum LitTextureUv : uint32_t { kLitNormalUv, kLitOcclusionUv, kLitMetalRoughUv, kLitEmissiveUv };
 
 struct MeshData {
   std::vector<Vertex> vertices;
@@ -105,7 +110,9 @@ struct Rgba8Image {
 
 struct ReferenceFrame {
   Rgba8Image color;
-  std::vector<uint32_t> covered;  // per pixel: 1 where the surface was drawn (after alpha test)
+  // Per pixel: bit 0 where the surface was drawn (after alpha test); bit 1 where its alpha was
+  // within a few steps above the cutoff (VirtualFrame::status bit 30).
+  std::vector<uint32_t> covered;
 };
 
 struct FeedbackImage {
@@ -116,8 +123,9 @@ struct FeedbackImage {
 
 struct VirtualFrame {
   Rgba8Image color;
-  // Per pixel: bit 31 covered, bits 0-7 the level wanted, bits 8-15 the coarsest level a fine
-  // tap actually sampled (31: nothing resident).
+  // Per pixel: bit 31 covered, bit 30 alpha-tested with alpha a few steps above the cutoff (a
+  // rounding apart from failing it), bits 0-7 the level wanted, bits 8-15 the coarsest level a
+  // fine tap actually sampled (31: nothing resident).
   std::vector<uint32_t> status;
 };
 
@@ -129,8 +137,11 @@ inline constexpr uint32_t kLitInputCount = 4;
 // One material's extra textures for the lit reference pass, beside its reference texture (the
 // albedo). Each a ReferenceTexture (RGBA8 mip chain); a 1 x 1 one where the material has none.
 struct LitMaterial {
-  ReferenceTexture normal;    // tangent-space normal map as stored (n * 0.5 + 0.5)
-  ReferenceTexture orm;       // occlusion, roughness, metallic, the material's factors applied
+  ReferenceTexture normal;  // tangent-space normal map as stored (n * 0.5 + 0.5)
+  // Roughness (G) and metallic (B) with the factors applied, R 1; occlusion (R, strength
+  // applied) apart, since glTF lets it read another UV set.
+  ReferenceTexture orm;
+  ReferenceTexture occlusion;
   ReferenceTexture emissive;  // sRGB; times emissive_scale (linear)
   float emissive_scale[3] = {0, 0, 0};
   float normal_scale = 1.0f;

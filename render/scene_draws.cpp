@@ -1,13 +1,11 @@
 #include "render/scene_draws.h"
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "common/srgb.h"
+#include "render/image_load.h"
 #include "scene/material_rules.h"
 
 namespace vt::render {
@@ -103,43 +101,14 @@ Expected<SceneDraws> draws(const scene::Scene& s, UvOf uv_of, bool reference) {
 // RGBA8 sRGB texels of an image, float images encoded from linear.
 Expected<std::vector<uint8_t>> load_rgba8(const scene::Image& image, uint32_t* width,
                                           uint32_t* height) {
-  std::unique_ptr<OIIO::ImageInput> in;
-  OIIO::Filesystem::IOMemReader mem(image.bytes.data(), image.bytes.size());
-  const std::string name = image.embedded()
-                               ? (image.mime_type == "image/jpeg" ? "embedded.jpg" : "embedded.png")
-                               : image.path;
-  if (image.embedded()) {
-    in = OIIO::ImageInput::open(name, nullptr, &mem);
-  } else {
-    in = OIIO::ImageInput::open(name);
-  }
-  if (!in) {
-    return Error(ErrorCode::kNotFound,
-                 "render: cannot open image '" + name + "': " + OIIO::geterror());
-  }
-  const OIIO::ImageSpec& spec = in->spec();
-  const int ch = spec.nchannels;
-  if (spec.width <= 0 || spec.height <= 0 || ch <= 0 || spec.width > 65536 || spec.height > 65536) {
-    return Error(ErrorCode::kCorrupt, "render: image '" + name + "' has a bad size");
-  }
-  std::vector<float> px(size_t(spec.width) * spec.height * ch);
-  if (!in->read_image(0, 0, 0, ch, OIIO::TypeDesc::FLOAT, px.data())) {
-    return Error(ErrorCode::kCorrupt,
-                 "render: cannot read image '" + name + "': " + in->geterror());
-  }
-  const bool linear = spec.format.is_floating_point();
-  *width = uint32_t(spec.width);
-  *height = uint32_t(spec.height);
-  std::vector<uint8_t> out(size_t(spec.width) * spec.height * 4);
-  for (size_t i = 0, n = size_t(spec.width) * spec.height; i < n; ++i) {
-    const float* s = &px[i * ch];
-    float rgb[3] = {s[0], ch >= 3 ? s[1] : s[0], ch >= 3 ? s[2] : s[0]};
-    float a = ch == 2 ? s[1] : ch >= 4 ? s[3] : 1.0f;
-    for (int c = 0; c < 3; ++c) {
-      out[i * 4 + c] = linear ? linear_to_srgb8(rgb[c])
-                              : uint8_t(std::lround(std::clamp(rgb[c], 0.0f, 1.0f) * 255.0f));
-    }
-    out[i * 4 + 3] = uint8_t(std::lround(std::clamp(a, 0.0f, 1.0f) * 255.0f));
+  VT_ASSIGN_OR_RETURN(const FloatImage img, load_float_image(image));
+  *width = img.width;
+  *height = img.height;
+  std::vector<uint8_t> out(img.rgba.size());
+  for (size_t i = 0; i < img.rgba.size(); ++i) {
+    const float v = img.rgba[i];
+    out[i] = img.is_float && i % 4 != 3 ? linear_to_srgb8(v)
+                                        : uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
   }
   return out;
 }

@@ -119,20 +119,21 @@ Expected<LevelTexture> assemble_level_texture(const PageSource& source, uint32_t
 
 StreamingBounds default_streaming_bounds(RuntimeFormat) {
   // Measured on the sample scene (vtbake sample-scene; bake --codec dct | bc | raw; BC3 cache;
-  // 6 views at 1280x720): every pixel within 5 steps but 1-2 isolated pixels in 3 of the 18
-  // views (up to 135 steps: the virtual render reads a transparent-black texel there, an open
-  // fault of the streaming path); at most 0.0007% of pixels beyond 4 steps; 55.7-57.4 dB whole
-  // view; worst tile 50.0 dB, 33.1 dB with an isolated pixel. A cache with zeroed borders:
-  // 37.5-42.4 dB, up to 168 steps.
+  // 6 views at 1280x720): every compared pixel within 5 steps (bc, raw) or 8 (dct, 9 pixels of
+  // one view beyond 4); 56.3-60.8 dB whole view, worst tile >= 51.8 dB. The 1-2 isolated pixels
+  // up to 135 steps seen before were alpha tests a rounding apart (a masked fragment just above
+  // the cutoff in one render, just below in the other, so each shows a different surface): they
+  // are excluded as alpha-edge pixels now (0-17 per view). Correct 512-texel boards at 192x128
+  // (tests/render/test_reference_rules.cpp): within 9 steps, at most 2 pixels beyond 4. A cache
+  // with zeroed borders: 37.5-42.4 dB, up to 168 steps; one neighbour page in place of another:
+  // 0.0043-0.0092% beyond 4 steps, up to 8.
   StreamingBounds b;
-  b.max_abs = 255;  // not a bound while the isolated pixels above stay unexplained
+  b.max_abs = 16;
   b.steps = 4;
-  b.max_share_beyond = 0.00005;
-  // Correct bakes of 512-texel boards at 320x180 (tests/render/test_reference_rules.cpp): 9-18
-  // such pixels; one neighbour page in place of another at 1280x720: 85.
-  b.max_pixels_beyond = 24;
+  b.max_share_beyond = 0.00002;
+  b.max_pixels_beyond = 4;
   b.min_psnr = 50;
-  b.min_tile_psnr = 30;
+  b.min_tile_psnr = 45;
   b.max_coverage_mismatch = 0.0005;
   return b;
 }
@@ -180,6 +181,13 @@ Expected<StreamingViewMetrics> compare_streaming(const ReferenceFrame& levels,
       const uint32_t sampled = (frame.status[i] >> 8) & 0xFF;
       if (sampled > wanted) {
         ++m.excluded_fallback;
+        continue;
+      }
+      // A masked fragment a rounding above the cutoff in one render may be discarded by the
+      // other, which then shows the surface behind: a flipped alpha test, not a wrong texel
+      // (the coverage comparisons bound those).
+      if ((frame.status[i] & 0x40000000u) || (levels.covered[i] & 2u)) {
+        ++m.excluded_alpha_edge;
         continue;
       }
       const uint8_t* r = &ref.texels[i * 4];
@@ -235,8 +243,8 @@ std::vector<std::string> check_streaming(const StreamingViewMetrics& m, const St
   add(m.psnr < b.min_psnr, "PSNR %.2f dB below %.2f dB", m.psnr, b.min_psnr);
   add(m.worst_tile_psnr < b.min_tile_psnr, "worst tile (pixel %u, %u) %.2f dB below %.2f dB",
       m.worst_tile_x, m.worst_tile_y, m.worst_tile_psnr, b.min_tile_psnr);
-  const uint64_t drawn =
-      m.pixels + m.excluded_fine + m.excluded_coarse + m.excluded_fallback + m.coverage_mismatch;
+  const uint64_t drawn = m.pixels + m.excluded_fine + m.excluded_coarse + m.excluded_fallback +
+                         m.excluded_alpha_edge + m.coverage_mismatch;
   const double mismatch = drawn ? double(m.coverage_mismatch) / double(drawn) : 0.0;
   add(mismatch > b.max_coverage_mismatch, "%.3f%% of pixels drawn by one render only, over %.3f%%",
       100.0 * mismatch, 100.0 * b.max_coverage_mismatch);
@@ -317,6 +325,7 @@ nlohmann::json to_json(const StreamingCheckReport& r) {
                      {"excluded_fine", m.excluded_fine},
                      {"excluded_coarse", m.excluded_coarse},
                      {"excluded_fallback", m.excluded_fallback},
+                     {"excluded_alpha_edge", m.excluded_alpha_edge},
                      {"coverage_mismatch", m.coverage_mismatch},
                      {"max_abs", m.max_abs},
                      {"psnr", m.psnr},

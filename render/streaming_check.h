@@ -48,8 +48,8 @@ struct StreamingBounds {
   int max_abs = 0;              // largest channel difference, 8-bit steps
   int steps = 0;                // a pixel "differs" when a channel is off by more than this
   double max_share_beyond = 0;  // share of compared pixels that differ
-  // ...or at most this many of them, whichever is more: small views and boards show a few
-  // isolated outliers (the open fault noted in streaming_check.cpp) that a share cannot absorb.
+  // ...or at most this many of them, whichever is more: a share of a small view rounds to no
+  // pixel at all.
   uint64_t max_pixels_beyond = 0;
   double min_psnr = 0;               // channels 0-2, whole view
   double min_tile_psnr = 0;          // worst 16 x 16 tile with at least 32 compared pixels
@@ -60,8 +60,9 @@ StreamingBounds default_streaming_bounds(RuntimeFormat cache_format);
 struct StreamingViewMetrics {
   uint64_t pixels = 0;         // compared: drawn by both renders, wanting a level the texture holds
   uint64_t excluded_fine = 0;  // wanted a dropped fine level
-  uint64_t excluded_coarse = 0;    // wanted a dropped coarse level
-  uint64_t excluded_fallback = 0;  // sampled a coarser level than wanted (page not resident)
+  uint64_t excluded_coarse = 0;      // wanted a dropped coarse level
+  uint64_t excluded_fallback = 0;    // sampled a coarser level than wanted (page not resident)
+  uint64_t excluded_alpha_edge = 0;  // alpha-tested, alpha a few steps above the cutoff
   uint64_t coverage_mismatch = 0;
   int max_abs = 0;
   double psnr = 0;

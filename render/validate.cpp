@@ -262,6 +262,7 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
   std::vector<VirtualFrame> frames;  // kept for the exact check
   converge.lit = options.lit;
   report.lit_thresholds = options.lit_thresholds;
+  report.emissive_bounds = options.emissive_bounds;
   for (uint32_t v = 0; v < cameras.size(); ++v) {
     // A cold cache per view: frames-to-converge then measures the view alone.
     VT_ASSIGN_OR_RETURN(std::unique_ptr<Streamer> streamer,
@@ -299,6 +300,13 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
       for (const std::string& why : check_view(lm, options.lit_thresholds))
         view.failures.push_back("lit: " + why);
       view.lit = LitViewReport{lm, lit->reference_ms, lit->virtual_ms};
+      if (lit->emissive_reference && lit->emissive_virtual) {
+        VT_ASSIGN_OR_RETURN(view.lit->emissive,
+                            compare_emissive(*lit->emissive_reference, *lit->emissive_virtual));
+        view.lit->emissive_ms = lit->emissive_ms;
+        for (const std::string& why : check_emissive(*view.lit->emissive, options.emissive_bounds))
+          view.failures.push_back("lit " + why);
+      }
     }
     if (!options.out_dir.empty()) {
       const std::string base = options.out_dir + "/view_" + std::to_string(v) + "_";
@@ -523,6 +531,7 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
   vopt.exact_meshes = in.virt.meshes;
   vopt.lit = lit.layers;
   vopt.lit_thresholds = o.lit_thresholds;
+  vopt.emissive_bounds = o.emissive_bounds;
 
   const double setup_seconds = seconds_since(setup_start);
   const auto views_start = std::chrono::steady_clock::now();

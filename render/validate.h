@@ -14,6 +14,7 @@
 #include "common/status.h"
 #include "render/atlas_check.h"
 #include "render/camera.h"
+#include "render/emissive_check.h"
 #include "render/lit_pass.h"
 #include "render/renderer.h"
 #include "render/streaming_check.h"
@@ -110,6 +111,8 @@ Thresholds lit_scene_thresholds();
 struct LitViewReport {
   ViewMetrics metrics;  // the lit virtual render against the lit reference
   double reference_ms = 0, virtual_ms = 0;
+  std::optional<EmissiveMetrics> emissive;  // with an emissive layer (emissive_check.h)
+  double emissive_ms = 0;                   // both emissive-only passes
 };
 // A view's "lit" object in report.json (docs/REPORTS.md).
 nlohmann::json to_json(const LitViewReport& lit);
@@ -137,6 +140,7 @@ struct ValidationReport {
   uint32_t width = 0, height = 0;
   Thresholds thresholds;
   Thresholds lit_thresholds;
+  EmissiveBounds emissive_bounds;
   std::vector<std::string> lit_layers;   // the layers the lit pass read (names); empty: no lit pass
   std::vector<std::string> lit_skipped;  // layers it could not render, and why
   std::vector<ViewReport> views;
@@ -166,6 +170,7 @@ struct ValidateOptions {
   std::optional<Thresholds> thresholds;  // default_thresholds(cache format) when unset
   LitLayers lit;                         // lit pass inputs; none set: no lit pass
   Thresholds lit_thresholds = lit_scene_thresholds();
+  EmissiveBounds emissive_bounds = default_emissive_bounds();
   std::string
       out_dir;  // where PNGs go (view_<i>_{reference,virtual,diff,residency}.png); "" = none
   std::vector<float> alpha_cutoffs;  // the scene's MASK cutoffs (compare_view)
@@ -198,6 +203,7 @@ struct BakeValidationOptions {
   uint32_t width = 1280, height = 720;
   Thresholds thresholds = scene_thresholds();
   Thresholds lit_thresholds = lit_scene_thresholds();
+  EmissiveBounds emissive_bounds = default_emissive_bounds();
   uint32_t slots = 32;           // physical cache slots per side
   uint32_t max_frames = 48;      // per view, before giving up converging
   bool prefer_hardware = false;  // a hardware Vulkan device rather than lavapipe

@@ -19,6 +19,11 @@ pc;
 #ifndef VT_VERTEX_STAGE
 const int kTaps = 4;
 
+// Alpha within this much of a material's cutoff may flip the alpha test between two renders of
+// the same texels (BC decoding and filtering rounding): the passes flag such fragments so the
+// exact check can tell a flipped alpha test from a wrong texel.
+const float kAlphaEdge = 4.5 / 255.0;
+
 // 4x anisotropic footprint: kTaps taps along the major axis of the pixel's footprint; the LOD
 // comes from the larger of the minor axis and the major axis over the tap count (each tap then
 // covers its share of the footprint). `step` is the uv distance between taps.

@@ -1,31 +1,36 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
-#define LIT_FRAME_BINDING 4
+#define LIT_FRAME_BINDING 5
 #include "lit.glsl"
 
-// Lit reference: the original materials. Albedo as reference.frag; the normal map decoded in the
-// mesh's tangent frame (the frame the bake's transfer decodes it in); ORM with the material's
-// factors applied; emissive texture times factor x strength.
+// Lit reference: the original materials under the bake's rules (scene/material_rules.h): each
+// texture on its own UV set through its own KHR_texture_transform (the vertex's tex_uv) and its
+// own per-axis sampler. Albedo as reference.frag; the normal map decoded in the mesh's tangent
+// frame (the frame the bake's transfer decodes it in); occlusion, roughness and metallic with the
+// material's factors applied; emissive texture times factor x strength.
 // Per draw: vt.xyz emissive factor x strength and vt.w normal scale (float bits); misc.x bit 0:
 // the material has a normal map, bit 1: a two-channel one (z reconstructed).
 layout(set = 0, binding = 0) uniform sampler2D u_albedo;
 layout(set = 0, binding = 1) uniform sampler2D u_normal;
 layout(set = 0, binding = 2) uniform sampler2D u_orm;
 layout(set = 0, binding = 3) uniform sampler2D u_emissive;
+layout(set = 0, binding = 4) uniform sampler2D u_occlusion;
 
 layout(location = 0) in vec2 v_uv;
 layout(location = 1) in vec4 v_color;  // vertex colour (linear), as reference.frag applies it
 layout(location = 2) in vec3 v_normal;
 layout(location = 3) in vec4 v_tangent;
 layout(location = 4) in vec3 v_world;
+layout(location = 5) in vec4 v_tex_uv01;  // normal, occlusion
+layout(location = 6) in vec4 v_tex_uv23;  // metallic-roughness, emissive
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out uint out_covered;
 
 // The same 4x anisotropic taps as common.glsl's footprint, in the texture's own texel size.
-vec4 sample_taps(sampler2D t, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
+vec4 sample_taps(sampler2D t, vec2 uv) {
   vec2 size = vec2(textureSize(t, 0));
-  vec2 dx = duv_dx * size, dy = duv_dy * size;
+  vec2 dx = dFdx(uv) * size, dy = dFdy(uv) * size;
   float lx = length(dx), ly = length(dy);
   vec2 major = lx >= ly ? dx : dy;
   float lod = clamp(log2(max(max(max(lx, ly) / float(kTaps), min(lx, ly)), 1e-6)), 0.0,
@@ -39,16 +44,18 @@ vec4 sample_taps(sampler2D t, vec2 uv, vec2 duv_dx, vec2 duv_dy) {
 }
 
 void main() {
-  vec2 duv_dx = dFdx(v_uv), duv_dy = dFdy(v_uv);
   Footprint f = footprint(v_uv, 1.0);
   vec4 albedo = vec4(0.0);
   for (int i = 0; i < kTaps; ++i) albedo += textureLod(u_albedo, tap_uv(v_uv, f, i), f.lod);
   albedo /= float(kTaps);
   albedo.a *= v_color.a;
   if (pc.tex.w >= 0.0 && albedo.a < pc.tex.w) discard;
-  vec4 tn = sample_taps(u_normal, v_uv, duv_dx, duv_dy);
-  vec4 torm = sample_taps(u_orm, v_uv, duv_dx, duv_dy);
-  vec4 te = sample_taps(u_emissive, v_uv, duv_dx, duv_dy);
+  // Only the inputs this frame shades with (uniform branches).
+  const bool normal_in = (pc.misc.w & kLitNormal) != 0, orm_in = (pc.misc.w & kLitOrm) != 0;
+  vec4 tn = normal_in ? sample_taps(u_normal, v_tex_uv01.xy) : vec4(0.5, 0.5, 1.0, 1.0);
+  float occlusion = orm_in ? sample_taps(u_occlusion, v_tex_uv01.zw).r : 1.0;
+  vec4 tmr = orm_in ? sample_taps(u_orm, v_tex_uv23.xy) : vec4(0.0);
+  vec4 te = (pc.misc.w & kLitEmissive) != 0 ? sample_taps(u_emissive, v_tex_uv23.zw) : vec4(0.0);
 
   vec3 n = normalize(v_normal);
   vec3 shading = n;
@@ -64,7 +71,7 @@ void main() {
   }
   // Back faces (open or two-sided surfaces) are lit as seen.
   if (dot(n, lit.eye.xyz - v_world) < 0.0) shading = -shading;
-  vec3 orm = (pc.misc.w & kLitOrm) != 0 ? torm.rgb : kLitDefaultOrm;
+  vec3 orm = (pc.misc.w & kLitOrm) != 0 ? vec3(occlusion, tmr.gb) : kLitDefaultOrm;
   vec3 emissive = vec3(0.0);
   if ((pc.misc.w & kLitEmissive) != 0) {
     emissive = srgb_to_linear3(te.rgb) *

@@ -3,10 +3,12 @@
 #include "common.glsl"
 #define LIT_FRAME_BINDING 5
 #include "lit.glsl"
+#include "virtual_texture.glsl"
 
 // Lit virtual texture: albedo, normal, ORM and emissive from their layers' physical caches, all
 // addressed through the one page table (every layer shares the page grid and slots) with the
-// taps and trilinear blend of virtual.frag. The baked normal is in the atlas tangent frame
+// taps and trilinear blend of virtual.frag (virtual_texture.glsl addresses the pages). The baked
+// normal is in the atlas tangent frame
 // (bake/transfer.cpp): tangent along +u of the atlas, bitangent up the atlas image.
 layout(set = 0, binding = 0) uniform usampler2D u_page_table;
 layout(set = 0, binding = 1) uniform sampler2D u_albedo;
@@ -24,37 +26,23 @@ struct Inputs {
   vec4 albedo, normal, orm, emissive;
 };
 
-ivec2 level_size(int level) {
-  return max(ivec2(1), (ivec2(pc.tex.xy) + (1 << level) - 1) >> level);
-}
-
 // One bilinear tap of every cache at `uv` in `level` (the resident ancestor where the page is
 // not in the cache).
 Inputs sample_level(vec2 uv, int level, inout int sampled) {
-  float payload = float(pc.vt.y);
-  ivec2 size = level_size(level);
-  ivec2 pages = (size + pc.vt.y - 1) / pc.vt.y;
-  ivec2 page = clamp(ivec2(floor(uv * vec2(size) / payload)), ivec2(0), pages - 1);
-  uvec4 e = texelFetch(u_page_table, page, level);
+  vec2 phys;
   Inputs r;
-  if ((e.a & 1u) == 0u) {
-    sampled = 31;
+  if (!vt_physical(u_page_table, uv, level, phys, sampled)) {
     r.albedo = r.emissive = vec4(1.0, 0.0, 1.0, 1.0);  // nothing resident at all: a loud colour
     r.normal = r.orm = vec4(0.5);
     return r;
   }
-  int resident = int(e.b);
-  ivec2 rpage = page >> max(resident - level, 0);
-  vec2 local = uv * vec2(level_size(resident)) - vec2(rpage) * payload;
-  float lo = 0.5 - float(pc.vt.z);
-  local = clamp(local, vec2(lo), vec2(payload - lo));
-  vec2 phys = (vec2(e.rg) * float(pc.vt.w) + float(pc.vt.z) + local) /
-              vec2(textureSize(u_albedo, 0));
-  sampled = max(sampled, resident);
+  phys /= vec2(textureSize(u_albedo, 0));
+  // Only the inputs this frame shades with (uniform branches): the emissive-only frame reads two
+  // caches of four.
   r.albedo = textureLod(u_albedo, phys, 0.0);
-  r.normal = textureLod(u_normal, phys, 0.0);
-  r.orm = textureLod(u_orm, phys, 0.0);
-  r.emissive = textureLod(u_emissive, phys, 0.0);
+  r.normal = (pc.misc.w & kLitNormal) != 0 ? textureLod(u_normal, phys, 0.0) : vec4(0.5);
+  r.orm = (pc.misc.w & kLitOrm) != 0 ? textureLod(u_orm, phys, 0.0) : vec4(0.0);
+  r.emissive = (pc.misc.w & kLitEmissive) != 0 ? textureLod(u_emissive, phys, 0.0) : vec4(0.0);
   return r;
 }
 

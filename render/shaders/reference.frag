@@ -10,7 +10,7 @@ layout(set = 0, binding = 0) uniform sampler2D u_texture;
 layout(location = 0) in vec2 v_uv;
 layout(location = 1) in vec4 v_color;
 layout(location = 0) out vec4 out_color;
-layout(location = 1) out uint out_covered;  // 1 where a fragment survived the alpha test
+layout(location = 1) out uint out_covered;  // bit 0 where a fragment survived the alpha test
 
 // The sRGB curve of common/srgb.h (IEC 61966-2-1).
 vec3 srgb_to_linear(vec3 c) {
@@ -32,5 +32,6 @@ void main() {
   c.a *= v_color.a;
   if (pc.tex.w >= 0.0 && c.a < pc.tex.w) discard;
   out_color = c;
-  out_covered = 1u;
+  // Bit 1: alpha-tested with alpha within kAlphaEdge of the cutoff (virtual.frag's bit 30).
+  out_covered = pc.tex.w >= 0.0 && c.a < pc.tex.w + kAlphaEdge ? 3u : 1u;
 }

@@ -7,10 +7,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -19,6 +21,7 @@
 
 #include "format/page_file.h"
 #include "tests/cli/cli_test_util.h"
+#include "tests/render/page_file_rewrite.h"
 
 namespace vt {
 namespace {
@@ -48,41 +51,31 @@ std::pair<int, int> image_size(const std::string& path) {
   return {in->spec().width, in->spec().height};
 }
 
-// Copies a page file, giving each stored page of `layer` the stored bytes of the next stored
-// page of its level (Morton-free row order, wrapping): every page decodes cleanly and passes
-// its checksum, but shows the wrong part of the texture. rotate = false copies faithfully.
+// Copies a page file, giving each stored page of `layer` the content of the next stored page of
+// its level (row order, wrapping): every page decodes cleanly and passes its checksum, but shows
+// the wrong part of the texture. rotate = false copies faithfully.
 Status rewrite_page_file(const std::string& in, const std::string& out, uint32_t layer,
                          bool rotate) {
   VT_ASSIGN_OR_RETURN(auto reader, PageFileReader::open(in));
-  PageFileDesc desc;
-  desc.geometry = reader->geometry();
-  desc.layers = reader->layers();
-  desc.metadata_json = reader->metadata_json();
-  VT_ASSIGN_OR_RETURN(auto writer, PageFileWriter::create(out, desc));
-  const PageGeometry& g = desc.geometry;
-  for (uint32_t l = 0; l < g.level_count(); ++l) {
-    for (uint32_t li = 0; li < desc.layers.size(); ++li) {
-      std::vector<PageId> stored;
-      for (uint32_t y = 0; y < g.pages_y(l); ++y) {
-        for (uint32_t x = 0; x < g.pages_x(l); ++x) {
-          const PageId id{l, x, y};
-          VT_ASSIGN_OR_RETURN(PageEntry e, reader->entry(id, li));
-          if (e.state == PageState::kConstant) {
-            VT_RETURN_IF_ERROR(writer->add_constant_page(
-                id, li, std::span<const uint8_t>(e.constant, desc.layers[li].texel_bytes())));
-          } else if (e.state == PageState::kStored) {
-            stored.push_back(id);
-          }
-        }
+  const PageGeometry& g = reader->geometry();
+  std::map<std::array<uint32_t, 3>, PageId> next;
+  for (uint32_t l = 0; rotate && l < g.level_count(); ++l) {
+    std::vector<PageId> stored;
+    for (uint32_t y = 0; y < g.pages_y(l); ++y)
+      for (uint32_t x = 0; x < g.pages_x(l); ++x) {
+        VT_ASSIGN_OR_RETURN(PageEntry e, reader->entry({l, x, y}, layer));
+        if (e.state == PageState::kStored) stored.push_back({l, x, y});
       }
-      for (size_t i = 0; i < stored.size(); ++i) {
-        const PageId from = rotate && li == layer ? stored[(i + 1) % stored.size()] : stored[i];
-        VT_ASSIGN_OR_RETURN(auto bytes, reader->read_stored(from, li));
-        VT_RETURN_IF_ERROR(writer->add_page(stored[i], li, bytes));
-      }
-    }
+    for (size_t i = 0; i < stored.size(); ++i)
+      next[{l, stored[i].x, stored[i].y}] = stored[(i + 1) % stored.size()];
   }
-  return writer->finish();
+  return vt::render::rewrite_page_file(
+      in, out,
+      [&](const PageId& id, uint32_t li) {
+        auto it = li == layer ? next.find({id.level, id.x, id.y}) : next.end();
+        return it == next.end() ? id : it->second;
+      },
+      [](const PageId&, uint32_t, std::vector<uint8_t>&) { return false; });
 }
 
 class ValidateCli : public ::testing::Test {

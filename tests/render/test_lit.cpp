@@ -1,7 +1,7 @@
 // The lit check (render/lit_pass.h): lights from the camera, the lit reference's materials, the
 // layers it reads; and on a small bake of the procedural sample scene (all four layers), the
-// correct bake passes while a normal layer with green flipped or an emissive layer at half
-// strength fails the lit comparison.
+// correct bake passes while a normal layer with green flipped fails the lit comparison and an
+// emissive layer at half strength the emissive-only one.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -95,6 +95,7 @@ TEST(LitMaterials, FactorsAndDefaultsAsTheBakeAppliesThem) {
   EXPECT_EQ(a.emissive_scale[1], 0.5f);
   EXPECT_EQ(a.emissive_scale[2], 2.0f);
   EXPECT_EQ(a.normal.levels[0], (std::vector<uint8_t>{128, 128, 255, 255}));
+  EXPECT_EQ(a.occlusion.levels[0], (std::vector<uint8_t>{255, 255, 255, 255}));
   // glTF's default material: fully rough, fully metallic, no emission.
   EXPECT_EQ((*lit)[1].orm.levels[0], (std::vector<uint8_t>{255, 255, 255, 255}));
   EXPECT_EQ((*lit)[1].emissive_scale[0], 0.0f);
@@ -116,7 +117,7 @@ TEST(LitShadingFrames, NormalsTangentsAndUvsInWorldSpace) {
   p.indices = {0, 1, 2};
   p.material = 0;
   scene::Material m;
-  m.normal_texture.image = 0;  // no base colour texture: the reference takes the normal map's UVs
+  m.normal_texture.image = 0;  // read through its own slot (tex_uv), the draw's UV left alone
   s.materials = {m};
   scene::Mesh mesh;
   mesh.primitives = {p};
@@ -136,8 +137,9 @@ TEST(LitShadingFrames, NormalsTangentsAndUvsInWorldSpace) {
   EXPECT_FLOAT_EQ(v.nz, 1.0f);  // counter-clockwise in xy: +z
   EXPECT_FLOAT_EQ(v.tx, 1.0f);  // u grows along +x
   EXPECT_FLOAT_EQ(v.tw, 1.0f);
-  EXPECT_FLOAT_EQ(v.u, 1.0f);
-  EXPECT_FLOAT_EQ(v.v, 1.0f);
+  EXPECT_FLOAT_EQ(v.tex_uv[kLitNormalUv][0], 1.0f);
+  EXPECT_FLOAT_EQ(v.tex_uv[kLitNormalUv][1], 1.0f);
+  EXPECT_FLOAT_EQ(v.u, 0.0f);
   draws.meshes.push_back(md);  // a draw the scene does not have
   EXPECT_FALSE(add_shading_frames(s, draws, true).ok());
 }
@@ -283,12 +285,25 @@ TEST_F(LitCheck, EmissiveAtHalfStrengthFails) {
   ASSERT_TRUE(correct.ok()) << correct.status().message();
   auto r = validate(file, "emissive", cameras);
   ASSERT_TRUE(r.ok()) << r.status().message();
-  // Close on the 1-texel emissive lines the correct bake itself scores only 24.5 / 17.5 dB (the
-  // atlas is coarser than the 256-texel source), below the lit bounds: so far the halved layer is
-  // shown only relative to it (measured 23.1 / 15.3 dB).
+  // Close on the 1-texel emissive lines the whole lit view of the correct bake scores only
+  // 24.5 / 17.5 dB (the atlas is coarser than the 256-texel source) and the halved layer 23.1 /
+  // 15.3 dB: the emissive contribution alone (emissive_check.h) tells them apart.
   lit_failed(*correct), lit_failed(*r);  // prints the figures
   ASSERT_TRUE(correct->views[0].lit && r->views[0].lit);
-  EXPECT_LT(r->views[0].lit->metrics.psnr_rgb, correct->views[0].lit->metrics.psnr_rgb - 0.7);
+  ASSERT_TRUE(correct->views[0].lit->emissive && r->views[0].lit->emissive);
+  const EmissiveMetrics& good = *correct->views[0].lit->emissive;
+  const EmissiveMetrics& bad = *r->views[0].lit->emissive;
+  std::printf("emissive alone: correct %.2f dB, energy %.3f; halved %.2f dB, energy %.3f\n",
+              good.psnr_rgb, good.energy_ratio, bad.psnr_rgb, bad.energy_ratio);
+  auto emissive_failed = [](const ValidationReport& v) {
+    for (const std::string& f : v.views[0].failures)
+      if (f.rfind("lit emissive: ", 0) == 0) return true;
+    return false;
+  };
+  EXPECT_FALSE(emissive_failed(*correct)) << ::testing::PrintToString(correct->views[0].failures);
+  EXPECT_TRUE(emissive_failed(*r));
+  EXPECT_FALSE(r->passed());
+  EXPECT_LT(bad.energy_ratio, 0.5);
   EXPECT_LT(r->views[0].lit->metrics.worst_tile_psnr,
             correct->views[0].lit->metrics.worst_tile_psnr - 1.0);
 }

@@ -1,0 +1,48 @@
+#include "render/image_load.h"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+#include <memory>
+
+namespace vt::render {
+
+Expected<FloatImage> load_float_image(const scene::Image& image) {
+  OIIO::Filesystem::IOMemReader mem(image.bytes.data(), image.bytes.size());
+  const std::string name = image.embedded()
+                               ? (image.mime_type == "image/jpeg" ? "embedded.jpg" : "embedded.png")
+                               : image.path;
+  std::unique_ptr<OIIO::ImageInput> in =
+      image.embedded() ? OIIO::ImageInput::open(name, nullptr, &mem) : OIIO::ImageInput::open(name);
+  if (!in) {
+    return Error(ErrorCode::kNotFound,
+                 "render: cannot open image '" + name + "': " + OIIO::geterror());
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  const int ch = spec.nchannels;
+  if (spec.width <= 0 || spec.height <= 0 || ch <= 0 || spec.width > 65536 || spec.height > 65536) {
+    return Error(ErrorCode::kCorrupt, "render: image '" + name + "' has a bad size");
+  }
+  std::vector<float> px(size_t(spec.width) * spec.height * ch);
+  if (!in->read_image(0, 0, 0, ch, OIIO::TypeDesc::FLOAT, px.data())) {
+    return Error(ErrorCode::kCorrupt,
+                 "render: cannot read image '" + name + "': " + in->geterror());
+  }
+  FloatImage out;
+  out.width = uint32_t(spec.width);
+  out.height = uint32_t(spec.height);
+  out.channels = uint32_t(ch);
+  out.is_float = spec.format.is_floating_point();
+  out.rgba.resize(size_t(out.width) * out.height * 4);
+  for (size_t i = 0, n = size_t(out.width) * out.height; i < n; ++i) {
+    const float* s = &px[i * ch];
+    float* d = &out.rgba[i * 4];
+    d[0] = s[0];
+    d[1] = ch >= 3 ? s[1] : s[0];
+    d[2] = ch >= 3 ? s[2] : s[0];
+    d[3] = ch == 2 ? s[1] : ch >= 4 ? s[3] : 1.0f;
+  }
+  return out;
+}
+
+}  // namespace vt::render

@@ -1,0 +1,63 @@
+// Page-table addressing shared by every pass that reads the virtual texture (virtual.frag,
+// lit_virtual.frag, feedback.frag), so that all of them agree on which page and texel a tap
+// reads. Include after common.glsl. The page table is the RGBA8 mip chain of runtime/: R, G =
+// physical slot, B = resident level, A bit 0 = valid.
+
+ivec2 vt_level_size(int level) {
+  return max(ivec2(1), (ivec2(pc.tex.xy) + (1 << level) - 1) >> level);
+}
+
+// The page of `level` holding `uv`.
+ivec2 vt_page(vec2 uv, int level) {
+  ivec2 pages = (vt_level_size(level) + pc.vt.y - 1) / pc.vt.y;
+  return clamp(ivec2(floor(uv * vec2(vt_level_size(level)) / float(pc.vt.y))), ivec2(0), pages - 1);
+}
+
+// Where the texel at `uv` of `level` lies in the physical cache, in texels: the resident
+// ancestor's slot where the page itself is not in the cache. False when nothing is resident
+// (`sampled` set to 31); otherwise `sampled` is raised to the level actually read.
+bool vt_physical(usampler2D table, vec2 uv, int level, out vec2 phys, inout int sampled) {
+  ivec2 page = vt_page(uv, level);
+  uvec4 e = texelFetch(table, page, level);
+  if ((e.a & 1u) == 0u) {
+    sampled = 31;
+    phys = vec2(0.0);
+    return false;
+  }
+  int resident = int(e.b);
+  // The slot holds the ancestor page; address its texels in the resident level.
+  ivec2 rpage = page >> max(resident - level, 0);
+  float payload = float(pc.vt.y);
+  vec2 local = uv * vec2(vt_level_size(resident)) - vec2(rpage) * payload;
+  float lo = 0.5 - float(pc.vt.z);
+  local = clamp(local, vec2(lo), vec2(payload - lo));
+  phys = vec2(e.rg) * float(pc.vt.w) + float(pc.vt.z) + local;
+  sampled = max(sampled, resident);
+  return true;
+}
+
+// One bilinear tap of `cache` at `uv` in `level` through the page table; a loud colour where
+// nothing is resident.
+vec4 vt_sample_level(sampler2D cache, usampler2D table, vec2 uv, int level, inout int sampled) {
+  vec2 phys;
+  if (!vt_physical(table, uv, level, phys, sampled)) return vec4(1.0, 0.0, 1.0, 1.0);
+  return textureLod(cache, phys / vec2(textureSize(cache, 0)), 0.0);
+}
+
+// The filtered virtual-texture colour at `uv`: common.glsl's anisotropic taps, each trilinear as
+// two levels and a blend. `sampled`: the coarsest level a tap of the finer level read.
+vec4 vt_filtered(sampler2D cache, usampler2D table, vec2 uv, Footprint f, out int sampled) {
+  int l0 = int(floor(f.lod));
+  int l1 = min(l0 + 1, pc.misc.z);
+  float blend = f.lod - float(l0);
+  sampled = 0;
+  int ignored = 0;
+  vec4 c = vec4(0.0);
+  for (int i = 0; i < kTaps; ++i) {
+    vec2 t = tap_uv(uv, f, i);
+    vec4 a = vt_sample_level(cache, table, t, l0, sampled);
+    vec4 b = l1 != l0 ? vt_sample_level(cache, table, t, l1, ignored) : a;
+    c += mix(a, b, blend);
+  }
+  return c / float(kTaps);
+}
