@@ -23,14 +23,15 @@ uint8_t unorm8(float v) {
 }
 
 // A ReferenceTexture from level-0 RGBA8 texels: full box mip chain, reduced to `max_side`, sampled
-// with `ref`'s sampler (wrap per axis, magFilter) when given.
+// with `ref`'s sampler (wrap per axis, magFilter) when given; `srgb` colour texels are filtered
+// in linear light.
 ReferenceTexture make_texture(std::vector<uint8_t> texels, uint32_t w, uint32_t h,
-                              const scene::TextureRef* ref, uint32_t max_side) {
+                              const scene::TextureRef* ref, uint32_t max_side, bool srgb = false) {
   ReferenceTexture tex;
   tex.width = w;
   tex.height = h;
   if (ref) tex.sampler = TextureSampler{ref->wrap_s, ref->wrap_t, ref->mag_filter};
-  tex.levels = box_mip_chain(texels.data(), w, h);
+  tex.levels = box_mip_chain(texels.data(), w, h, srgb);
   uint32_t drop = 0;
   while (std::max(w >> drop, h >> drop) > max_side) ++drop;
   if (drop > 0) {
@@ -106,7 +107,7 @@ ReferenceTexture image_texture(const FloatImage& img, bool colour, const scene::
     texels[i] = colour && img.is_float && i % 4 != 3 ? unorm8(linear_to_srgb(std::max(0.0f, v)))
                                                      : unorm8(v);
   }
-  return make_texture(std::move(texels), img.width, img.height, &ref, max_side);
+  return make_texture(std::move(texels), img.width, img.height, &ref, max_side, colour);
 }
 
 Expected<LitMaterial> lit_material(const scene::Material& m, ImageCache& images,

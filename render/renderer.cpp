@@ -1,5 +1,7 @@
 #include "render/renderer.h"
 
+#include "common/srgb.h"
+
 #include <algorithm>
 #include <array>
 #include <cstring>
@@ -81,7 +83,9 @@ struct LitState {
 }  // namespace
 
 std::vector<std::vector<uint8_t>> box_mip_chain(const uint8_t* rgba, uint32_t width,
-                                                uint32_t height) {
+                                                uint32_t height, bool srgb) {
+  float to_linear[256];
+  for (int v = 0; v < 256; ++v) to_linear[v] = srgb_to_linear(v / 255.0f);
   std::vector<std::vector<uint8_t>> levels;
   levels.emplace_back(rgba, rgba + size_t(width) * height * 4);
   uint32_t w = width, h = height;
@@ -93,10 +97,19 @@ std::vector<std::vector<uint8_t>> box_mip_chain(const uint8_t* rgba, uint32_t wi
       uint32_t y0 = std::min(2 * y, h - 1), y1 = std::min(2 * y + 1, h - 1);
       for (uint32_t x = 0; x < nw; ++x) {
         uint32_t x0 = std::min(2 * x, w - 1), x1 = std::min(2 * x + 1, w - 1);
+        const size_t taps[4] = {(size_t(y0) * w + x0) * 4, (size_t(y0) * w + x1) * 4,
+                                (size_t(y1) * w + x0) * 4, (size_t(y1) * w + x1) * 4};
         for (int c = 0; c < 4; ++c) {
-          uint32_t s = src[(size_t(y0) * w + x0) * 4 + c] + src[(size_t(y0) * w + x1) * 4 + c] +
-                       src[(size_t(y1) * w + x0) * 4 + c] + src[(size_t(y1) * w + x1) * 4 + c];
-          dst[(size_t(y) * nw + x) * 4 + c] = uint8_t((s + 2) / 4);
+          uint8_t& out = dst[(size_t(y) * nw + x) * 4 + c];
+          if (srgb && c < 3) {
+            float sum = 0;
+            for (size_t t : taps) sum += to_linear[src[t + c]];
+            out = uint8_t(std::lround(linear_to_srgb(sum * 0.25f) * 255.0f));
+          } else {
+            uint32_t sum = 0;
+            for (size_t t : taps) sum += src[t + c];
+            out = uint8_t((sum + 2) / 4);
+          }
         }
       }
     }

@@ -65,9 +65,11 @@ struct ReferenceTexture {
 };
 
 // Builds a mip chain from level 0 by 2x box filtering (odd sizes: the last row/column is
-// averaged with itself).
+// averaged with itself). `srgb`: the colour channels carry the sRGB curve and are averaged in
+// linear light, as the bake filters them (averaging the bytes darkens thin bright lines: an
+// emissive sign seen from afar glowed 2.6x brighter baked than in such a reference).
 std::vector<std::vector<uint8_t>> box_mip_chain(const uint8_t* rgba, uint32_t width,
-                                                uint32_t height);
+                                                uint32_t height, bool srgb = false);
 
 // The Vulkan format of a physical cache holding `f` (RGBA8, R8, RG8, BC1/3/4/5/7; float
 // formats are not rendered); VK_FORMAT_UNDEFINED otherwise.
