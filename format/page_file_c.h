@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "format/vt_error_c.h"
+#include "format/vt_version_c.h"
 
 #ifdef __cplusplus
 extern "C" {

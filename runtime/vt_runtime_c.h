@@ -9,12 +9,19 @@
 #include <stdint.h>
 
 #include "format/vt_error_c.h"
+#include "format/vt_version_c.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
 typedef struct vtrt_streamer vtrt_streamer;
+
+/* One feedback value (runtime/feedback.h): page (x, y) of `level` wanted by a pixel; x, y < 4096,
+ * level < 32. VTRT_FEEDBACK_NONE marks a pixel that wants nothing. */
+#define VTRT_FEEDBACK(level, x, y) \
+  (((uint32_t)(x)&0xFFFu) | (((uint32_t)(y)&0xFFFu) << 12) | (((uint32_t)(level)&0x1Fu) << 24))
+#define VTRT_FEEDBACK_NONE 0xFFFFFFFFu
 
 typedef struct vtrt_options {
   uint32_t slots_x, slots_y;    /* physical cache in slots (each <= 256) */
