@@ -39,6 +39,8 @@ pc_dir=$(dirname "$(find "$prefix" -name vtbake-runtime.pc)")
 export PKG_CONFIG_PATH=$pc_dir
 cflags=$(pkg-config --cflags vtbake-runtime)
 libs=$(pkg-config --libs vtbake-runtime)
+# A shared build's libraries live in a private prefix: the programs find them by rpath.
+libs+=" -Wl,-rpath,$(pkg-config --variable=libdir vtbake-runtime)"
 echo "pkg-config --libs vtbake-runtime: $libs"
 # shellcheck disable=SC2086
 "$cc" -std=c99 -pedantic-errors -Wall -Wextra $cflags "$src/stream_frames.c" -o "$work/pc_c" $libs

@@ -20,6 +20,10 @@ mkdir -p "$out/shim" "$out/obj"
 for h in zstd.h zstd_errors.h xxhash.h; do ln -s "/usr/include/$h" "$out/shim/$h"; done
 
 cd "$root"
+# format/version.cpp gets the project version from CMake; here it is read from project().
+version=$(sed -n 's/^project(vtbake VERSION \([0-9]*\)\.\([0-9]*\)\.\([0-9]*\).*/\1 \2 \3/p' CMakeLists.txt)
+read -r major minor patch <<<"$version"
+version_flags="-DVT_LIBRARY_VERSION_MAJOR=$major -DVT_LIBRARY_VERSION_MINOR=$minor -DVT_LIBRARY_VERSION_PATCH=$patch"
 posix_only=(format/page_file_writer.cpp format/atomic_output.cpp)
 sources=()
 for f in codec/*.cpp codec/*.c format/*.cpp format/*.c runtime/*.cpp runtime/*.c; do
@@ -32,11 +36,11 @@ compile() {
   local f=$1 obj=$out/obj/${1//\//_}.o
   case $f in
     *.c) "$cc" -std=c99 -Wall -Wextra -pedantic-errors -I"$root" -c "$f" -o "$obj" ;;
-    *) "$cxx" -std=c++20 -O1 -Wall -Wextra -I"$root" -I"$out/shim" -ffp-contract=off -c "$f" -o "$obj" ;;
+    *) "$cxx" -std=c++20 -O1 -Wall -Wextra -I"$root" -I"$out/shim" -ffp-contract=off $version_flags -c "$f" -o "$obj" ;;
   esac
 }
 export -f compile
-export out root cc cxx
+export out root cc cxx version_flags
 printf '%s\n' "${sources[@]}" | xargs -P "$jobs" -I{} bash -c 'compile {} || { echo "cross_windows: {} failed" >&2; exit 255; }'
 "$ar" rcs "$out/libvtbake_runtime_win64.a" "$out"/obj/*.o
 echo "cross_windows: ${#sources[@]} runtime-side sources compiled for x86_64-w64-mingw32 into $out/libvtbake_runtime_win64.a ($(stat -c %s "$out/libvtbake_runtime_win64.a") bytes)"
