@@ -19,11 +19,15 @@ using namespace pagefile;
 
 class PageFileReaderImpl final : public PageFileReader {
  public:
-  PageFileReaderImpl(std::string path, ReaderOptions options)
-      : path_(std::move(path)), options_(options) {}
+  PageFileReaderImpl(std::string path, ReaderOptions options,
+                     std::shared_ptr<const ByteSource> bytes = nullptr)
+      : path_(std::move(path)), options_(options), file_(std::move(bytes)) {}
 
   Status open_and_validate() {
-    VT_ASSIGN_OR_RETURN(file_, platform::ReadOnlyFile::open(path_));
+    if (!file_) {
+      VT_ASSIGN_OR_RETURN(auto file, platform::ReadOnlyFile::open(path_));
+      file_ = std::move(file);
+    }
     size_ = file_->size();
     if (size_ < kFixedHeaderBytes)
       return corrupt("truncated: " + std::to_string(size_) + " bytes is less than a header");
@@ -165,7 +169,7 @@ class PageFileReaderImpl final : public PageFileReader {
 
   std::string path_;
   ReaderOptions options_;
-  std::unique_ptr<platform::ReadOnlyFile> file_;
+  std::shared_ptr<const ByteSource> file_;  // a platform file, or the engine's storage
   uint64_t size_ = 0;
   uint32_t version_ = 0;
   std::vector<uint8_t> header_;  // the whole header, checksum included
@@ -367,6 +371,16 @@ Expected<std::unique_ptr<PageFileReader>> PageFileReader::open(const std::string
   auto reader = std::make_unique<PageFileReaderImpl>(path, options);
   Status s = reader->open_and_validate();
   if (!s.ok()) return s.with_context(path);
+  return std::unique_ptr<PageFileReader>(std::move(reader));
+}
+
+Expected<std::unique_ptr<PageFileReader>> PageFileReader::open(
+    std::shared_ptr<const ByteSource> bytes, const std::string& name,
+    const ReaderOptions& options) {
+  if (!bytes) return Error(ErrorCode::kInvalidArgument, name + ": no byte source");
+  auto reader = std::make_unique<PageFileReaderImpl>(name, options, std::move(bytes));
+  Status s = reader->open_and_validate();
+  if (!s.ok()) return s.with_context(name);
   return std::unique_ptr<PageFileReader>(std::move(reader));
 }
 
