@@ -36,30 +36,9 @@ void release_memory(void* user) {
   ++static_cast<MemoryStorage*>(user)->releases;
 }
 
-// 4 x 3 pages of 8 + 2 * 4 texels, raw RGBA8, every texel (level, x, y, 255); its bytes.
+// The bytes of runtime_test::write_marked_file's page file.
 std::vector<uint8_t> marked_file_bytes() {
-  PageFileDesc desc;
-  desc.geometry.width = 32;
-  desc.geometry.height = 24;
-  desc.geometry.payload = 8;
-  desc.geometry.border = 4;
-  desc.layers = {runtime_test::test_layer("albedo", 4, PageCodec::kRawZstd, RuntimeFormat::kRgba8)};
-  const std::string path = runtime_test::temp_file("callbacks.vtpf");
-  auto w = PageFileWriter::create(path, desc);
-  EXPECT_TRUE(w.ok());
-  const PageGeometry& g = desc.geometry;
-  for (uint32_t l = 0; l < g.level_count(); ++l)
-    for (uint32_t y = 0; y < g.pages_y(l); ++y)
-      for (uint32_t x = 0; x < g.pages_x(l); ++x) {
-        std::vector<uint8_t> page(16 * 16 * 4);
-        for (size_t i = 0; i < page.size(); i += 4) {
-          page[i] = uint8_t(l), page[i + 1] = uint8_t(x), page[i + 2] = uint8_t(y);
-          page[i + 3] = 255;
-        }
-        EXPECT_TRUE((*w)->add_page({l, x, y}, 0, page).ok());
-      }
-  EXPECT_TRUE((*w)->finish().ok());
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(runtime_test::write_marked_file(), std::ios::binary);
   return std::vector<uint8_t>(std::istreambuf_iterator<char>(in), {});
 }
 
