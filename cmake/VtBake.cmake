@@ -1,15 +1,25 @@
-# vt_add_library(NAME DIR PUBLIC_DEPS deps... PRIVATE_DEPS deps...)
+# vt_add_library(NAME [RUNTIME] PUBLIC_DEPS deps... PRIVATE_DEPS deps...)
 # Every .cpp in DIR (not in subfolders) becomes part of NAME, so adding a capability is adding
 # a file. A folder with no sources yet is an INTERFACE library so dependants still link.
+# RUNTIME marks a library of the runtime side, the part an engine links: it follows
+# BUILD_SHARED_LIBS (with SONAME and version), is installed as libvtbake_<name> and exported as
+# vtbake::<name> (cmake/VtPackage.cmake). The baker's libraries stay static either way.
 function(vt_add_library name)
-  cmake_parse_arguments(ARG "" "" "PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "RUNTIME" "" "PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
   file(GLOB sources CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/*.cpp" "${CMAKE_CURRENT_SOURCE_DIR}/*.c")
   if(sources)
-    add_library(${name} STATIC ${sources})
+    if(ARG_RUNTIME)
+      add_library(${name} ${sources})
+    else()
+      add_library(${name} STATIC ${sources})
+    endif()
     target_link_libraries(${name} PUBLIC vt_common ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
   else()
     add_library(${name} INTERFACE)
     target_link_libraries(${name} INTERFACE vt_common ${ARG_PUBLIC_DEPS})
+  endif()
+  if(ARG_RUNTIME)
+    vt_runtime_library(${name})
   endif()
 endfunction()
 

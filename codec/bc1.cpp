@@ -283,7 +283,7 @@ void refine_search(const Pixels& px, Candidate& best, int max_passes) {
 // same order per block (no FMA, no reassociation), so the bytes do not depend on the machine.
 constexpr int kLanes = 16;
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(_WIN32) && \
     !defined(__SANITIZE_ADDRESS__)
 #define VT_BC1_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else

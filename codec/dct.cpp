@@ -15,6 +15,7 @@
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <numbers>
 #include <string>
 #include <tuple>
 
@@ -518,7 +519,8 @@ struct ForwardBasis {
   ForwardBasis() {
     for (int u = 0; u < 8; u++) {
       const double s = u == 0 ? std::sqrt(0.125) : 0.5;
-      for (int x = 0; x < 8; x++) b[u][x] = float(s * std::cos((2 * x + 1) * u * M_PI / 16.0));
+      for (int x = 0; x < 8; x++)
+        b[u][x] = float(s * std::cos((2 * x + 1) * u * std::numbers::pi / 16.0));
     }
   }
 };

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -114,7 +115,8 @@ Expected<AngularError> normal_angular_error(const uint8_t* ref, const uint8_t* t
                  cz = a[0] * b[1] - a[1] * b[0];
     const double dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     // atan2 stays accurate for tiny angles, where acos(dot) loses precision.
-    const double deg = std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), dot) * (180.0 / M_PI);
+    const double deg =
+        std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), dot) * (180.0 / std::numbers::pi);
     angles[i] = float(deg);
     sum += deg;
     e.max_deg = std::max(e.max_deg, deg);

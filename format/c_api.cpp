@@ -26,6 +26,35 @@ int fail(const Status& status) {
   return int(status.code());
 }
 
+namespace {
+
+class CallbackByteSource final : public ByteSource {
+ public:
+  explicit CallbackByteSource(const vt_read_callbacks& io) : io_(io) {}
+  ~CallbackByteSource() override {
+    if (io_.release) io_.release(io_.user);
+  }
+  uint64_t size() const override { return io_.size; }
+  Expected<size_t> read_some(uint64_t offset, std::span<uint8_t> out) const override {
+    const int64_t n = io_.read(io_.user, offset, out.data(), out.size());
+    if (n < 0 || uint64_t(n) > out.size())
+      return Error(ErrorCode::kIo, n < 0 ? "read callback failed"
+                                         : "read callback returned more bytes than asked for");
+    return size_t(n);
+  }
+
+ private:
+  vt_read_callbacks io_;
+};
+
+}  // namespace
+
+std::shared_ptr<const ByteSource> callback_byte_source(const vt_read_callbacks* io) {
+  if (!io) return fail_null("io"), nullptr;
+  if (!io->read) return fail_null("io->read"), nullptr;
+  return std::make_shared<CallbackByteSource>(*io);
+}
+
 int fail_null(const char* what) {
   return fail(Error(ErrorCode::kInvalidArgument, std::string(what) + " is NULL"));
 }

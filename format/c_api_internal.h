@@ -3,11 +3,14 @@
 #pragma once
 
 #include <exception>
+#include <memory>
 #include <string>
 
 #include "common/status.h"
+#include "format/byte_source.h"
 #include "format/page_geometry.h"
 #include "format/vt_error_c.h"
+#include "format/vt_io_c.h"
 
 namespace vt::c_api {
 
@@ -25,6 +28,10 @@ int guard(Fn&& body) {
     return fail(Error(ErrorCode::kResourceLimit, e.what()));
   }
 }
+
+// The engine's read callbacks as a ByteSource (release called when the last user lets go);
+// nullptr after recording the error when the callbacks are unusable.
+std::shared_ptr<const ByteSource> callback_byte_source(const vt_read_callbacks* io);
 
 // Fills the geometry fields that vtpf_geometry and vtrt_geometry share.
 template <typename CGeometry>

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/status.h"
+#include "format/byte_source.h"
 #include "format/page_geometry.h"
 #include "format/runtime_format.h"
 
@@ -118,6 +119,10 @@ struct ReaderOptions {
 class PageFileReader {
  public:
   static Expected<std::unique_ptr<PageFileReader>> open(const std::string& path,
+                                                        const ReaderOptions& options = {});
+  // The same over the engine's own storage; `name` stands for the path in path() and messages.
+  static Expected<std::unique_ptr<PageFileReader>> open(std::shared_ptr<const ByteSource> bytes,
+                                                        const std::string& name,
                                                         const ReaderOptions& options = {});
   virtual ~PageFileReader() = default;
 

@@ -42,6 +42,22 @@ int vtpf_open(const char* path, int verify_checksums, vtpf_file** out) {
   });
 }
 
+int vtpf_open_callbacks(const vt_read_callbacks* io, const char* name, int verify_checksums,
+                        vtpf_file** out) {
+  if (!out) return fail_null("out");
+  *out = nullptr;
+  return guard([&] {
+    auto bytes = vt::c_api::callback_byte_source(io);
+    if (!bytes) return int(VT_ERR_INVALID_ARGUMENT);
+    vt::ReaderOptions options;
+    options.verify_checksums = verify_checksums != 0;
+    auto reader = vt::PageFileReader::open(std::move(bytes), name ? name : "(callbacks)", options);
+    if (!reader.ok()) return fail(reader.status());
+    *out = new vtpf_file{std::move(reader).value()};
+    return int(VT_OK);
+  });
+}
+
 void vtpf_close(vtpf_file* file) {
   delete file;
 }

@@ -8,6 +8,8 @@
 #include <stdint.h>
 
 #include "format/vt_error_c.h"
+#include "format/vt_io_c.h"
+#include "format/vt_version_c.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -47,6 +49,10 @@ typedef struct vtpf_page_entry {
 /* Opens and validates a page file into *out (NULL on failure). verify_checksums != 0 checks
  * every page's checksum when it is read. */
 int vtpf_open(const char* path, int verify_checksums, vtpf_file** out);
+/* vtpf_open over the engine's storage (format/vt_io_c.h); `name` stands for the path in
+ * messages. io->release, when set, is called once the file is closed (or the open failed). */
+int vtpf_open_callbacks(const vt_read_callbacks* io, const char* name, int verify_checksums,
+                        vtpf_file** out);
 void vtpf_close(vtpf_file* file);
 
 int vtpf_get_geometry(const vtpf_file* file, vtpf_geometry* out);

@@ -1,18 +1,15 @@
 // The runtime page-file reader: reads the header and index into owned memory, validates every
 // count, offset and size against the real file size before using it, then serves pages to any
 // number of threads with pread.
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #include <xxhash.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cstring>
 
 #include "format/layer_codec.h"
 #include "format/page_file.h"
 #include "format/page_file_layout.h"
+#include "format/platform_file.h"
 
 namespace vt {
 
@@ -22,26 +19,16 @@ using namespace pagefile;
 
 class PageFileReaderImpl final : public PageFileReader {
  public:
-  PageFileReaderImpl(std::string path, ReaderOptions options)
-      : path_(std::move(path)), options_(options) {}
-
-  ~PageFileReaderImpl() override {
-    if (fd_ >= 0) ::close(fd_);
-  }
+  PageFileReaderImpl(std::string path, ReaderOptions options,
+                     std::shared_ptr<const ByteSource> bytes = nullptr)
+      : path_(std::move(path)), options_(options), file_(std::move(bytes)) {}
 
   Status open_and_validate() {
-    // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer forever.
-    fd_ = ::open(path_.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-    if (fd_ < 0) {
-      ErrorCode code = errno == ENOENT ? ErrorCode::kNotFound : ErrorCode::kIo;
-      return Error(code, std::string("cannot open: ") + std::strerror(errno));
+    if (!file_) {
+      VT_ASSIGN_OR_RETURN(auto file, platform::ReadOnlyFile::open(path_));
+      file_ = std::move(file);
     }
-    struct stat st;
-    if (::fstat(fd_, &st) != 0) return Error(ErrorCode::kIo, "cannot stat");
-    if (!S_ISREG(st.st_mode))
-      return Error(ErrorCode::kInvalidArgument,
-                   std::string("not a regular file (") + file_kind_name(st.st_mode) + ")");
-    size_ = uint64_t(st.st_size);
+    size_ = file_->size();
     if (size_ < kFixedHeaderBytes)
       return corrupt("truncated: " + std::to_string(size_) + " bytes is less than a header");
     VT_RETURN_IF_ERROR(parse_header());
@@ -113,32 +100,22 @@ class PageFileReaderImpl final : public PageFileReader {
  private:
   Status corrupt(const std::string& what) const { return Error(ErrorCode::kCorrupt, what); }
 
-  static const char* file_kind_name(mode_t mode) {
-    if (S_ISDIR(mode)) return "a directory";
-    if (S_ISFIFO(mode)) return "a FIFO";
-    if (S_ISCHR(mode) || S_ISBLK(mode)) return "a device";
-    if (S_ISSOCK(mode)) return "a socket";
-    return "not a plain file";
-  }
-
-  // Reads exactly out.size() bytes at `offset` into memory this reader owns. Page reads use
-  // pread, never a mapping, so a file truncated or rewritten while open gives an error here
-  // rather than SIGBUS.
+  // Reads exactly out.size() bytes at `offset` into memory this reader owns (positioned reads,
+  // never a mapping: a file truncated or rewritten while open gives an error, not SIGBUS).
   Status read_at(uint64_t offset, std::span<uint8_t> out, const PageId* id = nullptr,
                  uint32_t layer = 0) const {
     size_t done = 0;
     while (done < out.size()) {
-      const ssize_t n = ::pread(fd_, out.data() + done, out.size() - done, off_t(offset + done));
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) {
+      Expected<size_t> n = file_->read_some(offset + done, out.subspan(done));
+      if (!n.ok() || *n == 0) {
         // Page reads name the file and page; open() adds the path to its own errors.
         const std::string what = id ? path_ + ": " + page_name(*id, layer) + ": " : std::string();
-        if (n < 0) return Error(ErrorCode::kIo, what + "read failed: " + std::strerror(errno));
+        if (!n.ok()) return Error(n.status().code(), what + n.status().message());
         return corrupt(what + "file changed while open: " + std::to_string(out.size()) +
                        " bytes at offset " + std::to_string(offset) +
                        " end past its end (truncated)");
       }
-      done += size_t(n);
+      done += *n;
     }
     return Status::Ok();
   }
@@ -192,7 +169,7 @@ class PageFileReaderImpl final : public PageFileReader {
 
   std::string path_;
   ReaderOptions options_;
-  int fd_ = -1;
+  std::shared_ptr<const ByteSource> file_;  // a platform file, or the engine's storage
   uint64_t size_ = 0;
   uint32_t version_ = 0;
   std::vector<uint8_t> header_;  // the whole header, checksum included
@@ -216,7 +193,8 @@ Status PageFileReaderImpl::parse_header() {
   if (version_ == 0) return corrupt("version 0 is not valid");
   if (version_ > kVersion)
     return Error(ErrorCode::kUnsupported, "page file version " + std::to_string(version_) +
-                                              " is newer than this reader (version 1)");
+                                              " is newer than this reader (version " +
+                                              std::to_string(kVersion) + ")");
   const uint64_t header_size = get_u32(h + kOffHeaderSize);
   if (header_size > size_)
     return corrupt("truncated: header of " + std::to_string(header_size) + " bytes, file of " +
@@ -393,6 +371,16 @@ Expected<std::unique_ptr<PageFileReader>> PageFileReader::open(const std::string
   auto reader = std::make_unique<PageFileReaderImpl>(path, options);
   Status s = reader->open_and_validate();
   if (!s.ok()) return s.with_context(path);
+  return std::unique_ptr<PageFileReader>(std::move(reader));
+}
+
+Expected<std::unique_ptr<PageFileReader>> PageFileReader::open(
+    std::shared_ptr<const ByteSource> bytes, const std::string& name,
+    const ReaderOptions& options) {
+  if (!bytes) return Error(ErrorCode::kInvalidArgument, name + ": no byte source");
+  auto reader = std::make_unique<PageFileReaderImpl>(name, options, std::move(bytes));
+  Status s = reader->open_and_validate();
+  if (!s.ok()) return s.with_context(name);
   return std::unique_ptr<PageFileReader>(std::move(reader));
 }
 

@@ -1,6 +1,8 @@
 #include "runtime/page_source.h"
 
+#include <algorithm>
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "format/layer_codec.h"
@@ -10,13 +12,33 @@ namespace vt {
 
 namespace {
 
+// Float texels of `ic` channels into `oc` >= ic channels of the same size: a missing colour
+// channel is 0, a missing alpha 1 (what the 8-bit path does with 0 and 255).
+void widen_float_texels(const uint8_t* in, uint32_t ic, uint32_t oc, uint32_t channel_bytes,
+                        size_t texels, uint8_t* out) {
+  if (ic == oc) {
+    std::memcpy(out, in, texels * ic * channel_bytes);
+    return;
+  }
+  const float one_f32 = 1.0f;
+  const uint16_t one_f16 = 0x3C00;
+  const void* one = channel_bytes == 2 ? static_cast<const void*>(&one_f16) : &one_f32;
+  for (size_t t = 0; t < texels; ++t) {
+    uint8_t* o = out + t * oc * channel_bytes;
+    std::memcpy(o, in + t * ic * channel_bytes, ic * channel_bytes);
+    std::memset(o + ic * channel_bytes, 0, (oc - ic) * channel_bytes);
+    if (oc == 4) std::memcpy(o + 3 * channel_bytes, one, channel_bytes);
+  }
+}
+
 struct LayerPlan {
   RuntimeFormat upload = RuntimeFormat::kRgba8;
   size_t upload_bytes = 0;
   size_t decoded_bytes = 0;
   uint32_t channels = 4;     // stored channels
   bool passthrough = false;  // stored BC blocks are already the upload format
-  bool float_copy = false;   // float layers delivered as they are
+  bool float_copy = false;   // float layers delivered in a float format of their channel size
+  uint32_t channel_bytes = 1;
 };
 
 class PageFileSource final : public PageSource {
@@ -61,11 +83,12 @@ class PageFileSource final : public PageSource {
     std::vector<uint8_t> texels(plan.decoded_bytes);
     VT_RETURN_IF_ERROR(reader_->read_texels(id, layer, texels));
     const int ps = int(geometry().page_size());
+    const RuntimeFormatInfo& upload = *runtime_format_info(plan.upload);
     if (plan.float_copy) {
-      std::memcpy(out.data(), texels.data(), out.size());
+      widen_float_texels(texels.data(), plan.channels, upload.channels, plan.channel_bytes,
+                         size_t(ps) * ps, out.data());
       return Status::Ok();
     }
-    const RuntimeFormatInfo& upload = *runtime_format_info(plan.upload);
     if (upload.bc) {
       return bc_encode_image(*upload.bc, options_.bc_quality, texels.data(), ps, ps,
                              int(plan.channels), out.data())
@@ -116,11 +139,16 @@ Expected<std::unique_ptr<PageSource>> make_page_file_source(
     const RuntimeFormatInfo* upload = runtime_format_info(plan.upload);
     if (!upload) return Error(ErrorCode::kCorrupt, where + ": unknown runtime format");
     if (spec.texel_type != TexelType::kU8) {
-      // Float texels go to the cache as they are: a float format of the same channels and size.
-      if (!upload->is_float || upload->channels != spec.channels ||
-          upload->bits_per_texel != spec.texel_bytes() * 8)
+      // Float texels go to the cache as they are, in a float format of their channel size with
+      // at least their channels (RGBA16F for half, RGBA32F for float; fewer channels widened).
+      plan.channel_bytes = spec.texel_bytes() / std::max<uint32_t>(spec.channels, 1);
+      if (!upload->is_float || upload->channels < spec.channels ||
+          upload->bits_per_texel != upload->channels * plan.channel_bytes * 8)
         return Error(ErrorCode::kUnsupported,
-                     where + ": float texels are only delivered as 4-channel float of their size");
+                     where + ": " + std::to_string(spec.channels) + "-channel " +
+                         to_string(spec.texel_type) + " texels cannot be delivered as " +
+                         upload->name + " (a float layer needs a float runtime format of its " +
+                         "channel size: rgba16f for half, rgba32f for float)");
       plan.float_copy = true;
     } else if (upload->is_float) {
       return Error(ErrorCode::kUnsupported, where + ": 8-bit texels with a float runtime format");

@@ -53,6 +53,41 @@ vt::StreamerOptions streamer_options(const vtrt_options& o) {
 
 }  // namespace
 
+namespace {
+
+// The streamer over an open reader, into *out (both vtrt_open forms).
+int open_streamer(std::shared_ptr<const vt::PageFileReader> reader, const vtrt_options* options,
+                  vtrt_streamer** out) {
+  vtrt_options o;
+  vtrt_default_options(&o);
+  if (options) o = *options;
+  const std::string reader_name = reader->path();
+  vt::PageFileSourceOptions so;
+  so.bc7_as_rgba8 = o.bc7_as_rgba8 != 0;
+  auto source = vt::make_page_file_source(std::move(reader), so);
+  if (!source.ok()) return fail(source.status());
+  std::shared_ptr<const vt::PageSource> shared(std::move(source).value());
+  auto streamer = vt::Streamer::create(shared, streamer_options(o));
+  if (!streamer.ok()) return fail(streamer.status().with_context(reader_name));
+  auto h = std::make_unique<vtrt_streamer>();
+  h->source = shared;
+  h->streamer = std::move(streamer).value();
+  h->streamer->with_page_table([&](const vt::PageTable& t) {
+    for (uint32_t l = 0; l < t.level_count(); ++l) {
+      auto d = t.level_data(l);
+      h->table.emplace_back(d.begin(), d.end());
+      h->table_w.push_back(t.width(l));
+      h->table_h.push_back(t.height(l));
+      h->dirty.push_back({0, 0, t.width(l), t.height(l)});
+    }
+  });
+  h->streamer->clear_table_dirty();
+  *out = h.release();
+  return int(VT_OK);
+}
+
+}  // namespace
+
 extern "C" {
 
 void vtrt_default_options(vtrt_options* o) {
@@ -65,35 +100,23 @@ int vtrt_open(const char* path, const vtrt_options* options, vtrt_streamer** out
   if (!out) return fail_null("out");
   *out = nullptr;
   if (!path) return fail_null("path");
-  vtrt_options o;
-  vtrt_default_options(&o);
-  if (options) o = *options;
   return guard([&] {
     auto reader = vt::PageFileReader::open(path);
     if (!reader.ok()) return fail(reader.status());
-    vt::PageFileSourceOptions so;
-    so.bc7_as_rgba8 = o.bc7_as_rgba8 != 0;
-    auto source = vt::make_page_file_source(
-        std::shared_ptr<const vt::PageFileReader>(std::move(reader).value()), so);
-    if (!source.ok()) return fail(source.status());
-    std::shared_ptr<const vt::PageSource> shared(std::move(source).value());
-    auto streamer = vt::Streamer::create(shared, streamer_options(o));
-    if (!streamer.ok()) return fail(streamer.status().with_context(path));
-    auto h = std::make_unique<vtrt_streamer>();
-    h->source = shared;
-    h->streamer = std::move(streamer).value();
-    h->streamer->with_page_table([&](const vt::PageTable& t) {
-      for (uint32_t l = 0; l < t.level_count(); ++l) {
-        auto d = t.level_data(l);
-        h->table.emplace_back(d.begin(), d.end());
-        h->table_w.push_back(t.width(l));
-        h->table_h.push_back(t.height(l));
-        h->dirty.push_back({0, 0, t.width(l), t.height(l)});
-      }
-    });
-    h->streamer->clear_table_dirty();
-    *out = h.release();
-    return int(VT_OK);
+    return open_streamer(std::move(reader).value(), options, out);
+  });
+}
+
+int vtrt_open_callbacks(const vt_read_callbacks* io, const char* name, const vtrt_options* options,
+                        vtrt_streamer** out) {
+  if (!out) return fail_null("out");
+  *out = nullptr;
+  return guard([&] {
+    auto bytes = vt::c_api::callback_byte_source(io);
+    if (!bytes) return int(VT_ERR_INVALID_ARGUMENT);
+    auto reader = vt::PageFileReader::open(std::move(bytes), name ? name : "(callbacks)");
+    if (!reader.ok()) return fail(reader.status());
+    return open_streamer(std::move(reader).value(), options, out);
   });
 }
 

@@ -9,12 +9,20 @@
 #include <stdint.h>
 
 #include "format/vt_error_c.h"
+#include "format/vt_io_c.h"
+#include "format/vt_version_c.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
 typedef struct vtrt_streamer vtrt_streamer;
+
+/* One feedback value (runtime/feedback.h): page (x, y) of `level` wanted by a pixel; x, y < 4096,
+ * level < 32. VTRT_FEEDBACK_NONE marks a pixel that wants nothing. */
+#define VTRT_FEEDBACK(level, x, y) \
+  (((uint32_t)(x)&0xFFFu) | (((uint32_t)(y)&0xFFFu) << 12) | (((uint32_t)(level)&0x1Fu) << 24))
+#define VTRT_FEEDBACK_NONE 0xFFFFFFFFu
 
 typedef struct vtrt_options {
   uint32_t slots_x, slots_y;    /* physical cache in slots (each <= 256) */
@@ -50,6 +58,11 @@ void vtrt_default_options(vtrt_options* options);
 /* Opens `path` and creates a streamer into *out (NULL on failure). options may be NULL (the
  * defaults). */
 int vtrt_open(const char* path, const vtrt_options* options, vtrt_streamer** out);
+/* vtrt_open over the engine's storage (format/vt_io_c.h): pak files, virtual file systems.
+ * `name` stands for the path in messages; io->read is called from the loader threads.
+ * io->release, when set, is called once the streamer is closed (or the open failed). */
+int vtrt_open_callbacks(const vt_read_callbacks* io, const char* name, const vtrt_options* options,
+                        vtrt_streamer** out);
 void vtrt_close(vtrt_streamer* streamer);
 
 int vtrt_get_geometry(const vtrt_streamer* streamer, vtrt_geometry* out);

@@ -13,6 +13,7 @@ packages=(
   libvulkan-dev glslc mesa-vulkan-drivers
   libjpeg62-turbo-dev libstb-dev
   clang libclang-rt-14-dev
+  help2man g++-mingw-w64-x86-64-posix
 )
 
 missing=()

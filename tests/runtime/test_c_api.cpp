@@ -1,52 +1,17 @@
 #include <gtest/gtest.h>
-#include <unistd.h>
 
-#include <filesystem>
 #include <string>
 
 #include "format/page_file.h"
 #include "runtime/feedback.h"
 #include "runtime/vt_runtime_c.h"
+#include "runtime_test_util.h"
 
 namespace vt {
 namespace {
 
-// 4 x 3 pages of 8 + 2 * 4 texels, raw RGBA8; every texel of a page is (level, x, y, 255).
-std::string write_marked_file() {
-  PageFileDesc desc;
-  desc.geometry.width = 32;
-  desc.geometry.height = 24;
-  desc.geometry.payload = 8;
-  desc.geometry.border = 4;
-  LayerSpec layer;
-  layer.name = "albedo";
-  layer.codec = PageCodec::kRaw;
-  desc.layers = {layer};
-  auto dir =
-      std::filesystem::temp_directory_path() / ("vtbake_runtime_c_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  const std::string path = (dir / "c.vtpf").string();
-  auto w = PageFileWriter::create(path, desc);
-  EXPECT_TRUE(w.ok());
-  const PageGeometry& g = desc.geometry;
-  for (uint32_t l = 0; l < g.level_count(); ++l)
-    for (uint32_t y = 0; y < g.pages_y(l); ++y)
-      for (uint32_t x = 0; x < g.pages_x(l); ++x) {
-        std::vector<uint8_t> page(16 * 16 * 4);
-        for (size_t i = 0; i < page.size(); i += 4) {
-          page[i] = uint8_t(l);
-          page[i + 1] = uint8_t(x);
-          page[i + 2] = uint8_t(y);
-          page[i + 3] = 255;
-        }
-        EXPECT_TRUE((*w)->add_page({l, x, y}, 0, page).ok());
-      }
-  EXPECT_TRUE((*w)->finish().ok());
-  return path;
-}
-
 TEST(RuntimeCApi, OpenStreamAndReadTable) {
-  const std::string path = write_marked_file();
+  const std::string path = runtime_test::write_marked_file();
   vtrt_options o;
   vtrt_default_options(&o);
   o.slots_x = 5;  // 20 slots for 12 + 4 + 1 pages
