@@ -123,10 +123,10 @@ struct BuildSummary {
   uint64_t scratch_bytes = 0;       // largest scratch file use at any time
   uint64_t level_memory_bytes = 0;  // largest in-memory level storage at any time
   std::vector<StageTime> stages;
-  uint64_t plan_hash = 0;  // BuildPlan::hash
+  uint64_t plan_hash = 0;           // BuildPlan::hash
+  std::vector<uint64_t> task_keys;  // per task of make_build_tasks (0 for level tasks)
   // What the build could not honour, e.g. a memory limit below its floor (BuildPlan).
   std::vector<std::string> warnings;
-  std::vector<uint64_t> task_keys;  // per task of make_build_tasks (0 for level tasks)
 };
 
 // Receives the pages of a build; PageFileWriter is the usual one, tests collect them.

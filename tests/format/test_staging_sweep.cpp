@@ -39,15 +39,16 @@ void touch(const std::string& path, int64_t age_seconds) {
 
 // A child that stages TARGET's file and its page writer's file inside it, reports the paths
 // through `out`, then waits on `hold` (a live writer) until the parent closes or kills it.
-pid_t start_writer(const std::string& target, int out, int hold) {
+pid_t start_writer(const std::string& target, int out, const int hold[2]) {
   const pid_t pid = ::fork();
   if (pid != 0) return pid;
+  ::close(hold[1]);  // else the read below never sees the parent close its end
   auto outer = create_staging_file(target);
   auto inner = outer.ok() ? create_staging_file(outer->path) : outer;
   const char ok = inner.ok() ? 1 : 0;
   (void)!::write(out, &ok, 1);
   char c;
-  (void)!::read(hold, &c, 1);
+  (void)!::read(hold[0], &c, 1);
   ::_exit(0);  // no cleanup, as after a SIGKILL
 }
 
@@ -57,7 +58,7 @@ TEST(StagingSweep, KilledWritersFilesGoLiveWritersStay) {
   int out[2], hold[2];
   ASSERT_EQ(::pipe(out), 0);
   ASSERT_EQ(::pipe(hold), 0);
-  const pid_t child = start_writer(target, out[1], hold[0]);
+  const pid_t child = start_writer(target, out[1], hold);
   ASSERT_GT(child, 0);
   char ok = 0;
   ASSERT_EQ(::read(out[0], &ok, 1), 1);
@@ -89,7 +90,7 @@ TEST(StagingSweep, OutputSetSweepsWhatAKillLeft) {
   int out[2], hold[2];
   ASSERT_EQ(::pipe(out), 0);
   ASSERT_EQ(::pipe(hold), 0);
-  const pid_t child = start_writer(target, out[1], hold[0]);
+  const pid_t child = start_writer(target, out[1], hold);
   char ok = 0;
   ASSERT_EQ(::read(out[0], &ok, 1), 1);
   ::close(hold[1]);  // the child returns from read and exits without removing anything
