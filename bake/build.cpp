@@ -339,6 +339,7 @@ Expected<BuildSummary> build_pages(const BuildPlan& plan, PageSink& sink) {
   }
   sum.pages = sum.stored + sum.constant + sum.absent;
   sum.stages = {{"read", t_read}, {"pyramid", t_pyramid}, {"encode", t_encode}};
+  sum.warnings = plan.warnings;
   return sum;
 }
 

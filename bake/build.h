@@ -125,6 +125,8 @@ struct BuildSummary {
   std::vector<StageTime> stages;
   uint64_t plan_hash = 0;           // BuildPlan::hash
   std::vector<uint64_t> task_keys;  // per task of make_build_tasks (0 for level tasks)
+  // What the build could not honour, e.g. a memory limit below its floor (BuildPlan).
+  std::vector<std::string> warnings;
 };
 
 // Receives the pages of a build; PageFileWriter is the usual one, tests collect them.

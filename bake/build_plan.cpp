@@ -215,6 +215,23 @@ std::vector<bool> choose_level_memory(const BuildPlan& plan, const LayerPlan& la
   return in_memory;
 }
 
+// Below level 0's working set a limit only sends levels to scratch files: the build says what
+// it needs instead of passing the limit in silence (layers are built one after another).
+void check_memory_floor(BuildPlan& plan) {
+  const PageGeometry& g = plan.desc.geometry;
+  for (const LayerPlan& layer : plan.layers)
+    plan.memory_floor = std::max(plan.memory_floor, working_set(plan, layer, g.level_width(0)));
+  const uint64_t limit = plan.options.memory_limit;
+  if (limit >= plan.memory_floor) return;
+  auto mib = [](uint64_t b) { return std::to_string((b + (1 << 20) - 1) >> 20) + " MiB"; };
+  plan.warnings.push_back("memory limit " + mib(limit) + " is below this build's floor of about " +
+                          mib(plan.memory_floor) + " (the libraries, level 0's bands of " +
+                          std::to_string(g.level_width(0)) + " texels and " +
+                          std::to_string(plan.threads) +
+                          " threads' page buffers): it needs that much; every level past 0 goes "
+                          "to scratch files, and fewer threads lower the floor a little");
+}
+
 std::string build_metadata(const BuildOptions& options, const std::vector<LayerPlan>& layers) {
   nlohmann::json sources = nlohmann::json::array();
   for (size_t i = 0; i < layers.size(); ++i)
@@ -371,6 +388,7 @@ Expected<BuildPlan> plan_build(const BuildOptions& options) {
     layer.encoder = std::make_shared<const PageEncoder>(std::move(trained));
   }
   for (const LayerPlan& layer : plan.layers) desc.layers.push_back(layer.spec);
+  check_memory_floor(plan);
   const std::string settings = settings_text(plan);
   VT_ASSIGN_OR_RETURN(plan.hash, plan_hash(plan, settings));
   for (LayerPlan& layer : plan.layers) layer.task_seed = task_seed(settings, layer.spec);

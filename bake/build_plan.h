@@ -55,6 +55,9 @@ struct BuildPlan {
   uint32_t margin = 0;  // rows a band reads past its pages: max(border, filter reach)
   std::string scratch_dir;
   uint64_t hash = 0;  // the plan's identity: settings, tool version, every source's content
+  // The least memory this build needs whatever the limit (level 0's working set, the libraries).
+  uint64_t memory_floor = 0;
+  std::vector<std::string> warnings;  // copied to BuildSummary::warnings
 };
 
 // Checks the options, reads each DCT layer's training sample and works out the plan. Errors

@@ -61,7 +61,7 @@ nlohmann::json to_json(const BuildSummary& s) {
   for (const LayerSummary& l : s.layers) layers.push_back(layer_json(l));
   nlohmann::json seconds = nlohmann::json::object();
   for (const StageTime& t : s.stages) seconds[t.name] = t.seconds;
-  return {
+  nlohmann::json j = {
       {"width", s.geometry.width},
       {"height", s.geometry.height},
       {"payload", s.geometry.payload},
@@ -78,6 +78,8 @@ nlohmann::json to_json(const BuildSummary& s) {
       {"levels", levels},
       {"layers", layers},
       {"seconds", seconds}};
+  if (!s.warnings.empty()) j["warnings"] = s.warnings;
+  return j;
 }
 
 }  // namespace vt

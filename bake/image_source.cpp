@@ -10,6 +10,8 @@
 #include <fstream>
 #include <map>
 
+#include "bake/png_check.h"
+
 namespace vt {
 namespace {
 
@@ -110,6 +112,7 @@ class FileImageSource final : public ImageSource {
 }  // namespace
 
 Expected<std::unique_ptr<ImageSource>> open_image_file(const std::string& path) {
+  VT_RETURN_IF_ERROR(check_png_chunks(path));  // before libpng can print its own line
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     return Status(ErrorCode::kNotFound, path + ": cannot open image: " + OIIO::geterror());

@@ -233,6 +233,7 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   auto built = build_page_file(bo);
   if (!built.ok()) return built.status().with_context("build");
   summary.build = std::move(built).value();
+  for (const std::string& w : summary.build.warnings) summary.warnings.push_back(w);
   mark_clipped(summary.build, summary.above_one);
   for (const LayerRange& r : summary.above_one) summary.warnings.push_back(range_warning(r));
   summary.stages.push_back({"build", seconds_since(t0)});

@@ -149,6 +149,7 @@ int run_build(BuildArgs& f, const vt::cli::GlobalOptions& global) {
   line.done();
   double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!summary.ok()) return vt::cli::report_error("build", summary.status());
+  for (const std::string& w : summary->warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   if (global.json) {
     nlohmann::json j = {{"output", o.output}};
     j.update(vt::to_json(*summary));

@@ -1,13 +1,19 @@
 // Output path resolution and staged outputs replaced together (see atomic_output.h).
 #include "format/atomic_output.h"
 
+#include <dirent.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
+#include <ctime>
+#include <string_view>
 
 namespace vt {
 
@@ -48,7 +54,133 @@ Status sync_file(const std::string& path) {
   return ok ? Status::Ok() : Error(ErrorCode::kIo, path + ": fsync failed: " + err);
 }
 
+// The host part of staging names: the name up to its first dot, only characters that cannot
+// be mistaken for the pattern's separators.
+const std::string& host_tag() {
+  static const std::string tag = [] {
+    char buf[256] = {};
+    std::string h;
+    if (::gethostname(buf, sizeof buf - 1) == 0)
+      for (const char* c = buf; *c != 0 && *c != '.' && h.size() < 32; ++c)
+        if (std::isalnum(static_cast<unsigned char>(*c)) || *c == '-') h += *c;
+    return h.empty() ? std::string("localhost") : h;
+  }();
+  return tag;
+}
+
+bool all_alnum(std::string_view s) {
+  for (char c : s)
+    if (!std::isalnum(static_cast<unsigned char>(c))) return false;
+  return !s.empty();
+}
+
+struct StagingOwner {
+  bool tagged = false;  // PID@HOST in the name (else a writer from before it was)
+  long pid = 0;
+  std::string_view host;
+};
+
+// Parses one staging suffix of `name` at `pos` (".tmp-" or ".old-", then PID@HOST- or nothing,
+// then mkstemp's 6 characters) and moves `pos` past it; false if there is none.
+bool parse_staging_suffix(std::string_view name, size_t& pos, StagingOwner& owner) {
+  const std::string_view rest = name.substr(pos);
+  if (rest.substr(0, 5) != ".tmp-" && rest.substr(0, 5) != ".old-") return false;
+  const std::string_view body = rest.substr(5, rest.find('.', 5) - 5);
+  pos += 5 + body.size();
+  owner = {};
+  if (body.size() == 6) return all_alnum(body);
+  const size_t at = body.find('@');
+  if (at == std::string_view::npos || at == 0 || at > 9 || body.size() < at + 9) return false;
+  const std::string_view pid = body.substr(0, at), tail = body.substr(at + 1);
+  for (char c : pid)
+    if (!std::isdigit(static_cast<unsigned char>(c))) return false;
+  if (tail[tail.size() - 7] != '-' || !all_alnum(tail.substr(tail.size() - 6))) return false;
+  owner.host = tail.substr(0, tail.size() - 7);
+  for (char c : owner.host)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-') return false;
+  owner.tagged = true;
+  owner.pid = std::stol(std::string(pid));
+  return owner.pid > 0;
+}
+
+// When process `pid` started, in seconds since the epoch (-1 if unknown): /proc/PID/stat's
+// start time in clock ticks after boot, plus /proc/stat's boot time.
+int64_t process_start_time(long pid) {
+  char path[64];
+  std::snprintf(path, sizeof path, "/proc/%ld/stat", pid);
+  FILE* f = std::fopen(path, "r");
+  if (!f) return -1;
+  char line[1024] = {};
+  const size_t n = std::fread(line, 1, sizeof line - 1, f);
+  std::fclose(f);
+  // Fields after the command name (which may hold spaces and parentheses): the start time is
+  // field 22, the 20th after ")".
+  const char* p = std::strrchr(line, ')');
+  if (!p || n == 0) return -1;
+  unsigned long long ticks = 0;
+  int field = 2;
+  for (const char* c = p + 1; *c != 0 && field < 22; ++c)
+    if (*c == ' ' && ++field == 22) ticks = std::strtoull(c + 1, nullptr, 10);
+  if (field != 22) return -1;
+  f = std::fopen("/proc/stat", "r");
+  if (!f) return -1;
+  long long boot = -1;
+  char key[64];
+  while (std::fscanf(f, "%63s", key) == 1)
+    if (std::strcmp(key, "btime") == 0 && std::fscanf(f, "%lld", &boot) == 1) break;
+  std::fclose(f);
+  const long hz = ::sysconf(_SC_CLK_TCK);
+  return boot < 0 || hz <= 0 ? -1 : int64_t(boot) + int64_t(ticks / (unsigned long long)hz);
+}
+
+bool staging_is_stale(const StagingOwner& owner, const struct stat& st) {
+  if (owner.tagged && owner.host == host_tag()) {
+    if (::kill(pid_t(owner.pid), 0) != 0) return errno == ESRCH;
+    // The PID runs: the owner only if it started before the file was last written (2 s
+    // for the boot time's whole seconds).
+    const int64_t started = process_start_time(owner.pid);
+    return started >= 0 && started > int64_t(st.st_mtime) + 2;
+  }
+  return int64_t(std::time(nullptr)) - int64_t(st.st_mtime) > kStaleStagingSeconds;
+}
+
 }  // namespace
+
+int sweep_stale_staging(const std::string& target) {
+  const size_t slash = target.rfind('/');
+  const std::string dir = dir_of(target);
+  const std::string base = slash == std::string::npos ? target : target.substr(slash + 1);
+  DIR* d = ::opendir(dir.c_str());
+  if (!d) return 0;
+  int removed = 0;
+  while (const dirent* e = ::readdir(d)) {
+    const std::string_view name = e->d_name;
+    if (name.size() <= base.size() || name.substr(0, base.size()) != base) continue;
+    // The first suffix names the owner; any after it are staging files of its own staging
+    // file (a bake's page writer), so the same process's.
+    size_t pos = base.size();
+    StagingOwner owner, inner;
+    bool ours = parse_staging_suffix(name, pos, owner);
+    while (ours && pos < name.size()) ours = parse_staging_suffix(name, pos, inner);
+    if (!ours) continue;
+    const std::string path = dir + "/" + std::string(name);
+    struct stat st;
+    if (::lstat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) continue;
+    if (staging_is_stale(owner, st) && ::unlink(path.c_str()) == 0) ++removed;
+  }
+  ::closedir(d);
+  return removed;
+}
+
+Expected<StagingFile> create_staging_file(const std::string& target, const char* kind) {
+  sweep_stale_staging(target);
+  StagingFile f;
+  f.path = target + "." + kind + "-" + std::to_string(::getpid()) + "@" + host_tag() + "-XXXXXX";
+  f.fd = ::mkstemp(f.path.data());
+  if (f.fd < 0)
+    return Error(ErrorCode::kIo, target + ": cannot create temporary file: " + errno_text());
+  return f;
+}
 
 Expected<std::string> resolve_output_path(const std::string& path) {
   if (path.empty()) return Error(ErrorCode::kInvalidArgument, "empty output path");
@@ -94,13 +226,11 @@ OutputSet::~OutputSet() {
 Expected<std::string> OutputSet::stage(const std::string& final_path) {
   if (committed_) return Error(ErrorCode::kInvalidArgument, final_path + ": outputs committed");
   VT_ASSIGN_OR_RETURN(std::string target, resolve_output_path(final_path));
-  std::string temp = target + ".tmp-XXXXXX";
-  const int fd = ::mkstemp(temp.data());
-  if (fd < 0)
-    return Error(ErrorCode::kIo, final_path + ": cannot create temporary file: " + errno_text());
-  ::close(fd);
-  staged_.push_back({final_path, std::move(target), temp});
-  return temp;
+  auto temp = create_staging_file(target);
+  if (!temp.ok()) return temp.status();
+  ::close(temp->fd);
+  staged_.push_back({final_path, std::move(target), temp->path});
+  return temp->path;
 }
 
 Status OutputSet::commit() {
@@ -120,12 +250,11 @@ Status OutputSet::commit() {
     struct stat st;
     existed[i] = ::lstat(staged_[i].target.c_str(), &st) == 0;
     if (!existed[i]) continue;
-    std::string backup = staged_[i].target + ".old-XXXXXX";
-    const int fd = ::mkstemp(backup.data());
-    if (fd < 0) continue;
-    ::close(fd);
-    ::unlink(backup.c_str());
-    if (::link(staged_[i].target.c_str(), backup.c_str()) == 0) backups[i] = backup;
+    auto backup = create_staging_file(staged_[i].target, "old");
+    if (!backup.ok()) continue;
+    ::close(backup->fd);
+    ::unlink(backup->path.c_str());
+    if (::link(staged_[i].target.c_str(), backup->path.c_str()) == 0) backups[i] = backup->path;
   }
   auto drop_backups = [&] {
     for (const std::string& b : backups)

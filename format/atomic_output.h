@@ -4,6 +4,7 @@
 // "Writing outputs", states the rules every `-o` follows.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,27 @@ Expected<std::string> resolve_output_path(const std::string& path);
 // blocks until a writer comes, a device never ends. kNotFound when nothing is there,
 // kInvalidArgument naming what is there otherwise.
 Status check_input_file(const std::string& path);
+
+// Staging files: every temporary a writer puts beside its target is named
+// TARGET.tmp-PID@HOST-XXXXXX (TARGET.old-PID@HOST-XXXXXX for commit()'s backups), so that a
+// later writer can tell one abandoned by a killed process from a live writer's. HOST is the
+// host name up to its first dot (letters, digits and '-', at most 32).
+struct StagingFile {
+  int fd = -1;  // open for writing, mode 0600; the caller closes it
+  std::string path;
+};
+// Sweeps `target`'s stale staging files (sweep_stale_staging), then creates a new one beside
+// it; `kind` is "tmp" or "old". Errors name `target`.
+Expected<StagingFile> create_staging_file(const std::string& target, const char* kind = "tmp");
+
+// Removes the staging files of `target` (only names of the pattern above, and staging files of
+// those, as a bake's page writer stages beside its own staged file) whose owner is gone: the
+// PID on this host is not running, or runs a process started after the file was last written
+// (a reused PID). Files from another host, and from writers before the PID was in the name
+// (TARGET.tmp-XXXXXX), are removed when untouched for kStaleStagingSeconds. A live writer's
+// file is never removed, whatever its age. Best effort: returns how many it removed.
+constexpr int64_t kStaleStagingSeconds = 24 * 3600;
+int sweep_stale_staging(const std::string& target);
 
 // Outputs staged under temporary names beside their final targets and renamed into place
 // together by commit(): both or neither for an error anywhere before or during commit. What

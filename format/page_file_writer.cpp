@@ -143,13 +143,11 @@ class PageFileWriterImpl final : public PageFileWriter {
     level_first_.resize(g.level_count());
     for (uint32_t l = 0; l < g.level_count(); ++l) level_first_[l] = level_first_page(g, l);
 
-    temp_path_ = target_ + ".tmp-XXXXXX";
-    out_fd_ = ::mkstemp(temp_path_.data());
-    if (out_fd_ < 0) {
-      std::string err = errno_text();
-      temp_path_.clear();
-      return Error(ErrorCode::kIo, path_ + ": cannot create temporary file: " + err);
-    }
+    // Named so that a later writer can sweep it if this process is killed (atomic_output.h).
+    auto temp = create_staging_file(target_);
+    if (!temp.ok()) return temp.status();
+    out_fd_ = temp->fd;
+    temp_path_ = temp->path;
     std::string spill = target_ + ".spill-XXXXXX";
     spill_fd_ = ::mkstemp(spill.data());
     if (spill_fd_ < 0)

@@ -244,13 +244,19 @@ namespace {
 // glTF 1.0 (a .glb header of version 1, or asset.version "1.x"): the own importer reads 2.0
 // only, assimp reads 1.0.
 bool is_gltf1(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  char head[8] = {};
-  f.read(head, 8);
+  std::ifstream f(path, std::ios::binary | std::ios::ate);
+  const uint64_t size = f ? uint64_t(f.tellg()) : 0;
+  f.seekg(0);
+  char head[20] = {};
+  f.read(head, 20);
   if (std::memcmp(head, "glTF", 4) == 0) {
-    uint32_t version;
+    uint32_t version, length, content_length;
     std::memcpy(&version, head + 4, 4);
-    return version == 1;
+    std::memcpy(&length, head + 8, 4);
+    std::memcpy(&content_length, head + 12, 4);
+    // assimp trusts a binary glTF 1.0's lengths (a 26-byte file made it ask for 2 GiB): only a
+    // header whose lengths match the file goes there; the own importer refuses the others.
+    return version == 1 && f && length == size && content_length <= size - 20;
   }
   f.clear();
   f.seekg(0);

@@ -432,25 +432,35 @@ def kill_class(vtbake, work, rng, n, classes):
         pairs[name] = (digest(vtpf), digest(glb), time.time() - t0)
     duration = pairs["b"][2]
     c = Counts("SIGKILL mid-bake (pair replaced together?)")
-    for i in range(n):
+    staging = lambda: [f for f in os.listdir(out) if ".tmp-" in f or ".old-" in f]
+    left_by_kills = unswept = 0
+    for i in range(n + 1):
+        # This bake also sweeps what the previous kill left (format/atomic_output.h).
         subprocess.run(bake(a), **quiet)
+        stale = staging()
+        if stale:
+            unswept += len(stale)
+            c.notes.append("case %d: the next bake left %d staging file(s) of the kill: %s"
+                           % (i - 1, len(stale), ", ".join(stale)))
+            for f in stale:
+                os.unlink(os.path.join(out, f))
+        if i == n:
+            break
         p = subprocess.Popen(bake(b), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         time.sleep(rng.uniform(0, duration * 1.1))
         p.send_signal(signal.SIGKILL)
         p.wait()
         now = (digest(vtpf), digest(glb))
         intact = now in (pairs["a"][:2], pairs["b"][:2])
-        leftovers = [f for f in os.listdir(out) if ".tmp-" in f]
-        for f in leftovers:
-            os.unlink(os.path.join(out, f))
         c.tried += 1
         if not intact:
             c.silent += 1
             c.notes.append("mixed pair after a kill at case %d" % i)
         else:
             c.accepted += 1
-        if leftovers:
-            c.notes.append("case %d left %d temporary file(s)" % (i, len(leftovers)))
+        left_by_kills += 1 if staging() else 0
+    c.notes.append("%d of %d kills left staging files; the next bake swept all but %d"
+                   % (left_by_kills, n, unswept))
     classes.append(c)
 
 

@@ -139,6 +139,19 @@ TEST(HostileScenes, AFifoSceneIsRefusedWithoutBlocking) {
   EXPECT_EQ(s.status().message(), fifo + ": not a regular file to read");
 }
 
+// Found by vt_fuzz_gltf: a 26-byte binary glTF 1.0 whose header claims 2 GiB went to assimp,
+// which allocated what the header said. Lengths that do not match the file keep it from assimp.
+TEST(HostileScenes, BinaryGltf1WithLengthsPastTheFileIsRefused) {
+  Tree t;
+  const std::string glb = t.car + "v1.glb";
+  const unsigned char bytes[26] = {'g', 'l', 'T',  'F', 1, 0, 0, 0, 0, 0x0e, 0, 0, 0,
+                                   0,   0,   0x86, 0,   0, 0, 0, 0, 0, 0,    0, 0, 'a'};
+  Tree::write(glb, std::string(reinterpret_cast<const char*>(bytes), sizeof bytes));
+  auto s = scene::load_scene(glb);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.status().message().rfind(glb + ": ", 0), 0u) << s.status().message();
+}
+
 scene::Scene triangle_scene() {
   scene::Scene s;
   s.source_path = "tri.gltf";
