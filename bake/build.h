@@ -105,7 +105,7 @@ struct LayerSummary {
   LayerSpec spec;      // as written (codec, runtime format, channels, texel type)
   double psnr_db = 0;  // stored pages vs unencoded texels; infinite when lossless
   uint32_t max_error = 0;
-  // After the runtime BC format (bake/runtime_error.h; no samples without a BC format), and
+  // After the runtime BC format (codec/runtime_error.h; no samples without a BC format), and
   // the stored pages per DCT page mode (format/dct_page_modes.h).
   RuntimeError runtime;
   uint64_t dct_modes[kDctModeKinds] = {};

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "bake/runtime_error.h"
+#include "codec/runtime_error.h"
 #include "codec/bc.h"
 #include "codec/dct.h"
 #include "common/status.h"

@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "bake/runtime_error.h"
+#include "codec/runtime_error.h"
 #include "codec/dct.h"
 #include "common/hash.h"
 #include "format/dct_page_modes.h"

@@ -1,5 +1,5 @@
 // The error after the runtime format (see runtime_error.h).
-#include "bake/runtime_error.h"
+#include "codec/runtime_error.h"
 
 #include <algorithm>
 #include <cmath>
