@@ -71,6 +71,8 @@ struct ErrorSum {
   double sse = 0;
   uint64_t samples = 0;
   uint32_t max_error = 0;
+  RuntimeError runtime;
+  uint64_t dct_modes[kDctModeKinds] = {};
 };
 
 // The state of one layer while its tasks run: the level being paged (read through a row
@@ -161,6 +163,8 @@ class LayerRun {
     ls.name = layer_.spec.name;
     ls.spec = layer_.spec;
     ls.max_error = error_.max_error;
+    ls.runtime = error_.runtime;
+    std::copy(std::begin(error_.dct_modes), std::end(error_.dct_modes), ls.dct_modes);
     ls.psnr_db = error_.samples == 0 || error_.sse == 0
                      ? std::numeric_limits<double>::infinity()
                      : 10.0 * std::log10(255.0 * 255.0 * double(error_.samples) / error_.sse);
@@ -235,6 +239,8 @@ class LayerRun {
       error_.sse += e.squared_error;
       error_.samples += e.samples;
       error_.max_error = std::max(error_.max_error, e.max_error);
+      error_.runtime.add(e.runtime);
+      if (layer_.spec.codec == PageCodec::kDct) ++error_.dct_modes[e.dct_mode];
       VT_RETURN_IF_ERROR(sink_.add_page(id, li_, e.bytes));
     }
     return Status::Ok();

@@ -20,6 +20,7 @@
 #include "bake/page_encoder.h"
 #include "bake/pyramid.h"
 #include "common/status.h"
+#include "format/dct_page_modes.h"
 #include "format/page_file.h"
 
 namespace vt {
@@ -104,6 +105,10 @@ struct LayerSummary {
   LayerSpec spec;      // as written (codec, runtime format, channels, texel type)
   double psnr_db = 0;  // stored pages vs unencoded texels; infinite when lossless
   uint32_t max_error = 0;
+  // After the runtime BC format (codec/runtime_error.h; no samples without a BC format), and
+  // the stored pages per DCT page mode (format/dct_page_modes.h).
+  RuntimeError runtime;
+  uint64_t dct_modes[kDctModeKinds] = {};
   NonFiniteReport non_finite;
   bool alpha_dropped = false;  // the input's alpha was opaque everywhere and is not stored
 };

@@ -239,10 +239,15 @@ std::string build_metadata(const BuildOptions& options, const std::vector<LayerP
         {{"layer", layers[i].spec.name}, {"color_space", options.layers[i].color_space}});
   nlohmann::json meta = nlohmann::json::parse(options.metadata_json, nullptr, false);
   if (meta.is_discarded() || !meta.is_object()) meta = nlohmann::json::object();
-  meta["build"] = {
-      {"filter", to_string(options.filter)},        {"address", to_string(options.address)},
-      {"codec", int(options.codec.codec)},          {"dct_quality", options.codec.dct_quality},
-      {"dct_adaptive", options.codec.dct_adaptive}, {"layers", sources}};
+  meta["build"] = {{"filter", to_string(options.filter)},
+                   {"address", to_string(options.address)},
+                   {"codec", int(options.codec.codec)},
+                   {"dct_quality", options.codec.dct_quality},
+                   {"dct_adaptive", options.codec.dct_adaptive},
+                   {"layers", sources},
+                   {"dct_page_modes", options.codec.dct_page_modes},
+                   {"min_psnr", options.codec.min_psnr},
+                   {"layer_min_psnr", options.codec.layer_min_psnr}};
   if (options.color_config && !options.color_config->is_builtin()) {
     meta["build"]["color_config"] = {{"path", options.color_config->path()},
                                      {"working_space", options.color_config->working_space()},

@@ -14,6 +14,29 @@ nlohmann::json level_json(uint32_t level, const LevelSummary& v) {
           {"scratch", v.scratch}};
 }
 
+nlohmann::json finite_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+// The error after the runtime format ("runtime": PSNR, max error, normal angles) and the DCT
+// page modes chosen ("dct_modes": pages per mode name).
+void add_runtime_json(const LayerSummary& l, nlohmann::json& j) {
+  const RuntimeError& r = l.runtime;
+  if (r.samples > 0) {
+    j["runtime"] = {{"format", to_string(l.spec.runtime_format)},
+                    {"psnr_db", finite_or_null(r.psnr_db())},
+                    {"max_error", r.max_error}};
+    if (r.normals > 0)
+      j["runtime"]["normal_error_deg"] = {
+          {"mean", r.angle_mean_deg()}, {"p99", r.angle_p99_deg()}, {"max", r.angle_max_deg}};
+  }
+  if (l.spec.codec != PageCodec::kDct) return;
+  nlohmann::json modes = nlohmann::json::object();
+  for (int m = 0; m < kDctModeKinds; ++m)
+    if (l.dct_modes[m]) modes[dct_mode_name(uint8_t(m))] = l.dct_modes[m];
+  j["dct_modes"] = modes;
+}
+
 nlohmann::json layer_json(const LayerSummary& l) {
   nlohmann::json j = {{"name", l.name},
                       {"semantic", to_string(l.spec.semantic)},
@@ -28,6 +51,7 @@ nlohmann::json layer_json(const LayerSummary& l) {
                       {"alpha_dropped", l.alpha_dropped},
                       {"non_finite", l.non_finite.non_finite},
                       {"negative", l.non_finite.negative}};
+  add_runtime_json(l, j);
   if (l.non_finite.any()) {
     j["first_bad_texel"] = {{"x", l.non_finite.first_x},
                             {"y", l.non_finite.first_y},

@@ -80,6 +80,8 @@ Expected<PageEncoder> PageEncoder::create(LayerSpec& layer, const PageEncoderOpt
   if (!codec.ok()) return codec.status().with_context("layer '" + layer.name + "'");
   PageEncoder e(std::move(codec).value(), layer, options);
   e.dct_settings_ = dct;
+  if (auto it = options.layer_min_psnr.find(layer.name); it != options.layer_min_psnr.end())
+    e.settings_.dct_min_psnr = it->second;
   return e;
 }
 
@@ -108,6 +110,8 @@ Status PageEncoder::encode(const uint8_t* texels, EncodedPage& out) const {
   out.squared_error = 0;
   out.max_error = 0;
   out.samples = 0;
+  out.dct_mode = 0;
+  out.runtime = RuntimeError{};
   if (is_constant(texels)) {
     out.state = PageState::kConstant;
     std::memset(out.constant, 0, sizeof(out.constant));
@@ -115,13 +119,32 @@ Status PageEncoder::encode(const uint8_t* texels, EncodedPage& out) const {
     return Status::Ok();
   }
   out.state = PageState::kStored;
-  if (!layer_.lossy()) return layer_.encode(texels, settings_, out.bytes);
+  if (!layer_.lossy()) {
+    VT_RETURN_IF_ERROR(layer_.encode(texels, settings_, out.bytes));
+    return measure_runtime(texels, texels, out);
+  }
   // BC formats store fewer channels than some layers hold (BC1 has no alpha): compare only
   // what the format keeps.
-  std::vector<uint8_t> back(page_bytes());
-  VT_RETURN_IF_ERROR(layer_.encode(texels, settings_, out.bytes, back.data()));
+  thread_local std::vector<uint8_t> back;
+  back.resize(page_bytes());
+  VT_RETURN_IF_ERROR(layer_.encode(texels, settings_, out.bytes, back.data(), &out.dct_mode));
   measure(texels, back.data(), back.size(), out);
-  return Status::Ok();
+  return measure_runtime(texels, back.data(), out);
+}
+
+Status PageEncoder::measure_runtime(const uint8_t* texels, const uint8_t* stored,
+                                    EncodedPage& out) const {
+  const std::optional<BcFormat> bc = layer_.bc_format();
+  if (!bc || spec_.texel_type != TexelType::kU8) return Status::Ok();
+  thread_local std::vector<uint8_t> blocks;
+  const uint8_t* own = nullptr;
+  if (codec() == PageCodec::kBcZstd) {
+    blocks.resize(layer_.bc_page_bytes());
+    VT_RETURN_IF_ERROR(layer_.bc_blocks(out.bytes, blocks));
+    own = blocks.data();
+  }
+  return measure_runtime_error(*bc, spec_.semantic == LayerSemantic::kNormal, texels, stored, own,
+                               int(layer_.page_size()), int(layer_.texel_bytes()), out.runtime);
 }
 
 Status PageEncoder::decode(std::span<const uint8_t> data, uint8_t* texels) const {

@@ -5,9 +5,12 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <span>
+#include <string>
 #include <vector>
 
+#include "codec/runtime_error.h"
 #include "codec/bc.h"
 #include "codec/dct.h"
 #include "common/status.h"
@@ -25,6 +28,11 @@ struct PageEncoderOptions {
   bool dct_adaptive = false;  // DctSettings::adaptive: smaller pages, slower decoding
   BcQuality bc_quality = BcQuality::kNormal;
   int zstd_level = 3;
+  // DCT layers: the per-page mode decision (format/dct_page_modes.h) and its error floor, a
+  // PSNR per page in dB (0: none), for every layer or by layer name.
+  bool dct_page_modes = true;
+  double min_psnr = 0;
+  std::map<std::string, double> layer_min_psnr;
 };
 
 // The BC format a layer is transcoded to: albedo/emissive RGB BC1, RGBA BC3; normal (XY) BC5;
@@ -38,6 +46,8 @@ struct EncodedPage {
   double squared_error = 0.0;  // lossy: sum over channels and texels, in 8-bit units
   uint32_t max_error = 0;      // lossy: largest absolute channel error (8-bit units)
   uint64_t samples = 0;        // channel values compared
+  uint8_t dct_mode = 0;        // DCT layers: the page mode chosen (format/dct_page_modes.h)
+  RuntimeError runtime;        // after the runtime BC format (layers that have one)
 };
 
 class PageEncoder {
@@ -66,7 +76,11 @@ class PageEncoder {
 
  private:
   PageEncoder(LayerCodec layer, const LayerSpec& spec, const PageEncoderOptions& options)
-      : layer_(std::move(layer)), spec_(spec), settings_{options.zstd_level, options.bc_quality} {}
+      : layer_(std::move(layer)),
+        spec_(spec),
+        settings_{options.zstd_level, options.bc_quality, options.dct_page_modes,
+                  options.min_psnr} {}
+  Status measure_runtime(const uint8_t* texels, const uint8_t* stored, EncodedPage& out) const;
 
   LayerCodec layer_;
   LayerSpec spec_;  // the completed layer, for remaking layer_ with trained tables

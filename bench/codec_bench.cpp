@@ -16,6 +16,7 @@
 #include "codec/bc.h"
 #include "codec/dct.h"
 #include "codec/metrics.h"
+#include "format/dct_page_modes.h"
 
 #define STB_DXT_IMPLEMENTATION
 #define STB_DXT_STATIC
@@ -312,7 +313,9 @@ Status page_codec_rows(const PageSet& set, const CodecBenchOptions& o, const std
   return Status::Ok();
 }
 
-Status run_dct(const PageSet& set, const CodecBenchOptions& o, int quality,
+// `modes`: the per-page mode decision (format/dct_page_modes.h) as a bake runs it; without, every
+// page in the tables' own mode.
+Status run_dct(const PageSet& set, const CodecBenchOptions& o, int quality, bool modes,
                std::vector<CodecBenchRow>& rows) {
   const int size = o.page_size;
   DctSettings settings;
@@ -328,12 +331,18 @@ Status run_dct(const PageSet& set, const CodecBenchOptions& o, int quality,
                       encode_pages(set, o.repeats, dct_serialize_tables(*tables).size(),
                                    [&](const uint8_t* texels, std::vector<uint8_t>& out) {
                                      out.clear();
-                                     return dct_encode_page(*tables, texels, size, size, out);
+                                     if (!modes)
+                                       return dct_encode_page(*tables, texels, size, size, out);
+                                     return dct_encode_page_modes(*tables, texels, size, 3,
+                                                                  {true, 0, 3}, out, nullptr)
+                                         .status();
                                    }));
+  const size_t page_bytes = size_t(size) * size * 3;
   auto decode = [&](const std::vector<uint8_t>& page, uint8_t* texels) {
-    return dct_decode_page(*tables, page, size, size, texels);
+    return dct_decode_page_modes(*tables, page, size, {texels, page_bytes});
   };
-  return page_codec_rows(set, o, "DCT q" + std::to_string(quality), coded, decode, rows);
+  return page_codec_rows(set, o, "DCT q" + std::to_string(quality) + (modes ? " modes" : ""), coded,
+                         decode, rows);
 }
 
 Status run_jpeg(const PageSet& set, const CodecBenchOptions& o, int quality,
@@ -490,7 +499,8 @@ Expected<CodecBenchResult> run_codec_bench(
     }
     for (int q : o.dct_qualities) {
       say("DCT q" + std::to_string(q));
-      VT_RETURN_IF_ERROR(run_dct(colour, o, q, result.rows));
+      VT_RETURN_IF_ERROR(run_dct(colour, o, q, false, result.rows));
+      VT_RETURN_IF_ERROR(run_dct(colour, o, q, true, result.rows));
     }
     for (int q : o.jpeg_qualities) {
       say("JPEG q" + std::to_string(q));
@@ -498,6 +508,7 @@ Expected<CodecBenchResult> run_codec_bench(
     }
     for (const auto& r : result.rows) {
       if (r.section != "page" || r.name.rfind("DCT q", 0) != 0) continue;
+      if (r.name.find(" modes") != std::string::npos) continue;  // the anchor is the plain mode
       const double jb = jpeg_bits_at(result.rows, r.psnr);
       if (jb > 0)
         result.equal_psnr_bytes_ratio.emplace_back(std::stoi(r.name.substr(5)),

@@ -4,12 +4,14 @@
 #include <sstream>
 
 #include "bench/codec_bench.h"
+#include "bench/hard_content_bench.h"
 
 namespace vt::bench {
 
 const std::vector<BenchKind>& bench_kinds() {
   static const std::vector<BenchKind> kinds = {
       codec_bench_kind(),
+      hard_content_bench_kind(),
   };
   return kinds;
 }

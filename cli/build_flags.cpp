@@ -5,6 +5,7 @@
 
 #include "bake/color.h"
 #include "cli/cli_util.h"
+#include "cli/layer_error_text.h"
 
 namespace vt::cli {
 namespace {
@@ -26,6 +27,17 @@ void add_build_flags(CLI::App& app, BuildOptions& o) {
       [&o](const std::string& text) { throw_if_error("--codec", parse_codec(text, &o.codec)); },
       "dct[:QUALITY][:adaptive] (default, quality 75; adaptive: smaller pages, slower "
       "decoding), bc[:high|fast] or raw (lossless)");
+  app.add_option_function<std::vector<std::string>>(
+      "--min-psnr",
+      [&o](const std::vector<std::string>& texts) {
+        for (const std::string& t : texts)
+          throw_if_error("--min-psnr", parse_min_psnr(t, &o.codec));
+      },
+      "DCT error floor: no page below DB (PSNR over its channels, stored codec); DB for every "
+      "layer or LAYER=DB, repeatable");
+  app.add_flag_callback(
+      "--no-page-modes", [&o] { o.codec.dct_page_modes = false; },
+      "DCT: every page in the tables' own mode (no per-page 4:4:4, finer or lossless choice)");
   app.add_option("--payload", o.payload, "Payload texels per page side")->capture_default_str();
   app.add_option("--border", o.border, "Border texels per page side")->capture_default_str();
   app.add_option_function<std::string>(

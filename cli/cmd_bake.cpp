@@ -12,6 +12,7 @@
 #include "cli/build_flags.h"
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/layer_error_text.h"
 #include "cli/scene_load_flags.h"
 #include "cli/unwrap_flags.h"
 #include "format/atomic_output.h"
@@ -39,7 +40,7 @@ void print_summary(const vt::SceneBakeSummary& s) {
     std::printf(" %s(%u ch, %s", l.name.c_str(), unsigned(l.spec.channels),
                 vt::to_string(l.spec.codec));
     if (std::isfinite(l.psnr_db)) std::printf(", %.1f dB", l.psnr_db);
-    std::printf(")");
+    std::printf("%s)", vt::cli::runtime_error_text(l).c_str());
   }
   std::printf("\n");
   std::printf("  pages      %llu in %u levels: %llu stored, %llu constant, %llu absent\n",

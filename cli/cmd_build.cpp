@@ -12,6 +12,7 @@
 #include "cli/build_flags.h"
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/layer_error_text.h"
 #include "format/atomic_output.h"
 #include "samples/procedural.h"
 
@@ -69,10 +70,11 @@ void print_text(const vt::BuildOptions& o, const vt::BuildSummary& s, double wal
                 vt::to_string(l.spec.texel_type), vt::to_string(l.spec.codec),
                 vt::to_string(l.spec.runtime_format));
     if (std::isfinite(l.psnr_db)) {
-      std::printf("PSNR %.2f dB, max error %u\n", l.psnr_db, l.max_error);
+      std::printf("PSNR %.2f dB, max error %u", l.psnr_db, l.max_error);
     } else {
-      std::printf("lossless\n");
+      std::printf("lossless");
     }
+    std::printf("%s\n", vt::cli::runtime_error_text(l).c_str());
     if (l.alpha_dropped) std::printf("  alpha dropped: opaque\n");
     if (l.non_finite.any()) {
       std::printf(

@@ -115,10 +115,15 @@ constexpr int kEscHist = kPairHist + kBands * kRemCtx * kNbCtx;  // per band and
 constexpr int kHistPerPlane = kEscHist + kBands * kNbCtx;
 
 constexpr uint8_t kMagic[4] = {'V', 'T', 'D', 'C'};
-constexpr uint8_t kTablesVersion = 3;
+// Version 4 added the per-page modes (kinds 3 and 4); version 3 tables still read, and their
+// pages may use only kinds 0-2.
+constexpr uint8_t kTablesVersion = 4;
+constexpr uint8_t kOldestTablesVersion = 3;
 constexpr uint8_t kPageCoded = 0;
 constexpr uint8_t kPageConstant = 1;
-constexpr uint8_t kPageStored = 2;  // texels raw, when coding would not make the page smaller
+constexpr uint8_t kPageStored = 2;     // texels raw, when coding would not make the page smaller
+constexpr uint8_t kPageCodedMode = 3;  // a mode byte (DctPageMode), then as kPageCoded
+static_assert(kDctPageLossless == 4);
 
 struct BucketTables {
   uint8_t nz[64];
@@ -263,6 +268,10 @@ struct DctTables {
   // path); untrained ones adapt while a page is coded.
   bool adaptive = true;
   std::vector<TokenModel> models[4];
+  uint8_t version = kTablesVersion;
+  // The tables of each page mode byte (full chroma | finer << 1), made with the tables; null
+  // where the mode does not apply. Mode 0 is these tables themselves.
+  std::array<std::unique_ptr<DctTables>, kDctPageModes> variant;
 };
 
 void DctTablesDeleter::operator()(DctTables* t) const {
@@ -895,6 +904,35 @@ void reconstruct_plane(const PlaneDims& d, const DctTables& t, int p, const int1
   }
 }
 
+uint8_t mode_byte(const DctPageMode& m) {
+  return uint8_t((m.full_chroma ? 1 : 0) | (m.finer << 1));
+}
+
+// The tables of every page mode: the same token models, full-resolution chroma and/or quantiser
+// steps divided by 2^finer (at least 1).
+void make_variants(DctTables& t) {
+  if (t.version < 4) return;
+  for (int m = 1; m < kDctPageModes; m++) {
+    const bool full_chroma = m & 1;
+    const int finer = m >> 1;
+    if (full_chroma && t.settings.layout != DctPlaneLayout::kYCoCg420) continue;
+    auto v = std::make_unique<DctTables>();
+    v->settings = t.settings;
+    if (full_chroma) v->settings.layout = DctPlaneLayout::kYCoCg;
+    v->width = t.width;
+    v->height = t.height;
+    v->adaptive = t.adaptive;
+    v->version = t.version;
+    for (int p = 0; p < plane_count(t.settings); p++) {
+      for (int i = 0; i < 64; i++)
+        v->quant[p][i] = uint8_t(std::max(1, (t.quant[p][i] + (1 << finer) / 2) >> finer));
+      set_dequantisation(*v, p);
+      v->models[p] = t.models[p];
+    }
+    t.variant[size_t(m)] = std::move(v);
+  }
+}
+
 Status corrupt_page(size_t size, const char* what) {
   return Error(ErrorCode::kCorrupt,
                std::string("dct page: ") + what + " (" + std::to_string(size) + " bytes)");
@@ -1025,6 +1063,7 @@ Expected<DctTablesPtr> dct_make_tables(const DctSettings& settings, int width, i
       t->models[p][i].seen() = uint16_t(std::min<uint32_t>(observed, dct_detail::kRateCap));
     }
   }
+  make_variants(*t);
   return t;
 }
 
@@ -1034,7 +1073,7 @@ Expected<DctTablesPtr> dct_make_tables(const DctSettings& settings, int width, i
 // one as LEB128 (1-2 bytes), summing to kFreqTotal.
 std::vector<uint8_t> dct_serialize_tables(const DctTables& t) {
   std::vector<uint8_t> out(std::begin(kMagic), std::end(kMagic));
-  out.push_back(kTablesVersion);
+  out.push_back(t.version);
   out.push_back(uint8_t(t.settings.quality));
   out.push_back(uint8_t(t.settings.channels));
   out.push_back(uint8_t(t.settings.layout));
@@ -1069,12 +1108,14 @@ Expected<DctTablesPtr> dct_parse_tables(std::span<const uint8_t> bytes) {
   if (bytes.size() < 13)
     return corrupt("truncated header (" + std::to_string(bytes.size()) + " bytes)");
   if (std::memcmp(bytes.data(), kMagic, 4) != 0) return corrupt("bad magic");
-  if (bytes[4] != kTablesVersion) {
-    return Error(ErrorCode::kUnsupported, "dct tables: version " + std::to_string(bytes[4]) +
-                                              " (this build reads " +
-                                              std::to_string(kTablesVersion) + ")");
+  if (bytes[4] < kOldestTablesVersion || bytes[4] > kTablesVersion) {
+    return Error(ErrorCode::kUnsupported,
+                 "dct tables: version " + std::to_string(bytes[4]) + " (this build reads " +
+                     std::to_string(kOldestTablesVersion) + " to " +
+                     std::to_string(kTablesVersion) + "; a newer vtbake wrote this file)");
   }
   DctTablesPtr t(new DctTables);
+  t->version = bytes[4];
   t->settings.quality = bytes[5];
   t->settings.channels = bytes[6];
   t->settings.layout = DctPlaneLayout(bytes[7]);
@@ -1121,13 +1162,20 @@ Expected<DctTablesPtr> dct_parse_tables(std::span<const uint8_t> bytes) {
   if (pos != bytes.size()) {
     return corrupt(std::to_string(bytes.size() - pos) + " trailing bytes");
   }
+  make_variants(*t);
   return t;
 }
 
 Status dct_encode_page(const DctTables& tables, const uint8_t* texels, int width, int height,
-                       std::vector<uint8_t>& out) {
+                       std::vector<uint8_t>& out, DctPageMode mode) {
   VT_RETURN_IF_ERROR(check_size(width, height));
   if (texels == nullptr) return Error(ErrorCode::kInvalidArgument, "dct: null texels");
+  if (!dct_mode_applies(tables, mode))
+    return Error(ErrorCode::kInvalidArgument,
+                 "dct: page mode (full chroma " + std::to_string(mode.full_chroma) + ", finer " +
+                     std::to_string(mode.finer) + ") does not apply to these tables");
+  const uint8_t m = mode_byte(mode);
+  const DctTables& t = m == 0 ? tables : *tables.variant[m];
   const DctSettings& s = tables.settings;
   out.clear();
   // A page of one colour is flagged and its texel stored raw, so it decodes exactly.
@@ -1143,12 +1191,17 @@ Status dct_encode_page(const DctTables& tables, const uint8_t* texels, int width
     return Status::Ok();
   }
   FloatPlane planes[4];
-  build_planes(s, texels, width, height, planes);
-  out.push_back(kPageCoded);
-  if (tables.adaptive) {
-    encode_tokens<true>(tables, planes, out);
+  build_planes(t.settings, texels, width, height, planes);
+  if (m == 0) {
+    out.push_back(kPageCoded);
   } else {
-    encode_tokens<false>(tables, planes, out);
+    out.push_back(kPageCodedMode);
+    out.push_back(m);
+  }
+  if (t.adaptive) {
+    encode_tokens<true>(t, planes, out);
+  } else {
+    encode_tokens<false>(t, planes, out);
   }
   const size_t raw_bytes = texel_count * size_t(ch);
   if (out.size() > raw_bytes) {
@@ -1156,6 +1209,19 @@ Status dct_encode_page(const DctTables& tables, const uint8_t* texels, int width
     out.insert(out.end(), texels, texels + raw_bytes);
   }
   return Status::Ok();
+}
+
+bool dct_mode_applies(const DctTables& tables, DctPageMode mode) {
+  const uint8_t m = mode_byte(mode);
+  return mode.finer <= kDctMaxFiner && (m == 0 || tables.variant[m] != nullptr);
+}
+
+int dct_base_step(const DctTables& tables) {
+  return tables.quant[0][0];
+}
+
+int dct_tables_version(const DctTables& tables) {
+  return tables.version;
 }
 
 Status dct_decode_page(const DctTables& tables, std::span<const uint8_t> data, int width,
@@ -1192,8 +1258,18 @@ Status dct_decode_page(const DctTables& tables, std::span<const uint8_t> data, i
     std::memcpy(texels, data.data() + 1, raw_bytes);
     return Status::Ok();
   }
-  if (data[0] != kPageCoded) return corrupt_page(data.size(), "unknown page kind");
   size_t pos = 1, rans_size = 0;
+  const DctTables* coded = &tables;
+  if (data[0] == kPageCodedMode && tables.version >= 4) {
+    if (data.size() < 2 || data[1] >= kDctPageModes || data[1] == 0 || !tables.variant[data[1]])
+      return corrupt_page(data.size(), "bad page mode");
+    coded = tables.variant[data[1]].get();
+    pos = 2;
+  } else if (data[0] == kDctPageLossless && tables.version >= 4) {
+    return corrupt_page(data.size(), "lossless page: the layer codec decodes it (zstd)");
+  } else if (data[0] != kPageCoded) {
+    return corrupt_page(data.size(), "unknown page kind");
+  }
   for (int shift = 0;; shift += 7) {
     if (pos >= data.size() || shift > 28) return corrupt_page(data.size(), "bad length field");
     const uint8_t b = data[pos++];
@@ -1204,30 +1280,31 @@ Status dct_decode_page(const DctTables& tables, std::span<const uint8_t> data, i
   thread_local DecodeScratch scratch;
   const std::span<const uint8_t> rans = data.subspan(pos, rans_size);
   const std::span<const uint8_t> raw = data.subspan(pos + rans_size);
-  VT_RETURN_IF_ERROR(tables.adaptive
-                         ? decode_tokens<true>(tables, rans, raw, width, height, scratch)
-                         : decode_tokens<false>(tables, rans, raw, width, height, scratch));
+  VT_RETURN_IF_ERROR(coded->adaptive
+                         ? decode_tokens<true>(*coded, rans, raw, width, height, scratch)
+                         : decode_tokens<false>(*coded, rans, raw, width, height, scratch));
 
-  if (s.layout == DctPlaneLayout::kPlanes) {
+  const DctSettings& cs = coded->settings;
+  if (cs.layout == DctPlaneLayout::kPlanes) {
     for (int p = 0; p < n; p++) {
-      plane_to_channel(scratch.samples[p].data(), plane_dims(s, p, width, height).w, width, height,
+      plane_to_channel(scratch.samples[p].data(), plane_dims(cs, p, width, height).w, width, height,
                        ch, p, texels);
     }
     return Status::Ok();
   }
   const int16_t* yp = scratch.samples[0].data();
-  const int ystride = plane_dims(s, 0, width, height).w;
+  const int ystride = plane_dims(cs, 0, width, height).w;
   const int16_t* co = scratch.samples[1].data();
   const int16_t* cg = scratch.samples[2].data();
-  const int cstride = plane_dims(s, 1, width, height).w;
-  if (s.layout == DctPlaneLayout::kYCoCg420) {
+  const int cstride = plane_dims(cs, 1, width, height).w;
+  if (cs.layout == DctPlaneLayout::kYCoCg420) {
     ycocg420_to_rgb(yp, ystride, co, cg, cstride, width, height, ch, texels);
   } else {
     ycocg_to_rgb(yp, ystride, co, cg, cstride, width, height, ch, texels);
   }
   if (ch == 4) {
-    plane_to_channel(scratch.samples[3].data(), plane_dims(s, 3, width, height).w, width, height, 4,
-                     3, texels);
+    plane_to_channel(scratch.samples[3].data(), plane_dims(cs, 3, width, height).w, width, height,
+                     4, 3, texels);
   }
   return Status::Ok();
 }

@@ -6,7 +6,10 @@
 // Decoding is integer-exact: the same bytes give the same texels on every machine.
 //
 // Coded page: a kind byte (0 coded, 1 constant: the texel follows raw, 2 stored: every texel
-// follows raw, used when coding would not make the page smaller). A coded page holds the length
+// follows raw, used when coding would not make the page smaller; from tables version 4 also 3
+// coded in another page mode: a mode byte, full chroma | finer << 1, then as kind 0; and 4
+// lossless: a zstd frame of the raw texels, which format/layer_codec.h decodes, since this
+// library has no zstd). A coded page holds the length
 // of its rANS part (LEB128), the rANS part (two 32-bit states, then 16-bit words; 16-token
 // alphabets at 14-bit precision, codec/dct_rans.h), then a raw bit stream (low bits and signs,
 // least significant bit first). Tokens, per plane (Y, Co, Cg, alpha; or channels 0..3 for
@@ -18,7 +21,8 @@
 // Cg=(2G-R-B)/4); 4:2:0 chroma is the 2x2 mean and comes back through a 9-3-3-1 filter.
 // Dequantised coefficients are clamped to +-2047 and inverted by a separable integer DCT with a
 // fixed 12-bit basis and specified rounding and saturation (codec/dct_transform.h).
-// Tables bytes (version 3): "VTDC", 3, quality, channels, layout, width and height (u16 LE),
+// Tables bytes (version 4; version 3, the same bytes without page kinds 3 and 4, still reads):
+// "VTDC", 4, quality, channels, layout, width and height (u16 LE),
 // mode (0 static, 1 adaptive), then per plane 64 quantiser steps (natural order) and per token
 // model an observation count and 16 frequencies (codec/dct.cpp, dct_serialize_tables).
 // Thread safety: tables are read-only once made; encode and decode may run on any number of
@@ -52,6 +56,17 @@ struct DctSettings {
   bool adaptive = false;
 };
 
+// A page's coding mode beside the tables' own (mode {} is the tables as made): the encoder picks
+// one per page by rate and distortion (format/dct_page_modes.h).
+struct DctPageMode {
+  bool full_chroma = false;  // 4:4:4 chroma on tables made for 4:2:0
+  uint8_t finer = 0;         // quantiser steps divided by 2^finer (at least 1), 0..kDctMaxFiner
+};
+inline constexpr int kDctMaxFiner = 3;
+inline constexpr int kDctPageModes = 8;  // mode bytes 0..7
+// The first byte of a lossless page (raw texels + zstd), stored by format/layer_codec.h.
+inline constexpr uint8_t kDctPageLossless = 4;
+
 // Tables shared by all pages of a layer. Opaque; serialise with dct_serialize_tables.
 struct DctTables;
 struct DctTablesDeleter {
@@ -78,10 +93,18 @@ struct DctTablesShape {
 };
 DctTablesShape dct_tables_shape(const DctTables& tables);
 
-// Encodes one page of width*height texels, `channels` interleaved 8-bit channels, row-major.
-// Replaces the contents of `out`. Deterministic: the same texels and tables give the same bytes.
+// Encodes one page of width*height texels, `channels` interleaved 8-bit channels, row-major, in
+// page mode `mode` (which must apply: dct_mode_applies). Replaces the contents of `out`.
+// Deterministic: the same texels, tables and mode give the same bytes.
 Status dct_encode_page(const DctTables& tables, const uint8_t* texels, int width, int height,
-                       std::vector<uint8_t>& out);
+                       std::vector<uint8_t>& out, DctPageMode mode = {});
+// Whether the tables code pages in `mode` (full chroma needs 4:2:0 tables).
+bool dct_mode_applies(const DctTables& tables, DctPageMode mode);
+// The luma DC quantiser step of mode {}: the scale of the tables' distortion, for rate-distortion
+// decisions.
+int dct_base_step(const DctTables& tables);
+// The tables' version (3 or 4): version 3 tables code only mode {} and no lossless pages.
+int dct_tables_version(const DctTables& tables);
 // Decodes one page into `texels`, which must be exactly width * height * channels bytes for the
 // tables' channel count (dct_tables_shape), else kInvalidArgument before anything is written:
 // whatever the tables say, the decoder writes only inside `texels`. Never reads past `data`;

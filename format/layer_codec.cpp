@@ -5,6 +5,7 @@
 #include <cstring>
 #include <string>
 
+#include "format/dct_page_modes.h"
 #include "format/zstd_frame.h"
 
 namespace vt {
@@ -55,7 +56,7 @@ size_t LayerCodec::bc_page_bytes() const {
 }
 
 Status LayerCodec::encode(const uint8_t* texels, const LayerEncodeSettings& settings,
-                          std::vector<uint8_t>& out, uint8_t* decoded) const {
+                          std::vector<uint8_t>& out, uint8_t* decoded, uint8_t* dct_mode) const {
   const std::span<const uint8_t> page(texels, page_bytes());
   const int size = int(page_size_);
   switch (codec_) {
@@ -65,10 +66,14 @@ Status LayerCodec::encode(const uint8_t* texels, const LayerEncodeSettings& sett
       if (codec_ == PageCodec::kRawZstd) return zstd_compress(page, settings.zstd_level, out);
       out.assign(page.begin(), page.end());
       return Status::Ok();
-    case PageCodec::kDct:
-      VT_RETURN_IF_ERROR(dct_encode_page(*dct_, texels, size, size, out));
-      return decoded ? dct_decode_page(*dct_, out, size, size, {decoded, page.size()})
-                     : Status::Ok();
+    case PageCodec::kDct: {
+      const DctModeSettings modes{settings.dct_page_modes, settings.dct_min_psnr,
+                                  settings.zstd_level};
+      VT_ASSIGN_OR_RETURN(uint8_t mode, dct_encode_page_modes(*dct_, texels, size, int(channels_),
+                                                              modes, out, decoded));
+      if (dct_mode) *dct_mode = mode;
+      return Status::Ok();
+    }
     case PageCodec::kBcZstd: {
       std::vector<uint8_t> blocks(bc_page_bytes());
       VT_RETURN_IF_ERROR(bc_encode_image(*bc_, settings.bc_quality, texels, size, size,
@@ -98,7 +103,7 @@ Status LayerCodec::decode(std::span<const uint8_t> data, std::span<uint8_t> out)
     case PageCodec::kRawZstd:
       return zstd_decompress_exact(data, out);
     case PageCodec::kDct:
-      return dct_decode_page(*dct_, data, size, size, out);
+      return dct_decode_page_modes(*dct_, data, size, out);
     case PageCodec::kBcZstd: {
       std::vector<uint8_t> blocks(bc_page_bytes());
       VT_RETURN_IF_ERROR(zstd_decompress_exact(data, blocks));

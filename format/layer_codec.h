@@ -23,6 +23,9 @@ namespace vt {
 struct LayerEncodeSettings {
   int zstd_level = 3;
   BcQuality bc_quality = BcQuality::kNormal;
+  // DCT layers: the per-page mode decision and its error floor (format/dct_page_modes.h).
+  bool dct_page_modes = true;
+  double dct_min_psnr = 0;
 };
 
 class LayerCodec {
@@ -47,9 +50,11 @@ class LayerCodec {
   bool lossy() const { return codec_ == PageCodec::kDct || codec_ == PageCodec::kBcZstd; }
 
   // Codes page_bytes() of texels with codec() into `out` (replaced). When `decoded` is not
-  // null it receives the page_bytes() texels decode() gives back for `out` (error reports).
+  // null it receives the page_bytes() texels decode() gives back for `out` (error reports);
+  // `dct_mode`, when not null, the DCT page mode chosen (kDctModeLossless or a mode byte).
   Status encode(const uint8_t* texels, const LayerEncodeSettings& settings,
-                std::vector<uint8_t>& out, uint8_t* decoded = nullptr) const;
+                std::vector<uint8_t>& out, uint8_t* decoded = nullptr,
+                uint8_t* dct_mode = nullptr) const;
   // Decodes one stored page into `out` (page_bytes()). Trusts no size in `data`: bad data gives
   // kCorrupt, never a read or write out of bounds.
   Status decode(std::span<const uint8_t> data, std::span<uint8_t> out) const;

@@ -1,0 +1,41 @@
+// The error of a page where it lands: its stored texels decoded, encoded to the layer's BC format
+// as the runtime transcodes them (BcQuality::kRealtime, runtime/page_source.h) or taken as the
+// stored BC blocks, decoded, and compared with the texels the page was made from. Normal layers
+// (BC5) also give the angle between source and landed normals in degrees.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "codec/bc.h"
+#include "common/status.h"
+
+namespace vt {
+
+struct RuntimeError {
+  double squared_error = 0;  // over the channels the BC format keeps, 8-bit units
+  uint64_t samples = 0;
+  uint32_t max_error = 0;
+  // Normal layers: texels compared, the sum and largest angle, and a histogram of angles in
+  // kAngleBinDeg bins (the last bin holds everything above) for the 99th percentile.
+  static constexpr double kAngleBinDeg = 0.02;
+  static constexpr int kAngleBins = 4096;
+  uint64_t normals = 0;
+  double angle_sum_deg = 0, angle_max_deg = 0;
+  std::vector<uint32_t> angle_histogram;
+
+  void add(const RuntimeError& other);
+  double psnr_db() const;  // infinite when nothing differs
+  double angle_mean_deg() const { return normals ? angle_sum_deg / double(normals) : 0; }
+  double angle_p99_deg() const;
+};
+
+// `landed` receives nothing; `source` and `stored` are size x size texels of `channels` bytes
+// (stored: what the page decodes to). `bc_blocks`, when not null, are the page's own BC blocks
+// (a BC layer), used as they are instead of encoding `stored`.
+Status measure_runtime_error(BcFormat format, bool normal, const uint8_t* source,
+                             const uint8_t* stored, const uint8_t* bc_blocks, int size,
+                             int channels, RuntimeError& out);
+
+}  // namespace vt
