@@ -26,6 +26,8 @@ class LevelSource {
   virtual Status read(uint32_t y0, uint32_t y1, float* out) = 0;
   // The level's coverage (width * height bytes, non-zero = covered), or nullptr: all covered.
   virtual const uint8_t* coverage() const { return nullptr; }
+  // True when the level's texels are held in memory (not streamed nor in a scratch file).
+  virtual bool in_memory() const { return false; }
   // NaN, Inf and negative values the source held (level 0; counted once per texel).
   virtual NonFiniteReport non_finite() const { return {}; }
 };
