@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <xxhash.h>
 #include <cerrno>
 #include <cstring>
 
@@ -103,6 +104,8 @@ Status LevelStore::read(uint32_t y0, uint32_t y1, float* out) {
   if (y0 > y1 || y1 > height_) return Error(ErrorCode::kInternal, "level rows past end");
   const size_t bytes = size_t(y1 - y0) * row_floats() * sizeof(float);
   if (in_memory()) {
+    if (memory_.size() < size_t(height_) * row_floats())
+      return Error(ErrorCode::kInternal, "level rows read after the texels were handed over");
     std::memcpy(out, memory_.data() + size_t(y0) * row_floats(), bytes);
     return Status::Ok();
   }
@@ -122,8 +125,16 @@ Status StoredImageSource::read_rows(uint32_t y0, uint32_t y1, float* out) {
 }
 
 std::vector<float> StoredImageSource::release_texels() {
-  if (store_->channels() != info_.channels) return {};
-  return store_->release();
+  if (store_->channels() != info_.channels || !store_->in_memory()) return {};
+  std::vector<float> texels = store_->release();
+  // The texels' identity outlives them (the plan hashes its sources after taking level 0).
+  released_hash_ = XXH3_64bits(texels.data(), texels.size() * sizeof(float));
+  return texels;
+}
+
+Expected<uint64_t> StoredImageSource::content_hash() {
+  if (released_hash_) return *released_hash_;
+  return ImageSource::content_hash();
 }
 
 }  // namespace vt

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -69,11 +70,14 @@ class StoredImageSource final : public ImageSource {
   Status read_rows(uint32_t y0, uint32_t y1, float* out) override;
   // An in-memory store with as many channels as the source hands its texels over.
   std::vector<float> release_texels() override;
+  // The hash of the rows (kept once the texels are handed over).
+  Expected<uint64_t> content_hash() override;
 
  private:
   ImageInfo info_;
   std::shared_ptr<LevelStore> store_;
   std::vector<float> rows_;
+  std::optional<uint64_t> released_hash_;
 };
 
 }  // namespace vt

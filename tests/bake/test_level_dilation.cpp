@@ -2,6 +2,7 @@
 // any band height, memory budget (pull levels in memory or scratch files) and level shape.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -33,8 +34,9 @@ Level random_level(uint32_t w, uint32_t h, uint32_t ch, uint32_t seed) {
   Level l{w, h, ch, std::vector<float>(size_t(w) * h * ch), std::vector<uint8_t>(size_t(w) * h)};
   for (float& v : l.texels) v = value(rng);
   for (int r = 0; r < 3; ++r) {
-    const uint32_t x0 = rng() % w, y0 = rng() % h;
-    const uint32_t x1 = std::min(w, x0 + 1 + rng() % 5), y1 = std::min(h, y0 + 1 + rng() % 7);
+    const uint32_t x0 = uint32_t(rng() % w), y0 = uint32_t(rng() % h);
+    const uint32_t x1 = std::min<uint32_t>(w, x0 + 1 + uint32_t(rng() % 5));
+    const uint32_t y1 = std::min<uint32_t>(h, y0 + 1 + uint32_t(rng() % 7));
     for (uint32_t y = y0; y < y1; ++y)
       for (uint32_t x = x0; x < x1; ++x) l.coverage[size_t(y) * w + x] = 1;
   }

@@ -32,7 +32,9 @@ std::vector<std::vector<float>> texels_of(TransferResult& r) {
       continue;
     }
     // A scratch albedo store keeps 4 channels; the layer hands out `channels` of them.
-    StoredImageSource src({r.width, r.height, l.channels}, l.store);
+    ImageInfo info;
+    info.width = r.width, info.height = r.height, info.channels = l.channels;
+    StoredImageSource src(info, l.store);
     std::vector<float> t(size_t(r.width) * r.height * l.channels);
     EXPECT_TRUE(src.read_rows(0, r.height, t.data()).ok());
     out.push_back(std::move(t));
