@@ -217,8 +217,9 @@ Expected<std::shared_ptr<LevelSource>> hold_level0(const LayerInput& input, cons
   const ImageInfo& info = input.source->info();
   const uint32_t w = info.width, h = info.height, wc = plan.work_channels;
   const uint64_t bytes = uint64_t(w) * h * wc * sizeof(float);
-  // Held in memory when it and the next level fit well within the limit, else in a scratch file.
-  const bool in_memory = bytes * 5 / 4 * 2 <= options.memory_limit;
+  // Held in memory when it and the next level, for every layer (all layers' level 0 are held
+  // from the plan on), fit well within the limit; else in a scratch file.
+  const bool in_memory = level0_fits_memory(bytes * options.layers.size(), options.memory_limit);
   Level0Converter converter(plan, input.source->origin(), w, h, options.non_finite,
                             thread_count(options.threads));
   const size_t in_row = size_t(w) * plan.source_channels, out_row = size_t(w) * wc;
@@ -251,7 +252,7 @@ Expected<std::shared_ptr<LevelSource>> hold_level0(const LayerInput& input, cons
     converter.convert(src, dst, y1 - y);
     if (!in_memory) VT_RETURN_IF_ERROR(store->write_rows(y, y1 - y, dst));
   }
-  VT_RETURN_IF_ERROR(store->set_coverage_and_dilate(*input.coverage, dilation_budget(options),
+  VT_RETURN_IF_ERROR(store->set_coverage_and_dilate(input.coverage, dilation_budget(options),
                                                     scratch_dir_for(options)));
   return std::shared_ptr<LevelSource>(new HeldLevel0(std::move(store), converter.report()));
 }

@@ -70,19 +70,19 @@ std::unique_ptr<LevelStore> LevelStore::adopt(uint32_t width, uint32_t height, u
   return s;
 }
 
-Status LevelStore::set_coverage_and_dilate(std::vector<uint8_t> coverage, uint64_t memory_budget,
-                                           const std::string& scratch_dir) {
-  if (coverage.size() != size_t(width_) * height_)
+Status LevelStore::set_coverage_and_dilate(std::shared_ptr<const std::vector<uint8_t>> coverage,
+                                           uint64_t memory_budget, const std::string& scratch_dir) {
+  if (!coverage || coverage->size() != size_t(width_) * height_)
     return Error(ErrorCode::kInternal, "coverage of a level of another size");
   coverage_ = std::move(coverage);
   if (in_memory() && pull_push_bytes(width_, height_, channels_) <= memory_budget) {
-    pull_push(memory_.data(), coverage_.data(), width_, height_, channels_);
+    pull_push(memory_.data(), coverage_->data(), width_, height_, channels_);
     return Status::Ok();
   }
   BandedDilationOptions o;
   o.memory_budget = memory_budget;
   o.scratch_dir = scratch_dir;
-  return pull_push_banded(*this, coverage_.data(), o).status();
+  return pull_push_banded(*this, coverage_->data(), o).status();
 }
 
 LevelStore::~LevelStore() {

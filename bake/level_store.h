@@ -42,14 +42,19 @@ class LevelStore final : public LevelSource {
   // Hands over an in-memory store's texels (empty for a scratch file); the store is empty after.
   std::vector<float> release() { return std::move(memory_); }
 
-  const uint8_t* coverage() const override {
-    return coverage_.empty() ? nullptr : coverage_.data();
-  }
+  const uint8_t* coverage() const override { return coverage_ ? coverage_->data() : nullptr; }
   // Sets the level's mask and dilates its uncovered texels (pull-push, same bytes as pull_push
   // on the whole level). A scratch-file level, or one whose pull levels do not fit
   // `memory_budget` bytes, is dilated in bands (level_dilation.h).
-  Status set_coverage_and_dilate(std::vector<uint8_t> coverage, uint64_t memory_budget = ~0ull,
+  Status set_coverage_and_dilate(std::shared_ptr<const std::vector<uint8_t>> coverage,
+                                 uint64_t memory_budget = ~0ull,
                                  const std::string& scratch_dir = "");
+  Status set_coverage_and_dilate(std::vector<uint8_t> coverage, uint64_t memory_budget = ~0ull,
+                                 const std::string& scratch_dir = "") {
+    return set_coverage_and_dilate(
+        std::make_shared<const std::vector<uint8_t>>(std::move(coverage)), memory_budget,
+        scratch_dir);
+  }
 
  private:
   LevelStore() = default;
@@ -57,7 +62,7 @@ class LevelStore final : public LevelSource {
   int fd_ = -1;
   std::string path_;
   std::vector<float> memory_;
-  std::vector<uint8_t> coverage_;
+  std::shared_ptr<const std::vector<uint8_t>> coverage_;  // shared with the layer's input
 };
 
 // A store's rows as an image source (the scene bake's transferred layers): `info` gives the

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/build_summary_json.h"
+#include "bake/level_source.h"
 #include "bake/level_store.h"
 #include "bake/unwrap/texel_density.h"
 #include "format/atomic_output.h"
@@ -267,11 +268,11 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
                        ? std::filesystem::path(output).parent_path().string()
                        : options.build.scratch_dir;
   to.progress = [&](double f) { report("transfer", f); };
-  // Bands of rows straight to the layers' stores: in memory while they fit half the limit.
+  // Bands of rows straight to the layers' stores: in memory where the build holds level 0 so.
   to.band_rows = options.transfer_band_rows;
   to.band_memory = band_bytes(limit);
-  to.stores_in_memory =
-      !options.transfer_to_scratch && transfer_store_bytes(unwrapped->scene, W, H) <= limit / 2;
+  to.stores_in_memory = !options.transfer_to_scratch &&
+                        level0_fits_memory(transfer_store_bytes(unwrapped->scene, W, H), limit);
   auto transfer = guarded("transfer", [&] { return transfer_to_stores(unwrapped->scene, to); });
   if (!transfer.ok()) return transfer.status().with_context("transfer");
   summary.peak_rss.push_back({"transfer", peak_rss_bytes()});

@@ -37,13 +37,15 @@ struct SceneBakeOptions {
   scene::SceneLoadOptions load;  // how the scene file is read (bake_scene(path, ...) only)
   // Atlas rows the transfer rasterises and samples at a time (TransferOptions::band_rows;
   // 0 = from the memory limit), and whether its layers go to scratch files whatever the limit
-  // (else only past half of it). The output depends on neither; tests force small bands.
+  // (else where the build would not hold them in memory either). The output depends on neither;
+  // tests force small bands.
   uint32_t transfer_band_rows = 0;
   bool transfer_to_scratch = false;
   std::function<void(const SceneBakeProgress&)> progress;
 
   // 8 GiB by default rather than the build's 2: the transfer's layers stay in memory (faster)
-  // while they fit half of it; past that every stage works in bands through scratch files.
+  // while the build can hold them (level0_fits_memory); past that every stage works in bands
+  // through scratch files.
   SceneBakeOptions() { build.memory_limit = uint64_t(8) << 30; }
 };
 
