@@ -355,11 +355,7 @@ TEST(SceneBake, SceneWithoutAtlasUvsIsAnError) {
 
 TEST(SceneBake, SampleSceneBakesWithEveryLayer) {
   test::ScratchDir dir;
-  SampleSceneOptions so;
-  so.texture_size = 64;
-  so.sphere_segments = 16;
-  so.ground_cells = 4;
-  ASSERT_TRUE(write_sample_scene(dir.file("sample"), so).ok());
+  ASSERT_TRUE(test::write_small_sample_scene(dir.file("sample"), 64, 16).ok());
   SceneBakeOptions o;
   o.build.output = dir.file("sample.vtpf");
   o.unwrap.size_pages = 4;
@@ -532,11 +528,7 @@ std::vector<char> file_bytes(const std::string& path) {
 // in-memory one, at 1 and 2 threads and across memory limits.
 TEST(SceneBake, BandedBakeWritesTheBytesOfTheInMemoryBake) {
   test::ScratchDir dir;
-  SampleSceneOptions so;
-  so.texture_size = 32;
-  so.sphere_segments = 12;
-  so.ground_cells = 4;
-  ASSERT_TRUE(write_sample_scene(dir.file("sample"), so).ok());
+  ASSERT_TRUE(test::write_small_sample_scene(dir.file("sample")).ok());
   std::vector<char> first;
   int run = 0;
   for (uint32_t rows : {0u, 16u, 32u}) {

@@ -102,11 +102,7 @@ TEST(BandedTransfer, HandMadeChartsAcrossBandEdgesMatchTheInMemoryTransfer) {
 
 TEST(BandedTransfer, SampleSceneMatchesTheInMemoryTransfer) {
   test::ScratchDir dir;
-  SampleSceneOptions so;
-  so.texture_size = 32;
-  so.sphere_segments = 12;
-  so.ground_cells = 4;
-  ASSERT_TRUE(write_sample_scene(dir.file("sample"), so).ok());
+  ASSERT_TRUE(test::write_small_sample_scene(dir.file("sample")).ok());
   auto loaded = scene::load_scene(dir.file("sample/scene.gltf"));
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
   unwrap::UnwrapOptions uo;
