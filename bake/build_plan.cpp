@@ -201,7 +201,13 @@ uint64_t working_set(const BuildPlan& plan, const LayerPlan& layer, uint32_t wid
 // bands over scratch files too).
 std::vector<bool> choose_level_memory(const BuildPlan& plan, const LayerPlan& layer) {
   const PageGeometry& g = plan.desc.geometry;
-  const uint64_t limit = plan.options.memory_limit;
+  uint64_t limit = plan.options.memory_limit;
+  // A coverage layer also holds its masks (a third more than level 0's) and a dilation's pull
+  // levels beside the level images.
+  if (layer.level0->coverage()) {
+    const uint64_t masks = uint64_t(g.width) * g.height * 4 / 3;
+    limit -= std::min(limit, masks + dilation_budget(plan.options));
+  }
   auto level_bytes = [&](uint32_t l) {
     return uint64_t(g.level_width(l)) * g.level_height(l) * layer.work_channels * sizeof(float);
   };
