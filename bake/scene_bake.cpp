@@ -174,7 +174,7 @@ Expected<SceneBakeSummary> bake_scene(const std::string& scene_path,
                                       const SceneBakeOptions& options) {
   auto t0 = Clock::now();
   if (options.progress) options.progress({"load", 0.0});
-  auto loaded = scene::load_scene(scene_path, options.load);
+  auto loaded = guarded("load", [&] { return scene::load_scene(scene_path, options.load); });
   if (!loaded.ok()) return loaded.status();
   VT_RETURN_IF_ERROR(scene::validate_geometry(*loaded));  // its messages name the file
   double load_seconds = seconds_since(t0);
