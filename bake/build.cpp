@@ -112,7 +112,7 @@ class LayerRun {
     // Levels held at once: this one (unless streamed from the source) and the next.
     const uint64_t cur = level_bytes(*current_), nxt = next->bytes();
     const bool cur_in_memory = layer_.level_in_memory[level],
-               cur_streamed = level == 0 && !cur_in_memory;
+               cur_streamed = level == 0 && !cur_in_memory && !current_->coverage();
     if (!in_memory) sum_.levels[level + 1].scratch = true;
     sum_.level_memory_bytes =
         std::max(sum_.level_memory_bytes, (cur_in_memory ? cur : 0) + (in_memory ? nxt : 0));
@@ -146,7 +146,8 @@ class LayerRun {
     if (!next_) return Status::Ok();
     if (const uint8_t* cov = current_->coverage()) {
       VT_RETURN_IF_ERROR(next_->set_coverage_and_dilate(
-          downsample_coverage(cov, current_->width(), current_->height())));
+          downsample_coverage(cov, current_->width(), current_->height()),
+          dilation_budget(plan_.options), plan_.scratch_dir));
     }
     if (alpha_.active) {
       alpha_.finish_level(uint64_t(next_->width()) * next_->height(),

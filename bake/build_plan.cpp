@@ -197,20 +197,26 @@ uint64_t working_set(const BuildPlan& plan, const LayerPlan& layer, uint32_t wid
 }
 
 // Which levels live in memory: level l + 1 does if it and level l fit in what the working set
-// leaves; coverage layers keep every level (pull-push needs the whole level).
-std::vector<bool> choose_level_memory(const BuildPlan& plan, const LayerPlan& layer,
-                                      bool coverage) {
+// leaves. Level 0 streams, or with coverage is held where open_level0 put it (pull-push runs in
+// bands over scratch files too).
+std::vector<bool> choose_level_memory(const BuildPlan& plan, const LayerPlan& layer) {
   const PageGeometry& g = plan.desc.geometry;
-  const uint64_t limit = plan.options.memory_limit;
+  uint64_t limit = plan.options.memory_limit;
+  // A coverage layer also holds its masks (a third more than level 0's) and a dilation's pull
+  // levels beside the level images.
+  if (layer.level0->coverage()) {
+    const uint64_t masks = uint64_t(g.width) * g.height * 4 / 3;
+    limit -= std::min(limit, masks + dilation_budget(plan.options));
+  }
   auto level_bytes = [&](uint32_t l) {
     return uint64_t(g.level_width(l)) * g.level_height(l) * layer.work_channels * sizeof(float);
   };
   std::vector<bool> in_memory(g.level_count());
-  in_memory[0] = coverage;
+  in_memory[0] = layer.level0->in_memory();
   for (uint32_t l = 0; l + 1 < g.level_count(); ++l) {
     const uint64_t cur = in_memory[l] ? level_bytes(l) : 0;
     const uint64_t ws = working_set(plan, layer, g.level_width(l));
-    in_memory[l + 1] = coverage || (ws < limit && cur + level_bytes(l + 1) <= limit - ws);
+    in_memory[l + 1] = ws < limit && cur + level_bytes(l + 1) <= limit - ws;
   }
   return in_memory;
 }
@@ -301,13 +307,13 @@ uint64_t task_seed(const std::string& settings, const LayerSpec& spec) {
   return XXH3_64bits_digest(&state);
 }
 
+}  // namespace
+
 std::string scratch_dir_for(const BuildOptions& o) {
   if (!o.scratch_dir.empty()) return o.scratch_dir;
   std::string dir = std::filesystem::path(o.output).parent_path().string();
   return dir.empty() ? "." : dir;
 }
-
-}  // namespace
 
 void LayerPlan::store_page(float* texels, size_t count, float alpha_scale, uint8_t* out) const {
   const uint32_t wc = work_channels;
@@ -378,7 +384,7 @@ Expected<BuildPlan> plan_build(const BuildOptions& options) {
     LayerPlan& layer = plan.layers[i];
     const LayerInput& in = options.layers[i];
     VT_ASSIGN_OR_RETURN(layer.level0, open_level0(in, layer, options));
-    layer.level_in_memory = choose_level_memory(plan, layer, in.coverage != nullptr);
+    layer.level_in_memory = choose_level_memory(plan, layer);
     if (!layer.encoder->wants_training()) continue;
     // DCT tables are trained on up to 256 of the layer's own pages or 16 MiB of their texels
     // (all of level 0 for a 2K layer).

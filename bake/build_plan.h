@@ -60,6 +60,13 @@ struct BuildPlan {
   std::vector<std::string> warnings;  // copied to BuildSummary::warnings
 };
 
+// Where scratch files go: BuildOptions::scratch_dir, else the output's folder.
+std::string scratch_dir_for(const BuildOptions& options);
+// The memory a level's pull-push dilation may use before its pull levels go to scratch files.
+inline uint64_t dilation_budget(const BuildOptions& options) {
+  return options.memory_limit / 4;
+}
+
 // Checks the options, reads each DCT layer's training sample and works out the plan. Errors
 // name the layer at fault.
 Expected<BuildPlan> plan_build(const BuildOptions& options);

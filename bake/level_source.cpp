@@ -204,6 +204,7 @@ class HeldLevel0 final : public LevelSource {
   uint32_t channels() const override { return store_->channels(); }
   Status read(uint32_t y0, uint32_t y1, float* out) override { return store_->read(y0, y1, out); }
   const uint8_t* coverage() const override { return store_->coverage(); }
+  bool in_memory() const override { return store_->in_memory(); }
   NonFiniteReport non_finite() const override { return report_; }
 
  private:
@@ -216,29 +217,30 @@ Expected<std::shared_ptr<LevelSource>> hold_level0(const LayerInput& input, cons
   const ImageInfo& info = input.source->info();
   const uint32_t w = info.width, h = info.height, wc = plan.work_channels;
   const uint64_t bytes = uint64_t(w) * h * wc * sizeof(float);
-  if (bytes * 5 / 4 * 2 > options.memory_limit) {
-    return Status(ErrorCode::kResourceLimit,
-                  plan.spec.name + ": a layer with a coverage mask keeps its levels in memory; " +
-                      std::to_string(bytes >> 20) + " MiB per level does not fit the memory limit");
-  }
+  // Held in memory when it and the next level, for every layer (all layers' level 0 are held
+  // from the plan on), fit well within the limit; else in a scratch file.
+  const bool in_memory = level0_fits_memory(bytes * options.layers.size(), options.memory_limit);
   Level0Converter converter(plan, input.source->origin(), w, h, options.non_finite,
                             thread_count(options.threads));
   const size_t in_row = size_t(w) * plan.source_channels, out_row = size_t(w) * wc;
   // Scene bakes hand over their transfer buffers: converted in place, level 0 costs no copy.
   std::vector<float> texels;
-  if (input.consume_source && plan.source_channels == wc) texels = input.source->release_texels();
+  if (in_memory && input.consume_source && plan.source_channels == wc)
+    texels = input.source->release_texels();
   const bool in_place = texels.size() == size_t(h) * out_row;
   std::unique_ptr<LevelStore> store;
   if (in_place) {
     store = LevelStore::adopt(w, h, wc, std::move(texels));
   } else {
-    VT_ASSIGN_OR_RETURN(store, LevelStore::create(w, h, wc, true, ""));
+    VT_ASSIGN_OR_RETURN(store, LevelStore::create(w, h, wc, in_memory, scratch_dir_for(options)));
   }
-  std::vector<float> raw;
-  constexpr uint32_t kChunk = 256;
-  for (uint32_t y = 0; y < h; y += kChunk) {
-    const uint32_t y1 = std::min(h, y + kChunk);
-    float* dst = store->data() + size_t(y) * out_row;
+  std::vector<float> raw, converted;
+  // Chunks of a few MiB of source rows (at least one row).
+  const uint32_t chunk = uint32_t(std::clamp<size_t>((size_t(16) << 20) / (out_row * 4), 1, 256));
+  for (uint32_t y = 0; y < h; y += chunk) {
+    const uint32_t y1 = std::min(h, y + chunk);
+    float* dst = in_memory ? store->data() + size_t(y) * out_row : nullptr;
+    if (!dst) converted.resize(size_t(y1 - y) * out_row), dst = converted.data();
     const float* src = dst;
     if (!in_place) {
       raw.resize(size_t(y1 - y) * in_row);
@@ -248,8 +250,10 @@ Expected<std::shared_ptr<LevelSource>> hold_level0(const LayerInput& input, cons
     for (uint32_t r = y; r < y1; ++r)
       VT_RETURN_IF_ERROR(converter.scan_row(r, src + size_t(r - y) * in_row));
     converter.convert(src, dst, y1 - y);
+    if (!in_memory) VT_RETURN_IF_ERROR(store->write_rows(y, y1 - y, dst));
   }
-  VT_RETURN_IF_ERROR(store->set_coverage_and_dilate(*input.coverage));
+  VT_RETURN_IF_ERROR(store->set_coverage_and_dilate(input.coverage, dilation_budget(options),
+                                                    scratch_dir_for(options)));
   return std::shared_ptr<LevelSource>(new HeldLevel0(std::move(store), converter.report()));
 }
 

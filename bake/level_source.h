@@ -26,6 +26,8 @@ class LevelSource {
   virtual Status read(uint32_t y0, uint32_t y1, float* out) = 0;
   // The level's coverage (width * height bytes, non-zero = covered), or nullptr: all covered.
   virtual const uint8_t* coverage() const { return nullptr; }
+  // True when the level's texels are held in memory (not streamed nor in a scratch file).
+  virtual bool in_memory() const { return false; }
   // NaN, Inf and negative values the source held (level 0; counted once per texel).
   virtual NonFiniteReport non_finite() const { return {}; }
 };
@@ -36,6 +38,12 @@ class LevelSource {
 // not count, such as the training sample). With a mask the whole level is converted once, in
 // place when the source hands over its texels in the working channel layout, and dilated by
 // pull-push; it must then fit the memory limit.
+// Whether held level-0 images of `bytes` in all (layers with coverage) stay in memory under
+// `memory_limit` (else they go to scratch files): the rule the scene bake's transfer follows too.
+inline bool level0_fits_memory(uint64_t bytes, uint64_t memory_limit) {
+  return bytes * 5 / 4 * 2 <= memory_limit;
+}
+
 Expected<std::shared_ptr<LevelSource>> open_level0(const LayerInput& input, const LayerPlan& plan,
                                                    const BuildOptions& options,
                                                    bool count_bad_values = true);

@@ -3,9 +3,11 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <xxhash.h>
 #include <cerrno>
 #include <cstring>
 
+#include "bake/level_dilation.h"
 #include "bake/pyramid.h"
 
 namespace vt {
@@ -68,12 +70,19 @@ std::unique_ptr<LevelStore> LevelStore::adopt(uint32_t width, uint32_t height, u
   return s;
 }
 
-Status LevelStore::set_coverage_and_dilate(std::vector<uint8_t> coverage) {
-  if (!in_memory() || coverage.size() != size_t(width_) * height_)
-    return Error(ErrorCode::kInternal, "coverage of a level not held in memory, or of wrong size");
+Status LevelStore::set_coverage_and_dilate(std::shared_ptr<const std::vector<uint8_t>> coverage,
+                                           uint64_t memory_budget, const std::string& scratch_dir) {
+  if (!coverage || coverage->size() != size_t(width_) * height_)
+    return Error(ErrorCode::kInternal, "coverage of a level of another size");
   coverage_ = std::move(coverage);
-  pull_push(memory_.data(), coverage_.data(), width_, height_, channels_);
-  return Status::Ok();
+  if (in_memory() && pull_push_bytes(width_, height_, channels_) <= memory_budget) {
+    pull_push(memory_.data(), coverage_->data(), width_, height_, channels_);
+    return Status::Ok();
+  }
+  BandedDilationOptions o;
+  o.memory_budget = memory_budget;
+  o.scratch_dir = scratch_dir;
+  return pull_push_banded(*this, coverage_->data(), o).status();
 }
 
 LevelStore::~LevelStore() {
@@ -95,11 +104,37 @@ Status LevelStore::read(uint32_t y0, uint32_t y1, float* out) {
   if (y0 > y1 || y1 > height_) return Error(ErrorCode::kInternal, "level rows past end");
   const size_t bytes = size_t(y1 - y0) * row_floats() * sizeof(float);
   if (in_memory()) {
+    if (memory_.size() < size_t(height_) * row_floats())
+      return Error(ErrorCode::kInternal, "level rows read after the texels were handed over");
     std::memcpy(out, memory_.data() + size_t(y0) * row_floats(), bytes);
     return Status::Ok();
   }
   return move_all(::pread, fd_, reinterpret_cast<char*>(out), bytes, row_offset(y0, row_floats()),
                   path_, "read");
+}
+
+Status StoredImageSource::read_rows(uint32_t y0, uint32_t y1, float* out) {
+  const uint32_t sc = store_->channels(), c = info_.channels;
+  if (sc == c) return store_->read(y0, y1, out);
+  rows_.resize(size_t(y1 - y0) * store_->row_floats());
+  VT_RETURN_IF_ERROR(store_->read(y0, y1, rows_.data()));
+  const size_t texels = size_t(y1 - y0) * info_.width;
+  for (size_t i = 0; i < texels; ++i)
+    for (uint32_t k = 0; k < c; ++k) out[i * c + k] = rows_[i * sc + k];
+  return Status::Ok();
+}
+
+std::vector<float> StoredImageSource::release_texels() {
+  if (store_->channels() != info_.channels || !store_->in_memory()) return {};
+  std::vector<float> texels = store_->release();
+  // The texels' identity outlives them (the plan hashes its sources after taking level 0).
+  released_hash_ = XXH3_64bits(texels.data(), texels.size() * sizeof(float));
+  return texels;
+}
+
+Expected<uint64_t> StoredImageSource::content_hash() {
+  if (released_hash_) return *released_hash_;
+  return ImageSource::content_hash();
 }
 
 }  // namespace vt

@@ -5,9 +5,11 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "bake/image_source.h"
 #include "bake/level_source.h"
 #include "common/status.h"
 
@@ -30,19 +32,29 @@ class LevelStore final : public LevelSource {
   uint32_t width() const override { return width_; }
   uint32_t height() const override { return height_; }
   uint32_t channels() const override { return channels_; }
-  bool in_memory() const { return fd_ < 0; }
+  bool in_memory() const override { return fd_ < 0; }
   uint64_t bytes() const { return uint64_t(width_) * height_ * channels_ * sizeof(float); }
 
   Status write_rows(uint32_t y0, uint32_t rows, const float* data);
   Status read(uint32_t y0, uint32_t y1, float* out) override;
   // The texels of an in-memory store (nullptr for a scratch file).
   float* data() { return in_memory() ? memory_.data() : nullptr; }
+  // Hands over an in-memory store's texels (empty for a scratch file); the store is empty after.
+  std::vector<float> release() { return std::move(memory_); }
 
-  const uint8_t* coverage() const override {
-    return coverage_.empty() ? nullptr : coverage_.data();
+  const uint8_t* coverage() const override { return coverage_ ? coverage_->data() : nullptr; }
+  // Sets the level's mask and dilates its uncovered texels (pull-push, same bytes as pull_push
+  // on the whole level). A scratch-file level, or one whose pull levels do not fit
+  // `memory_budget` bytes, is dilated in bands (level_dilation.h).
+  Status set_coverage_and_dilate(std::shared_ptr<const std::vector<uint8_t>> coverage,
+                                 uint64_t memory_budget = ~0ull,
+                                 const std::string& scratch_dir = "");
+  Status set_coverage_and_dilate(std::vector<uint8_t> coverage, uint64_t memory_budget = ~0ull,
+                                 const std::string& scratch_dir = "") {
+    return set_coverage_and_dilate(
+        std::make_shared<const std::vector<uint8_t>>(std::move(coverage)), memory_budget,
+        scratch_dir);
   }
-  // Sets the level's mask and dilates its uncovered texels (pull-push); in-memory stores only.
-  Status set_coverage_and_dilate(std::vector<uint8_t> coverage);
 
  private:
   LevelStore() = default;
@@ -50,7 +62,27 @@ class LevelStore final : public LevelSource {
   int fd_ = -1;
   std::string path_;
   std::vector<float> memory_;
-  std::vector<uint8_t> coverage_;
+  std::shared_ptr<const std::vector<uint8_t>> coverage_;  // shared with the layer's input
+};
+
+// A store's rows as an image source (the scene bake's transferred layers): `info` gives the
+// channels handed out, the first info.channels of the store's (an opaque alpha left behind).
+class StoredImageSource final : public ImageSource {
+ public:
+  StoredImageSource(ImageInfo info, std::shared_ptr<LevelStore> store)
+      : info_(std::move(info)), store_(std::move(store)) {}
+  const ImageInfo& info() const override { return info_; }
+  Status read_rows(uint32_t y0, uint32_t y1, float* out) override;
+  // An in-memory store with as many channels as the source hands its texels over.
+  std::vector<float> release_texels() override;
+  // The hash of the rows (kept once the texels are handed over).
+  Expected<uint64_t> content_hash() override;
+
+ private:
+  ImageInfo info_;
+  std::shared_ptr<LevelStore> store_;
+  std::vector<float> rows_;
+  std::optional<uint64_t> released_hash_;
 };
 
 }  // namespace vt

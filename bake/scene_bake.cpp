@@ -1,13 +1,18 @@
 // The main job (see scene_bake.h).
 #include "bake/scene_bake.h"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <new>
 #include <nlohmann/json.hpp>
 
 #include "bake/build_summary_json.h"
+#include "bake/level_source.h"
+#include "bake/level_store.h"
 #include "bake/unwrap/texel_density.h"
 #include "format/atomic_output.h"
 
@@ -19,8 +24,60 @@ double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-// The transfer's buffers per atlas texel: 13 floats at most, plus coverage.
-constexpr uint64_t kTransferBytesPerTexel = 13 * sizeof(float) + 1 + 24;
+// What a bake holds per atlas texel whatever the bands: the coverage masks of every level.
+constexpr double kFixedBytesPerTexel = 4.0 / 3.0;
+// And beside them: a transfer pass's accumulators (at most 256 MiB, an eighth of the limit)
+// and the libraries, the scene and the build's working set.
+uint64_t band_bytes(uint64_t memory_limit) {
+  return std::min(uint64_t(256) << 20, memory_limit / 8);
+}
+constexpr uint64_t kFixedBytes = uint64_t(64) << 20;
+
+// Atlas texels a bake fits in `memory_limit` (0 when not even the fixed part does).
+double texels_within(uint64_t memory_limit) {
+  const uint64_t fixed = band_bytes(memory_limit) + kFixedBytes;
+  return memory_limit > fixed ? double(memory_limit - fixed) / kFixedBytesPerTexel : 0.0;
+}
+
+// Refuses an atlas of `side` texels a side whose fixed part passes the memory limit.
+Status check_atlas_memory(uint64_t width, uint64_t height, uint64_t memory_limit) {
+  if (double(width) * double(height) <= texels_within(memory_limit)) return Status::Ok();
+  const uint64_t need = uint64_t(double(width) * double(height) * kFixedBytesPerTexel) +
+                        band_bytes(memory_limit) + kFixedBytes;
+  return Error(ErrorCode::kResourceLimit,
+               "an atlas of " + std::to_string(width) + "x" + std::to_string(height) +
+                   " texels needs at least " + std::to_string(need >> 20) +
+                   " MiB (coverage masks and band buffers), over the memory limit of " +
+                   std::to_string(memory_limit >> 20) +
+                   " MiB; raise --memory-limit or lower --texels-per-unit or --size");
+}
+
+// The process's peak resident set so far, in bytes.
+uint64_t peak_rss_bytes() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return uint64_t(u.ru_maxrss) * 1024;
+}
+
+// Runs a stage, turning an allocation failure into an error naming it.
+template <class Fn>
+auto guarded(const char* stage, Fn&& fn) -> decltype(fn()) {
+  try {
+    return fn();
+  } catch (const std::bad_alloc&) {
+    return Error(ErrorCode::kResourceLimit,
+                 std::string(stage) +
+                     ": out of memory (lower --memory-limit to bake in smaller bands, or lower "
+                     "--texels-per-unit or --size)");
+  }
+}
+
+// Bytes of the transfer's layer stores for a W x H atlas of `scene`'s materials.
+uint64_t transfer_store_bytes(const scene::Scene& scene, uint32_t W, uint32_t H) {
+  uint64_t channels = 0;
+  for (LayerSemantic l : layers_used(scene)) channels += l == LayerSemantic::kAlbedo ? 4 : 3;
+  return uint64_t(W) * H * channels * sizeof(float);
+}
 
 std::string default_unwrapped(const std::string& output) {
   std::filesystem::path p(output);
@@ -101,8 +158,12 @@ std::vector<LayerInput> layer_inputs(TransferResult& transfer) {
         info.is_float = layer.hdr;
         break;
     }
-    in.source = std::make_shared<MemoryImageSource>(info, std::move(layer.texels));
-    in.consume_source = true;  // the build converts the transfer's buffers in place
+    if (layer.store) {
+      in.source = std::make_shared<StoredImageSource>(info, std::move(layer.store));
+    } else {
+      in.source = std::make_shared<MemoryImageSource>(info, std::move(layer.texels));
+    }
+    in.consume_source = true;  // the build converts in-memory texels in place
     layer.texels.clear();
     inputs.push_back(std::move(in));
   }
@@ -113,7 +174,7 @@ Expected<SceneBakeSummary> bake_scene(const std::string& scene_path,
                                       const SceneBakeOptions& options) {
   auto t0 = Clock::now();
   if (options.progress) options.progress({"load", 0.0});
-  auto loaded = scene::load_scene(scene_path, options.load);
+  auto loaded = guarded("load", [&] { return scene::load_scene(scene_path, options.load); });
   if (!loaded.ok()) return loaded.status();
   VT_RETURN_IF_ERROR(scene::validate_geometry(*loaded));  // its messages name the file
   double load_seconds = seconds_since(t0);
@@ -157,14 +218,25 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   unwrap::UnwrapOptions uo = options.unwrap;
   uo.page_payload = int(options.build.payload);
   uo.threads = options.build.threads;
-  // A density from the sources is capped where the transfer's buffers would pass the limit.
+  // Limits before the work: an asked size must fit the memory limit; a density from the sources
+  // is capped where it would not.
+  const uint64_t limit = options.build.memory_limit;
+  if (uo.size_pages > 0) {
+    const uint64_t side = uint64_t(uo.size_pages) * uint64_t(uo.page_payload);
+    if (double(side) * double(side) > double(uo.max_atlas_texels)) {
+      return Error(ErrorCode::kResourceLimit, "bake: an atlas of " + std::to_string(uo.size_pages) +
+                                                  " pages (" + std::to_string(side) +
+                                                  " texels) a side exceeds the page format's " +
+                                                  "2^24 texels a side");
+    }
+    VT_RETURN_IF_ERROR(check_atlas_memory(side, side, limit).with_context("bake"));
+  }
   uo.max_size_pages = std::max(
-      1, std::min(uo.max_size_pages,
-                  unwrap::pages_within(double(options.build.memory_limit) / kTransferBytesPerTexel,
-                                       uo.page_payload)));
-  auto unwrapped = unwrap::unwrap_scene(input, uo);
+      1, std::min(uo.max_size_pages, unwrap::pages_within(texels_within(limit), uo.page_payload)));
+  auto unwrapped = guarded("unwrap", [&] { return unwrap::unwrap_scene(input, uo); });
   if (!unwrapped.ok()) return unwrapped.status().with_context("unwrap");
   summary.unwrap = unwrapped->stats;
+  summary.peak_rss.push_back({"unwrap", peak_rss_bytes()});
   summary.triangles = uint64_t(unwrapped->stats.faces);
   // Charts that cover almost nothing (degenerate or needle geometry, one huge chart beside
   // specks) leave the atlas empty: every texel baked is then wasted on background.
@@ -183,13 +255,7 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   t0 = Clock::now();
   const uint32_t W = uint32_t(unwrapped->stats.atlas_width),
                  H = uint32_t(unwrapped->stats.atlas_height);
-  uint64_t transfer_bytes = uint64_t(W) * H * kTransferBytesPerTexel;
-  if (transfer_bytes > options.build.memory_limit) {
-    return Error(ErrorCode::kResourceLimit,
-                 "transfer: an atlas of " + std::to_string(W) + "x" + std::to_string(H) +
-                     " texels needs about " + std::to_string(transfer_bytes >> 20) +
-                     " MiB, over the memory limit; lower --texels-per-unit or --size");
-  }
+  VT_RETURN_IF_ERROR(check_atlas_memory(W, H, limit).with_context("transfer"));
   TransferOptions to;
   to.width = W, to.height = H;
   to.supersample = options.supersample;
@@ -202,8 +268,14 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
                        ? std::filesystem::path(output).parent_path().string()
                        : options.build.scratch_dir;
   to.progress = [&](double f) { report("transfer", f); };
-  auto transfer = transfer_materials(unwrapped->scene, to);
+  // Bands of rows straight to the layers' stores: in memory where the build holds level 0 so.
+  to.band_rows = options.transfer_band_rows;
+  to.band_memory = band_bytes(limit);
+  to.stores_in_memory = !options.transfer_to_scratch &&
+                        level0_fits_memory(transfer_store_bytes(unwrapped->scene, W, H), limit);
+  auto transfer = guarded("transfer", [&] { return transfer_to_stores(unwrapped->scene, to); });
   if (!transfer.ok()) return transfer.status().with_context("transfer");
+  summary.peak_rss.push_back({"transfer", peak_rss_bytes()});
   summary.transfer = transfer->stats;
   summary.missing_textures = transfer->missing_textures;
   for (const MissingTexture& m : summary.missing_textures)
@@ -230,8 +302,9 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   bo.progress = [&](const BuildProgress& p) {
     report("build", p.pages_total ? double(p.pages_done) / double(p.pages_total) : 0.0);
   };
-  auto built = build_page_file(bo);
+  auto built = guarded("build", [&] { return build_page_file(bo); });
   if (!built.ok()) return built.status().with_context("build");
+  summary.peak_rss.push_back({"build", peak_rss_bytes()});
   summary.build = std::move(built).value();
   for (const std::string& w : summary.build.warnings) summary.warnings.push_back(w);
   mark_clipped(summary.build, summary.above_one);
@@ -242,8 +315,9 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   if (!summary.unwrapped.empty()) {
     t0 = Clock::now();
     report("write scene", 0.0);
-    VT_RETURN_IF_ERROR(
-        unwrap::save_unwrapped_glb(*unwrapped, staged_scene).with_context(summary.unwrapped));
+    VT_RETURN_IF_ERROR(guarded("write scene", [&] {
+                         return unwrap::save_unwrapped_glb(*unwrapped, staged_scene);
+                       }).with_context(summary.unwrapped));
     summary.stages.push_back({"write scene", seconds_since(t0)});
   }
   VT_RETURN_IF_ERROR(outputs.commit());
@@ -255,6 +329,8 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
 nlohmann::json to_json(const SceneBakeSummary& s) {
   nlohmann::json stages = nlohmann::json::object();
   for (const StageTime& st : s.stages) stages[st.name] = st.seconds;
+  nlohmann::json peak_rss = nlohmann::json::object();
+  for (const auto& [stage, bytes] : s.peak_rss) peak_rss[stage] = bytes;
   const unwrap::UnwrapStats& u = s.unwrap;
   const TransferStats& t = s.transfer;
   nlohmann::json above_one = nlohmann::json::array();
@@ -297,6 +373,7 @@ nlohmann::json to_json(const SceneBakeSummary& s) {
       {"build", to_json(s.build)},
       {"seconds", stages},
       {"total_seconds", s.seconds},
+      {"peak_rss_bytes", peak_rss},
       {"warnings", s.warnings},
   };
 }

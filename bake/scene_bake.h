@@ -6,6 +6,7 @@
 #include <functional>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bake/build.h"
@@ -34,9 +35,17 @@ struct SceneBakeOptions {
   int supersample = 1;           // 1, 4 or 16 transfer samples per texel
   MissingTextures missing_textures = MissingTextures::kError;  // see TransferOptions
   scene::SceneLoadOptions load;  // how the scene file is read (bake_scene(path, ...) only)
+  // Atlas rows the transfer rasterises and samples at a time (TransferOptions::band_rows;
+  // 0 = from the memory limit), and whether its layers go to scratch files whatever the limit
+  // (else where the build would not hold them in memory either). The output depends on neither;
+  // tests force small bands.
+  uint32_t transfer_band_rows = 0;
+  bool transfer_to_scratch = false;
   std::function<void(const SceneBakeProgress&)> progress;
 
-  // A scene bake holds the transfer's buffers too: 8 GiB by default rather than the build's 2.
+  // 8 GiB by default rather than the build's 2: the transfer's layers stay in memory (faster)
+  // while the build can hold them (level0_fits_memory); past that every stage works in bands
+  // through scratch files.
   SceneBakeOptions() { build.memory_limit = uint64_t(8) << 30; }
 };
 
@@ -62,6 +71,9 @@ struct SceneBakeSummary {
   // textures, then clipped layers. The CLI prints them as "warning: LINE".
   std::vector<std::string> warnings;
   std::vector<StageTime> stages;  // load, unwrap, transfer, build, write scene
+  // The process's peak resident set (bytes) at the end of unwrap, transfer and build: the
+  // first is the load's and the unwrap's own memory, apart from the bands that follow.
+  std::vector<std::pair<std::string, uint64_t>> peak_rss;
   double seconds = 0;
 };
 

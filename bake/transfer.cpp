@@ -2,6 +2,7 @@
 // the triangles that overlap it in index order, so the result does not depend on threads.
 #include "bake/transfer.h"
 #include "bake/color.h"
+#include "bake/level_store.h"
 #include "bake/unwrap/atlas_raster.h"
 #include "common/parallel.h"
 #include "common/vec.h"
@@ -254,6 +255,20 @@ std::vector<int32_t> connected_charts(const scene::Primitive& p, const std::vect
   return chart;
 }
 
+// What the layers' texels show as bands finish: values above 1, HDR, whether alpha is needed.
+struct LayerFacts {
+  uint64_t texels_above_one = 0;
+  float max_value = 0;
+  bool hdr = false;        // colour or data channel above 1 (albedo: RGB only)
+  bool alpha_hdr = false;  // albedo's alpha above 1
+  bool alpha = false;      // albedo: some covered texel is not opaque
+};
+
+// Texel and sample counts over the passes.
+struct RowCounts {
+  uint64_t sampled = 0, edge_only = 0, contested = 0, samples = 0;
+};
+
 class Transfer {
  public:
   Transfer(const scene::Scene& scene, const TransferOptions& opt) : scene_(scene), opt_(opt) {}
@@ -279,8 +294,14 @@ class Transfer {
   void evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, const double l[3],
                 Sample& s) const;
   void make_eval(uint32_t t, TriEval& te) const;
-  std::vector<TransferLayer> make_layers(std::vector<float> (&acc)[kSlots],
-                                         const std::vector<uint8_t>& coverage) const;
+  void transfer_rows(uint32_t r0, uint32_t r1, std::vector<float> (&acc)[kSlots],
+                     std::vector<uint8_t>& coverage, RowCounts& counts,
+                     const std::function<void(double)>& progress) const;
+  void finish_rows(std::vector<float> (&acc)[kSlots], const uint8_t* coverage, size_t n,
+                   LayerFacts (&facts)[kSlots]) const;
+  std::vector<TransferLayer> make_layers(std::shared_ptr<LevelStore> (&stores)[kSlots],
+                                         const LayerFacts (&facts)[kSlots]) const;
+  uint32_t rows_per_pass() const;
 
   const scene::Scene& scene_;
   const TransferOptions& opt_;
@@ -290,6 +311,7 @@ class Transfer {
   std::vector<std::string> temp_files_;
   std::vector<PrimInfo> prims_;
   std::vector<RasterTriangle> tris_;
+  std::vector<std::vector<uint32_t>> bins_;             // triangles per band of kBandRows rows
   std::vector<int32_t> chart_;                          // per triangle
   std::vector<std::pair<uint32_t, uint32_t>> tri_src_;  // (prim info, face)
   scene::Material default_material_;
@@ -668,81 +690,76 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
   }
 }
 
-// The layers called for, from the accumulators: alpha only if some covered texel is not
-// opaque, normals renormalised, values above 1 counted.
-std::vector<TransferLayer> Transfer::make_layers(std::vector<float> (&acc)[kSlots],
-                                                 const std::vector<uint8_t>& coverage) const {
-  const size_t N = coverage.size();
+// One band's accumulators as final layer texels: values above 1 counted, normals renormalised.
+void Transfer::finish_rows(std::vector<float> (&acc)[kSlots], const uint8_t* coverage, size_t n,
+                           LayerFacts (&facts)[kSlots]) const {
+  for (int l = 0; l < kSlots; ++l) {
+    if (!want_[l]) continue;
+    LayerFacts& f = facts[l];
+    const uint32_t channels = kSlotInfo[l].channels;
+    if (l == kNormalSlot) {
+      for (size_t i = 0; i < n; ++i) {
+        float* v = &acc[l][3 * i];
+        if (!coverage[i]) continue;
+        Vec3d u = normalized(Vec3d{v[0], v[1], v[2]}, {0, 0, 1});
+        v[0] = float(u.x), v[1] = float(u.y), v[2] = float(u.z);
+      }
+      continue;
+    }
+    // Channels 0-2 of albedo are colour, 3 is alpha (counted before alpha is dropped).
+    const uint32_t counted = l == kAlbedoSlot ? 3 : channels;
+    for (size_t i = 0; i < n; ++i) {
+      const float* v = &acc[l][i * channels];
+      for (uint32_t c = 0; c < counted; ++c) f.hdr |= v[c] > 1.0f;
+      if (l == kAlbedoSlot) f.alpha_hdr |= v[3] > 1.0f;
+      if (!coverage[i]) continue;
+      if (l == kAlbedoSlot) f.alpha |= v[3] < kOpaque;
+      const float top = *std::max_element(v, v + counted);
+      if (top > 1.0f) ++f.texels_above_one, f.max_value = std::max(f.max_value, top);
+    }
+  }
+}
+
+// The layers called for, from their stores: alpha only if some covered texel is not opaque
+// (an in-memory albedo store then loses its alpha; a scratch one is read without it).
+std::vector<TransferLayer> Transfer::make_layers(std::shared_ptr<LevelStore> (&stores)[kSlots],
+                                                 const LayerFacts (&facts)[kSlots]) const {
   std::vector<TransferLayer> layers;
   for (int l = 0; l < kSlots; ++l) {
     if (!want_[l]) continue;
+    const LayerFacts& f = facts[l];
     TransferLayer layer;
     layer.semantic = kSlotInfo[l].semantic;
     layer.channels = kSlotInfo[l].channels;
-    if (l != kNormalSlot) {
-      // Channels 0-2 of albedo are colour, 3 is alpha (counted before alpha is dropped).
-      const uint32_t channels = kSlotInfo[l].channels;
-      const uint32_t counted = l == kAlbedoSlot ? 3 : channels;
-      for (size_t i = 0; i < N; ++i) {
-        if (!coverage[i]) continue;
-        const float* v = &acc[l][i * channels];
-        const float top = *std::max_element(v, v + counted);
-        if (top > 1.0f) ++layer.texels_above_one, layer.max_value = std::max(layer.max_value, top);
-      }
-    }
+    layer.texels_above_one = f.texels_above_one;
+    layer.max_value = f.max_value;
+    layer.hdr = l != kNormalSlot && f.hdr;
     if (l == kAlbedoSlot) {
-      bool alpha = false;
-      for (size_t i = 0; i < N && !alpha; ++i) alpha = coverage[i] && acc[l][4 * i + 3] < kOpaque;
-      if (!alpha) {
-        std::vector<float> rgb(N * 3);
-        for (size_t i = 0; i < N; ++i)
-          for (int c = 0; c < 3; ++c) rgb[3 * i + c] = acc[l][4 * i + c];
-        acc[l] = std::move(rgb);
-        layer.channels = 3;
+      layer.hdr |= f.alpha && f.alpha_hdr;
+      if (!f.alpha) layer.channels = 3;
+      if (!f.alpha && stores[l]->in_memory()) {
+        const uint32_t W = stores[l]->width(), H = stores[l]->height();
+        std::vector<float> rgba = stores[l]->release(), rgb(size_t(W) * H * 3);
+        for (size_t i = 0; i < size_t(W) * H; ++i)
+          for (int c = 0; c < 3; ++c) rgb[3 * i + c] = rgba[4 * i + c];
+        rgba = {};
+        stores[l] = LevelStore::adopt(W, H, 3, std::move(rgb));
       }
     }
-    if (l == kNormalSlot) {
-      for (size_t i = 0; i < N; ++i) {
-        float* n = &acc[l][3 * i];
-        if (!coverage[i]) continue;
-        Vec3d v = normalized(Vec3d{n[0], n[1], n[2]}, {0, 0, 1});
-        n[0] = float(v.x), n[1] = float(v.y), n[2] = float(v.z);
-      }
-    } else {
-      for (float v : acc[l]) layer.hdr |= v > 1.0f;
-    }
-    layer.texels = std::move(acc[l]);
+    layer.store = std::move(stores[l]);
     layers.push_back(std::move(layer));
   }
   return layers;
 }
 
-Expected<TransferResult> Transfer::run() {
-  auto start = std::chrono::steady_clock::now();
+// Rows [r0, r1) of the atlas (r0 a multiple of kBandRows) into `acc` (those rows only) and the
+// coverage; the bands run on all threads.
+void Transfer::transfer_rows(uint32_t r0, uint32_t r1, std::vector<float> (&acc)[kSlots],
+                             std::vector<uint8_t>& coverage, RowCounts& counts,
+                             const std::function<void(double)>& progress) const {
   const uint32_t W = opt_.width, H = opt_.height;
-  if (W == 0 || H == 0) return Error(ErrorCode::kInvalidArgument, "transfer: empty atlas");
-  if (opt_.supersample != 1 && opt_.supersample != 4 && opt_.supersample != 16) {
-    return Error(ErrorCode::kInvalidArgument, "transfer: supersample must be 1, 4 or 16");
-  }
-  if (uint64_t(W) * H > opt_.max_texels) {
-    return Error(ErrorCode::kResourceLimit, "transfer: atlas of " + std::to_string(W) + "x" +
-                                                std::to_string(H) + " texels exceeds the limit");
-  }
-  sub_scale_ = 1.0 / std::sqrt(double(opt_.supersample));
-  VT_RETURN_IF_ERROR(setup_images());
-  VT_RETURN_IF_ERROR(setup_prims());
-
-  TransferResult result;
-  result.width = W, result.height = H;
-  const size_t N = size_t(W) * H;
-  // Accumulators, per slot.
-  std::vector<float> acc[kSlots];
-  for (int l = 0; l < kSlots; ++l)
-    if (want_[l]) acc[l].assign(N * kSlotInfo[l].channels, 0.0f);
-  auto coverage = std::make_shared<std::vector<uint8_t>>(N, 0);
   const auto pattern = supersample_pattern(opt_.supersample);
-  const uint32_t bands = (H + kBandRows - 1) / kBandRows;
-  auto bins = bin_by_rows(tris_, H, kBandRows);
+  const uint32_t b0 = r0 / kBandRows, bands = (r1 - r0 + kBandRows - 1) / kBandRows;
   std::atomic<uint64_t> sampled{0}, edge_only{0}, contested{0}, samples{0};
 
   auto store = [&](size_t texel, const Sample& s, float weight, bool add) {
@@ -755,29 +772,31 @@ Expected<TransferResult> Transfer::run() {
     }
   };
 
-  for_each_band(bands, opt_.threads, opt_.progress, [&](uint32_t b) {
+  for_each_band(bands, opt_.threads, progress, [&](uint32_t bi) {
+    const uint32_t b = b0 + bi;
     OIIO::TextureSystem::Perthread* pt = ts_->get_perthread_info();
     BandRaster band;
     uint32_t y0 = b * kBandRows, y1 = std::min(H, y0 + kBandRows);
     band.reset(W, y0, y1);
+    const size_t base = size_t(y0 - r0) * W;  // the band's first texel in `acc`
     TriEval te;
     Sample s{};
     uint64_t n_samples = 0;
     const float weight = 1.0f / float(pattern.size());
-    for (uint32_t t : bins[b]) {
+    for (uint32_t t : bins_[b]) {
       make_eval(t, te);
       raster_triangle(tris_[t], int32_t(t), chart_[t], band, pattern, H,
                       [&](size_t i, const double* l) {
                         evaluate(pt, te, l, s);
-                        store(size_t(y0) * W + i, s, weight, true);
+                        store(base + i, s, weight, true);
                         ++n_samples;
                       });
     }
     uint64_t n_sampled = 0, n_edge = 0, n_contested = 0;
     for (size_t i = 0; i < band.best_tri.size(); ++i) {
       if (band.best_tri[i] < 0) continue;
-      size_t texel = size_t(y0) * W + i;
-      (*coverage)[texel] = 1;
+      const size_t texel = base + i;
+      coverage[size_t(y0) * W + i] = 1;
       n_contested += band.contested[i];
       if (band.inside[i] > 0) {
         ++n_sampled;
@@ -804,17 +823,81 @@ Expected<TransferResult> Transfer::run() {
     }
     sampled += n_sampled, edge_only += n_edge, contested += n_contested, samples += n_samples;
   });
-  if (lookup_failed_) return Error(ErrorCode::kIo, lookup_error_);
+  counts.sampled += sampled, counts.edge_only += edge_only, counts.contested += contested;
+  counts.samples += samples;
+}
 
-  result.layers = make_layers(acc, *coverage);
+// Rows transferred at a time: a multiple of kBandRows, as many as TransferOptions allow.
+uint32_t Transfer::rows_per_pass() const {
+  const uint32_t H = opt_.height;
+  uint64_t rows = opt_.band_rows;
+  if (rows == 0) {
+    uint64_t per_row = 0;
+    for (int l = 0; l < kSlots; ++l)
+      if (want_[l]) per_row += uint64_t(opt_.width) * kSlotInfo[l].channels * sizeof(float);
+    rows = opt_.band_memory / std::max<uint64_t>(per_row, 1);
+  }
+  rows = std::max<uint64_t>(kBandRows, rows / kBandRows * kBandRows);
+  return uint32_t(std::min<uint64_t>(rows, (H + kBandRows - 1) / kBandRows * kBandRows));
+}
+
+Expected<TransferResult> Transfer::run() {
+  auto start = std::chrono::steady_clock::now();
+  const uint32_t W = opt_.width, H = opt_.height;
+  if (W == 0 || H == 0) return Error(ErrorCode::kInvalidArgument, "transfer: empty atlas");
+  if (opt_.supersample != 1 && opt_.supersample != 4 && opt_.supersample != 16) {
+    return Error(ErrorCode::kInvalidArgument, "transfer: supersample must be 1, 4 or 16");
+  }
+  if (uint64_t(W) * H > opt_.max_texels) {
+    return Error(ErrorCode::kResourceLimit, "transfer: atlas of " + std::to_string(W) + "x" +
+                                                std::to_string(H) + " texels exceeds the limit");
+  }
+  sub_scale_ = 1.0 / std::sqrt(double(opt_.supersample));
+  VT_RETURN_IF_ERROR(setup_images());
+  VT_RETURN_IF_ERROR(setup_prims());
+
+  TransferResult result;
+  result.width = W, result.height = H;
+  std::shared_ptr<LevelStore> stores[kSlots];
+  for (int l = 0; l < kSlots; ++l) {
+    if (!want_[l]) continue;
+    VT_ASSIGN_OR_RETURN(stores[l], LevelStore::create(W, H, kSlotInfo[l].channels,
+                                                      opt_.stores_in_memory, opt_.scratch_dir));
+  }
+  auto coverage = std::make_shared<std::vector<uint8_t>>(size_t(W) * H, 0);
+  bins_ = bin_by_rows(tris_, H, kBandRows);
+  const uint32_t pass = rows_per_pass();
+  std::vector<float> acc[kSlots];
+  LayerFacts facts[kSlots];
+  RowCounts counts;
+  for (uint32_t r0 = 0; r0 < H; r0 += pass) {
+    const uint32_t r1 = std::min(H, r0 + pass);
+    const size_t n = size_t(r1 - r0) * W;
+    for (int l = 0; l < kSlots; ++l)
+      if (want_[l]) acc[l].assign(n * kSlotInfo[l].channels, 0.0f);
+    std::function<void(double)> progress;
+    if (opt_.progress)
+      progress = [&](double f) { opt_.progress((double(r0) + f * double(r1 - r0)) / double(H)); };
+    transfer_rows(r0, r1, acc, *coverage, counts, progress);
+    if (lookup_failed_) return Error(ErrorCode::kIo, lookup_error_);
+    finish_rows(acc, coverage->data() + size_t(r0) * W, n, facts);
+    for (int l = 0; l < kSlots; ++l) {
+      if (!want_[l]) continue;
+      VT_RETURN_IF_ERROR(
+          stores[l]->write_rows(r0, r1 - r0, acc[l].data()).with_context("transfer"));
+    }
+  }
+  for (auto& a : acc) a = {};
+
+  result.layers = make_layers(stores, facts);
   result.coverage = coverage;
   result.missing_textures = missing_;
   result.stats.triangles = tris_.size();
-  result.stats.sampled_texels = sampled;
-  result.stats.edge_only_texels = edge_only;
-  result.stats.covered_texels = sampled + edge_only;
-  result.stats.contested_texels = contested;
-  result.stats.samples = samples;
+  result.stats.sampled_texels = counts.sampled;
+  result.stats.edge_only_texels = counts.edge_only;
+  result.stats.covered_texels = counts.sampled + counts.edge_only;
+  result.stats.contested_texels = counts.contested;
+  result.stats.samples = counts.samples;
   result.stats.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
@@ -888,10 +971,22 @@ std::vector<LayerSemantic> layers_used(const scene::Scene& scene) {
   return out;
 }
 
-Expected<TransferResult> transfer_materials(const scene::Scene& scene,
+Expected<TransferResult> transfer_to_stores(const scene::Scene& scene,
                                             const TransferOptions& options) {
   Transfer t(scene, options);
   return t.run();
+}
+
+Expected<TransferResult> transfer_materials(const scene::Scene& scene,
+                                            const TransferOptions& options) {
+  TransferOptions in_memory = options;
+  in_memory.stores_in_memory = true;
+  VT_ASSIGN_OR_RETURN(TransferResult r, transfer_to_stores(scene, in_memory));
+  for (TransferLayer& layer : r.layers) {
+    layer.texels = layer.store->release();
+    layer.store.reset();
+  }
+  return r;
 }
 
 AtlasRaster rasterize_atlas(const std::vector<std::array<double, 6>>& triangles,

@@ -23,6 +23,7 @@
 namespace vt {
 
 class ColorConfig;
+class LevelStore;
 
 // What a texture that cannot be read does to the transfer.
 enum class MissingTextures {
@@ -39,7 +40,15 @@ struct TransferOptions {
   // Folder for copies of embedded images (OpenImageIO's texture cache reads files). "" = the
   // system temporary folder. Copies are removed before transfer_materials returns.
   std::string scratch_dir;
-  uint64_t max_texels = uint64_t(16384) * 16384;  // larger atlases are a resource error
+  // Larger atlases are a resource error (default: the page format's 2^24 texels a side).
+  uint64_t max_texels = uint64_t(1) << 48;
+  // The atlas is transferred `band_rows` rows at a time (rounded to a multiple of 16; 0 = as
+  // many as `band_memory` bytes of accumulators hold), each pass written to the layers' stores.
+  // The texels do not depend on it.
+  uint32_t band_rows = 0;
+  uint64_t band_memory = uint64_t(256) << 20;
+  // transfer_to_stores: the layers' stores are in memory, or scratch files under scratch_dir.
+  bool stores_in_memory = true;
   // Filter for MIP levels made (maketx-style, in the scratch folder) for untiled sources;
   // "" = OpenImageIO's automatic box-filtered levels. Measured against the texel-footprint
   // (box) average on stripes above the atlas Nyquist limit: "lanczos3" lowers the RMSE at 1
@@ -69,6 +78,9 @@ struct TransferLayer {
   // ORM: occlusion, roughness, metallic. Normal: unit xyz in the atlas tangent frame.
   // Uncovered texels are 0 (the build dilates them away).
   std::vector<float> texels;
+  // transfer_to_stores: the texels in a store instead (memory or scratch file). An albedo store
+  // may keep 4 channels where `channels` is 3: the alpha is then opaque and read past.
+  std::shared_ptr<LevelStore> store;
 };
 
 struct TransferStats {
@@ -125,6 +137,12 @@ std::vector<LayerSemantic> layers_used(const scene::Scene& scene);
 // strength x texture; base colour is factor x texture x COLOR_0. Errors name the image or mesh
 // at fault; an unreadable texture names the material and slot too (see MissingTextures).
 Expected<TransferResult> transfer_materials(const scene::Scene& scene,
+                                            const TransferOptions& options);
+// The same transfer out of core: the atlas is rasterised and sampled one band of rows at a
+// time and each layer's texels go to TransferLayer::store (scratch files unless
+// TransferOptions::stores_in_memory), so memory holds only a band's accumulators and the
+// coverage. The texels are those transfer_materials gives, bit for bit.
+Expected<TransferResult> transfer_to_stores(const scene::Scene& scene,
                                             const TransferOptions& options);
 
 // Rasterisation alone, for tests and the atlas checks: triangles given as atlas texel

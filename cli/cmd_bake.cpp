@@ -53,6 +53,11 @@ void print_summary(const vt::SceneBakeSummary& s) {
   std::printf("  time      ");
   for (const auto& st : s.stages) std::printf(" %s %.2f s,", st.name.c_str(), st.seconds);
   std::printf(" total %.2f s\n", s.seconds);
+  // Peak RSS so far at the end of each stage: the first is the unwrap's own memory.
+  std::printf("  memory    ");
+  for (const auto& [stage, bytes] : s.peak_rss)
+    std::printf(" %s %.0f MiB,", stage.c_str(), double(bytes) / (1 << 20));
+  std::printf(" peak resident set at the end of each stage\n");
 }
 
 vt::cli::CommandRunner make_bake(CLI::App& app) {

@@ -8,17 +8,17 @@ void add_unwrap_flags(CLI::App& app, unwrap::UnwrapOptions& o) {
                              "World texel density (default: twice the textures' density on "
                              "the surfaces, 90th percentile by area, within --max-size)")
                   ->check(CLI::PositiveNumber);
-  // 1024 pages is far past the atlas limit (UnwrapOptions::max_atlas_texels), which then
-  // reports the size; the bound only keeps size * payload from overflowing.
+  // 16384 pages a side is the page format's 2^28 pages in level 0; the memory limit and the
+  // format's 2^24 texels a side are checked before the unwrap.
   app.add_option("--size", o.size_pages,
                  "Fit the atlas to this many pages per side (density derived; default: from "
                  "the textures)")
-      ->check(CLI::Range(1, 1024))
+      ->check(CLI::Range(1, 16384))
       ->excludes(tpu);
   app.add_option("--max-size", o.max_size_pages,
                  "Largest atlas side in pages when the density comes from the textures (the "
                  "scene bake's --memory-limit can lower it)")
-      ->check(CLI::Range(1, 1024))
+      ->check(CLI::Range(1, 16384))
       ->capture_default_str();
   app.add_option("--density", o.density_file,
                  "Density file (JSON): {\"materials\": {NAME: texels per unit or "

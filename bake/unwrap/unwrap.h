@@ -33,7 +33,9 @@ struct UnwrapOptions {
   double max_chart_stretch = 1.05;    // chart L2 stretch above this is split and redone
   int max_split_rounds = 4;           // stretch split-and-redo rounds (disk/flip splits always run)
   int threads = 0;                    // 0 = hardware concurrency
-  int64_t max_atlas_texels = int64_t{16384} * 16384;  // larger atlases are a resource error
+  // Larger atlases are a resource error; the default is the page format's bound (2^24 texels a
+  // side): memory limits are the bake's to check (bands make any size fit).
+  int64_t max_atlas_texels = int64_t{1} << 48;
   // Bounds on the side of an atlas sized by the sources' density: a larger one is fitted to
   // max_size_pages (every density scaled alike), a smaller one to min_size_pages.
   int max_size_pages = 128;

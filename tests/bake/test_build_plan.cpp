@@ -231,8 +231,8 @@ TEST(LevelStore, MemoryAndScratchHoldTheSameRows) {
     EXPECT_TRUE(std::equal(back.begin(), back.end(), rows.begin() + size_t(7) * w * ch));
     EXPECT_FALSE((*store)->read(20, h + 1, back.data()).ok());
     EXPECT_FALSE((*store)->write_rows(h - 1, 2, rows.data()).ok());
-    EXPECT_EQ((*store)->set_coverage_and_dilate(std::vector<uint8_t>(size_t(w) * h, 1)).ok(),
-              in_memory);
+    // Scratch levels dilate too (in bands: level_dilation.h).
+    EXPECT_TRUE((*store)->set_coverage_and_dilate(std::vector<uint8_t>(size_t(w) * h, 1)).ok());
   }
 }
 

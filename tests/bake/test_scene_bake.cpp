@@ -355,11 +355,7 @@ TEST(SceneBake, SceneWithoutAtlasUvsIsAnError) {
 
 TEST(SceneBake, SampleSceneBakesWithEveryLayer) {
   test::ScratchDir dir;
-  SampleSceneOptions so;
-  so.texture_size = 64;
-  so.sphere_segments = 16;
-  so.ground_cells = 4;
-  ASSERT_TRUE(write_sample_scene(dir.file("sample"), so).ok());
+  ASSERT_TRUE(test::write_small_sample_scene(dir.file("sample"), 64, 16).ok());
   SceneBakeOptions o;
   o.build.output = dir.file("sample.vtpf");
   o.unwrap.size_pages = 4;
@@ -515,6 +511,73 @@ TEST(SceneBake, NestedBuildOptionsReachTheBuild) {
     return std::string(std::istreambuf_iterator<char>(f), {});
   };
   EXPECT_NE(bytes(dir.file("kaiser.vtpf")), bytes(dir.file("box.vtpf")));
+}
+
+}  // namespace
+}  // namespace vt
+
+namespace vt {
+namespace {
+
+std::vector<char> file_bytes(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+}
+
+// The out-of-core bake (transfer in bands of 16 rows to scratch files) writes the bytes of the
+// in-memory one, at 1 and 2 threads and across memory limits.
+TEST(SceneBake, BandedBakeWritesTheBytesOfTheInMemoryBake) {
+  test::ScratchDir dir;
+  ASSERT_TRUE(test::write_small_sample_scene(dir.file("sample")).ok());
+  std::vector<char> first;
+  int run = 0;
+  for (uint32_t rows : {0u, 16u, 32u}) {
+    for (int threads : {1, 2}) {
+      for (uint64_t limit : {uint64_t(8) << 30, uint64_t(600) << 20}) {
+        if (rows == 0 && threads == 2 && limit != (uint64_t(8) << 30)) continue;
+        SceneBakeOptions o;
+        o.build.output = dir.file("out" + std::to_string(run) + ".vtpf");
+        o.unwrapped = "-";
+        o.unwrap.size_pages = 2;
+        o.build.threads = threads;
+        o.build.memory_limit = limit;
+        o.transfer_band_rows = rows;
+        o.transfer_to_scratch = rows > 0;
+        auto summary = bake_scene(dir.file("sample/scene.gltf"), o);
+        ASSERT_TRUE(summary.ok()) << summary.status().message();
+        EXPECT_EQ(summary->peak_rss.size(), 3u);
+        const std::vector<char> bytes = file_bytes(o.build.output);
+        if (first.empty()) {
+          first = bytes;
+        } else {
+          EXPECT_TRUE(bytes == first)
+              << "rows " << rows << " threads " << threads << " limit " << (limit >> 20) << " MiB";
+        }
+        ++run;
+      }
+    }
+  }
+}
+
+TEST(SceneBake, AnAtlasOverTheMemoryLimitIsRefusedBeforeTheUnwrap) {
+  test::ScratchDir dir;
+  scene::Scene s = test::single_mesh_scene(make_grid(1, 1, 1), {});
+  SceneBakeOptions o;
+  o.build.output = dir.file("big.vtpf");
+  o.build.memory_limit = uint64_t(1) << 30;
+  o.unwrap.size_pages = 16384;  // 1,966,080 texels a side: terabytes of coverage alone
+  auto summary = bake_scene(s, o);
+  ASSERT_FALSE(summary.ok());
+  EXPECT_EQ(summary.status().code(), ErrorCode::kResourceLimit);
+  o.unwrap.size_pages = 300;  // 36,000 texels a side: coverage alone is 1.6 GiB
+  summary = bake_scene(s, o);
+  ASSERT_FALSE(summary.ok());
+  EXPECT_NE(summary.status().message().find("over the memory limit"), std::string::npos)
+      << summary.status().message();
+  EXPECT_NE(summary.status().message().find("36000x36000"), std::string::npos)
+      << summary.status().message();
+  EXPECT_TRUE(summary.status().message().find("unwrap") == std::string::npos)
+      << summary.status().message();
 }
 
 }  // namespace

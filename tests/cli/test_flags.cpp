@@ -78,7 +78,7 @@ TEST(CliFlags, UnwrapFlagsHaveOneRangeInUnwrapAndBake) {
     EXPECT_EQ(ok.exit_code, 2) << ok.out;
     EXPECT_TRUE(contains(ok.out, "missing.gltf")) << ok.out;
     EXPECT_FALSE(contains(ok.out, "--padding")) << ok.out;
-    for (const char* flag : {"--padding 1025", "--size 0", "--size 1025", "--method abf",
+    for (const char* flag : {"--padding 1025", "--size 0", "--size 16385", "--method abf",
                              "--max-stretch 0.5", "--size 4 --texels-per-unit 10"}) {
       auto r = run_vtbake(std::string(command) + " " + flag, true);
       EXPECT_EQ(r.exit_code, 2) << command << " " << flag << "\n" << r.out;

@@ -62,8 +62,9 @@ TEST_F(Reports, SceneBakeNestsTheBuildSchema) {
                       false);
   ASSERT_EQ(r.exit_code, 0) << r.out;
   auto j = nlohmann::json::parse(r.out);
-  EXPECT_EQ(keys(j), (std::set<std::string>{"output", "unwrapped", "triangles", "atlas", "transfer",
-                                            "build", "seconds", "total_seconds", "warnings"}));
+  EXPECT_EQ(keys(j),
+            (std::set<std::string>{"output", "unwrapped", "triangles", "atlas", "transfer", "build",
+                                   "seconds", "total_seconds", "peak_rss_bytes", "warnings"}));
   EXPECT_EQ(j["unwrapped"], "");
   EXPECT_EQ(j["warnings"], nlohmann::json::array());  // the sample scene bakes cleanly
   EXPECT_EQ(j["transfer"]["above_one"], nlohmann::json::array());

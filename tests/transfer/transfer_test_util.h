@@ -57,6 +57,16 @@ inline scene::Scene textured_scene(scene::Primitive prim, const std::string& pat
   return s;
 }
 
+// The procedural sample scene, small: `texture_size` textures, few triangles, at dir/scene.gltf.
+inline Status write_small_sample_scene(const std::string& dir, uint32_t texture_size = 32,
+                                       uint32_t sphere_segments = 12) {
+  SampleSceneOptions so;
+  so.texture_size = texture_size;
+  so.sphere_segments = sphere_segments;
+  so.ground_cells = 4;
+  return write_sample_scene(dir, so);
+}
+
 // Transfer options at the unwrapped atlas's size, the others at their defaults.
 inline TransferOptions atlas_transfer_options(const unwrap::UnwrapStats& stats) {
   TransferOptions o;

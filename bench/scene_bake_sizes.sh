@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Scene bakes of one real scene at growing atlas sizes under one memory limit (issue 16):
+# peak RSS (the process's, and at the end of each stage), time per stage, transfer texels/s.
+#   bench/scene_bake_sizes.sh VTBAKE SCENE OUTDIR "SIZES_IN_PAGES" [MEMORY_LIMIT] [EXTRA FLAGS]
+# e.g. bench/scene_bake_sizes.sh build/release/cli/vtbake \
+#        /work/shared/testdata/meshes/scene/VirtualCity/VC.gltf /tmp/sizes "35 69 137" 2G
+set -euo pipefail
+vtbake=$1 scene=$2 out=$3 sizes=$4 limit=${5:-2G}
+shift $(($# < 5 ? $# : 5))
+mkdir -p "$out"
+printf '%-6s %-13s %9s %9s %9s %9s %9s %9s %10s %12s %12s\n' pages atlas unwrap_s transfer_s \
+  build_s total_s rss_unw rss_peak covered texels/s/core file_MiB
+for n in $sizes; do
+  json=$out/bake_$n.json
+  /usr/bin/time -f '%M' -o "$out/rss_$n" "$vtbake" --json --threads 2 bake "$scene" --size "$n" \
+    --memory-limit "$limit" --unwrapped - -o "$out/bake_$n.vtpf" "$@" > "$json"
+  python3 - "$json" "$out/rss_$n" "$n" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1])); rss = int(open(sys.argv[2]).read().split()[-1]) * 1024
+s = j["seconds"]; a = j["atlas"]; t = j["transfer"]; mib = 1 << 20
+print("%-6s %-13s %9.1f %9.1f %9.1f %9.1f %8.0fM %8.0fM %10d %12.0f %12.1f" % (
+    sys.argv[3], "%dx%d" % (a["width"], a["height"]), s.get("unwrap", 0), s.get("transfer", 0),
+    s.get("build", 0), j["total_seconds"], j["peak_rss_bytes"].get("unwrap", 0) / mib, rss / mib,
+    t["covered_texels"], t["texels_per_second"] / 2, j["build"]["bytes"]["file"] / mib))
+PY
+  rm -f "$out/bake_$n.vtpf"
+done
