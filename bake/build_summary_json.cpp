@@ -36,6 +36,20 @@ nlohmann::json layer_json(const LayerSummary& l) {
   return j;
 }
 
+// Null for a clean build with trained tables.
+nlohmann::json update_json(const UpdateSummary& u) {
+  if (!u.requested && !u.tables_pinned) return nullptr;
+  return {{"requested", u.requested},
+          {"unchanged", u.unchanged},
+          {"pages_reused", u.reused},
+          {"pages_reencoded", u.reencoded},
+          {"pages_dropped", u.dropped},
+          {"full_rebuild", u.full_rebuild.empty() ? nlohmann::json(nullptr) : u.full_rebuild},
+          {"tables_pinned", u.tables_pinned},
+          {"tables_retrained", u.tables_retrained},
+          {"tables_fit", u.tables_fit}};
+}
+
 }  // namespace
 
 uint64_t raw_texel_bytes(const BuildSummary& s) {
@@ -77,7 +91,8 @@ nlohmann::json to_json(const BuildSummary& s) {
         {"level_memory_peak", s.level_memory_bytes}}},
       {"levels", levels},
       {"layers", layers},
-      {"seconds", seconds}};
+      {"seconds", seconds},
+      {"update", update_json(s.update)}};
 }
 
 }  // namespace vt
