@@ -44,7 +44,8 @@ nlohmann::json update_json(const UpdateSummary& u) {
           {"pages_reused", u.reused},
           {"pages_reencoded", u.reencoded},
           {"pages_dropped", u.dropped},
-          {"full_rebuild", u.full_rebuild.empty() ? nlohmann::json(nullptr) : u.full_rebuild},
+          {"full_rebuild",
+           u.full_rebuild.empty() ? nlohmann::json(nullptr) : nlohmann::json(u.full_rebuild)},
           {"tables_pinned", u.tables_pinned},
           {"tables_retrained", u.tables_retrained},
           {"tables_fit", u.tables_fit}};
