@@ -36,9 +36,7 @@ nlohmann::json layer_json(const LayerSummary& l) {
   return j;
 }
 
-// Null for a clean build with trained tables.
 nlohmann::json update_json(const UpdateSummary& u) {
-  if (!u.requested && !u.tables_pinned) return nullptr;
   return {{"requested", u.requested},
           {"unchanged", u.unchanged},
           {"pages_reused", u.reused},
@@ -76,7 +74,7 @@ nlohmann::json to_json(const BuildSummary& s) {
   for (const LayerSummary& l : s.layers) layers.push_back(layer_json(l));
   nlohmann::json seconds = nlohmann::json::object();
   for (const StageTime& t : s.stages) seconds[t.name] = t.seconds;
-  return {
+  nlohmann::json j = {
       {"width", s.geometry.width},
       {"height", s.geometry.height},
       {"payload", s.geometry.payload},
@@ -92,8 +90,10 @@ nlohmann::json to_json(const BuildSummary& s) {
         {"level_memory_peak", s.level_memory_bytes}}},
       {"levels", levels},
       {"layers", layers},
-      {"seconds", seconds},
-      {"update", update_json(s.update)}};
+      {"seconds", seconds}};
+  // Only for updates and pinned tables: a clean build's report keeps its schema.
+  if (s.update.requested || s.update.tables_pinned) j["update"] = update_json(s.update);
+  return j;
 }
 
 }  // namespace vt
