@@ -88,6 +88,8 @@ class LayerRun {
         sum_(sum) {
     alpha_.active = plan.options.alpha_coverage_reference > 0 && layer_.alpha >= 0;
     alpha_.reference = plan.options.alpha_coverage_reference;
+    if (plan.previous) previous_layer_ = plan.previous->layer_index(layer_.spec.name);
+    sum_.page_keys[li].assign(g_.total_pages(), 0);
   }
 
   // Makes `level` the one being paged (level 0 from the plan's source, later ones from the
@@ -201,12 +203,42 @@ class LayerRun {
     }
   }
 
+  // hash(layer's task seed, page, alpha scale, its bordered working texels): the page's stored
+  // bytes are a function of these alone.
+  uint64_t page_key(const PageId& id, const std::vector<float>& texels) const {
+    XXH3_state_t state;
+    XXH3_INITSTATE(&state);
+    XXH3_64bits_reset_withSeed(&state, layer_.task_seed);
+    const uint32_t where[3] = {id.level, id.x, id.y};
+    XXH3_64bits_update(&state, where, sizeof where);
+    XXH3_64bits_update(&state, &alpha_.scale, sizeof alpha_.scale);
+    XXH3_64bits_update(&state, texels.data(), texels.size() * sizeof(float));
+    return XXH3_64bits_digest(&state) | 1;  // never 0, which marks an absent page
+  }
+
+  // The previous file's page under the same key (update mode), as an encoded page.
+  Expected<bool> reuse(const PageId& id, uint64_t key, EncodedPage& out) const {
+    if (previous_layer_ < 0 || plan_.previous->key(previous_layer_, id) != key) return false;
+    const PageFileReader& reader = plan_.previous->reader();
+    VT_ASSIGN_OR_RETURN(const PageEntry entry, reader.entry(id, uint32_t(previous_layer_)));
+    out.state = entry.state;
+    if (entry.state == PageState::kConstant) {
+      std::copy(std::begin(entry.constant), std::end(entry.constant), out.constant);
+    } else if (entry.state == PageState::kStored) {
+      VT_ASSIGN_OR_RETURN(out.bytes, reader.read_stored(id, uint32_t(previous_layer_)));
+    } else {
+      return false;
+    }
+    return true;
+  }
+
   Status encode_row(const RowBand& band, uint32_t row) {
     const uint32_t px = g_.pages_x(level_), S = g_.page_size();
     const size_t page_texels = size_t(S) * S;
     const uint8_t* coverage = current_->coverage();
     std::vector<EncodedPage> encoded(px);
-    std::vector<uint8_t> present(px);
+    std::vector<uint8_t> present(px), reused(px);
+    std::vector<uint64_t> keys(px);
     std::vector<Status> errors(px);
     parallel_for(px, plan_.threads, [&](size_t x) {
       const PageId id{level_, uint32_t(x), row};
@@ -217,10 +249,18 @@ class LayerRun {
       page.resize(page_texels * layer_.work_channels);
       bytes.resize(layer_.encoder->page_bytes());
       cut_page(g_, id, plan_.options.address, band, page.data());
+      keys[x] = page_key(id, page);
+      auto copied = reuse(id, keys[x], encoded[x]);
+      if (!copied.ok() || *copied) {
+        errors[x] = copied.status();
+        reused[x] = 1;
+        return;
+      }
       layer_.store_page(page.data(), page_texels, alpha_.scale, bytes.data());
       errors[x] = layer_.encoder->encode(bytes.data(), encoded[x]);
     });
     LevelSummary& lsum = sum_.levels[level_];
+    std::vector<uint64_t>& layer_keys = sum_.page_keys[li_];
     for (uint32_t x = 0; x < px; ++x) {
       const PageId id{level_, x, row};
       VT_RETURN_IF_ERROR(errors[x].with_context(layer_.spec.name + " " + page_name(id)));
@@ -228,6 +268,8 @@ class LayerRun {
         ++lsum.absent;
         continue;
       }
+      layer_keys[page_key_index(g_, id)] = keys[x];
+      ++(reused[x] ? sum_.update.reused : sum_.update.reencoded);
       const EncodedPage& e = encoded[x];
       if (e.state == PageState::kConstant) {
         ++lsum.constant;
@@ -282,9 +324,61 @@ class LayerRun {
   std::vector<float> next_rows_;
   AlphaCoverage alpha_;
   ErrorSum error_;
+  int previous_layer_ = -1;  // the same layer in the previous file (update mode)
 };
 
+// The plan's metadata with the provenance merged in and the update record (bake/update.h).
+std::string final_metadata(const BuildPlan& plan, const BuildSummary& sum) {
+  UpdateRecord r;
+  r.tool = VTBAKE_VERSION;
+  r.plan_hash = plan.hash;
+  r.settings_key = plan.settings_key;
+  r.input_key = plan.options.input_key;
+  for (const LayerPlan& layer : plan.layers) r.layer_names.push_back(layer.spec.name);
+  r.page_keys = sum.page_keys;
+  return with_update_record(merge_metadata(plan.desc.metadata_json, plan.options.provenance_json),
+                            r);
+}
+
 }  // namespace
+
+Expected<BuildSummary> summarize_unchanged(const PreviousBuild& previous) {
+  const PageFileReader& reader = previous.reader();
+  const PageGeometry& g = reader.geometry();
+  BuildSummary sum;
+  sum.geometry = g;
+  sum.plan_hash = previous.record().plan_hash;
+  sum.update.requested = true;
+  sum.update.unchanged = true;
+  sum.page_keys = previous.record().page_keys;
+  for (uint32_t l = 0; l < g.level_count(); ++l) {
+    LevelSummary ls;
+    ls.width = g.level_width(l), ls.height = g.level_height(l);
+    ls.pages_x = g.pages_x(l), ls.pages_y = g.pages_y(l);
+    for (uint32_t layer = 0; layer < reader.layers().size(); ++layer)
+      for (uint32_t y = 0; y < ls.pages_y; ++y)
+        for (uint32_t x = 0; x < ls.pages_x; ++x) {
+          VT_ASSIGN_OR_RETURN(const PageEntry e, reader.entry(PageId{l, x, y}, layer));
+          if (e.state == PageState::kStored) ++ls.stored, ls.stored_bytes += e.size;
+          if (e.state == PageState::kConstant) ++ls.constant;
+          if (e.state == PageState::kAbsent) ++ls.absent;
+        }
+    sum.stored += ls.stored, sum.constant += ls.constant, sum.absent += ls.absent;
+    sum.stored_bytes += ls.stored_bytes;
+    sum.levels.push_back(ls);
+  }
+  sum.pages = sum.stored + sum.constant + sum.absent;
+  sum.update.reused = sum.stored + sum.constant;
+  for (const LayerSpec& spec : reader.layers()) {
+    LayerSummary ls;
+    ls.name = spec.name;
+    ls.spec = spec;
+    ls.psnr_db = std::numeric_limits<double>::quiet_NaN();  // not measured: nothing encoded
+    sum.layers.push_back(ls);
+  }
+  sum.file_bytes = reader.file_size();
+  return sum;
+}
 
 Expected<NonFinitePolicy> parse_non_finite_policy(const std::string& name) {
   if (name == "black") return NonFinitePolicy::kBlack;
@@ -299,6 +393,8 @@ Expected<BuildSummary> build_pages(const BuildPlan& plan, PageSink& sink) {
   BuildSummary sum;
   sum.geometry = g;
   sum.plan_hash = plan.hash;
+  sum.update = plan.update;
+  sum.page_keys.resize(plan.layers.size());
   sum.levels.resize(g.level_count());
   for (uint32_t l = 0; l < g.level_count(); ++l) {
     LevelSummary& ls = sum.levels[l];
@@ -347,6 +443,12 @@ Expected<BuildSummary> build_pages(const BuildPlan& plan, PageSink& sink) {
   sum.pages = sum.stored + sum.constant + sum.absent;
   sum.stages = {{"read", t_read}, {"pyramid", t_pyramid}, {"encode", t_encode}};
   sum.warnings = plan.warnings;
+  if (plan.previous) {
+    for (size_t li = 0; li < plan.layers.size(); ++li) {
+      const int previous = plan.previous->layer_index(plan.layers[li].spec.name);
+      sum.update.dropped += count_dropped(*plan.previous, previous, g, sum.page_keys[li]);
+    }
+  }
   return sum;
 }
 
@@ -370,10 +472,16 @@ Expected<BuildSummary> build_page_file(const BuildOptions& opts) {
   auto t0 = Clock::now();
   VT_ASSIGN_OR_RETURN(BuildPlan plan, plan_build(options));
   const double t_plan = seconds_since(t0);
+  if (plan.unchanged) {
+    VT_ASSIGN_OR_RETURN(BuildSummary sum, summarize_unchanged(*plan.previous));
+    sum.stages.insert(sum.stages.begin(), StageTime{"plan", t_plan});
+    return sum;
+  }
   VT_ASSIGN_OR_RETURN(auto writer, PageFileWriter::create(options.output, plan.desc));
   WriterSink sink(*writer);
   VT_ASSIGN_OR_RETURN(BuildSummary sum, build_pages(plan, sink));
   sum.stages.insert(sum.stages.begin(), StageTime{"plan", t_plan});
+  writer->set_metadata_json(final_metadata(plan, sum));
   t0 = Clock::now();
   if (options.progress) {
     BuildProgress p;

@@ -19,6 +19,7 @@
 #include "bake/image_source.h"
 #include "bake/page_encoder.h"
 #include "bake/pyramid.h"
+#include "bake/update.h"
 #include "common/status.h"
 #include "format/dct_page_modes.h"
 #include "format/page_file.h"
@@ -81,6 +82,20 @@ struct BuildOptions {
   // its scene_linear role is the working space. Null = the built-in config (bake/color.h).
   std::shared_ptr<const ColorConfig> color_config;
   std::string metadata_json = "{}";
+  // Recorded in the metadata but outside the plan hash and the task keys (source paths: the
+  // same inputs reached by another path give the same keys).
+  std::string provenance_json = "{}";
+  // Update mode (bake/update.h). With `update`, the previous output (update_from, "" = output)
+  // has its pages whose task key is unchanged copied, and its DCT tables pinned unless
+  // retrain_tables is set or they fit the new pages worse than kRetrainFitBound. With the same
+  // plan as the previous file nothing is written. tables_from: a page file whose DCT tables the
+  // layers of the same name use instead of training. input_key: the caller's key of what it
+  // derived the layers from, recorded for its own unchanged check (a scene bake's scene).
+  bool update = false;
+  std::string update_from;
+  std::string tables_from;
+  bool retrain_tables = false;
+  uint64_t input_key = 0;
   std::function<void(const BuildProgress&)> progress;
 };
 
@@ -132,6 +147,9 @@ struct BuildSummary {
   std::vector<uint64_t> task_keys;  // per task of make_build_tasks (0 for level tasks)
   // What the build could not honour, e.g. a memory limit below its floor (BuildPlan).
   std::vector<std::string> warnings;
+  // page_keys[layer][page_key_index(id)]: each page's task key (0 = absent), as recorded.
+  std::vector<std::vector<uint64_t>> page_keys;
+  UpdateSummary update;
 };
 
 // Receives the pages of a build; PageFileWriter is the usual one, tests collect them.
@@ -154,6 +172,9 @@ Expected<BuildSummary> build_pages(const BuildPlan& plan, PageSink& sink);
 // >= 1, replaces the source by one without the alpha channel (so the layer is RGB, BC1 rather
 // than BC3) and sets LayerInput::alpha_dropped. Runs before plan_build.
 Status drop_opaque_alpha(BuildOptions& options);
+
+// The summary of an update that found nothing changed: the previous file's pages, all reused.
+Expected<BuildSummary> summarize_unchanged(const PreviousBuild& previous);
 
 // drop_opaque_alpha + plan_build + a PageFileWriter at options.output + build_pages + finish.
 // Nothing is left under options.output on failure.

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <limits>
@@ -315,6 +316,120 @@ std::string scratch_dir_for(const BuildOptions& o) {
   return dir.empty() ? "." : dir;
 }
 
+// Update mode: opens the previous output and keeps it when its pages can be reused (same
+// tool, settings and size); sets plan.unchanged when its plan equals this one. Returns the
+// tables to pin: --tables-from's, else the kept previous file's.
+Expected<PinnedTables> choose_previous(BuildPlan& plan) {
+  const BuildOptions& o = plan.options;
+  UpdateSummary& u = plan.update;
+  u.requested = o.update;
+  PinnedTables pinned;
+  if (!o.tables_from.empty()) {
+    VT_ASSIGN_OR_RETURN(pinned, read_pinned_tables(o.tables_from));
+  }
+  if (!u.requested) return pinned;
+  auto previous = PreviousBuild::open(o.update_from.empty() ? o.output : o.update_from);
+  if (!previous.ok()) {
+    u.full_rebuild = previous.status().code() == ErrorCode::kNotFound
+                         ? "no previous file"
+                         : "previous file unreadable (" + previous.status().message() + ")";
+    return pinned;
+  }
+  const UpdateRecord& r = (*previous)->record();
+  const PageGeometry &g = (*previous)->reader().geometry(), &ng = plan.desc.geometry;
+  if (!(*previous)->has_record()) {
+    u.full_rebuild = "the previous file has no page keys";
+  } else if (r.tool != VTBAKE_VERSION) {
+    u.full_rebuild = "tool version changed (" + r.tool + " -> " VTBAKE_VERSION ")";
+  } else if (r.settings_key != plan.settings_key) {
+    u.full_rebuild = "settings changed";
+  } else if (g.width != ng.width || g.height != ng.height) {
+    u.full_rebuild = "size changed (" + std::to_string(g.width) + "x" + std::to_string(g.height) +
+                     " -> " + std::to_string(ng.width) + "x" + std::to_string(ng.height) + ")";
+  }
+  if (!u.full_rebuild.empty()) return pinned;
+  plan.previous = std::move(previous).value();
+  plan.unchanged = r.plan_hash == plan.hash && !o.retrain_tables && o.tables_from.empty();
+  if (!o.tables_from.empty() || o.retrain_tables) return pinned;
+  for (const LayerSpec& spec : plan.previous->reader().layers()) {
+    if (spec.codec != PageCodec::kDct) continue;
+    pinned.names.push_back(spec.name);
+    pinned.tables.push_back(spec.codec_tables);
+  }
+  return pinned;
+}
+
+// Stored bytes of `pages` coded by `encoder`.
+Expected<uint64_t> sample_bytes(const PageEncoder& encoder,
+                                const std::vector<std::vector<uint8_t>>& pages, int threads) {
+  std::vector<uint64_t> bytes(pages.size());
+  std::vector<Status> errors(pages.size());
+  parallel_for(pages.size(), threads, [&](size_t i) {
+    EncodedPage e;
+    errors[i] = encoder.encode(pages[i].data(), e);
+    bytes[i] = e.bytes.size();
+  });
+  uint64_t total = 0;
+  for (size_t i = 0; i < pages.size(); ++i) {
+    VT_RETURN_IF_ERROR(errors[i]);
+    total += bytes[i];
+  }
+  return total;
+}
+
+// A DCT layer's tables: `pinned` when given (in update mode only while they code the training
+// sample within kRetrainFitBound of fresh tables), else trained on up to 256 of the layer's own
+// pages or 16 MiB of their texels (all of level 0 for a 2K layer).
+Status plan_tables(BuildPlan& plan, const LayerInput& in, LayerPlan& layer,
+                   const std::vector<uint8_t>* pinned) {
+  const BuildOptions& o = plan.options;
+  PageEncoder pinned_encoder = *layer.encoder;
+  if (pinned) {
+    const std::string what =
+        (o.tables_from.empty() ? plan.previous->reader().path() : o.tables_from) + ": layer '" +
+        layer.spec.name + "' tables";
+    VT_RETURN_IF_ERROR(pinned_encoder.use_tables(*pinned).with_context(what));
+    plan.update.tables_pinned = true;
+    if (!plan.options.tables_from.empty() || !plan.previous) {
+      layer.spec.codec_tables = *pinned;
+      layer.encoder = std::make_shared<const PageEncoder>(std::move(pinned_encoder));
+      return Status::Ok();
+    }
+  }
+  const size_t limit = std::clamp<size_t>((size_t(16) << 20) / layer.encoder->page_bytes(), 1, 256);
+  VT_ASSIGN_OR_RETURN(auto pages, training_sample(plan, in, layer, limit));
+  std::vector<std::span<const uint8_t>> spans(pages.begin(), pages.end());
+  PageEncoder trained = *layer.encoder;
+  auto tables = trained.train(spans);
+  if (!tables.ok()) return tables.status().with_context(layer.spec.name);
+  if (pinned) {
+    VT_ASSIGN_OR_RETURN(const uint64_t old_bytes,
+                        sample_bytes(pinned_encoder, pages, plan.threads));
+    VT_ASSIGN_OR_RETURN(const uint64_t new_bytes, sample_bytes(trained, pages, plan.threads));
+    const double fit = new_bytes ? double(old_bytes) / double(new_bytes) : 1.0;
+    plan.update.tables_fit = std::max(plan.update.tables_fit, fit);
+    if (fit <= kRetrainFitBound) {
+      layer.spec.codec_tables = *pinned;
+      layer.encoder = std::make_shared<const PageEncoder>(std::move(pinned_encoder));
+      return Status::Ok();
+    }
+    char why[160];
+    std::snprintf(why, sizeof why, "tables retrained (layer '%s': pinned tables %.3fx over %.2f)",
+                  layer.spec.name.c_str(), fit, kRetrainFitBound);
+    plan.update.tables_retrained = true;
+    if (plan.update.full_rebuild.empty()) plan.update.full_rebuild = why;
+  } else if (o.retrain_tables && plan.previous) {
+    plan.update.tables_retrained = true;
+    if (plan.update.full_rebuild.empty())
+      plan.update.full_rebuild = "tables retrained (--retrain-tables)";
+  }
+  layer.spec.codec_tables = std::move(tables).value();
+  layer.encoder = std::make_shared<const PageEncoder>(std::move(trained));
+  return Status::Ok();
+}
+
+}  // namespace
+
 void LayerPlan::store_page(float* texels, size_t count, float alpha_scale, uint8_t* out) const {
   const uint32_t wc = work_channels;
   if (alpha >= 0) {
@@ -379,6 +494,11 @@ Expected<BuildPlan> plan_build(const BuildOptions& options) {
     layer.encoder = std::make_shared<const PageEncoder>(std::move(encoder));
   }
   desc.metadata_json = build_metadata(options, plan.layers);
+  const std::string settings = settings_text(plan);
+  plan.settings_key = XXH3_64bits(settings.data(), settings.size());
+  VT_ASSIGN_OR_RETURN(plan.hash, plan_hash(plan, settings));
+  VT_ASSIGN_OR_RETURN(const PinnedTables pinned, choose_previous(plan));
+  if (plan.unchanged) return plan;
 
   for (size_t i = 0; i < plan.layers.size(); ++i) {
     LayerPlan& layer = plan.layers[i];
@@ -386,22 +506,10 @@ Expected<BuildPlan> plan_build(const BuildOptions& options) {
     VT_ASSIGN_OR_RETURN(layer.level0, open_level0(in, layer, options));
     layer.level_in_memory = choose_level_memory(plan, layer);
     if (!layer.encoder->wants_training()) continue;
-    // DCT tables are trained on up to 256 of the layer's own pages or 16 MiB of their texels
-    // (all of level 0 for a 2K layer).
-    const size_t limit =
-        std::clamp<size_t>((size_t(16) << 20) / layer.encoder->page_bytes(), 1, 256);
-    VT_ASSIGN_OR_RETURN(auto pages, training_sample(plan, in, layer, limit));
-    std::vector<std::span<const uint8_t>> spans(pages.begin(), pages.end());
-    PageEncoder trained = *layer.encoder;
-    auto tables = trained.train(spans);
-    if (!tables.ok()) return tables.status().with_context(layer.spec.name);
-    layer.spec.codec_tables = std::move(tables).value();
-    layer.encoder = std::make_shared<const PageEncoder>(std::move(trained));
+    VT_RETURN_IF_ERROR(plan_tables(plan, in, layer, pinned.find(layer.spec.name)));
   }
   for (const LayerPlan& layer : plan.layers) desc.layers.push_back(layer.spec);
   check_memory_floor(plan);
-  const std::string settings = settings_text(plan);
-  VT_ASSIGN_OR_RETURN(plan.hash, plan_hash(plan, settings));
   for (LayerPlan& layer : plan.layers) layer.task_seed = task_seed(settings, layer.spec);
   return plan;
 }

@@ -15,6 +15,7 @@
 #include "bake/color.h"
 #include "bake/page_encoder.h"
 #include "bake/pyramid.h"
+#include "bake/update.h"
 
 namespace vt {
 
@@ -54,7 +55,14 @@ struct BuildPlan {
   DownsampleKernel kernel;
   uint32_t margin = 0;  // rows a band reads past its pages: max(border, filter reach)
   std::string scratch_dir;
-  uint64_t hash = 0;  // the plan's identity: settings, tool version, every source's content
+  uint64_t hash = 0;          // the plan's identity: settings, tool version, every source's content
+  uint64_t settings_key = 0;  // the settings alone (tool version included)
+  // Update mode: the previous output when its pages can be reused (same tool, settings and
+  // size), and what the plan decided about it. With `unchanged` the plan stops before opening
+  // the sources' level 0 and training: the previous file is the output.
+  std::shared_ptr<const PreviousBuild> previous;
+  UpdateSummary update;
+  bool unchanged = false;
   // The least memory this build needs whatever the limit (level 0's working set, the libraries).
   uint64_t memory_floor = 0;
   std::vector<std::string> warnings;  // copied to BuildSummary::warnings

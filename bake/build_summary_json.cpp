@@ -60,6 +60,19 @@ nlohmann::json layer_json(const LayerSummary& l) {
   return j;
 }
 
+nlohmann::json update_json(const UpdateSummary& u) {
+  return {{"requested", u.requested},
+          {"unchanged", u.unchanged},
+          {"pages_reused", u.reused},
+          {"pages_reencoded", u.reencoded},
+          {"pages_dropped", u.dropped},
+          {"full_rebuild",
+           u.full_rebuild.empty() ? nlohmann::json(nullptr) : nlohmann::json(u.full_rebuild)},
+          {"tables_pinned", u.tables_pinned},
+          {"tables_retrained", u.tables_retrained},
+          {"tables_fit", u.tables_fit}};
+}
+
 }  // namespace
 
 uint64_t raw_texel_bytes(const BuildSummary& s) {
@@ -103,6 +116,8 @@ nlohmann::json to_json(const BuildSummary& s) {
       {"layers", layers},
       {"seconds", seconds}};
   if (!s.warnings.empty()) j["warnings"] = s.warnings;
+  // Only for updates and pinned tables: a clean build's report keeps its schema.
+  if (s.update.requested || s.update.tables_pinned) j["update"] = update_json(s.update);
   return j;
 }
 

@@ -13,9 +13,6 @@
 #include "bake/png_check.h"
 
 namespace vt {
-namespace {
-
-namespace OIIO = OIIO_NAMESPACE;
 
 Expected<uint64_t> hash_file(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
@@ -30,6 +27,10 @@ Expected<uint64_t> hash_file(const std::string& path) {
   if (f.bad()) return Status(ErrorCode::kIo, path + ": read error while hashing");
   return XXH3_64bits_digest(&state);
 }
+
+namespace {
+
+namespace OIIO = OIIO_NAMESPACE;
 
 // A failed decode of a file that opened: the file is corrupt or truncated (kCorrupt, exit 2).
 // OpenImageIO's message is one line per error it collected; libpng's adds a bare "PNG library

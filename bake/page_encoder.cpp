@@ -105,6 +105,17 @@ Expected<std::vector<uint8_t>> PageEncoder::train(std::span<const std::span<cons
   return dct_serialize_tables(*tables);
 }
 
+Status PageEncoder::use_tables(std::span<const uint8_t> bytes) {
+  if (codec() != PageCodec::kDct) {
+    return Status(ErrorCode::kInvalidArgument, "only DCT layers take tables");
+  }
+  LayerSpec spec = spec_;
+  spec.codec_tables.assign(bytes.begin(), bytes.end());
+  VT_ASSIGN_OR_RETURN(layer_, LayerCodec::create(spec, layer_.page_size(), nullptr));
+  trained_ = true;
+  return Status::Ok();
+}
+
 Status PageEncoder::encode(const uint8_t* texels, EncodedPage& out) const {
   out.bytes.clear();
   out.squared_error = 0;

@@ -70,6 +70,9 @@ class PageEncoder {
   // must then hold; pages encoded before it used the old tables. Not thread-safe.
   bool wants_training() const { return codec() == PageCodec::kDct && !trained_; }
   Expected<std::vector<uint8_t>> train(std::span<const std::span<const uint8_t>> pages);
+  // Takes tables trained before (a previous file's, for update mode and --tables-from) instead
+  // of training: they must code this layer's channels and page size. Not thread-safe.
+  Status use_tables(std::span<const uint8_t> tables);
 
   PageCodec codec() const { return layer_.codec(); }
   size_t page_bytes() const { return layer_.page_bytes(); }

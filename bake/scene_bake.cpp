@@ -14,6 +14,7 @@
 #include "bake/level_source.h"
 #include "bake/level_store.h"
 #include "bake/unwrap/texel_density.h"
+#include "bake/update_scene.h"
 #include "format/atomic_output.h"
 
 namespace vt {
@@ -203,6 +204,15 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   summary.unwrapped = options.unwrapped.empty()  ? default_unwrapped(output)
                       : options.unwrapped == "-" ? ""
                                                  : options.unwrapped;
+  // Update mode: with the scene, its textures and the settings as the previous output was
+  // baked from, the outputs stay as they are.
+  VT_ASSIGN_OR_RETURN(const uint64_t input_key, scene_bake_key(input, options));
+  if (auto same = unchanged_bake(options, summary.unwrapped, input_key)) {
+    same->warnings = summary.warnings;
+    same->triangles = uint64_t(input.triangle_count());
+    same->seconds = seconds_since(start);
+    return *same;
+  }
   // The page file and the unwrapped scene replace what was there as a pair, or not at all; a
   // bad output path fails here, before the work.
   OutputSet outputs;
@@ -289,9 +299,14 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   bo.output = staged_pages;
   bo.layers = layer_inputs(*transfer);
   bo.address = AddressMode::kClamp;
+  bo.update_from = output;
+  bo.input_key = input_key;
+  bo.provenance_json =
+      nlohmann::json{
+          {"scene", input.source_path.empty() ? "" : path_for_metadata(input.source_path, output)}}
+          .dump();
   nlohmann::json meta = {
       {"tool", "vtbake bake"},
-      {"scene", input.source_path},
       {"supersample", options.supersample},
       {"texels_per_unit", summary.unwrap.texels_per_unit},
       {"atlas", {W, H}},

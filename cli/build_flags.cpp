@@ -69,6 +69,16 @@ void add_build_flags(CLI::App& app, BuildOptions& o) {
       ->default_str(format_byte_size(o.memory_limit));
   app.add_option("--scratch-dir", o.scratch_dir,
                  "Where levels larger than memory go (default: beside the output)");
+  app.add_flag("--update", o.update,
+               "Update the output: copy every page of the existing file whose key (settings, "
+               "codec tables, the page's input texels) is unchanged, encode the rest; its DCT "
+               "tables stay pinned. Nothing is written when no input or setting changed");
+  app.add_option("--tables-from", o.tables_from,
+                 "Take the DCT tables of the layers from this page file instead of training "
+                 "(a clean build equal to an --update of that file)")
+      ->check(CLI::ExistingFile);
+  app.add_flag("--retrain-tables", o.retrain_tables,
+               "With --update: train new DCT tables (every page of a DCT layer is re-encoded)");
   app.add_option_function<std::string>(
          "--colorconfig",
          [&o](const std::string& path) {

@@ -10,9 +10,9 @@
 namespace vt::cli {
 
 // -o/--output (required), --codec, --payload, --border, --filter, --alpha-coverage,
-// --fix-nonfinite, --memory-limit, --scratch-dir, --colorconfig (else $OCIO). A bad value is a
-// parse error that names the flag (exit status 2). The layers, the address mode and the metadata
-// are the command's.
+// --fix-nonfinite, --memory-limit, --scratch-dir, --update, --tables-from, --retrain-tables,
+// --colorconfig (else $OCIO). A bad value is a parse error that names the flag (exit status 2).
+// The layers, the address mode and the metadata are the command's.
 void add_build_flags(CLI::App& app, BuildOptions& options);
 
 }  // namespace vt::cli

@@ -50,6 +50,8 @@ void print_summary(const vt::SceneBakeSummary& s) {
   std::printf("  bytes      %llu in the file, %llu raw texels, ratio %.1f:1\n",
               (unsigned long long)s.build.file_bytes,
               (unsigned long long)vt::raw_texel_bytes(s.build), vt::compression_ratio(s.build));
+  if (s.build.update.requested || s.build.update.tables_pinned)
+    std::printf("  %s\n", vt::update_text(s.build.update).c_str());
   std::printf("  time      ");
   for (const auto& st : s.stages) std::printf(" %s %.2f s,", st.name.c_str(), st.seconds);
   std::printf(" total %.2f s\n", s.seconds);

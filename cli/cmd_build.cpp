@@ -69,7 +69,9 @@ void print_text(const vt::BuildOptions& o, const vt::BuildSummary& s, double wal
     std::printf("  layer \"%s\": %u x %s, %s -> %s, ", l.name.c_str(), l.spec.channels,
                 vt::to_string(l.spec.texel_type), vt::to_string(l.spec.codec),
                 vt::to_string(l.spec.runtime_format));
-    if (std::isfinite(l.psnr_db)) {
+    if (s.update.unchanged) {
+      std::printf("unchanged");
+    } else if (std::isfinite(l.psnr_db)) {
       std::printf("PSNR %.2f dB, max error %u", l.psnr_db, l.max_error);
     } else {
       std::printf("lossless");
@@ -84,6 +86,8 @@ void print_text(const vt::BuildOptions& o, const vt::BuildSummary& s, double wal
           l.non_finite.first_x, l.non_finite.first_y, l.non_finite.first_channel);
     }
   }
+  if (s.update.requested || s.update.tables_pinned)
+    std::printf("  %s\n", vt::update_text(s.update).c_str());
   std::printf("  stages:");
   for (const vt::StageTime& t : s.stages) std::printf(" %s %.2f s", t.name.c_str(), t.seconds);
   std::printf("\n");
@@ -140,9 +144,16 @@ int run_build(BuildArgs& f, const vt::cli::GlobalOptions& global) {
 
   nlohmann::json meta;
   meta["tool"] = "vtbake " VTBAKE_VERSION;
-  meta["sources"] = nlohmann::json::array();
-  for (auto& [name, path] : inputs) meta["sources"].push_back({{"layer", name}, {"path", path}});
   o.metadata_json = meta.dump();
+  // Paths relative to the output, outside the plan hash: any spelling gives the same bytes.
+  nlohmann::json provenance;
+  provenance["sources"] = nlohmann::json::array();
+  for (auto& [name, path] : inputs) {
+    const std::string where =
+        path.rfind("procedural:", 0) == 0 ? path : vt::path_for_metadata(path, o.output);
+    provenance["sources"].push_back({{"layer", name}, {"path", where}});
+  }
+  o.provenance_json = provenance.dump();
 
   vt::cli::ProgressLine line(global.quiet);
   o.progress = [&line](const vt::BuildProgress& p) { show_progress(line, p); };

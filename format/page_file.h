@@ -99,6 +99,9 @@ class PageFileWriter {
   // Adds a page whose every texel equals `texel` (texel_bytes() bytes). Thread-safe.
   virtual Status add_constant_page(const PageId& id, uint32_t layer,
                                    std::span<const uint8_t> texel) = 0;
+  // Replaces the metadata given at create(), before finish(): a build's page keys are known only
+  // once its pages are.
+  virtual void set_metadata_json(std::string json) = 0;
   // Writes the index and header, fsyncs and renames into place. No add_* after it.
   virtual Status finish() = 0;
 };

@@ -202,6 +202,11 @@ class PageFileWriterImpl final : public PageFileWriter {
     return Status::Ok();
   }
 
+  void set_metadata_json(std::string json) override {
+    std::lock_guard lock(mutex_);
+    desc_.metadata_json = std::move(json);
+  }
+
   Status finish() override {
     {
       std::unique_lock lock(mutex_);

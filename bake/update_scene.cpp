@@ -1,0 +1,154 @@
+#include "bake/update_scene.h"
+
+#define XXH_STATIC_LINKING_ONLY  // XXH3_state_t on the stack
+#include <xxhash.h>
+
+#include <filesystem>
+#include <type_traits>
+
+#include "bake/color.h"
+#include "bake/image_source.h"
+#include "bake/unwrap/texel_density.h"
+
+namespace vt {
+namespace {
+
+// Feeds values to one XXH3 stream; strings and arrays with their length, so that no two
+// different inputs give the same byte stream.
+class KeyStream {
+ public:
+  KeyStream() { XXH3_64bits_reset(&state_); }
+  template <typename T>
+  void add(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    XXH3_64bits_update(&state_, &v, sizeof v);
+  }
+  void add(const std::string& s) {
+    add(uint64_t(s.size()));
+    XXH3_64bits_update(&state_, s.data(), s.size());
+  }
+  template <typename T>
+  void add(const std::vector<T>& v) {
+    add(uint64_t(v.size()));
+    if constexpr (std::is_trivially_copyable_v<T>) {
+      XXH3_64bits_update(&state_, v.data(), v.size() * sizeof(T));
+    } else {
+      for (const T& e : v) add(e);
+    }
+  }
+  uint64_t digest() const { return XXH3_64bits_digest(&state_); }
+
+ private:
+  XXH3_state_t state_;
+};
+
+void add_texture(KeyStream& k, const scene::TextureRef& t) {
+  k.add(t.image), k.add(t.texcoord), k.add(t.wrap_s), k.add(t.wrap_t), k.add(t.mag_filter);
+  k.add(t.transform.offset), k.add(t.transform.rotation), k.add(t.transform.scale);
+}
+
+void add_material(KeyStream& k, const scene::Material& m) {
+  k.add(m.name), k.add(m.base_color_factor);
+  add_texture(k, m.base_color_texture);
+  k.add(m.metallic_factor), k.add(m.roughness_factor);
+  add_texture(k, m.metallic_roughness_texture);
+  add_texture(k, m.normal_texture);
+  k.add(m.normal_scale);
+  add_texture(k, m.occlusion_texture);
+  k.add(m.occlusion_strength), k.add(m.emissive_factor), k.add(m.emissive_strength);
+  add_texture(k, m.emissive_texture);
+  k.add(m.alpha_mode), k.add(m.alpha_cutoff), k.add(m.double_sided), k.add(m.texels_per_unit);
+}
+
+// A file's content, or a marker for a file that cannot be read (a missing texture bakes from
+// the factor alone; the key changes when it appears).
+void add_file(KeyStream& k, const std::string& path) {
+  auto h = hash_file(path);
+  k.add(uint8_t(h.ok()));
+  k.add(h.ok() ? *h : uint64_t(0));
+}
+
+void add_scene(KeyStream& k, const scene::Scene& s) {
+  k.add(uint64_t(s.meshes.size()));
+  for (const scene::Mesh& mesh : s.meshes) {
+    k.add(mesh.name), k.add(uint64_t(mesh.primitives.size()));
+    for (const scene::Primitive& p : mesh.primitives) {
+      k.add(p.positions), k.add(p.normals), k.add(p.tangents), k.add(p.uvs), k.add(p.colors);
+      k.add(p.indices), k.add(p.material);
+    }
+  }
+  k.add(uint64_t(s.materials.size()));
+  for (const scene::Material& m : s.materials) add_material(k, m);
+  k.add(uint64_t(s.images.size()));
+  for (const scene::Image& image : s.images) {
+    // The uri as written (relative to the scene) is in the unwrapped scene; the path is not.
+    k.add(image.name), k.add(image.uri), k.add(image.mime_type), k.add(image.bytes);
+    if (!image.embedded()) add_file(k, image.path);
+  }
+  k.add(uint64_t(s.nodes.size()));
+  for (const scene::Node& n : s.nodes) {
+    k.add(n.name), k.add(n.local), k.add(n.mesh), k.add(n.children), k.add(n.texels_per_unit);
+  }
+  k.add(s.roots);
+}
+
+// Every option that decides the output's bytes; thread count and paths do not.
+void add_options(KeyStream& k, const SceneBakeOptions& o) {
+  const BuildOptions& b = o.build;
+  k.add(b.codec.codec), k.add(b.codec.dct_quality), k.add(b.codec.dct_adaptive);
+  k.add(b.codec.bc_quality), k.add(b.codec.zstd_level);
+  k.add(b.payload), k.add(b.border), k.add(b.filter), k.add(b.non_finite);
+  k.add(b.alpha_coverage_reference);
+  k.add(b.memory_limit);  // it caps the atlas size the sources' density asks for
+  k.add(b.color_config && !b.color_config->is_builtin() ? b.color_config->cache_id()
+                                                        : std::string());
+  const unwrap::UnwrapOptions& u = o.unwrap;
+  k.add(u.texels_per_unit), k.add(u.size_pages), k.add(u.padding), k.add(u.method);
+  k.add(u.share_instances), k.add(u.max_chart_angle_deg), k.add(u.max_chart_stretch);
+  k.add(u.max_split_rounds), k.add(u.max_atlas_texels), k.add(u.max_size_pages);
+  k.add(u.min_size_pages);
+  k.add(o.supersample), k.add(o.missing_textures);
+  k.add(uint8_t(o.unwrapped == "-"));
+}
+
+}  // namespace
+
+Expected<uint64_t> scene_bake_key(const scene::Scene& scene, const SceneBakeOptions& options) {
+  KeyStream k;
+  k.add(std::string(VTBAKE_VERSION));
+  add_options(k, options);
+  add_scene(k, scene);
+  // The density file the unwrap reads (the scene's NAME.density.json unless one is named).
+  std::string density = options.unwrap.density_file == "-" ? "" : options.unwrap.density_file;
+  if (options.unwrap.density_file.empty())
+    density = unwrap::default_density_file(scene.source_path);
+  std::error_code ec;
+  const bool has_density = !density.empty() && std::filesystem::exists(density, ec);
+  k.add(uint8_t(has_density));
+  if (has_density) add_file(k, density);
+  return k.digest();
+}
+
+std::optional<SceneBakeSummary> unchanged_bake(const SceneBakeOptions& options,
+                                               const std::string& unwrapped, uint64_t key) {
+  const BuildOptions& b = options.build;
+  if (!b.update || b.retrain_tables || !b.tables_from.empty()) return std::nullopt;
+  std::error_code ec;
+  if (!unwrapped.empty() && !std::filesystem::is_regular_file(unwrapped, ec)) return std::nullopt;
+  auto previous = PreviousBuild::open(b.output);
+  if (!previous.ok() || !(*previous)->has_record()) return std::nullopt;
+  const UpdateRecord& r = (*previous)->record();
+  if (r.tool != VTBAKE_VERSION || r.input_key != key) return std::nullopt;
+  auto build = summarize_unchanged(**previous);
+  if (!build.ok()) return std::nullopt;
+  SceneBakeSummary summary;
+  summary.output = b.output;
+  summary.unwrapped = unwrapped;
+  summary.build = std::move(build).value();
+  summary.build.update.requested = true;
+  const PageGeometry& g = summary.build.geometry;
+  summary.unwrap.atlas_width = int(g.width), summary.unwrap.atlas_height = int(g.height);
+  return summary;
+}
+
+}  // namespace vt
