@@ -316,6 +316,8 @@ std::string scratch_dir_for(const BuildOptions& o) {
   return dir.empty() ? "." : dir;
 }
 
+namespace {
+
 // Update mode: opens the previous output and keeps it when its pages can be reused (same
 // tool, settings and size); sets plan.unchanged when its plan equals this one. Returns the
 // tables to pin: --tables-from's, else the kept previous file's.
