@@ -99,7 +99,9 @@ void add_options(KeyStream& k, const SceneBakeOptions& o) {
   k.add(b.codec.bc_quality), k.add(b.codec.zstd_level);
   k.add(b.payload), k.add(b.border), k.add(b.filter), k.add(b.non_finite);
   k.add(b.alpha_coverage_reference);
-  k.add(b.memory_limit);  // it caps the atlas size the sources' density asks for
+  // The limit caps the atlas size the sources' density asks for; a given size it does not change
+  // (the bytes are the same at every limit that lets the bake run).
+  if (o.unwrap.size_pages == 0) k.add(b.memory_limit);
   k.add(b.color_config && !b.color_config->is_builtin() ? b.color_config->cache_id()
                                                         : std::string());
   const unwrap::UnwrapOptions& u = o.unwrap;
