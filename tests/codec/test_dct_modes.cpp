@@ -22,7 +22,7 @@ std::vector<uint8_t> busy_page(int channels) {
     for (int x = 0; x < kSize; ++x)
       for (int c = 0; c < channels; ++c)
         p[(size_t(y) * kSize + x) * channels + c] =
-            uint8_t(((x / 4 + y / 4 + c) % 2 ? 200 : 40) + int(rng.next() >> 60));
+            uint8_t(((x / 4 + y / 4 + c) % 2 ? 200 : 40) + int(rng.next() >> 28));
   return p;
 }
 

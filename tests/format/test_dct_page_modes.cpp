@@ -43,7 +43,7 @@ std::vector<uint8_t> photo_like() {
     for (int x = 0; x < kSize; ++x)
       for (int c = 0; c < 3; ++c) {
         const double v =
-            128 + 60 * std::sin(0.05 * x + c) * std::cos(0.04 * y) + int(rng.next() >> 59) - 16;
+            128 + 60 * std::sin(0.05 * x + c) * std::cos(0.04 * y) + int(rng.next() >> 27) - 16;
         p[(size_t(y) * kSize + x) * 3 + c] = uint8_t(std::clamp(v, 0.0, 255.0));
       }
   return p;
