@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <numbers>
 
 namespace vt {
 namespace {
@@ -23,7 +24,7 @@ double angle_deg(const uint8_t* a, const uint8_t* b) {
   const double lv = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
   if (lu <= 0 || lv <= 0) return 0;
   const double c = (u[0] * v[0] + u[1] * v[1] + u[2] * v[2]) / (lu * lv);
-  return std::acos(std::clamp(c, -1.0, 1.0)) * (180.0 / M_PI);
+  return std::acos(std::clamp(c, -1.0, 1.0)) * (180.0 / std::numbers::pi);
 }
 
 }  // namespace
