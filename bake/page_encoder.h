@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "codec/runtime_error.h"
 #include "codec/bc.h"
 #include "codec/dct.h"
+#include "codec/runtime_error.h"
 #include "common/status.h"
 #include "format/layer_codec.h"
 #include "format/page_file.h"
