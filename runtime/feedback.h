@@ -5,10 +5,11 @@
 //   bits  0-11  page x at the wanted level (0..4095)
 //   bits 12-23  page y at the wanted level (0..4095)
 //   bits 24-28  wanted level (0..31)
-//   bits 29-31  zero
+//   bits 29-31  virtual texture id (0..6): several virtual textures share one buffer, each
+//               streamer reads the values of its own id (0 for an engine with one)
 //   0xFFFFFFFF  no request (background pixel)
-// Any other value with bits 29-31 set, or naming a page outside the geometry, is counted as
-// invalid and ignored.
+// Values of another texture are skipped (counted apart); texture id 7 (other than the
+// background value) or a page outside the geometry is counted as invalid and ignored.
 //
 // The resolver turns a buffer into the deduplicated set of pages the frame needs: each request
 // is shifted by the LOD bias, moved to its nearest present ancestor (pages absent from the file
@@ -30,9 +31,13 @@ namespace vt {
 inline constexpr uint32_t kFeedbackNone = 0xFFFFFFFFu;
 inline constexpr uint32_t kFeedbackMaxPages = 4096;  // per axis, 12 bits
 inline constexpr uint32_t kFeedbackMaxLevels = 32;   // 5 bits
+inline constexpr uint32_t kFeedbackMaxTextures = 7;  // 3 bits; 7 is reserved (background)
 
-inline uint32_t feedback_pack(uint32_t level, uint32_t x, uint32_t y) {
-  return (x & 0xFFFu) | ((y & 0xFFFu) << 12) | ((level & 0x1Fu) << 24);
+inline uint32_t feedback_pack(uint32_t level, uint32_t x, uint32_t y, uint32_t texture = 0) {
+  return (x & 0xFFFu) | ((y & 0xFFFu) << 12) | ((level & 0x1Fu) << 24) | ((texture & 7u) << 29);
+}
+inline uint32_t feedback_texture(uint32_t value) {
+  return value >> 29;
 }
 inline PageId feedback_unpack(uint32_t value) {
   return PageId{(value >> 24) & 0x1Fu, value & 0xFFFu, (value >> 12) & 0xFFFu};
@@ -44,9 +49,10 @@ struct PageRequest {
 };
 
 struct ResolveStats {
-  uint64_t pixels = 0;          // non-background pixels read
-  uint64_t invalid_pixels = 0;  // malformed values or pages outside the geometry
-  uint32_t unique_values = 0;   // distinct feedback values before ancestor completion
+  uint64_t pixels = 0;                // non-background pixels of this resolver's texture
+  uint64_t invalid_pixels = 0;        // of them: malformed values or pages outside the geometry
+  uint64_t other_texture_pixels = 0;  // pixels of other virtual textures (skipped)
+  uint32_t unique_values = 0;         // distinct feedback values before ancestor completion
 };
 
 // Reusable: keeps its hash tables between frames so a steady state allocates nothing.
@@ -55,8 +61,8 @@ class FeedbackResolver {
  public:
   // `source` gives the geometry (at most 4096 x 4096 pages at level 0 and 32 levels, the
   // format's limits; Streamer::create checks) and the presence map; it must outlive the
-  // resolver.
-  explicit FeedbackResolver(const PageSource& source);
+  // resolver. Only values whose texture id is `texture_id` (< kFeedbackMaxTextures) count.
+  explicit FeedbackResolver(const PageSource& source, uint32_t texture_id = 0);
   ~FeedbackResolver();
   FeedbackResolver(FeedbackResolver&&) noexcept;
   FeedbackResolver& operator=(FeedbackResolver&&) noexcept;

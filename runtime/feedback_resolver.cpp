@@ -78,6 +78,7 @@ class CountTable {
 
 struct FeedbackResolver::Impl {
   const PageSource& source;
+  uint32_t texture_id = 0;
   PageGeometry geometry;
   uint32_t levels = 0;
   std::vector<uint32_t> level_base;
@@ -90,7 +91,8 @@ struct FeedbackResolver::Impl {
   std::array<Recent, 256> recent;
   std::vector<std::vector<std::pair<PageId, uint32_t>>> buckets;  // per level: page, entry
 
-  explicit Impl(const PageSource& s) : source(s), geometry(s.geometry()) {
+  Impl(const PageSource& s, uint32_t texture)
+      : source(s), texture_id(texture), geometry(s.geometry()) {
     levels = geometry.level_count();
     uint64_t base = 0;
     for (uint32_t l = 0; l < levels; ++l) {
@@ -110,8 +112,8 @@ struct FeedbackResolver::Impl {
   }
 };
 
-FeedbackResolver::FeedbackResolver(const PageSource& source)
-    : impl_(std::make_unique<Impl>(source)) {}
+FeedbackResolver::FeedbackResolver(const PageSource& source, uint32_t texture_id)
+    : impl_(std::make_unique<Impl>(source, texture_id)) {}
 FeedbackResolver::~FeedbackResolver() = default;
 FeedbackResolver::FeedbackResolver(FeedbackResolver&&) noexcept = default;
 FeedbackResolver& FeedbackResolver::operator=(FeedbackResolver&&) noexcept = default;
@@ -160,9 +162,14 @@ ResolveStats FeedbackResolver::resolve(std::span<const uint32_t> feedback, uint3
   for (uint32_t e = 0; e < m.values.size(); ++e) {
     const uint32_t v = m.values.key(e);
     const uint32_t count = m.values.count(e);
+    const uint32_t texture = feedback_texture(v);
+    if (texture != m.texture_id && texture < kFeedbackMaxTextures) {
+      stats.other_texture_pixels += count;
+      continue;
+    }
     stats.pixels += count;
     const PageId req = feedback_unpack(v);
-    if ((v >> 29) != 0 || !m.geometry.contains(req)) {
+    if (texture != m.texture_id || !m.geometry.contains(req)) {
       stats.invalid_pixels += count;
       continue;
     }

@@ -1,5 +1,6 @@
-// One mutex guards the queue and the page states; workers hold it only to pick a job and to
-// hand the result back, never while reading or decoding, so request/cancel/collect stay cheap.
+// One mutex guards the queue and the page states; workers and jobs hold it only to pick a page
+// and to hand the result back, never while reading or decoding, so request/cancel/collect stay
+// cheap. A submitted job owns a reference to the state, so the engine may run it late.
 #include "runtime/page_loader.h"
 
 #include <algorithm>
@@ -31,7 +32,7 @@ bool before(const Job& a, const Job& b) {
 }  // namespace
 
 struct PageLoader::Impl {
-  std::shared_ptr<const PageSource> source;
+  std::shared_ptr<const PageSource> source;  // reset by the destructor: late jobs never read
   LoaderOptions options;
   mutable std::mutex mutex;
   std::condition_variable work_cv;
@@ -42,61 +43,85 @@ struct PageLoader::Impl {
   bool stop = false;
   std::vector<std::thread> workers;
 
-  void run() {
+  // Loads the best queued page, if any; `lock` is held on entry and on return.
+  void load_best(std::unique_lock<std::mutex>& lock) {
+    Job* best = nullptr;
+    for (auto& [k, job] : jobs)
+      if (job.state == JobState::kQueued && (!best || before(job, *best))) best = &job;
+    if (!best) return;
+    best->state = JobState::kLoading;
+    --queued;
+    ++loading;
+    const PageId id = best->id;
+    const uint64_t key = page_key(id);
+    lock.unlock();
+
+    LoadedPage page;
+    page.id = id;
+    const uint32_t layers = source->layer_count();
+    page.layers.reserve(layers);
+    for (uint32_t l = 0; l < layers && page.status.ok(); ++l) {
+      const size_t bytes = source->upload_bytes(l);
+      page.layers.emplace_back(bytes, options.allocator);
+      page.status = page.layers[l].size() == bytes
+                        ? source->load(id, l, page.layers[l])
+                        : Error(ErrorCode::kResourceLimit,
+                                "page loader: the allocator returned no memory for a page");
+    }
+    if (!page.status.ok()) page.layers.clear();
+
+    lock.lock();
+    --loading;
+    auto it = jobs.find(key);
+    if (it->second.state == JobState::kCancelledWhileLoading) {
+      jobs.erase(it);
+    } else {
+      it->second.state = JobState::kDone;
+      it->second.result = std::move(page);
+    }
+    if (loading == 0) idle_cv.notify_all();  // the destructor waits for running jobs too
+  }
+
+  void run_worker() {
     std::unique_lock lock(mutex);
     for (;;) {
       work_cv.wait(lock, [&] { return stop || queued > 0; });
       if (stop) return;
-      Job* best = nullptr;
-      for (auto& [k, job] : jobs)
-        if (job.state == JobState::kQueued && (!best || before(job, *best))) best = &job;
-      best->state = JobState::kLoading;
-      --queued;
-      ++loading;
-      const PageId id = best->id;
-      const uint64_t key = page_key(id);
-      lock.unlock();
-
-      LoadedPage page;
-      page.id = id;
-      const uint32_t layers = source->layer_count();
-      page.layers.resize(layers);
-      for (uint32_t l = 0; l < layers && page.status.ok(); ++l) {
-        page.layers[l].resize(source->upload_bytes(l));
-        page.status = source->load(id, l, page.layers[l]);
-      }
-      if (!page.status.ok()) page.layers.clear();
-
-      lock.lock();
-      --loading;
-      auto it = jobs.find(key);
-      if (it->second.state == JobState::kCancelledWhileLoading) {
-        jobs.erase(it);
-      } else {
-        it->second.state = JobState::kDone;
-        it->second.result = std::move(page);
-      }
-      if (queued == 0 && loading == 0) idle_cv.notify_all();
+      load_best(lock);
     }
+  }
+
+  // One submitted job: loads one page unless the loader is gone.
+  static void run_job(void* token) {
+    std::unique_ptr<std::shared_ptr<Impl>> self(static_cast<std::shared_ptr<Impl>*>(token));
+    Impl& m = **self;
+    std::unique_lock lock(m.mutex);
+    if (!m.stop) m.load_best(lock);
   }
 };
 
-PageLoader::PageLoader(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+PageLoader::PageLoader(std::shared_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 Expected<std::unique_ptr<PageLoader>> PageLoader::create(std::shared_ptr<const PageSource> source,
                                                          const LoaderOptions& options) {
   if (!source) return Error(ErrorCode::kInvalidArgument, "page loader: no page source");
-  if (options.threads == 0 || options.threads > 256)
+  if (!options.jobs.enabled() && (options.threads == 0 || options.threads > 256))
     return Error(ErrorCode::kInvalidArgument, "page loader: threads must be 1..256");
   if (options.max_in_flight == 0)
     return Error(ErrorCode::kInvalidArgument, "page loader: max_in_flight must be >= 1");
-  auto impl = std::make_unique<Impl>();
+  if (!options.allocator.valid())
+    return Error(ErrorCode::kInvalidArgument,
+                 "page loader: an allocator needs both allocate and release");
+  auto impl = std::make_shared<Impl>();
   impl->source = std::move(source);
   impl->options = options;
   impl->jobs.reserve(options.max_in_flight * 2);
-  std::unique_ptr<PageLoader> loader(new PageLoader(std::move(impl)));
-  Impl* m = loader->impl_.get();
-  for (uint32_t t = 0; t < options.threads; ++t) m->workers.emplace_back([m] { m->run(); });
+  std::unique_ptr<PageLoader> loader(new PageLoader(impl));
+  if (!options.jobs.enabled()) {
+    Impl* m = impl.get();
+    for (uint32_t t = 0; t < options.threads; ++t)
+      m->workers.emplace_back([m] { m->run_worker(); });
+  }
   return loader;
 }
 
@@ -107,28 +132,41 @@ PageLoader::~PageLoader() {
   }
   impl_->work_cv.notify_all();
   for (auto& t : impl_->workers) t.join();
+  // Jobs already running finish their page; the ones not started find `stop` and return.
+  std::unique_lock lock(impl_->mutex);
+  impl_->idle_cv.wait(lock, [&] { return impl_->loading == 0; });
+  impl_->jobs.clear();
+  impl_->source.reset();
 }
 
 bool PageLoader::request(const PageId& id, LoadPriority priority) {
-  std::lock_guard lock(impl_->mutex);
-  Impl& m = *impl_;
-  const uint64_t key = page_key(id);
-  auto it = m.jobs.find(key);
-  if (it != m.jobs.end()) {
-    if (it->second.state != JobState::kCancelledWhileLoading) return false;
-    // Un-cancel: the load already running is wanted again.
-    it->second.state = JobState::kLoading;
-    it->second.priority = priority;
-    return true;
+  {
+    std::lock_guard lock(impl_->mutex);
+    Impl& m = *impl_;
+    const uint64_t key = page_key(id);
+    auto it = m.jobs.find(key);
+    if (it != m.jobs.end()) {
+      if (it->second.state != JobState::kCancelledWhileLoading) return false;
+      // Un-cancel: the load already running is wanted again.
+      it->second.state = JobState::kLoading;
+      it->second.priority = priority;
+      return true;
+    }
+    if (m.jobs.size() >= m.options.max_in_flight) return false;
+    Job job;
+    job.id = id;
+    job.priority = priority;
+    job.sequence = m.next_sequence++;
+    m.jobs.emplace(key, std::move(job));
+    ++m.queued;
+    if (!m.options.jobs.enabled()) {
+      m.work_cv.notify_one();
+      return true;
+    }
   }
-  if (m.jobs.size() >= m.options.max_in_flight) return false;
-  Job job;
-  job.id = id;
-  job.priority = priority;
-  job.sequence = m.next_sequence++;
-  m.jobs.emplace(key, std::move(job));
-  ++m.queued;
-  m.work_cv.notify_one();
+  // Outside the lock: a job system may run the job inside submit.
+  const JobSystem& js = impl_->options.jobs;
+  js.submit(&Impl::run_job, new std::shared_ptr<Impl>(impl_), js.user);
   return true;
 }
 

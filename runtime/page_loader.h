@@ -1,7 +1,7 @@
-// Asynchronous page loading: worker threads read, decode and transcode pages (through a
-// PageSource) off the calling thread. The caller queues requests with a priority, cancels the
-// ones no longer needed and collects finished pages; none of these calls waits for I/O or
-// decoding (they only take a short internal lock). Thread-safe.
+// Asynchronous page loading: worker threads (or the engine's job system) read, decode and
+// transcode pages (through a PageSource) off the calling thread. The caller queues requests with a
+// priority, cancels the ones no longer needed and collects finished pages; none of these calls
+// waits for I/O or decoding (they only take a short internal lock). Thread-safe.
 #pragma once
 
 #include <cstdint>
@@ -10,13 +10,19 @@
 
 #include "common/status.h"
 #include "format/page_geometry.h"
+#include "runtime/page_buffer.h"
 #include "runtime/page_source.h"
 
 namespace vt {
 
 struct LoaderOptions {
-  uint32_t threads = 2;         // worker threads (>= 1)
+  uint32_t threads = 2;         // worker threads (1..256); ignored with a job system
   uint32_t max_in_flight = 64;  // queued + loading + finished-but-not-collected pages
+  // When enabled, the loader starts no thread: each request() submits one job, which loads the
+  // best-priority queued page when it runs (so priorities hold whatever order jobs run in).
+  // A job that runs after the loader is destroyed returns at once.
+  JobSystem jobs;
+  Allocator allocator;  // the pages' upload buffers
 };
 
 // Lower sorts first: coarser level, then more pixels, then request order.
@@ -27,15 +33,17 @@ struct LoadPriority {
 
 struct LoadedPage {
   PageId id;
-  Status status;                             // not ok: the source failed (data is empty)
-  std::vector<std::vector<uint8_t>> layers;  // upload bytes per layer
+  Status status;                   // not ok: the source failed (layers is empty)
+  std::vector<PageBuffer> layers;  // upload bytes per layer
 };
 
 class PageLoader {
  public:
   static Expected<std::unique_ptr<PageLoader>> create(std::shared_ptr<const PageSource> source,
                                                       const LoaderOptions& options);
-  ~PageLoader();  // cancels everything and joins the workers
+  // Cancels everything, joins the workers and waits for jobs already running (jobs submitted
+  // but not started are not waited for).
+  ~PageLoader();
   PageLoader(const PageLoader&) = delete;
   PageLoader& operator=(const PageLoader&) = delete;
 
@@ -55,12 +63,13 @@ class PageLoader {
   uint32_t in_flight() const;
   // Blocks until nothing is queued or loading (finished pages stay until collected). For tools,
   // tests and the validation renderer, which want every frame to converge deterministically.
+  // With a job system this needs the engine to run the submitted jobs meanwhile.
   void wait_idle();
 
  private:
   struct Impl;
-  explicit PageLoader(std::unique_ptr<Impl> impl);
-  std::unique_ptr<Impl> impl_;
+  explicit PageLoader(std::shared_ptr<Impl> impl);
+  std::shared_ptr<Impl> impl_;  // shared with submitted jobs, which may outlive the loader
 };
 
 }  // namespace vt

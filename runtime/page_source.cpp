@@ -80,7 +80,9 @@ class PageFileSource final : public PageSource {
       return reader_->layer_codec(layer).bc_blocks(*stored, out).with_context(where);
     }
     // Reader errors name the file and the page already.
-    std::vector<uint8_t> texels(plan.decoded_bytes);
+    PageBuffer texels(plan.decoded_bytes, options_.allocator);
+    if (texels.size() != plan.decoded_bytes)
+      return Error(ErrorCode::kResourceLimit, where + ": the allocator returned no memory");
     VT_RETURN_IF_ERROR(reader_->read_texels(id, layer, texels));
     const int ps = int(geometry().page_size());
     const RuntimeFormatInfo& upload = *runtime_format_info(plan.upload);
@@ -117,6 +119,9 @@ class PageFileSource final : public PageSource {
 Expected<std::unique_ptr<PageSource>> make_page_file_source(
     std::shared_ptr<const PageFileReader> reader, const PageFileSourceOptions& options) {
   if (!reader) return Error(ErrorCode::kInvalidArgument, "page file source: no reader");
+  if (!options.allocator.valid())
+    return Error(ErrorCode::kInvalidArgument,
+                 "page file source: an allocator needs both allocate and release");
   const std::string& path = reader->path();
   const PageGeometry& g = reader->geometry();
   if (g.pages_x(0) > kFeedbackMaxPages || g.pages_y(0) > kFeedbackMaxPages ||

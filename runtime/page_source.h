@@ -14,6 +14,7 @@
 #include "common/status.h"
 #include "format/page_file.h"
 #include "format/page_geometry.h"
+#include "runtime/page_buffer.h"
 
 namespace vt {
 
@@ -47,6 +48,7 @@ struct PageFileSourceOptions {
   BcQuality bc_quality = BcQuality::kRealtime;  // used when a page must be (re)encoded to BC
   // Lavapipe samples BC7 very slowly: optionally upload BC7 layers as RGBA8 instead.
   bool bc7_as_rgba8 = false;
+  Allocator allocator;  // a page's decode scratch (decoded texels before the BC encode)
 };
 
 // Adapts a page file. Checks up front that every layer can be delivered (8-bit layers to any

@@ -46,7 +46,7 @@ struct Streamer::Impl {
         slot_bytes(vt::slot_bytes(*source)),
         cache(geometry, slots),
         table(geometry),
-        resolver(*source) {}
+        resolver(*source, o.texture_id) {}
 
   PageId root() const { return PageId{last_level, 0, 0}; }
 
@@ -181,6 +181,7 @@ struct Streamer::Impl {
     stats.frame = frame;
     const ResolveStats rs = resolver.resolve(feedback, lod_bias, needed);
     stats.invalid_pixels = rs.invalid_pixels;
+    stats.other_texture_pixels = rs.other_texture_pixels;
     stats.needed = uint32_t(needed.size());
     needed_keys.clear();
     for (const PageRequest& r : needed) needed_keys.insert(page_key(r.id));
@@ -267,9 +268,14 @@ Expected<std::unique_ptr<Streamer>> Streamer::create(std::shared_ptr<const PageS
                        std::to_string(per_slot) + " bytes");
     slots = std::min(slots, (options.memory_budget_bytes - staging) / per_slot);
   }
+  if (options.texture_id >= kFeedbackMaxTextures)
+    return Error(ErrorCode::kInvalidArgument,
+                 "streamer: texture_id must be 0.." + std::to_string(kFeedbackMaxTextures - 1));
   LoaderOptions lo;
   lo.threads = options.threads;
   lo.max_in_flight = options.max_in_flight;
+  lo.jobs = options.jobs;
+  lo.allocator = options.allocator;
   auto loader = PageLoader::create(source, lo);
   if (!loader.ok()) return loader.status().with_context("streamer");
 
@@ -279,9 +285,10 @@ Expected<std::unique_ptr<Streamer>> Streamer::create(std::shared_ptr<const PageS
   // The root is pinned and loaded here, so the table is valid from the first frame on.
   LoadedPage root;
   root.id = impl->root();
-  root.layers.resize(source->layer_count());
   for (uint32_t l = 0; l < source->layer_count(); ++l) {
-    root.layers[l].assign(source->upload_bytes(l), 0);
+    root.layers.emplace_back(source->upload_bytes(l), options.allocator);
+    if (root.layers[l].size() != source->upload_bytes(l))
+      return Error(ErrorCode::kResourceLimit, "streamer: the allocator returned no memory");
     if (source->present(root.id)) {
       Status s = source->load(root.id, l, root.layers[l]);
       if (!s.ok()) return s.with_context("streamer: " + page_name(root.id));

@@ -35,19 +35,24 @@ struct StreamerOptions {
   // (max_in_flight pages). 0: no bound beyond the slot count. Slots that would exceed it are
   // not used; create() fails with kResourceLimit when not even the staging and one slot fit.
   uint64_t memory_budget_bytes = 0;
-  uint32_t threads = 2;
+  uint32_t threads = 2;  // loader threads; ignored when `jobs` is enabled
   uint32_t max_in_flight = 64;
   uint64_t upload_byte_limit = 16u << 20;  // per update(); at least one page is always let out
   uint32_t max_lod_bias = 8;
   // The bias is lowered after this many consecutive frames whose working set, at one level
   // finer, would have filled at most 3/4 of the cache.
   uint32_t frames_before_lowering = 30;
+  // Which virtual texture of the feedback buffer this streamer serves (feedback.h: several
+  // textures share one buffer). 0..kFeedbackMaxTextures-1.
+  uint32_t texture_id = 0;
+  JobSystem jobs;       // the engine's job system instead of the loader's threads
+  Allocator allocator;  // upload and staging buffers (see page_buffer.h)
 };
 
 struct PageUpload {
   PageId page;
   uint32_t slot_x = 0, slot_y = 0;
-  std::vector<std::vector<uint8_t>> layers;  // PageSource::upload_bytes(l) bytes per layer
+  std::vector<PageBuffer> layers;  // PageSource::upload_bytes(l) bytes per layer
 };
 
 struct FrameStats {
@@ -64,6 +69,7 @@ struct FrameStats {
   uint32_t lod_bias = 0;     // bias in force for the next frame
   bool thrashing = false;    // the working set did not fit the cache this frame
   uint64_t invalid_pixels = 0;
+  uint64_t other_texture_pixels = 0;  // pixels of another virtual texture's id (skipped)
   uint64_t resident_bytes = 0;
 };
 

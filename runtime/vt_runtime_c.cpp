@@ -55,19 +55,27 @@ vt::StreamerOptions streamer_options(const vtrt_options& o) {
 
 namespace {
 
-// The streamer over an open reader, into *out (both vtrt_open forms).
-int open_streamer(std::shared_ptr<const vt::PageFileReader> reader, const vtrt_options* options,
+// The streamer over an open reader, into *out (every vtrt_open form).
+int open_streamer(std::shared_ptr<const vt::PageFileReader> reader, const vtrt_open_info& info,
                   vtrt_streamer** out) {
   vtrt_options o;
   vtrt_default_options(&o);
-  if (options) o = *options;
+  if (info.options) o = *info.options;
   const std::string reader_name = reader->path();
+  vt::Allocator allocator;
+  if (info.allocator)
+    allocator = {info.allocator->allocate, info.allocator->release, info.allocator->user};
   vt::PageFileSourceOptions so;
   so.bc7_as_rgba8 = o.bc7_as_rgba8 != 0;
+  so.allocator = allocator;
   auto source = vt::make_page_file_source(std::move(reader), so);
-  if (!source.ok()) return fail(source.status());
+  if (!source.ok()) return fail(source.status().with_context(reader_name));
   std::shared_ptr<const vt::PageSource> shared(std::move(source).value());
-  auto streamer = vt::Streamer::create(shared, streamer_options(o));
+  vt::StreamerOptions sto = streamer_options(o);
+  sto.texture_id = info.texture_id;
+  sto.allocator = allocator;
+  if (info.jobs) sto.jobs = {info.jobs->submit, info.jobs->user};
+  auto streamer = vt::Streamer::create(shared, sto);
   if (!streamer.ok()) return fail(streamer.status().with_context(reader_name));
   auto h = std::make_unique<vtrt_streamer>();
   h->source = shared;
@@ -96,28 +104,55 @@ void vtrt_default_options(vtrt_options* o) {
   o->bc7_as_rgba8 = 0;
 }
 
+int vtrt_open_ex(const vtrt_open_info* info, vtrt_streamer** out) {
+  if (!out) return fail_null("out");
+  *out = nullptr;
+  if (!info) return fail_null("info");
+  if (info->struct_size < sizeof(vtrt_open_info))
+    return fail(vt::Error(vt::ErrorCode::kInvalidArgument,
+                          "vtrt_open_ex: struct_size " + std::to_string(info->struct_size) +
+                              " is not sizeof(vtrt_open_info) (" +
+                              std::to_string(sizeof(vtrt_open_info)) + ")"));
+  if ((info->path != nullptr) == (info->io != nullptr))
+    return fail(vt::Error(vt::ErrorCode::kInvalidArgument,
+                          "vtrt_open_ex: give exactly one of path and io"));
+  if (info->jobs && !info->jobs->submit) return fail_null("jobs->submit");
+  return guard([&] {
+    std::shared_ptr<const vt::ByteSource> bytes;
+    if (info->io) {
+      bytes = vt::c_api::callback_byte_source(info->io);
+      if (!bytes) return int(VT_ERR_INVALID_ARGUMENT);  // the message is set
+    }
+    auto reader =
+        bytes ? vt::PageFileReader::open(std::move(bytes), info->name ? info->name : "(callbacks)")
+              : vt::PageFileReader::open(info->path);
+    if (!reader.ok()) return fail(reader.status());
+    return open_streamer(std::move(reader).value(), *info, out);
+  });
+}
+
 int vtrt_open(const char* path, const vtrt_options* options, vtrt_streamer** out) {
   if (!out) return fail_null("out");
   *out = nullptr;
   if (!path) return fail_null("path");
-  return guard([&] {
-    auto reader = vt::PageFileReader::open(path);
-    if (!reader.ok()) return fail(reader.status());
-    return open_streamer(std::move(reader).value(), options, out);
-  });
+  vtrt_open_info info{};
+  info.struct_size = sizeof info;
+  info.path = path;
+  info.options = options;
+  return vtrt_open_ex(&info, out);
 }
 
 int vtrt_open_callbacks(const vt_read_callbacks* io, const char* name, const vtrt_options* options,
                         vtrt_streamer** out) {
   if (!out) return fail_null("out");
   *out = nullptr;
-  return guard([&] {
-    auto bytes = vt::c_api::callback_byte_source(io);
-    if (!bytes) return int(VT_ERR_INVALID_ARGUMENT);
-    auto reader = vt::PageFileReader::open(std::move(bytes), name ? name : "(callbacks)");
-    if (!reader.ok()) return fail(reader.status());
-    return open_streamer(std::move(reader).value(), options, out);
-  });
+  if (!io) return fail_null("io");
+  vtrt_open_info info{};
+  info.struct_size = sizeof info;
+  info.io = io;
+  info.name = name;
+  info.options = options;
+  return vtrt_open_ex(&info, out);
 }
 
 void vtrt_close(vtrt_streamer* h) {

@@ -19,10 +19,15 @@ extern "C" {
 typedef struct vtrt_streamer vtrt_streamer;
 
 /* One feedback value (runtime/feedback.h): page (x, y) of `level` wanted by a pixel; x, y < 4096,
- * level < 32. VTRT_FEEDBACK_NONE marks a pixel that wants nothing. */
-#define VTRT_FEEDBACK(level, x, y) \
-  (((uint32_t)(x)&0xFFFu) | (((uint32_t)(y)&0xFFFu) << 12) | (((uint32_t)(level)&0x1Fu) << 24))
+ * level < 32. VTRT_FEEDBACK_NONE marks a pixel that wants nothing. VTRT_FEEDBACK_TEX adds the
+ * virtual texture id (0..6) when several streamers share one feedback buffer; VTRT_FEEDBACK is
+ * texture 0. */
+#define VTRT_FEEDBACK(level, x, y) VTRT_FEEDBACK_TEX(0, level, x, y)
+#define VTRT_FEEDBACK_TEX(texture, level, x, y)                                                  \
+  (((uint32_t)(x)&0xFFFu) | (((uint32_t)(y)&0xFFFu) << 12) | (((uint32_t)(level)&0x1Fu) << 24) | \
+   (((uint32_t)(texture)&7u) << 29))
 #define VTRT_FEEDBACK_NONE 0xFFFFFFFFu
+#define VTRT_MAX_TEXTURES 7u
 
 typedef struct vtrt_options {
   uint32_t slots_x, slots_y;    /* physical cache in slots (each <= 256) */
@@ -53,6 +58,39 @@ typedef struct vtrt_upload {
   size_t size;
 } vtrt_upload;
 
+/* Engine hooks (runtime/page_buffer.h). The allocator gets every page-sized buffer (staging,
+ * uploads, decode scratch): `allocate` returns `size` bytes aligned to `alignment` (a power of
+ * two <= 4096) or NULL; both are called from the loader's threads or jobs, so they must be
+ * thread-safe, and `user` must stay valid until vtrt_close returns. */
+typedef struct vtrt_allocator {
+  void* (*allocate)(size_t size, size_t alignment, void* user);
+  void (*release)(void* memory, size_t size, void* user);
+  void* user;
+} vtrt_allocator;
+
+/* The job hook: instead of starting loader threads, the streamer hands each page load to
+ * `submit`, which must run `run(job)` exactly once, on any thread, later or inside submit. A job
+ * is one page (read, decode, BC encode: 0.2-2 ms) and never waits on another. submit is called
+ * from the thread calling vtrt_update. Jobs that run after vtrt_close return at once (the
+ * handle's state lives until the last one has run). */
+typedef struct vtrt_job_system {
+  void (*submit)(void (*run)(void* job), void* job, void* user);
+  void* user;
+} vtrt_job_system;
+
+/* Everything vtrt_open_ex takes. Set struct_size = sizeof(vtrt_open_info) (later versions add
+ * fields at the end); zero what is not used. */
+typedef struct vtrt_open_info {
+  size_t struct_size;
+  const char* path;                /* the page file, or NULL with io */
+  const vt_read_callbacks* io;     /* the engine's storage (format/vt_io_c.h), or NULL with path */
+  const char* name;                /* stands for the path in messages with io; may be NULL */
+  const vtrt_options* options;     /* NULL: the defaults */
+  const vtrt_allocator* allocator; /* NULL: the C++ runtime's operator new */
+  const vtrt_job_system* jobs;     /* NULL: options->threads loader threads */
+  uint32_t texture_id; /* 0..6: the feedback values of this streamer (VTRT_FEEDBACK_TEX) */
+} vtrt_open_info;
+
 /* Fills the defaults (32 x 32 slots, 2 threads, 64 in flight, 16 MiB per frame, bias <= 8). */
 void vtrt_default_options(vtrt_options* options);
 /* Opens `path` and creates a streamer into *out (NULL on failure). options may be NULL (the
@@ -63,6 +101,8 @@ int vtrt_open(const char* path, const vtrt_options* options, vtrt_streamer** out
  * io->release, when set, is called once the streamer is closed (or the open failed). */
 int vtrt_open_callbacks(const vt_read_callbacks* io, const char* name, const vtrt_options* options,
                         vtrt_streamer** out);
+/* The general form of both: path or io, plus the engine hooks and the texture id. */
+int vtrt_open_ex(const vtrt_open_info* info, vtrt_streamer** out);
 void vtrt_close(vtrt_streamer* streamer);
 
 int vtrt_get_geometry(const vtrt_streamer* streamer, vtrt_geometry* out);

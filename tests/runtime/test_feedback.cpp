@@ -23,6 +23,13 @@ TEST(Feedback, PackUnpackRoundTrip) {
         EXPECT_EQ(feedback_unpack(v), (PageId{level, x, y}));
       }
   EXPECT_EQ(feedback_pack(3, 5, 9), 5u | (9u << 12) | (3u << 24));
+  for (uint32_t t = 0; t < kFeedbackMaxTextures; ++t) {
+    const uint32_t v = feedback_pack(31, 4095, 4095, t);
+    EXPECT_NE(v, kFeedbackNone);
+    EXPECT_EQ(feedback_texture(v), t);
+    EXPECT_EQ(feedback_unpack(v), (PageId{31, 4095, 4095}));
+  }
+  EXPECT_EQ(feedback_texture(kFeedbackNone), 7u);  // the reserved id is the background's
 }
 
 // Straightforward std::map version of the resolver's contract.
@@ -99,9 +106,14 @@ TEST(FeedbackResolver, MatchesNaiveReferenceOnRandomBuffers) {
     const uint32_t bias = iter % 4;
     const ResolveStats st = resolver.resolve(fb, bias, got);
     expect_same(got, naive_resolve(src, fb, bias));
-    uint64_t non_bg = 0;
-    for (uint32_t v : fb) non_bg += v != kFeedbackNone;
-    EXPECT_EQ(st.pixels, non_bg);
+    uint64_t own = 0, other = 0;
+    for (uint32_t v : fb) {
+      const uint32_t t = feedback_texture(v);
+      own += v != kFeedbackNone && (t == 0 || t == 7);  // 7: invalid, but counted as ours
+      other += t != 0 && t != 7;
+    }
+    EXPECT_EQ(st.pixels, own);
+    EXPECT_EQ(st.other_texture_pixels, other);
   }
 }
 
@@ -167,6 +179,36 @@ TEST(FeedbackResolver, FullHdBufferManyPages) {
   EXPECT_EQ(st.pixels, 1920u * 1080u);
   EXPECT_EQ(st.unique_values, 240u * 135u);
   expect_same(out, naive_resolve(src, fb, 0));
+}
+
+TEST(FeedbackResolver, TexturesShareOneBufferEachResolverSeesItsOwn) {
+  FakeSource src(small_geometry(8, 6), 1);
+  std::vector<uint32_t> fb;
+  for (int i = 0; i < 40; ++i) fb.push_back(feedback_pack(0, 1, 2, 0));
+  for (int i = 0; i < 25; ++i) fb.push_back(feedback_pack(0, 6, 5, 3));
+  fb.push_back(feedback_pack(1, 3, 2, 3));
+  fb.push_back(0xE0000001u);  // texture 7 is reserved: invalid for everyone
+  fb.push_back(kFeedbackNone);
+  std::vector<PageRequest> out0, out3, out5;
+  const ResolveStats s0 = FeedbackResolver(src, 0).resolve(fb, 0, out0);
+  const ResolveStats s3 = FeedbackResolver(src, 3).resolve(fb, 0, out3);
+  const ResolveStats s5 = FeedbackResolver(src, 5).resolve(fb, 0, out5);
+  EXPECT_EQ(s0.pixels, 41u);  // its 40 and the invalid one
+  EXPECT_EQ(s0.invalid_pixels, 1u);
+  EXPECT_EQ(s0.other_texture_pixels, 26u);
+  EXPECT_EQ(s3.pixels, 27u);
+  EXPECT_EQ(s3.invalid_pixels, 1u);
+  EXPECT_EQ(s3.other_texture_pixels, 40u);
+  EXPECT_EQ(s5.pixels, 1u);
+  EXPECT_EQ(s5.other_texture_pixels, 66u);
+  EXPECT_TRUE(out5.empty());
+  // Texture 0 wants (0,1,2) and its ancestors; texture 3 (0,6,5), (1,3,2) and theirs.
+  const std::vector<PageRequest> want0 = {
+      {{3, 0, 0}, 40}, {{2, 0, 0}, 40}, {{1, 0, 1}, 40}, {{0, 1, 2}, 40}};
+  const std::vector<PageRequest> want3 = {
+      {{3, 0, 0}, 26}, {{2, 1, 1}, 26}, {{1, 3, 2}, 26}, {{0, 6, 5}, 25}};
+  expect_same(out0, want0);
+  expect_same(out3, want3);
 }
 
 }  // namespace

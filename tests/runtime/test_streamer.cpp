@@ -5,19 +5,25 @@
 #include <random>
 #include <thread>
 
+#include "engine_hooks.h"
 #include "fake_source.h"
 #include "runtime/streamer.h"
 
 namespace vt {
 namespace {
 
+using testing::CountingAllocator;
 using testing::FakeSource;
 using testing::small_geometry;
+using testing::TestJobQueue;
 
 std::unique_ptr<Streamer> make_streamer(std::shared_ptr<const PageSource> src, uint32_t sx,
                                         uint32_t sy, uint32_t threads, uint64_t budget = 0,
-                                        uint32_t in_flight = 16) {
+                                        uint32_t in_flight = 16, JobSystem jobs = {},
+                                        Allocator allocator = {}) {
   StreamerOptions o;
+  o.jobs = jobs;
+  o.allocator = allocator;
   o.slots_x = sx;
   o.slots_y = sy;
   o.threads = threads;
@@ -49,7 +55,8 @@ struct CpuCache {
   std::map<uint32_t, std::pair<PageId, std::vector<uint8_t>>> slots;
   uint32_t sx;
   void apply(std::vector<PageUpload> ups) {
-    for (auto& u : ups) slots[u.slot_y * sx + u.slot_x] = {u.page, std::move(u.layers[0])};
+    for (auto& u : ups)
+      slots[u.slot_y * sx + u.slot_x] = {u.page, {u.layers[0].begin(), u.layers[0].end()}};
   }
 };
 
@@ -98,19 +105,22 @@ TEST(Streamer, PropertyRandomRequestsAndEvictions) {
 }
 
 // Runs a fixed sequence of feedback buffers, converging after each (update + wait_idle until
-// nothing changes), and returns the resident set with each slot's page.
-std::vector<std::pair<uint32_t, PageId>> converge_sequence(uint32_t threads) {
+// nothing changes), and returns the resident set with each slot's page. With `jobs`, the
+// engine's job system does the loads: its queued jobs run before each wait.
+std::vector<std::pair<uint32_t, PageId>> converge_sequence(uint32_t threads,
+                                                           TestJobQueue* jobs = nullptr) {
   auto src = std::make_shared<FakeSource>(small_geometry(16, 16), 1, [](const PageId& id) {
     return id.level == 0 && (id.x * 3 + id.y) % 11 == 0;
   });
   src->set_delay_us(threads > 1 ? 50 : 0);  // let workers finish out of order
-  auto s = make_streamer(src, 6, 5, threads, 0, 8);
+  auto s = make_streamer(src, 6, 5, threads, 0, 8, jobs ? jobs->hook() : JobSystem{});
   std::mt19937 rng(5);
   for (int step = 0; step < 25; ++step) {
     const auto fb = random_view(rng, src->geometry(), 200);
     for (int i = 0; i < 100; ++i) {
       const FrameStats st = s->update(fb);
       s->take_uploads();
+      if (jobs) jobs->run_all();
       s->wait_idle();
       if (st.queued == 0 && st.mapped == 0 && s->idle()) break;
     }
@@ -137,6 +147,95 @@ TEST(Streamer, ResultsIndependentOfThreadCount) {
       EXPECT_EQ(one[i].second, many[i].second);
     }
   }
+}
+
+TEST(Streamer, JobHookGivesTheSameResultsAsThreads) {
+  const auto threads = converge_sequence(2);
+  TestJobQueue deferred, inline_jobs;
+  inline_jobs.inline_run = true;
+  for (TestJobQueue* q : {&deferred, &inline_jobs}) {
+    const auto jobs = converge_sequence(0, q);  // threads ignored with a job system
+    EXPECT_GT(q->submitted(), 50u);
+    ASSERT_EQ(jobs.size(), threads.size()) << (q->inline_run ? "inline" : "deferred");
+    for (size_t i = 0; i < jobs.size(); ++i) {
+      EXPECT_EQ(jobs[i].first, threads[i].first);
+      EXPECT_EQ(jobs[i].second, threads[i].second);
+    }
+  }
+}
+
+TEST(Streamer, JobsThatRunAfterTheStreamerIsGoneDoNothing) {
+  auto src = std::make_shared<FakeSource>(small_geometry(8, 6), 1);
+  TestJobQueue q;
+  auto s = make_streamer(src, 9, 8, 0, 0, 16, q.hook());
+  std::vector<uint32_t> fb;
+  for (uint32_t x = 0; x < 8; ++x) fb.push_back(feedback_pack(0, x, 1));
+  const FrameStats st = s->update(fb);
+  EXPECT_GT(st.queued, 2u);
+  EXPECT_EQ(q.queued(), st.queued);  // no thread of its own: nothing runs until the engine does
+  const uint64_t loads_before = src->loads();
+  s.reset();
+  EXPECT_EQ(q.run_all(), st.queued);  // late jobs run (ASan: no use after free) and do nothing
+  EXPECT_EQ(src->loads(), loads_before);
+}
+
+TEST(Streamer, AllocatorGetsEveryPageBufferBackAndItsFailuresFallBack) {
+  auto src = std::make_shared<FakeSource>(small_geometry(8, 6), 2);
+  std::vector<uint32_t> fb;
+  for (uint32_t y = 0; y < 6; ++y)
+    for (uint32_t x = 0; x < 8; ++x) fb.push_back(feedback_pack(0, x, y));
+  CountingAllocator alloc;
+  {
+    auto s = make_streamer(src, 9, 8, 2, 0, 16, {}, alloc.hook());
+    for (int f = 0; f < 30; ++f) {
+      s->update(fb);
+      auto ups = s->take_uploads();
+      for (const PageUpload& u : ups) {
+        ASSERT_EQ(u.layers.size(), 2u);
+        std::vector<uint8_t> want(src->upload_bytes(1));
+        FakeSource::fill(u.page, 1, want);
+        EXPECT_TRUE(std::equal(want.begin(), want.end(), u.layers[1].begin()));
+      }
+      s->wait_idle();
+    }
+    EXPECT_EQ(s->resident_pages().size(), 65u);
+    // Two layers of 65 pages went through the hook; uploads were dropped, so none is live
+    // except what the loader still holds (nothing: converged).
+    EXPECT_GE(alloc.allocations.load(), 2 * 65);
+    EXPECT_EQ(alloc.live_blocks.load(), 0);
+  }
+  EXPECT_EQ(alloc.live_bytes.load(), 0);
+  EXPECT_EQ(alloc.misaligned.load(), 0);
+  EXPECT_EQ(alloc.size_mismatches.load(), 0);
+
+  // An allocator that runs dry after the root: pages fail to load (counted, never retried),
+  // the root stands in and the streamer stays consistent.
+  CountingAllocator dry;
+  dry.fail_after = 2;  // the root's two layers
+  auto s = make_streamer(src, 9, 8, 2, 0, 16, {}, dry.hook());
+  uint32_t errors = 0;
+  for (int f = 0; f < 10; ++f) {
+    errors += s->update(fb).load_errors;
+    s->take_uploads();
+    s->wait_idle();
+    ASSERT_TRUE(s->check_invariants().ok());
+  }
+  EXPECT_GT(errors, 0u);
+  EXPECT_EQ(s->resident_pages().size(), 1u);
+  EXPECT_EQ(s->page_table().entry({0, 3, 3}).level, 3);
+  // Not even the root: create fails with a clear error.
+  CountingAllocator empty;
+  empty.fail_after = 0;
+  StreamerOptions o;
+  o.allocator = empty.hook();
+  auto none = Streamer::create(src, o);
+  ASSERT_FALSE(none.ok());
+  EXPECT_EQ(none.status().code(), ErrorCode::kResourceLimit);
+  o.allocator.release = nullptr;
+  EXPECT_EQ(Streamer::create(src, o).status().code(), ErrorCode::kInvalidArgument);
+  o.allocator = {};
+  o.texture_id = kFeedbackMaxTextures;
+  EXPECT_EQ(Streamer::create(src, o).status().code(), ErrorCode::kInvalidArgument);
 }
 
 TEST(Streamer, ConvergesToEveryRequestedPage) {
