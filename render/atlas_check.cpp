@@ -13,6 +13,7 @@
 #include "bake/paging.h"
 #include "bake/pyramid.h"
 #include "bake/transfer.h"
+#include "codec/bc.h"
 #include "codec/metrics.h"
 #include "common/parallel.h"
 #include "format/runtime_format.h"
@@ -191,16 +192,39 @@ Status measure_page(const ReferenceLayer& r, const uint8_t* ref, const uint8_t* 
   return Status::Ok();
 }
 
+// The PSNR a page must reach: its layer's bound, or less where the runtime format alone cannot
+// reach that on the reference itself.
+double page_min_psnr(const AtlasPageError& e, const AtlasLayerBounds& b) {
+  if (e.runtime_floor_psnr <= 0) return b.min_psnr;
+  return std::min(b.min_psnr, e.runtime_floor_psnr - b.floor_margin_db);
+}
+
+// PSNR of the reference page after the BC format alone (the floor a perfect bake scores).
+Expected<double> runtime_floor_psnr(const ReferenceLayer& r, BcFormat bc, BcQuality quality,
+                                    const uint8_t* ref, int ps) {
+  thread_local std::vector<uint8_t> blocks, decoded;
+  blocks.resize(bc_image_bytes(bc, ps, ps));
+  decoded.resize(size_t(ps) * ps * r.spec.channels);
+  const int channels = int(r.spec.channels);
+  VT_RETURN_IF_ERROR(bc_encode_image(bc, quality, ref, ps, ps, channels, blocks.data()));
+  VT_RETURN_IF_ERROR(bc_decode_image(bc, blocks.data(), ps, ps, channels, decoded.data()));
+  VT_ASSIGN_OR_RETURN(ImageError err, compare_images(ref, decoded.data(), ps, ps, channels));
+  double mse = 0;
+  for (int c = 0; c < err.channels; ++c) mse += err.mse[c] / err.channels;
+  return psnr_from_mse(mse);
+}
+
 // How close a page is to failing: 0 well inside its bounds, 1 at a bound, above 1 failing.
 double badness(const AtlasPageError& e, const AtlasLayerBounds& b, bool normal) {
   if (e.missing) return 10.0;
-  double s = std::max((b.min_psnr + 15.0 - e.psnr) / 15.0, e.mean_shift / b.max_mean_shift);
+  const double min_psnr = page_min_psnr(e, b);
+  double s = std::max((min_psnr + 15.0 - e.psnr) / 15.0, e.mean_shift / b.max_mean_shift);
   if (normal) s = std::max({s, e.mean_deg / b.max_mean_deg, e.max_deg / b.max_max_deg});
   return s;
 }
 
 bool fails(const AtlasPageError& e, const AtlasLayerBounds& b, bool normal) {
-  return e.missing || e.psnr < b.min_psnr || e.mean_shift > b.max_mean_shift ||
+  return e.missing || e.psnr < page_min_psnr(e, b) || e.mean_shift > b.max_mean_shift ||
          (normal && (e.mean_deg > b.max_mean_deg || e.max_deg > b.max_max_deg));
 }
 
@@ -254,6 +278,12 @@ Status check_level(const PageSource& source, const PageFileReader& reader, uint3
   std::vector<AtlasPageError> errors(g.pages_in_level(level));
   std::vector<Status> status(errors.size());
   std::vector<int8_t> checked(errors.size());
+  // The runtime format's floor, as the runtime gets there: stored BC blocks were encoded by
+  // the baker (default quality), DCT pages are transcoded by the streamer (real-time).
+  const std::optional<BcFormat> floor_bc =
+      o.stored_texels ? std::nullopt : runtime_bc_format(source.upload_format(r.index));
+  const BcQuality floor_quality =
+      r.spec.codec == PageCodec::kBcZstd ? BcQuality::kNormal : BcQuality::kRealtime;
   parallel_for(errors.size(), o.threads, [&](size_t k) {
     const PageId id{level, uint32_t(k % px), uint32_t(k / px)};
     AtlasPageError& e = errors[k];
@@ -279,6 +309,11 @@ Status check_level(const PageSource& source, const PageFileReader& reader, uint3
     status[k] = o.stored_texels ? reader.read_texels(id, r.index, test)
                                 : uploaded_texels(source, r.spec, id, r.index, upload, test.data());
     if (status[k].ok()) status[k] = measure_page(r, ref.data(), test.data(), int(ps), e);
+    if (status[k].ok() && floor_bc && e.psnr < run.report.bounds.min_psnr) {
+      auto floor = runtime_floor_psnr(r, *floor_bc, floor_quality, ref.data(), int(ps));
+      if (floor.ok()) e.runtime_floor_psnr = *floor;
+      status[k] = floor.status();
+    }
     checked[k] = 1;
   });
   std::vector<double> score(errors.size(), -1.0);
@@ -335,7 +370,12 @@ std::string page_line(const AtlasPageError& e, bool normal) {
     std::snprintf(buf, sizeof buf, "(%u, %u, %u) %.1f dB, mean shift %.1f", e.id.level, e.id.x,
                   e.id.y, e.psnr, e.mean_shift);
   }
-  return buf;
+  std::string line = buf;
+  if (e.runtime_floor_psnr > 0) {
+    std::snprintf(buf, sizeof buf, " (runtime format alone %.1f dB)", e.runtime_floor_psnr);
+    line += buf;
+  }
+  return line;
 }
 
 // Sorts the layer's pages worst first, keeps the failing ones and the closest to failing, and
@@ -411,24 +451,22 @@ AtlasLayerBounds default_atlas_bounds(const LayerSpec& layer) {
     b.max_mean_shift = 1;
     return b;
   }
-  const Row& row = layer.codec == PageCodec::kDct ? kDct : kBc;
-  switch (layer.semantic) {
-    case LayerSemantic::kAlbedo:
-      b.min_psnr = row.albedo;
-      break;
-    case LayerSemantic::kNormal:
-      b.min_psnr = row.normal;
-      break;
-    case LayerSemantic::kOrm:
-      b.min_psnr = row.orm;
-      break;
-    case LayerSemantic::kEmissive:
-      b.min_psnr = row.emissive;
-      break;
-    default:
-      b.min_psnr = std::min({row.albedo, row.orm, row.emissive});
-      break;
-  }
+  auto bound = [&](const Row& row) {
+    switch (layer.semantic) {
+      case LayerSemantic::kAlbedo:
+        return row.albedo;
+      case LayerSemantic::kNormal:
+        return row.normal;
+      case LayerSemantic::kOrm:
+        return row.orm;
+      case LayerSemantic::kEmissive:
+        return row.emissive;
+      default:
+        return std::min({row.albedo, row.orm, row.emissive});
+    }
+  };
+  b.min_psnr = bound(layer.codec == PageCodec::kDct ? kDct : kBc);
+  if (layer.codec == PageCodec::kDct) b.floor_margin_db += bound(kBc) - bound(kDct);
   b.max_mean_deg = layer.codec == PageCodec::kDct ? 4.0 : 3.0;
   b.max_max_deg = layer.codec == PageCodec::kDct ? 50.0 : 45.0;
   b.max_mean_shift = layer.codec == PageCodec::kDct ? 8.0 : 3.0;
@@ -517,6 +555,7 @@ nlohmann::json to_json(const AtlasCheckReport& r) {
       json p = {{"level", e.id.level},  {"x", e.id.x},          {"y", e.id.y},
                 {"psnr", e.psnr},       {"max_abs", e.max_abs}, {"mean_shift", e.mean_shift},
                 {"missing", e.missing}, {"failed", e.failed}};
+      if (e.runtime_floor_psnr > 0) p["runtime_floor_psnr"] = e.runtime_floor_psnr;
       if (l.semantic == LayerSemantic::kNormal) {
         p["mean_deg"] = e.mean_deg;
         p["max_deg"] = e.max_deg;

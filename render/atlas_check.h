@@ -33,6 +33,12 @@ struct AtlasLayerBounds {
   // Largest per-channel shift of a page's mean, 8-bit steps: catches a scaled or offset layer
   // on dark pages, where PSNR hardly moves (emissive at half strength).
   double max_mean_shift = 2.0;
+  // A page below min_psnr still passes when within this of its runtime floor (the reference
+  // page through the runtime's BC format alone; AtlasPageError::runtime_floor_psnr): content
+  // that BC cannot hold, e.g. a coarse-level mosaic of tiny charts of unrelated colours, is not
+  // the bake's error. 3 dB, plus what DCT storage costs on top of BC alone (the sample scene's
+  // dct - bc bound difference) for DCT layers.
+  double floor_margin_db = 3.0;
 };
 
 // Bounds for a layer from its semantic, storage codec and runtime format: the worst page
@@ -64,6 +70,10 @@ struct AtlasPageError {
   int max_abs = 0;
   double mean_shift = 0;  // largest |mean(upload) - mean(reference)| over channels, 8-bit steps
   double mean_deg = 0, max_deg = 0;
+  // The reference page through the runtime's BC format alone (encode + decode): what a perfect
+  // bake scores. Computed only for pages below their layer's min_psnr, 0 otherwise (see
+  // AtlasLayerBounds::floor_margin_db).
+  double runtime_floor_psnr = 0;
   bool missing = false;  // the reference covers the page but the file has none
   bool failed = false;
 };

@@ -13,10 +13,12 @@
 
 #include "bake/scene_bake.h"
 #include "codec/metrics.h"
+#include "common/hash.h"
 #include "common/srgb.h"
 #include "format/layer_codec.h"
 #include "render/atlas_check.h"
 #include "samples/sample_scene.h"
+#include "scene/gltf_export.h"
 #include "tests/render/page_file_rewrite.h"
 
 namespace vt::render {
@@ -297,6 +299,87 @@ TEST_F(AtlasCheck, InputErrorsSayWhatIsWrong) {
   EXPECT_FALSE(r->ran);
   EXPECT_TRUE(r->passed());
   EXPECT_NE(r->note.find("memory limit"), std::string::npos);
+}
+
+// A plane of 24 x 24 separate quads, each its own saturated colour: a mosaic of tiny charts
+// that BC1 cannot hold (4x4 blocks straddle charts of unrelated colours), worst on the coarse
+// levels. A correct bake passes on the runtime floor; swapped pages still fail.
+TEST(AtlasCheckFloor, MosaicPassesOnItsRuntimeFloorAndSwappedPagesStillFail) {
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / ("vt_atlas_floor_" + std::to_string(::getpid())))
+          .string();
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  scene::Scene sc;
+  scene::Mesh mesh;
+  constexpr int kCells = 24;
+  for (int y = 0; y < kCells; ++y)
+    for (int x = 0; x < kCells; ++x) {
+      scene::Material m;
+      const uint32_t h = hash32(uint32_t(y * kCells + x) * 2654435761u);
+      m.base_color_factor = {float(h & 1), float((h >> 1) & 1), float((h >> 2) & 1), 1.0f};
+      m.metallic_factor = 0;
+      sc.materials.push_back(m);
+      scene::Primitive p;
+      const float x0 = float(x), z0 = float(y);
+      p.positions = {{x0, 0, z0}, {x0 + 1, 0, z0}, {x0 + 1, 0, z0 + 1}, {x0, 0, z0 + 1}};
+      p.normals.assign(4, {0, 1, 0});
+      p.indices = {0, 2, 1, 0, 3, 2};
+      p.material = int(sc.materials.size() - 1);
+      mesh.primitives.push_back(std::move(p));
+    }
+  sc.meshes.push_back(std::move(mesh));
+  scene::Node node;
+  node.mesh = 0;
+  sc.nodes.push_back(node);
+  sc.roots = {0};
+  ASSERT_TRUE(scene::save_gltf(sc, dir + "/mosaic.gltf").ok());
+  SceneBakeOptions o;
+  o.build.output = dir + "/mosaic.vtpf";
+  o.unwrap.size_pages = 4;
+  auto baked = bake_scene(dir + "/mosaic.gltf", o);
+  ASSERT_TRUE(baked.ok()) << baked.status().message();
+  auto original = scene::load_scene(dir + "/mosaic.gltf");
+  auto unwrapped = scene::load_scene(dir + "/mosaic.glb");
+  ASSERT_TRUE(original.ok() && unwrapped.ok());
+  auto check = [&](const std::string& file) {
+    auto reader = PageFileReader::open(file);
+    EXPECT_TRUE(reader.ok());
+    auto r = check_atlas_pages(std::move(*reader), *original, *unwrapped, {});
+    EXPECT_TRUE(r.ok()) << r.status().message();
+    return r.ok() ? *r : AtlasCheckReport{};
+  };
+  const AtlasCheckReport clean = check(o.build.output);
+  EXPECT_TRUE(clean.passed()) << (clean.failures.empty() ? "" : clean.failures[0]);
+  ASSERT_FALSE(clean.layers.empty());
+  const AtlasLayerReport& albedo = clean.layers[0];
+  ASSERT_EQ(albedo.semantic, LayerSemantic::kAlbedo);
+  // The layer bound alone would have failed it: pages below it passed on their floor.
+  EXPECT_LT(albedo.min_psnr, albedo.bounds.min_psnr);
+  ASSERT_FALSE(albedo.worst.empty());
+  EXPECT_GT(albedo.worst[0].runtime_floor_psnr, 0.0);
+  EXPECT_GE(albedo.worst[0].psnr,
+            albedo.worst[0].runtime_floor_psnr - albedo.bounds.floor_margin_db);
+
+  // Level-0 pages (0,0) and (1,1) swapped, checksums recomputed: both fail.
+  const PageId a{0, 0, 0}, b{0, 1, 1};
+  const std::string swapped = dir + "/swapped.vtpf";
+  ASSERT_TRUE(rewrite(
+                  o.build.output, swapped,
+                  [&](const PageId& id, uint32_t layer) {
+                    if (layer != 0) return id;
+                    return id == a ? b : id == b ? a : id;
+                  },
+                  kNoEdit)
+                  .ok());
+  const AtlasCheckReport bad = check(swapped);
+  ASSERT_FALSE(bad.passed());
+  const AtlasLayerReport& l = bad.layers[0];
+  EXPECT_EQ(l.pages_failed, 2u);
+  for (const PageId& id : {a, b})
+    EXPECT_TRUE(std::any_of(l.worst.begin(), l.worst.end(),
+                            [&](const AtlasPageError& e) { return e.failed && e.id == id; }));
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
