@@ -47,6 +47,7 @@ Expected<EmissiveMetrics> compare_emissive(const ReferenceFrame& reference,
       const uint8_t* a = &r.texels[i * 4];
       const uint8_t* b = &t.texels[i * 4];
       for (int c = 0; c < 3; ++c) energy_ref += linear[a[c]], energy_test += linear[b[c]];
+      m.reference_glow_pixels += std::max({a[0], a[1], a[2]}) > kEmissiveDark;
       if (std::max({a[0], a[1], a[2], b[0], b[1], b[2]}) <= kEmissiveDark) continue;
       double px = 0;
       for (int c = 0; c < 3; ++c) px += double(int(a[c]) - b[c]) * double(int(a[c]) - b[c]);
@@ -85,7 +86,7 @@ std::vector<std::string> check_emissive(const EmissiveMetrics& m, const Emissive
     why.push_back(line);
   }
   const double stops = m.energy_ratio > 0 ? std::abs(std::log2(m.energy_ratio)) : 1e9;
-  if (stops > b.max_energy_stops) {
+  if (m.energy_judged() && stops > b.max_energy_stops) {
     std::snprintf(
         line, sizeof line,
         "emissive: the virtual texture emits %.2fx the materials' light, beyond %.2fx-%.2fx",
@@ -99,7 +100,9 @@ nlohmann::json to_json(const EmissiveMetrics& m) {
   return {{"psnr_rgb", m.psnr_rgb},
           {"worst_tile_psnr", m.worst_tile_psnr},
           {"pixels_compared", m.pixels},
-          {"energy_ratio", m.energy_ratio}};
+          {"energy_ratio", m.energy_ratio},
+          {"reference_glow_pixels", m.reference_glow_pixels},
+          {"energy_judged", m.energy_judged()}};
 }
 
 }  // namespace vt::render

@@ -23,6 +23,12 @@ struct EmissiveMetrics {
   // Virtual over reference emission summed in linear light over the pixels both drew; 1 when
   // neither emits.
   double energy_ratio = 1;
+  uint64_t reference_glow_pixels = 0;  // pixels the reference lights up (above kEmissiveDark)
+  // Whether energy_ratio is judged: the reference glows on at least kMinGlowPixels. A view of
+  // surfaces that emit nothing has no light to keep; what the virtual render shows there
+  // (codec bleed from a glowing chart next door) is judged by the PSNR bounds alone.
+  bool energy_judged() const { return reference_glow_pixels >= kMinGlowPixels; }
+  static constexpr uint64_t kMinGlowPixels = 32;  // one 16 x 16 tile's worth, as the tiles count
 };
 
 // A channel at or below this (8-bit sRGB) does not count as emitting.

@@ -5,12 +5,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 
 #include "bake/scene_bake.h"
 #include "common/srgb.h"
+#include "render/emissive_check.h"
 #include "render/lit_pass.h"
 #include "render/validate.h"
 #include "render/vulkan_context.h"
@@ -306,6 +308,48 @@ TEST_F(LitCheck, EmissiveAtHalfStrengthFails) {
   EXPECT_LT(bad.energy_ratio, 0.5);
   EXPECT_LT(r->views[0].lit->metrics.worst_tile_psnr,
             correct->views[0].lit->metrics.worst_tile_psnr - 1.0);
+}
+
+// Synthetic frames, no GPU: a view whose surfaces emit nothing. Faint stray glow in the
+// virtual render (codec bleed from a glowing chart nearby: ClearCoatTest's label) is judged by
+// PSNR, not as an infinite energy ratio; a bright false glow still fails.
+TEST(EmissiveCheck, ViewWithoutGlowIsJudgedByPsnrNotTheEnergyRatio) {
+  constexpr uint32_t w = 64, h = 64;
+  ReferenceFrame ref;
+  ref.color.width = w;
+  ref.color.height = h;
+  ref.color.texels.assign(size_t(w) * h * 4, 0);
+  ref.covered.assign(size_t(w) * h, 1u);
+  VirtualFrame test;
+  test.color = ref.color;
+  test.status.assign(size_t(w) * h, 0x80000000u);
+  auto paint = [&](Rgba8Image& img, uint32_t pixels, uint8_t v) {
+    for (uint32_t i = 0; i < pixels; ++i)
+      for (int c = 0; c < 3; ++c) img.texels[size_t(i) * 97 % (w * h) * 4 + c] = v;
+  };
+  const EmissiveBounds b = default_emissive_bounds();
+  paint(test.color, 40, 20);  // speckles at 20/255
+  auto faint = compare_emissive(ref, test);
+  ASSERT_TRUE(faint.ok());
+  EXPECT_EQ(faint->reference_glow_pixels, 0u);
+  EXPECT_FALSE(faint->energy_judged());
+  EXPECT_GT(faint->energy_ratio, 10.0);  // reported, not judged
+  EXPECT_TRUE(check_emissive(*faint, b).empty()) << check_emissive(*faint, b)[0];
+  paint(test.color, 2000, 200);  // a glow that is not there
+  auto bright = compare_emissive(ref, test);
+  ASSERT_TRUE(bright.ok());
+  EXPECT_FALSE(check_emissive(*bright, b).empty());
+  // Where the reference glows, the ratio is judged: the virtual at a quarter of its light fails.
+  paint(ref.color, 2000, 200);
+  paint(test.color, 2000, 110);  // sRGB 110 is about a quarter of 200's linear light
+  auto dim = compare_emissive(ref, test);
+  ASSERT_TRUE(dim.ok());
+  EXPECT_TRUE(dim->energy_judged());
+  EXPECT_LT(dim->energy_ratio, 0.3);
+  const auto why = check_emissive(*dim, b);
+  EXPECT_TRUE(std::any_of(why.begin(), why.end(), [](const std::string& l) {
+    return l.find("emits") != std::string::npos;
+  }));
 }
 
 }  // namespace
