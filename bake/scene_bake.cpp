@@ -198,6 +198,8 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   }
   // Before the unwrapper adds the atlas set, which a slot reading a missing set would read.
   VT_RETURN_IF_ERROR(check_texcoord_sets(input));
+  // Damaged PNGs fail now, not after the unwrap (the transfer checks them again, from cache).
+  VT_RETURN_IF_ERROR(check_scene_textures(input));
   SceneBakeSummary summary;
   summary.warnings = input.warnings;
   summary.output = output;

@@ -3,6 +3,7 @@
 #include "bake/transfer.h"
 #include "bake/color.h"
 #include "bake/level_store.h"
+#include "bake/png_check.h"
 #include "bake/unwrap/atlas_raster.h"
 #include "common/parallel.h"
 #include "common/vec.h"
@@ -347,6 +348,8 @@ Status Transfer::set_colour_space(ImageSlot& slot, const std::string& path,
 }
 
 Status Transfer::setup_images() {
+  // Before OpenImageIO opens them: libpng would print its own line for a damaged file.
+  VT_RETURN_IF_ERROR(check_scene_textures(scene_));
   std::vector<bool> used(scene_.images.size(), false);
   for (const scene::Material* m : materials_in_use(scene_)) {
     for (const TextureSlot& ts : kTextureSlots) {
@@ -926,6 +929,24 @@ Status check_texcoord_sets(const scene::Scene& scene) {
                          std::to_string(p.uvs.size()) +
                          (p.uvs.size() == 1 ? " UV set)" : " UV sets)"));
       }
+    }
+  }
+  return Status::Ok();
+}
+
+Status check_scene_textures(const scene::Scene& scene) {
+  std::vector<bool> checked(scene.images.size(), false);
+  for (const scene::Material* m : materials_in_use(scene)) {
+    for (const TextureSlot& ts : kTextureSlots) {
+      const scene::TextureRef& r = m->*ts.ref;
+      if (!r.valid() || size_t(r.image) >= scene.images.size() || checked[r.image]) continue;
+      checked[r.image] = true;
+      const scene::Image& img = scene.images[r.image];
+      const Status s =
+          img.embedded() ? check_png_chunks(img.bytes, "embedded image " + std::to_string(r.image) +
+                                                           " '" + img.name + "'")
+                         : check_png_chunks(img.path);
+      if (!s.ok()) return s.with_context(material_label(scene, *m) + " " + ts.name);
     }
   }
   return Status::Ok();

@@ -126,6 +126,12 @@ std::span<const TextureSlot> texture_slots();
 // atlas set the unwrapper appends would otherwise pass for a missing one.
 Status check_texcoord_sets(const scene::Scene& scene);
 
+// Every PNG a material in use reads (file or embedded) has whole chunks with correct CRCs
+// (check_png_chunks). The error (kCorrupt, whatever MissingTextures says: the file is there but
+// damaged) names the material, the slot, the file and the chunk. Files that cannot be opened
+// pass here: the transfer reports them as missing textures.
+Status check_scene_textures(const scene::Scene& scene);
+
 // Which layers the materials of `scene` call for: albedo always; normal if some material has a
 // normal map; ORM if some material has a metallic-roughness or occlusion texture or factors
 // other than glTF's defaults; emissive if some material emits. (Alpha is decided by texels.)
