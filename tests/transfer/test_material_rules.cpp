@@ -252,6 +252,15 @@ TEST(TransferRules, DamagedEmbeddedPngIsAnErrorNamingMaterialSlotAndImage) {
   EXPECT_TRUE(check_scene_textures(s).ok());
 }
 
+// The texture cache's share of a bake's memory limit: a quarter, 32 MiB to 2 GiB.
+TEST(TransferRules, TextureCacheFollowsTheMemoryLimit) {
+  constexpr uint64_t MiB = uint64_t(1) << 20;
+  EXPECT_EQ(texture_cache_bytes(64 * MiB), 32 * MiB);
+  EXPECT_EQ(texture_cache_bytes(256 * MiB), 64 * MiB);
+  EXPECT_EQ(texture_cache_bytes(uint64_t(8) << 30), uint64_t(2) << 30);  // the bake's default
+  EXPECT_EQ(texture_cache_bytes(uint64_t(64) << 30), uint64_t(2) << 30);
+}
+
 TEST(TransferRules, MissingTextureWarnBakesTheFactorAlone) {
   test::ScratchDir dir;
   scene::Scene s = brick_scene(dir);
