@@ -180,21 +180,35 @@ Expected<std::vector<std::vector<uint8_t>>> training_sample(const BuildPlan& pla
   return pages;
 }
 
-// Bytes the build holds beside the level images while it works on a level `width` wide.
-uint64_t working_set(const BuildPlan& plan, const LayerPlan& layer, uint32_t width) {
+// What the level choice keeps beside a level's own working set for the libraries, the writer's
+// index and thread stacks (measured: ~190 MiB in all at 16K wide RGB). Lower than the process's
+// real resident size below; kept so, since the levels that docs/BENCHMARKS.md's large builds
+// hold in memory (and their measured peaks) follow from it.
+constexpr uint64_t kLevelChoiceAllowance = uint64_t(64) << 20;
+// The process's resident set before any work (the linked libraries as loaded, OpenImageIO's
+// and the allocator's start-up), peak RSS on 2026-12-02: `vtbake version` 135 MiB, `info` of a
+// small file 136, `build procedural:64x64` 138 (docs/RELIABILITY.md, "Memory under
+// --memory-limit"). The memory floor counts it whole.
+constexpr uint64_t kProcessBytes = uint64_t(136) << 20;
+
+// Bytes the build holds beside the level images and the process's own while it works on a
+// level `width` wide.
+uint64_t level_working_set(const BuildPlan& plan, const LayerPlan& layer, uint32_t width) {
   const PageGeometry& g = plan.desc.geometry;
   const uint32_t P = g.payload, S = g.page_size(), wc = layer.work_channels;
   const uint64_t row = uint64_t(width) * wc * sizeof(float);
   const uint64_t band_rows = P + 2 * plan.margin;
-  // Window, band, read buffer and the allocator's slack on them; 64 MiB for the libraries,
-  // the writer's index and thread stacks (measured: ~190 MiB at 16K wide RGB).
-  uint64_t ws = row * band_rows * 4 + (uint64_t(64) << 20);
+  // Window, band, read buffer and the allocator's slack on them.
+  uint64_t ws = row * band_rows * 4;
   if (plan.options.address == AddressMode::kWrap) ws += row * (band_rows + plan.margin);
   ws += uint64_t(plan.threads) * (row / 2 * 2 * (16 + plan.kernel.taps()));  // downsample
   ws += row / 2 * (P / 2);                                                   // next level's rows
   ws += uint64_t(plan.threads) * S * S * (wc * 4 + 16) * 3;                  // page buffers
   ws += uint64_t(g.pages_x(0)) * S * S * 4;  // encoded pages of a row
   return ws;
+}
+uint64_t working_set(const BuildPlan& plan, const LayerPlan& layer, uint32_t width) {
+  return level_working_set(plan, layer, width) + kLevelChoiceAllowance;
 }
 
 // Which levels live in memory: level l + 1 does if it and level l fit in what the working set
@@ -227,14 +241,15 @@ std::vector<bool> choose_level_memory(const BuildPlan& plan, const LayerPlan& la
 void check_memory_floor(BuildPlan& plan) {
   const PageGeometry& g = plan.desc.geometry;
   for (const LayerPlan& layer : plan.layers)
-    plan.memory_floor = std::max(plan.memory_floor, working_set(plan, layer, g.level_width(0)));
+    plan.memory_floor = std::max(plan.memory_floor,
+                                 kProcessBytes + level_working_set(plan, layer, g.level_width(0)));
   const uint64_t limit = plan.options.memory_limit;
   if (limit >= plan.memory_floor) return;
   auto mib = [](uint64_t b) { return std::to_string((b + (1 << 20) - 1) >> 20) + " MiB"; };
   plan.warnings.push_back("memory limit " + mib(limit) + " is below this build's floor of about " +
-                          mib(plan.memory_floor) + " (the libraries, level 0's bands of " +
-                          std::to_string(g.level_width(0)) + " texels and " +
-                          std::to_string(plan.threads) +
+                          mib(plan.memory_floor) + " (the process's own " + mib(kProcessBytes) +
+                          ", level 0's bands of " + std::to_string(g.level_width(0)) +
+                          " texels and " + std::to_string(plan.threads) +
                           " threads' page buffers): it needs that much; every level past 0 goes "
                           "to scratch files, and fewer threads lower the floor a little");
 }

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <vector>
 
 namespace vt {
@@ -35,26 +36,20 @@ std::string hex(uint32_t v) {
   return text;
 }
 
-}  // namespace
-
-Status check_png_chunks(const std::string& path) {
+// The chunk walk over `size` bytes read in order through `read`; `name` starts the messages.
+Status check_chunks(uint64_t size, const std::function<bool(uint8_t*, size_t)>& read,
+                    const std::string& name) {
   static constexpr uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) return Status::Ok();  // the image reader reports what cannot be opened
-  const uint64_t size = uint64_t(in.tellg());
-  in.seekg(0);
   uint8_t head[8] = {};
-  if (size < 8 || !in.read(reinterpret_cast<char*>(head), 8) ||
-      std::memcmp(head, kSignature, 8) != 0)
-    return Status::Ok();
+  if (size < 8 || !read(head, 8) || std::memcmp(head, kSignature, 8) != 0) return Status::Ok();
   auto corrupt = [&](const std::string& what) {
-    return Error(ErrorCode::kCorrupt, path + ": corrupt PNG: " + what);
+    return Error(ErrorCode::kCorrupt, name + ": corrupt PNG: " + what);
   };
   std::vector<uint8_t> data(size_t(1) << 16);
   uint64_t at = 8;
   for (bool first = true;; first = false) {
     uint8_t h[8];
-    if (size - at < 12 || !in.read(reinterpret_cast<char*>(h), 8))
+    if (size - at < 12 || !read(h, 8))
       return corrupt("truncated at byte " + std::to_string(at) + " (no IEND chunk)");
     const uint32_t length = be32(h);
     const std::string type(reinterpret_cast<const char*>(h + 4), 4);
@@ -66,12 +61,12 @@ Status check_png_chunks(const std::string& path) {
     uint32_t crc = crc_update(0xFFFFFFFFu, h + 4, 4);
     for (uint32_t left = length; left > 0;) {
       const uint32_t n = std::min<uint32_t>(left, uint32_t(data.size()));
-      if (!in.read(reinterpret_cast<char*>(data.data()), n)) return corrupt(chunk + ": read error");
+      if (!read(data.data(), n)) return corrupt(chunk + ": read error");
       crc = crc_update(crc, data.data(), n);
       left -= n;
     }
     uint8_t stored[4];
-    if (!in.read(reinterpret_cast<char*>(stored), 4)) return corrupt(chunk + ": read error");
+    if (!read(stored, 4)) return corrupt(chunk + ": read error");
     crc ^= 0xFFFFFFFFu;
     // libpng skips an ancillary chunk (lower-case first letter) whose CRC fails; a critical
     // one is an error there too.
@@ -82,6 +77,34 @@ Status check_png_chunks(const std::string& path) {
     at += 12 + uint64_t(length);
     if (type == "IEND") return Status::Ok();
   }
+}
+
+}  // namespace
+
+Status check_png_chunks(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) return Status::Ok();  // the image reader reports what cannot be opened
+  const uint64_t size = uint64_t(in.tellg());
+  in.seekg(0);
+  return check_chunks(
+      size,
+      [&](uint8_t* dst, size_t n) {
+        return bool(in.read(reinterpret_cast<char*>(dst), std::streamsize(n)));
+      },
+      path);
+}
+
+Status check_png_chunks(std::span<const uint8_t> bytes, const std::string& name) {
+  size_t at = 0;
+  return check_chunks(
+      bytes.size(),
+      [&](uint8_t* dst, size_t n) {
+        if (bytes.size() - at < n) return false;
+        std::memcpy(dst, bytes.data() + at, n);
+        at += n;
+        return true;
+      },
+      name);
 }
 
 }  // namespace vt

@@ -5,6 +5,8 @@
 // truncated files, whose chunk checksums or lengths no longer match.
 #pragma once
 
+#include <cstdint>
+#include <span>
 #include <string>
 
 #include "common/status.h"
@@ -16,5 +18,7 @@ namespace vt {
 // an IEND. Otherwise kCorrupt naming the file, the chunk, its byte offset and the problem.
 // What it cannot see: compressed data that is wrong under a correct CRC (a crafted file).
 Status check_png_chunks(const std::string& path);
+// The same for a PNG in memory (a glTF's embedded image); `name` stands for the file in messages.
+Status check_png_chunks(std::span<const uint8_t> bytes, const std::string& name);
 
 }  // namespace vt

@@ -198,6 +198,8 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   }
   // Before the unwrapper adds the atlas set, which a slot reading a missing set would read.
   VT_RETURN_IF_ERROR(check_texcoord_sets(input));
+  // Damaged PNGs fail now, not after the unwrap (the transfer checks them again, from cache).
+  VT_RETURN_IF_ERROR(check_scene_textures(input));
   SceneBakeSummary summary;
   summary.warnings = input.warnings;
   summary.output = output;
@@ -281,6 +283,7 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   // Bands of rows straight to the layers' stores: in memory where the build holds level 0 so.
   to.band_rows = options.transfer_band_rows;
   to.band_memory = band_bytes(limit);
+  to.texture_cache = texture_cache_bytes(limit);
   to.stores_in_memory = !options.transfer_to_scratch &&
                         level0_fits_memory(transfer_store_bytes(unwrapped->scene, W, H), limit);
   auto transfer = guarded("transfer", [&] { return transfer_to_stores(unwrapped->scene, to); });

@@ -47,6 +47,11 @@ struct TransferOptions {
   // The texels do not depend on it.
   uint32_t band_rows = 0;
   uint64_t band_memory = uint64_t(256) << 20;
+  // OpenImageIO's texture cache for the scene's textures (its max_memory_MB): tiles and MIP
+  // levels beyond it are dropped and re-read. The scene bake passes texture_cache_bytes(limit).
+  // Raised to the largest untiled source (w x h x channels floats and its MIP levels), which
+  // OpenImageIO holds whole: below that it re-reads the file for every eviction.
+  uint64_t texture_cache = uint64_t(2) << 30;
   // transfer_to_stores: the layers' stores are in memory, or scratch files under scratch_dir.
   bool stores_in_memory = true;
   // Filter for MIP levels made (maketx-style, in the scratch folder) for untiled sources;
@@ -125,6 +130,17 @@ std::span<const TextureSlot> texture_slots();
 // names the mesh, primitive, material, slot and set. Run on the scene before unwrapping: the
 // atlas set the unwrapper appends would otherwise pass for a missing one.
 Status check_texcoord_sets(const scene::Scene& scene);
+
+// The texture cache a transfer gets within a memory limit: a quarter of it, at least 32 MiB
+// (a few tiles per texture and MIP level; below that the cache re-reads tiles without end) and
+// at most 2 GiB (the scene bake's default 8 GiB limit gives 2 GiB, as before the budget).
+uint64_t texture_cache_bytes(uint64_t memory_limit);
+
+// Every PNG a material in use reads (file or embedded) has whole chunks with correct CRCs
+// (check_png_chunks). The error (kCorrupt, whatever MissingTextures says: the file is there but
+// damaged) names the material, the slot, the file and the chunk. Files that cannot be opened
+// pass here: the transfer reports them as missing textures.
+Status check_scene_textures(const scene::Scene& scene);
 
 // Which layers the materials of `scene` call for: albedo always; normal if some material has a
 // normal map; ORM if some material has a metallic-roughness or occlusion texture or factors

@@ -1,6 +1,7 @@
 // Hostile inputs end to end (issue 20): a scene naming a texture above its folder tree is
 // refused (exit 2) unless --allow-outside-paths; NaN UVs are an error naming the vertex, never
-// baked black; a corrupt PNG exits 2 naming the file with no stray libpng line in the message;
+// baked black; a corrupt PNG exits 2 naming the file with no stray libpng line in the message
+// (a scene's texture: naming the material and slot too);
 // --fix-nonfinite error names the file and the layer; unwrap refuses a FIFO without blocking.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -8,6 +9,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -109,6 +111,44 @@ TEST(CliHostileInputs, CorruptPngExitsTwoNamingTheFile) {
   EXPECT_EQ(r.out.find("libpng"), std::string::npos) << r.out;  // libpng's own stderr line
   EXPECT_NE(r.out.find(png + ": corrupt PNG: chunk 'IDAT'"), std::string::npos) << r.out;
   EXPECT_FALSE(fs::exists(dir + "/b.vtpf"));
+  fs::remove_all(dir);
+}
+
+// A scene texture damaged in two ways: a flipped IDAT byte (stale CRC) and a cut-off file.
+// Either is one error naming the material, the slot and the file before the transfer starts,
+// exit 2, with no libpng line; --missing-textures warn does not bake past it (the file is there).
+TEST(CliHostileInputs, CorruptSceneTextureNamesMaterialSlotAndFile) {
+  const std::string dir = fresh_dir("scene_png");
+  const std::string obj = quad(dir, "paint.png");
+  const std::string png = dir + "/car/paint.png";
+  write_png(png);
+  std::string clean;
+  {
+    std::ifstream in(png, std::ios::binary);
+    clean.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const size_t idat = clean.find("IDAT");
+  ASSERT_NE(idat, std::string::npos);
+  std::string flipped = clean;
+  flipped[idat + 6] = char(~flipped[idat + 6]);
+  const std::string bake = "bake " + obj + " -o " + dir + "/q.vtpf --size 1 --unwrapped -";
+  for (const std::string& bytes : {flipped, clean.substr(0, idat + 8)}) {
+    std::ofstream(png, std::ios::binary | std::ios::trunc) << bytes;
+    for (const std::string& policy : {"", " --missing-textures warn"}) {
+      auto r = run_vtbake(bake + policy, true);
+      EXPECT_EQ(r.exit_code, 2) << r.out;
+      EXPECT_NE(r.out.find("vtbake bake: " + obj + ": material 'Paint' baseColorTexture: " + png +
+                           ": corrupt PNG: "),
+                std::string::npos)
+          << r.out;
+      EXPECT_EQ(r.out.find("libpng"), std::string::npos) << r.out;
+      EXPECT_EQ(r.out.find("PNG library error"), std::string::npos) << r.out;
+      EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;  // one line
+      EXPECT_FALSE(fs::exists(dir + "/q.vtpf"));
+    }
+  }
+  std::ofstream(png, std::ios::binary | std::ios::trunc) << clean;
+  EXPECT_EQ(run_vtbake("-q " + bake, true).exit_code, 0);
   fs::remove_all(dir);
 }
 

@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -208,6 +210,55 @@ TEST(TransferRules, MissingTextureIsAnErrorNamingMaterialSlotAndPath) {
       dir.file("missing.png") + "): ";
   EXPECT_EQ(r.status().message().substr(0, want.size()), want) << r.status().message();
   EXPECT_GT(r.status().message().size(), want.size());  // OpenImageIO's reason follows
+}
+
+// An embedded PNG with a damaged IDAT is one kCorrupt error naming the material, the slot and
+// the embedded image before OpenImageIO sees it, whatever the missing-texture policy.
+TEST(TransferRules, DamagedEmbeddedPngIsAnErrorNamingMaterialSlotAndImage) {
+  test::ScratchDir dir;
+  const std::string png = dir.file("e.png");
+  {
+    auto out = OIIO::ImageOutput::create(png);
+    ASSERT_TRUE(out);
+    OIIO::ImageSpec spec(8, 8, 3, OIIO::TypeDesc::UINT8);
+    std::vector<uint8_t> texels(8 * 8 * 3, 77);
+    ASSERT_TRUE(out->open(png, spec));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, texels.data()));
+    out->close();
+  }
+  std::ifstream f(png, std::ios::binary);
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  const std::string text(bytes.begin(), bytes.end());
+  const size_t idat = text.find("IDAT");
+  ASSERT_NE(idat, std::string::npos);
+  bytes[idat + 6] ^= 0xFF;
+  scene::Scene s = brick_scene(dir);
+  scene::Image& im = s.images[0];
+  im.bytes = bytes, im.path.clear(), im.uri.clear(), im.name = "paint", im.mime_type = "image/png";
+  for (MissingTextures policy : {MissingTextures::kError, MissingTextures::kWarn}) {
+    TransferOptions o = atlas_options();
+    o.missing_textures = policy;
+    o.scratch_dir = dir.file("");
+    auto r = transfer_materials(s, o);
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.status().code(), ErrorCode::kCorrupt);
+    const std::string want =
+        "material 'Brick' baseColorTexture: embedded image 0 'paint': corrupt PNG: chunk 'IDAT'";
+    EXPECT_EQ(r.status().message().substr(0, want.size()), want) << r.status().message();
+  }
+  EXPECT_EQ(check_scene_textures(s).code(), ErrorCode::kCorrupt);
+  bytes[idat + 6] ^= 0xFF;
+  im.bytes = bytes;
+  EXPECT_TRUE(check_scene_textures(s).ok());
+}
+
+// The texture cache's share of a bake's memory limit: a quarter, 32 MiB to 2 GiB.
+TEST(TransferRules, TextureCacheFollowsTheMemoryLimit) {
+  constexpr uint64_t MiB = uint64_t(1) << 20;
+  EXPECT_EQ(texture_cache_bytes(64 * MiB), 32 * MiB);
+  EXPECT_EQ(texture_cache_bytes(256 * MiB), 64 * MiB);
+  EXPECT_EQ(texture_cache_bytes(uint64_t(8) << 30), uint64_t(2) << 30);  // the bake's default
+  EXPECT_EQ(texture_cache_bytes(uint64_t(64) << 30), uint64_t(2) << 30);
 }
 
 TEST(TransferRules, MissingTextureWarnBakesTheFactorAlone) {
