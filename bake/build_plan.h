@@ -43,8 +43,12 @@ struct LayerPlan {
   // Where this layer's task keys start: the settings and the layer's spec, tables included.
   uint64_t task_seed = 0;
 
-  // Linear working texels of a page (modified) to the layer's stored bytes.
-  void store_page(float* texels, size_t count, float alpha_scale, uint8_t* out) const;
+  // Linear working texels of a page (modified) to the layer's stored bytes. Returns true when
+  // 8-bit storage clipped some value outside [0, 1]; then `reference`, when not null, receives
+  // what the stored bytes would be unclipped (count * spec.channels values in 8-bit code units,
+  // unrounded): the values the page's error is measured against.
+  bool store_page(float* texels, size_t count, float alpha_scale, uint8_t* out,
+                  float* reference = nullptr) const;
 };
 
 struct BuildPlan {
