@@ -278,6 +278,9 @@ class LayerRun {
       const EncodedPage& e = encoded[x];
       if (e.state == PageState::kConstant) {
         ++lsum.constant;
+        error_.sse += e.squared_error;  // a clipped constant page's error (else nothing)
+        error_.samples += e.samples;
+        error_.max_error = std::max(error_.max_error, e.max_error);
         VT_RETURN_IF_ERROR(sink_.add_constant_page(
             id, li_, std::span<const uint8_t>(e.constant, layer_.spec.texel_bytes())));
         continue;

@@ -161,6 +161,8 @@ Status PageEncoder::encode(const uint8_t* texels, EncodedPage& out, const float*
     out.state = PageState::kConstant;
     std::memset(out.constant, 0, sizeof(out.constant));
     std::memcpy(out.constant, texels, layer_.texel_bytes());
+    // Exact, and not counted, unless clipped: then what clipping lost counts.
+    if (reference) measure(reference, texels, page_bytes(), out);
     return Status::Ok();
   }
   out.state = PageState::kStored;

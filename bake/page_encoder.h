@@ -56,7 +56,8 @@ struct EncodedPage {
   std::vector<uint8_t> bytes;  // kStored: the coded page
   uint8_t constant[16] = {};   // kConstant: the texel value
   // Against the texels given (or their unclipped reference): the sum over channels and texels,
-  // in 8-bit units; 0 for a lossless page without a reference.
+  // in 8-bit units; 0 for a lossless page without a reference. A constant page is measured
+  // (samples > 0) only with a reference.
   double squared_error = 0.0;
   uint32_t max_error = 0;  // largest absolute channel error (8-bit units, rounded)
   uint64_t samples = 0;    // channel values compared (every stored 8-bit page's)

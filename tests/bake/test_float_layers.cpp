@@ -23,14 +23,14 @@ std::shared_ptr<ImageSource> float_image(uint32_t ch, std::vector<float> texels,
   return std::make_shared<MemoryImageSource>(info, std::move(texels));
 }
 
-// A smooth linear RGB image in [0.05, 0.85] with `hot` texels (the first of every 7th row, 8
+// A smooth linear RGB ramp in [0.05, 0.85] with `hot` texels (the first of every 7th row, 8
 // of them along it) at 8.0 in red and 3.0 in green: an emissive-like HDR source.
 std::vector<float> hdr_rgb(bool clamp_to_one = false) {
   std::vector<float> t(size_t(kW) * kH * 3);
   for (uint32_t y = 0; y < kH; ++y)
     for (uint32_t x = 0; x < kW; ++x)
       for (uint32_t c = 0; c < 3; ++c)
-        t[(size_t(y) * kW + x) * 3 + c] = 0.05f + 0.8f * float((x * 3 + y * 5 + c * 7) % 41) / 40;
+        t[(size_t(y) * kW + x) * 3 + c] = 0.05f + 0.7f * float(x + y) / float(kW + kH) + 0.05f * c;
   for (uint32_t y = 0; y < kH; y += 7)
     for (uint32_t x = 0; x < 8; ++x) {
       t[(size_t(y) * kW + x) * 3 + 0] = clamp_to_one ? 1.0f : 8.0f;
