@@ -261,8 +261,8 @@ class LayerRun {
       }
       const bool clipped = layer_.store_page(page.data(), page_texels, alpha_.scale, bytes.data(),
                                              reference.empty() ? nullptr : reference.data());
-      errors[x] =
-          layer_.encoder->encode(bytes.data(), encoded[x], clipped ? reference.data() : nullptr);
+      errors[x] = layer_.encoder->encode(
+          bytes.data(), encoded[x], clipped && !reference.empty() ? reference.data() : nullptr);
     });
     LevelSummary& lsum = sum_.levels[level_];
     std::vector<uint64_t>& layer_keys = sum_.page_keys[li_];
@@ -338,6 +338,7 @@ class LayerRun {
 // One line for a layer whose 8-bit storage clipped values (LayerSummary::clipped).
 std::string clip_warning(const LayerInput& in, const LayerSummary& l) {
   const ClipReport& c = l.clipped;
+  const bool half = l.spec.texel_type == TexelType::kF16;
   char range[96];
   if (c.min_value < 0 && c.max_value > 1) {
     std::snprintf(range, sizeof range, "from %g to %g", double(c.min_value), double(c.max_value));
@@ -349,8 +350,12 @@ std::string clip_warning(const LayerInput& in, const LayerSummary& l) {
   const std::string origin = in.source ? in.source->origin() : "";
   return (origin.empty() ? "" : origin + ": ") + "layer '" + l.name +
          "': " + std::to_string(c.texels) + " texels (" + std::to_string(c.values) +
-         " values) outside [0, 1], " + range + ", clipped by its 8-bit " + to_string(l.spec.codec) +
-         " storage; its PSNR counts the clipping (--float-texels half or float keeps the range)";
+         " values) outside " +
+         (half ? "the half-float range (+-65504; alpha [0, 1]), " : "[0, 1], ") + range +
+         (half ? ", clipped by its half-float storage (--float-texels float keeps the range)"
+               : std::string(", clipped by its 8-bit ") + to_string(l.spec.codec) +
+                     " storage; its PSNR counts the clipping (--float-texels half or float "
+                     "keeps the range)");
 }
 
 // The plan's metadata with the provenance merged in and the update record (bake/update.h).

@@ -108,10 +108,11 @@ struct NonFiniteReport {
   float first_value = 0;
 };
 
-// Level-0 texels of an 8-bit layer with a value outside [0, 1] (an HDR or out-of-range float
-// source): the stored texels clip them. Colour layers count the linear colour before the
-// transfer curve and alpha as given; data layers (ORM, custom) every channel; normal layers
-// never clip. Non-finite values are NonFiniteReport's, not counted here.
+// Level-0 texels with a value outside what the layer stores: [0, 1] in an 8-bit layer (an HDR
+// or out-of-range float source), +-65504 in a half-float one; the stored texels clip them.
+// Colour layers count the linear colour before the transfer curve and alpha (always [0, 1]) as
+// given; data layers (ORM, custom) every channel; normal layers never clip, nor do 32-bit float
+// layers. Non-finite values are NonFiniteReport's, not counted here.
 struct ClipReport {
   uint64_t texels = 0;  // texels with at least one channel out of range
   uint64_t values = 0;  // channel values out of range
@@ -138,8 +139,8 @@ struct LayerSummary {
   RuntimeError runtime;
   uint64_t dct_modes[kDctModeKinds] = {};
   NonFiniteReport non_finite;
-  // Out-of-range values clipped by 8-bit storage. psnr_db, max_error and the runtime figures
-  // are then measured against the unclipped values (so clipping counts as error).
+  // Out-of-range values the storage clipped. In an 8-bit layer psnr_db, max_error and the
+  // runtime figures are then measured against the unclipped values (clipping counts as error).
   ClipReport clipped;
   bool alpha_dropped = false;  // the input's alpha was opaque everywhere and is not stored
 };

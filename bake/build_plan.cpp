@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -469,11 +470,13 @@ bool LayerPlan::store_page(float* texels, size_t count, float alpha_scale, uint8
   }
   if (spec.texel_type == TexelType::kF16) {
     if (to_storage) to_storage->apply(texels, count, int(wc));
+    bool clipped = false;
     for (size_t i = 0; i < count * wc; ++i) {
+      clipped |= std::abs(texels[i]) > kHalfMax;  // float_to_half clamps to +-kHalfMax
       const uint16_t h = float_to_half(texels[i]);
       std::memcpy(out + 2 * i, &h, 2);
     }
-    return false;
+    return clipped;  // (no reference: float layers report no 8-bit error figures)
   }
   // 8-bit storage: working values outside [0, 1] clip (colour after its transfer curve, which
   // maps [0, 1] onto itself); normals are unit vectors and never do.

@@ -9,6 +9,7 @@
 
 #include "bake/build_plan.h"
 #include "bake/level_store.h"
+#include "common/half.h"
 #include "common/parallel.h"
 
 namespace vt {
@@ -26,12 +27,17 @@ struct Conversion {
         normal(p.normal),
         decode_unorm_normal(p.decode_unorm_normal),
         colour(p.colour),
-        clips(p.spec.texel_type == TexelType::kU8 && !p.normal),
+        clips((p.spec.texel_type == TexelType::kU8 && !p.normal) ||
+              p.spec.texel_type == TexelType::kF16),
+        clip_limit(p.spec.texel_type == TexelType::kF16 ? kHalfMax : 1.0f),
         to_linear(p.to_linear) {}
   uint32_t source_channels, work_channels;
   int alpha;
   bool normal, decode_unorm_normal, colour;
-  bool clips;  // stored in 8 bits: values outside [0, 1] are clipped (normals never are)
+  // Stored in 8 bits, values outside [0, 1] are clipped (normals never are); in half floats,
+  // values beyond +-kHalfMax. Alpha is clamped to [0, 1] whatever the storage.
+  bool clips;
+  float clip_limit;  // 1 or kHalfMax
   std::shared_ptr<const ColorConverter> to_linear;
 };
 
@@ -89,14 +95,15 @@ class Level0Converter {
     return Status::Ok();
   }
 
-  // Counts the values of row y that the layer's 8-bit storage clips, once: `src` is the source
-  // row, `work` the row convert() made of it.
+  // Counts the values of row y that the layer's storage clips, once: `src` is the source row,
+  // `work` the row convert() made of it.
   void count_clipped(uint32_t y, const float* src, const float* work) {
     if (!conv_.clips || clip_counted_[y]) return;
     clip_counted_[y] = true;
     const uint32_t sc = conv_.source_channels, wc = conv_.work_channels;
-    auto out_of_range = [&](float v, bool& any) {
-      if (!(v < 0 || v > 1) || std::abs(v) >= kFloatMax) return;  // in range or non-finite
+    const float hi = conv_.clip_limit, lo = hi == 1.0f ? 0.0f : -hi;
+    auto out_of_range = [&](float v, bool& any, float lo, float hi) {
+      if (!(v < lo || v > hi) || std::abs(v) >= kFloatMax) return;  // in range or non-finite
       if (clipped_.values == 0) clipped_.max_value = clipped_.min_value = v;
       clipped_.max_value = std::max(clipped_.max_value, v);
       clipped_.min_value = std::min(clipped_.min_value, v);
@@ -112,10 +119,11 @@ class Level0Converter {
         const float a = conv_.alpha >= 0 ? d[conv_.alpha] : 1.0f;
         if (a > 0)
           for (int c = 0; c < 3; ++c)
-            if (d[c] < kFloatMax) out_of_range(d[c] / a, any);
-        if (conv_.alpha >= 0) out_of_range(s[sc - 1], any);  // the source alpha, before its clamp
+            if (d[c] < kFloatMax) out_of_range(d[c] / a, any, lo, hi);
+        // The source alpha, before its clamp.
+        if (conv_.alpha >= 0) out_of_range(s[sc - 1], any, 0.0f, 1.0f);
       } else {
-        for (uint32_t c = 0; c < wc; ++c) out_of_range(d[c], any);
+        for (uint32_t c = 0; c < wc; ++c) out_of_range(d[c], any, lo, hi);
       }
       clipped_.texels += any;
     }

@@ -192,6 +192,27 @@ TEST(FloatLayers, HalfStorageKeepsTheRange) {
     }
     EXPECT_GT(brightest, 2.0f);
   }
+  // Past the half range: clamped to 65504, counted and warned about; so is an alpha above 1.
+  {
+    std::vector<float> t(size_t(kW) * kH * 4, 0.5f);
+    t[(size_t(3) * kW + 4) * 4 + 0] = 1e6f;
+    t[(size_t(9) * kW + 2) * 4 + 3] = 1.5f;  // alpha
+    BuildOptions o = options_for(LayerSemantic::kAlbedo, float_image(4, t));
+    o.codec.float_texels = FloatTexels::kHalf;
+    auto b = test::build_in_memory(o);
+    ASSERT_TRUE(b);
+    const LayerSummary& l = b->summary.layers[0];
+    EXPECT_EQ(l.spec.texel_type, TexelType::kF16);
+    EXPECT_EQ(l.clipped.texels, 2u);
+    EXPECT_EQ(l.clipped.max_value, 1e6f);
+    ASSERT_EQ(b->summary.warnings.size(), 1u);
+    EXPECT_NE(b->summary.warnings[0].find("half-float range"), std::string::npos)
+        << b->summary.warnings[0];
+    auto level = test::reassemble_level(*b, 0, 0, test::encoder_for(*b, 0, o));
+    uint16_t h;
+    std::memcpy(&h, &level[((size_t(3) * kW + 4) * 4 + 0) * 2], 2);
+    EXPECT_EQ(h, 0x7bff);
+  }
   // FloatTexels::kFloat: 32-bit float whatever the codec; the names parse.
   BuildOptions o = options_for(LayerSemantic::kCustom, float_image(3, hdr_rgb()));
   o.codec.float_texels = FloatTexels::kFloat;
