@@ -30,7 +30,7 @@ void measure(const float* reference, const uint8_t* b, size_t n, EncodedPage& ou
     mx = std::max(mx, std::abs(d));
   }
   out.squared_error = sse;
-  out.max_error = uint32_t(std::min(std::lround(mx), long(UINT32_MAX)));
+  out.max_error = uint32_t(std::min(std::round(mx), double(UINT32_MAX)));
   out.samples = n;
 }
 

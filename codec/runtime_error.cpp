@@ -83,7 +83,7 @@ Status measure_runtime_error(BcFormat format, bool normal, const uint8_t* source
       }
     }
     out.squared_error = sse;
-    out.max_error = uint32_t(std::min(std::lround(mx), long(UINT32_MAX)));
+    out.max_error = uint32_t(std::min(std::round(mx), double(UINT32_MAX)));
   } else {
     uint64_t sse = 0;
     for (size_t i = 0; i < texels; ++i) {
