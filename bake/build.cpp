@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <limits>
 
@@ -172,6 +173,7 @@ class LayerRun {
                      ? std::numeric_limits<double>::infinity()
                      : 10.0 * std::log10(255.0 * 255.0 * double(error_.samples) / error_.sse);
     ls.non_finite = layer_.level0->non_finite();
+    ls.clipped = layer_.level0->clipped();
     ls.alpha_dropped = plan_.options.layers[li_].alpha_dropped;
     return ls;
   }
@@ -244,10 +246,11 @@ class LayerRun {
       const PageId id{level_, uint32_t(x), row};
       present[x] = !coverage || page_has_coverage(g_, id, coverage);
       if (!present[x]) return;
-      thread_local std::vector<float> page;
+      thread_local std::vector<float> page, reference;
       thread_local std::vector<uint8_t> bytes;
       page.resize(page_texels * layer_.work_channels);
       bytes.resize(layer_.encoder->page_bytes());
+      reference.resize(layer_.spec.texel_type == TexelType::kU8 ? bytes.size() : 0);
       cut_page(g_, id, plan_.options.address, band, page.data());
       keys[x] = page_key(id, page);
       auto copied = reuse(id, keys[x], encoded[x]);
@@ -256,8 +259,10 @@ class LayerRun {
         reused[x] = 1;
         return;
       }
-      layer_.store_page(page.data(), page_texels, alpha_.scale, bytes.data());
-      errors[x] = layer_.encoder->encode(bytes.data(), encoded[x]);
+      const bool clipped = layer_.store_page(page.data(), page_texels, alpha_.scale, bytes.data(),
+                                             reference.empty() ? nullptr : reference.data());
+      errors[x] = layer_.encoder->encode(
+          bytes.data(), encoded[x], clipped && !reference.empty() ? reference.data() : nullptr);
     });
     LevelSummary& lsum = sum_.levels[level_];
     std::vector<uint64_t>& layer_keys = sum_.page_keys[li_];
@@ -273,6 +278,9 @@ class LayerRun {
       const EncodedPage& e = encoded[x];
       if (e.state == PageState::kConstant) {
         ++lsum.constant;
+        error_.sse += e.squared_error;  // a clipped constant page's error (else nothing)
+        error_.samples += e.samples;
+        error_.max_error = std::max(error_.max_error, e.max_error);
         VT_RETURN_IF_ERROR(sink_.add_constant_page(
             id, li_, std::span<const uint8_t>(e.constant, layer_.spec.texel_bytes())));
         continue;
@@ -327,6 +335,29 @@ class LayerRun {
   int previous_layer_ = -1;  // the same layer in the previous file (update mode)
 };
 
+// One line for a layer whose 8-bit storage clipped values (LayerSummary::clipped).
+std::string clip_warning(const LayerInput& in, const LayerSummary& l) {
+  const ClipReport& c = l.clipped;
+  const bool half = l.spec.texel_type == TexelType::kF16;
+  char range[96];
+  if (c.min_value < 0 && c.max_value > 1) {
+    std::snprintf(range, sizeof range, "from %g to %g", double(c.min_value), double(c.max_value));
+  } else if (c.max_value > 1) {
+    std::snprintf(range, sizeof range, "up to %g", double(c.max_value));
+  } else {
+    std::snprintf(range, sizeof range, "down to %g", double(c.min_value));
+  }
+  const std::string origin = in.source ? in.source->origin() : "";
+  return (origin.empty() ? "" : origin + ": ") + "layer '" + l.name +
+         "': " + std::to_string(c.texels) + " texels (" + std::to_string(c.values) +
+         " values) outside " +
+         (half ? "the half-float range (+-65504; alpha [0, 1]), " : "[0, 1], ") + range +
+         (half ? ", clipped by its half-float storage (--float-texels float keeps the range)"
+               : std::string(", clipped by its 8-bit ") + to_string(l.spec.codec) +
+                     " storage; its PSNR counts the clipping (--float-texels half or float "
+                     "keeps the range)");
+}
+
 // The plan's metadata with the provenance merged in and the update record (bake/update.h).
 std::string final_metadata(const BuildPlan& plan, const BuildSummary& sum) {
   UpdateRecord r;
@@ -378,6 +409,14 @@ Expected<BuildSummary> summarize_unchanged(const PreviousBuild& previous) {
   }
   sum.file_bytes = reader.file_size();
   return sum;
+}
+
+void ClipReport::add(const ClipReport& o) {
+  if (!o.any()) return;
+  max_value = any() ? std::max(max_value, o.max_value) : o.max_value;
+  min_value = any() ? std::min(min_value, o.min_value) : o.min_value;
+  texels += o.texels;
+  values += o.values;
 }
 
 Expected<NonFinitePolicy> parse_non_finite_policy(const std::string& name) {
@@ -443,6 +482,9 @@ Expected<BuildSummary> build_pages(const BuildPlan& plan, PageSink& sink) {
   sum.pages = sum.stored + sum.constant + sum.absent;
   sum.stages = {{"read", t_read}, {"pyramid", t_pyramid}, {"encode", t_encode}};
   sum.warnings = plan.warnings;
+  for (size_t li = 0; li < sum.layers.size(); ++li)
+    if (sum.layers[li].clipped.any())
+      sum.warnings.push_back(clip_warning(plan.options.layers[li], sum.layers[li]));
   if (plan.previous) {
     for (size_t li = 0; li < plan.layers.size(); ++li) {
       const int previous = plan.previous->layer_index(plan.layers[li].spec.name);

@@ -108,6 +108,20 @@ struct NonFiniteReport {
   float first_value = 0;
 };
 
+// Level-0 texels with a value outside what the layer stores: [0, 1] in an 8-bit layer (an HDR
+// or out-of-range float source), +-65504 in a half-float one; the stored texels clip them.
+// Colour layers count the linear colour before the transfer curve and alpha (always [0, 1]) as
+// given; data layers (ORM, custom) every channel; normal layers never clip, nor do 32-bit float
+// layers. Non-finite values are NonFiniteReport's, not counted here.
+struct ClipReport {
+  uint64_t texels = 0;  // texels with at least one channel out of range
+  uint64_t values = 0;  // channel values out of range
+  float max_value = 0;  // the largest and smallest out-of-range values (0 when none)
+  float min_value = 0;
+  bool any() const { return texels > 0; }
+  void add(const ClipReport& o);
+};
+
 struct LevelSummary {
   uint32_t width = 0, height = 0, pages_x = 0, pages_y = 0;
   uint64_t stored = 0, constant = 0, absent = 0;  // over all layers
@@ -125,6 +139,9 @@ struct LayerSummary {
   RuntimeError runtime;
   uint64_t dct_modes[kDctModeKinds] = {};
   NonFiniteReport non_finite;
+  // Out-of-range values the storage clipped. In an 8-bit layer psnr_db, max_error and the
+  // runtime figures are then measured against the unclipped values (clipping counts as error).
+  ClipReport clipped;
   bool alpha_dropped = false;  // the input's alpha was opaque everywhere and is not stored
 };
 
@@ -145,7 +162,8 @@ struct BuildSummary {
   std::vector<StageTime> stages;
   uint64_t plan_hash = 0;           // BuildPlan::hash
   std::vector<uint64_t> task_keys;  // per task of make_build_tasks (0 for level tasks)
-  // What the build could not honour, e.g. a memory limit below its floor (BuildPlan).
+  // What the build could not honour, e.g. a memory limit below its floor (BuildPlan), and one
+  // line per layer whose values were clipped (LayerSummary::clipped).
   std::vector<std::string> warnings;
   // page_keys[layer][page_key_index(id)]: each page's task key (0 = absent), as recorded.
   std::vector<std::vector<uint64_t>> page_keys;

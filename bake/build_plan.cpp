@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "bake/level_source.h"
 #include "bake/paging.h"
 #include "bake/row_window.h"
+#include "common/half.h"
 #include "common/parallel.h"
 
 #ifndef VTBAKE_VERSION
@@ -38,7 +40,22 @@ Expected<LayerPlan> plan_layer(const LayerInput& in, const BuildOptions& options
   if (info.channels < 1 || info.channels > 4) {
     return Status(ErrorCode::kUnsupported, p.spec.name + ": 1-4 channels expected");
   }
-  const bool want_float = info.is_float && options.codec.codec == CodecKind::kRaw;
+  // Float sources keep floats when asked (PageEncoderOptions::float_texels), else 8 bits.
+  TexelType float_type = TexelType::kU8;
+  if (info.is_float) {
+    switch (options.codec.float_texels) {
+      case FloatTexels::kAuto:
+        if (options.codec.codec == CodecKind::kRaw) float_type = TexelType::kF32;
+        break;
+      case FloatTexels::kHalf:
+        float_type = TexelType::kF16;
+        break;
+      case FloatTexels::kFloat:
+        float_type = TexelType::kF32;
+        break;
+    }
+  }
+  const bool want_float = float_type != TexelType::kU8;
   if (in.semantic == LayerSemantic::kNormal) {
     if (info.channels < 2) {
       return Status(ErrorCode::kInvalidArgument, p.spec.name + ": a normal map needs 2+ channels");
@@ -56,7 +73,7 @@ Expected<LayerPlan> plan_layer(const LayerInput& in, const BuildOptions& options
     p.work_channels = has_alpha ? 4 : 3;
     p.alpha = has_alpha ? 3 : -1;
     p.spec.channels = uint8_t(p.work_channels);
-    p.spec.texel_type = want_float ? TexelType::kF32 : TexelType::kU8;
+    p.spec.texel_type = float_type;
     const ColorConfig& colours =
         options.color_config ? *options.color_config : *ColorConfig::builtin();
     const std::string src_space = in.color_space.empty()
@@ -76,7 +93,7 @@ Expected<LayerPlan> plan_layer(const LayerInput& in, const BuildOptions& options
     // ORM and custom layers are data: no colour conversion.
     p.work_channels = info.channels;
     p.spec.channels = uint8_t(info.channels);
-    p.spec.texel_type = want_float ? TexelType::kF32 : TexelType::kU8;
+    p.spec.texel_type = float_type;
     if (!want_float) {
       for (uint32_t c = 0; c < p.work_channels; ++c)
         p.rules.min_value[c] = 0, p.rules.max_value[c] = 1;
@@ -270,6 +287,9 @@ std::string build_metadata(const BuildOptions& options, const std::vector<LayerP
                    {"dct_page_modes", options.codec.dct_page_modes},
                    {"min_psnr", options.codec.min_psnr},
                    {"layer_min_psnr", options.codec.layer_min_psnr}};
+  // Recorded only when set, so that earlier files' metadata (and plans) stay as they were.
+  if (options.codec.float_texels != FloatTexels::kAuto)
+    meta["build"]["float_texels"] = to_string(options.codec.float_texels);
   if (options.color_config && !options.color_config->is_builtin()) {
     meta["build"]["color_config"] = {{"path", options.color_config->path()},
                                      {"working_space", options.color_config->working_space()},
@@ -447,7 +467,8 @@ Status plan_tables(BuildPlan& plan, const LayerInput& in, LayerPlan& layer,
 
 }  // namespace
 
-void LayerPlan::store_page(float* texels, size_t count, float alpha_scale, uint8_t* out) const {
+bool LayerPlan::store_page(float* texels, size_t count, float alpha_scale, uint8_t* out,
+                           float* reference) const {
   const uint32_t wc = work_channels;
   if (alpha >= 0) {
     for (size_t i = 0; i < count; ++i) {
@@ -460,11 +481,33 @@ void LayerPlan::store_page(float* texels, size_t count, float alpha_scale, uint8
   if (spec.texel_type == TexelType::kF32) {
     if (to_storage) to_storage->apply(texels, count, int(wc));
     std::memcpy(out, texels, count * wc * sizeof(float));
-    return;
+    return false;
+  }
+  if (spec.texel_type == TexelType::kF16) {
+    if (to_storage) to_storage->apply(texels, count, int(wc));
+    bool clipped = false;
+    for (size_t i = 0; i < count * wc; ++i) {
+      clipped |= std::abs(texels[i]) > kHalfMax;  // float_to_half clamps to +-kHalfMax
+      const uint16_t h = float_to_half(texels[i]);
+      std::memcpy(out + 2 * i, &h, 2);
+    }
+    return clipped;  // (no reference: float layers report no 8-bit error figures)
+  }
+  // 8-bit storage: working values outside [0, 1] clip (colour after its transfer curve, which
+  // maps [0, 1] onto itself); normals are unit vectors and never do.
+  bool clipped = false;
+  if (!normal) {
+    for (size_t i = 0; i < count * wc && !clipped; ++i) clipped = texels[i] < 0 || texels[i] > 1;
+  }
+  if (clipped && reference) {
+    std::vector<float> unclipped(texels, texels + count * wc);
+    if (to_storage) to_storage->apply(unclipped.data(), count, int(wc));
+    for (size_t i = 0; i < count * wc; ++i)
+      reference[i] = std::min(unclipped[i], kFloatMax / 256) * 255.0f;
   }
   if (to_storage) {
     to_storage->apply_to_u8(texels, count, int(wc), out);
-    return;
+    return clipped;
   }
   auto q = [](float v) -> uint8_t {
     if (!(v > 0)) return 0;
@@ -476,9 +519,10 @@ void LayerPlan::store_page(float* texels, size_t count, float alpha_scale, uint8
       out[i * 2 + 0] = q(texels[i * 3 + 0] * 0.5f + 0.5f);
       out[i * 2 + 1] = q(texels[i * 3 + 1] * 0.5f + 0.5f);
     }
-    return;
+    return false;
   }
   for (size_t i = 0; i < count * wc; ++i) out[i] = q(texels[i]);
+  return clipped;
 }
 
 Expected<BuildPlan> plan_build(const BuildOptions& options) {

@@ -43,8 +43,13 @@ struct LayerPlan {
   // Where this layer's task keys start: the settings and the layer's spec, tables included.
   uint64_t task_seed = 0;
 
-  // Linear working texels of a page (modified) to the layer's stored bytes.
-  void store_page(float* texels, size_t count, float alpha_scale, uint8_t* out) const;
+  // Linear working texels of a page (modified) to the layer's stored bytes. Returns true when
+  // the storage clipped some value (8 bits: outside [0, 1]; half: beyond +-kHalfMax); for 8-bit
+  // layers `reference`, when not null, then receives
+  // what the stored bytes would be unclipped (count * spec.channels values in 8-bit code units,
+  // unrounded): the values the page's error is measured against.
+  bool store_page(float* texels, size_t count, float alpha_scale, uint8_t* out,
+                  float* reference = nullptr) const;
 };
 
 struct BuildPlan {

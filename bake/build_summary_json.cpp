@@ -57,6 +57,11 @@ nlohmann::json layer_json(const LayerSummary& l) {
                             {"y", l.non_finite.first_y},
                             {"channel", l.non_finite.first_channel}};
   }
+  // Level-0 values outside [0, 1] that 8-bit storage clipped (psnr_db and runtime count them).
+  j["clipped"] = {{"texels", l.clipped.texels},
+                  {"values", l.clipped.values},
+                  {"min", l.clipped.min_value},
+                  {"max", l.clipped.max_value}};
   return j;
 }
 

@@ -9,6 +9,7 @@
 
 #include "bake/build_plan.h"
 #include "bake/level_store.h"
+#include "common/half.h"
 #include "common/parallel.h"
 
 namespace vt {
@@ -26,10 +27,17 @@ struct Conversion {
         normal(p.normal),
         decode_unorm_normal(p.decode_unorm_normal),
         colour(p.colour),
+        clips((p.spec.texel_type == TexelType::kU8 && !p.normal) ||
+              p.spec.texel_type == TexelType::kF16),
+        clip_limit(p.spec.texel_type == TexelType::kF16 ? kHalfMax : 1.0f),
         to_linear(p.to_linear) {}
   uint32_t source_channels, work_channels;
   int alpha;
   bool normal, decode_unorm_normal, colour;
+  // Stored in 8 bits, values outside [0, 1] are clipped (normals never are); in half floats,
+  // values beyond +-kHalfMax. Alpha is clamped to [0, 1] whatever the storage.
+  bool clips;
+  float clip_limit;  // 1 or kHalfMax
   std::shared_ptr<const ColorConverter> to_linear;
 };
 
@@ -45,9 +53,11 @@ class Level0Converter {
         width_(width),
         policy_(policy),
         threads_(threads),
-        counted_(height, false) {}
+        counted_(height, false),
+        clip_counted_(conv_.clips ? height : 0, false) {}
 
   const NonFiniteReport& report() const { return report_; }
+  const ClipReport& clipped() const { return clipped_; }
   const Conversion& conversion() const { return conv_; }
 
   // Counts and reports bad values of source row y once, in raster order; with kError the first
@@ -83,6 +93,40 @@ class Level0Converter {
       return Error(ErrorCode::kInvalidArgument, where_ + buf);
     }
     return Status::Ok();
+  }
+
+  // Counts the values of row y that the layer's storage clips, once: `src` is the source row,
+  // `work` the row convert() made of it.
+  void count_clipped(uint32_t y, const float* src, const float* work) {
+    if (!conv_.clips || clip_counted_[y]) return;
+    clip_counted_[y] = true;
+    const uint32_t sc = conv_.source_channels, wc = conv_.work_channels;
+    const float hi = conv_.clip_limit, lo = hi == 1.0f ? 0.0f : -hi;
+    auto out_of_range = [&](float v, bool& any, float lo, float hi) {
+      if (!(v < lo || v > hi) || std::abs(v) >= kFloatMax) return;  // in range or non-finite
+      if (clipped_.values == 0) clipped_.max_value = clipped_.min_value = v;
+      clipped_.max_value = std::max(clipped_.max_value, v);
+      clipped_.min_value = std::min(clipped_.min_value, v);
+      ++clipped_.values;
+      any = true;
+    };
+    for (uint32_t x = 0; x < width_; ++x) {
+      const float* s = src + size_t(x) * sc;
+      const float* d = work + size_t(x) * wc;
+      bool any = false;
+      if (conv_.colour) {
+        // Linear colour as stored (unpremultiplied); negatives were fixed and reported.
+        const float a = conv_.alpha >= 0 ? d[conv_.alpha] : 1.0f;
+        if (a > 0)
+          for (int c = 0; c < 3; ++c)
+            if (d[c] < kFloatMax) out_of_range(d[c] / a, any, lo, hi);
+        // The source alpha, before its clamp.
+        if (conv_.alpha >= 0) out_of_range(s[sc - 1], any, 0.0f, 1.0f);
+      } else {
+        for (uint32_t c = 0; c < wc; ++c) out_of_range(d[c], any, lo, hi);
+      }
+      clipped_.texels += any;
+    }
   }
 
   // Converts `rows` source rows into working rows, on all threads. `src` may equal `dst` when
@@ -158,6 +202,8 @@ class Level0Converter {
   int threads_;
   std::vector<bool> counted_;
   NonFiniteReport report_;
+  std::vector<bool> clip_counted_;
+  ClipReport clipped_;
 };
 
 // Level 0 read from the source and converted as the build asks for rows.
@@ -174,6 +220,7 @@ class StreamedLevel0 final : public LevelSource {
   uint32_t height() const override { return source_->info().height; }
   uint32_t channels() const override { return converter_.conversion().work_channels; }
   NonFiniteReport non_finite() const override { return converter_.report(); }
+  ClipReport clipped() const override { return converter_.clipped(); }
 
   Status read(uint32_t y0, uint32_t y1, float* out) override {
     const size_t in_row = size_t(width()) * converter_.conversion().source_channels;
@@ -184,6 +231,11 @@ class StreamedLevel0 final : public LevelSource {
         VT_RETURN_IF_ERROR(converter_.scan_row(y, raw_.data() + size_t(y - y0) * in_row));
     }
     converter_.convert(raw_.data(), out, y1 - y0);
+    if (count_) {
+      for (uint32_t y = y0; y < y1; ++y)
+        converter_.count_clipped(y, raw_.data() + size_t(y - y0) * in_row,
+                                 out + size_t(y - y0) * row_floats());
+    }
     return Status::Ok();
   }
 
@@ -197,8 +249,8 @@ class StreamedLevel0 final : public LevelSource {
 // Level 0 converted whole, with its coverage mask, and dilated.
 class HeldLevel0 final : public LevelSource {
  public:
-  HeldLevel0(std::unique_ptr<LevelStore> store, NonFiniteReport report)
-      : store_(std::move(store)), report_(report) {}
+  HeldLevel0(std::unique_ptr<LevelStore> store, NonFiniteReport report, ClipReport clipped)
+      : store_(std::move(store)), report_(report), clipped_(clipped) {}
   uint32_t width() const override { return store_->width(); }
   uint32_t height() const override { return store_->height(); }
   uint32_t channels() const override { return store_->channels(); }
@@ -206,10 +258,12 @@ class HeldLevel0 final : public LevelSource {
   const uint8_t* coverage() const override { return store_->coverage(); }
   bool in_memory() const override { return store_->in_memory(); }
   NonFiniteReport non_finite() const override { return report_; }
+  ClipReport clipped() const override { return clipped_; }
 
  private:
   std::unique_ptr<LevelStore> store_;
   NonFiniteReport report_;
+  ClipReport clipped_;
 };
 
 Expected<std::shared_ptr<LevelSource>> hold_level0(const LayerInput& input, const LayerPlan& plan,
@@ -250,11 +304,15 @@ Expected<std::shared_ptr<LevelSource>> hold_level0(const LayerInput& input, cons
     for (uint32_t r = y; r < y1; ++r)
       VT_RETURN_IF_ERROR(converter.scan_row(r, src + size_t(r - y) * in_row));
     converter.convert(src, dst, y1 - y);
+    // (Converted in place, the source alpha is already clamped: only colour is counted.)
+    for (uint32_t r = y; r < y1; ++r)
+      converter.count_clipped(r, src + size_t(r - y) * in_row, dst + size_t(r - y) * out_row);
     if (!in_memory) VT_RETURN_IF_ERROR(store->write_rows(y, y1 - y, dst));
   }
   VT_RETURN_IF_ERROR(store->set_coverage_and_dilate(input.coverage, dilation_budget(options),
                                                     scratch_dir_for(options)));
-  return std::shared_ptr<LevelSource>(new HeldLevel0(std::move(store), converter.report()));
+  return std::shared_ptr<LevelSource>(
+      new HeldLevel0(std::move(store), converter.report(), converter.clipped()));
 }
 
 }  // namespace

@@ -30,6 +30,8 @@ class LevelSource {
   virtual bool in_memory() const { return false; }
   // NaN, Inf and negative values the source held (level 0; counted once per texel).
   virtual NonFiniteReport non_finite() const { return {}; }
+  // Level 0 of an 8-bit layer: the values its storage clips (counted once per texel).
+  virtual ClipReport clipped() const { return {}; }
 };
 
 // Level 0 of `input` as `plan` converts it. Without a coverage mask it streams: rows are read

@@ -1,6 +1,7 @@
 #include "bake/page_encoder.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 
@@ -20,7 +21,40 @@ void measure(const uint8_t* a, const uint8_t* b, size_t n, EncodedPage& out) {
   out.samples = n;
 }
 
+// The same against unclipped reference values (8-bit code units, unrounded).
+void measure(const float* reference, const uint8_t* b, size_t n, EncodedPage& out) {
+  double sse = 0, mx = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const double d = double(reference[i]) - double(b[i]);
+    sse += d * d;
+    mx = std::max(mx, std::abs(d));
+  }
+  out.squared_error = sse;
+  out.max_error = uint32_t(std::min(std::round(mx), double(UINT32_MAX)));
+  out.samples = n;
+}
+
 }  // namespace
+
+Expected<FloatTexels> parse_float_texels(const std::string& name) {
+  if (name == "auto") return FloatTexels::kAuto;
+  if (name == "half") return FloatTexels::kHalf;
+  if (name == "float") return FloatTexels::kFloat;
+  return Status(ErrorCode::kInvalidArgument,
+                "unknown float storage '" + name + "' (expected auto, half or float)");
+}
+
+const char* to_string(FloatTexels v) {
+  switch (v) {
+    case FloatTexels::kAuto:
+      return "auto";
+    case FloatTexels::kHalf:
+      return "half";
+    case FloatTexels::kFloat:
+      return "float";
+  }
+  return "?";
+}
 
 BcFormat bc_format_for(LayerSemantic semantic, uint32_t channels) {
   if (semantic == LayerSemantic::kNormal) return BcFormat::kBc5;
@@ -116,7 +150,7 @@ Status PageEncoder::use_tables(std::span<const uint8_t> bytes) {
   return Status::Ok();
 }
 
-Status PageEncoder::encode(const uint8_t* texels, EncodedPage& out) const {
+Status PageEncoder::encode(const uint8_t* texels, EncodedPage& out, const float* reference) const {
   out.bytes.clear();
   out.squared_error = 0;
   out.max_error = 0;
@@ -127,24 +161,38 @@ Status PageEncoder::encode(const uint8_t* texels, EncodedPage& out) const {
     out.state = PageState::kConstant;
     std::memset(out.constant, 0, sizeof(out.constant));
     std::memcpy(out.constant, texels, layer_.texel_bytes());
+    // Exact, and not counted, unless clipped: then what clipping lost counts.
+    if (reference) measure(reference, texels, page_bytes(), out);
     return Status::Ok();
   }
   out.state = PageState::kStored;
   if (!layer_.lossy()) {
     VT_RETURN_IF_ERROR(layer_.encode(texels, settings_, out.bytes));
-    return measure_runtime(texels, texels, out);
+    if (spec_.texel_type == TexelType::kU8) {
+      // Exact unless clipped: every page counts, so a layer's PSNR covers all its pages.
+      if (reference) {
+        measure(reference, texels, page_bytes(), out);
+      } else {
+        out.samples = page_bytes();
+      }
+    }
+    return measure_runtime(texels, texels, reference, out);
   }
   // BC formats store fewer channels than some layers hold (BC1 has no alpha): compare only
   // what the format keeps.
   thread_local std::vector<uint8_t> back;
   back.resize(page_bytes());
   VT_RETURN_IF_ERROR(layer_.encode(texels, settings_, out.bytes, back.data(), &out.dct_mode));
-  measure(texels, back.data(), back.size(), out);
-  return measure_runtime(texels, back.data(), out);
+  if (reference) {
+    measure(reference, back.data(), back.size(), out);
+  } else {
+    measure(texels, back.data(), back.size(), out);
+  }
+  return measure_runtime(texels, back.data(), reference, out);
 }
 
 Status PageEncoder::measure_runtime(const uint8_t* texels, const uint8_t* stored,
-                                    EncodedPage& out) const {
+                                    const float* reference, EncodedPage& out) const {
   const std::optional<BcFormat> bc = layer_.bc_format();
   if (!bc || spec_.texel_type != TexelType::kU8) return Status::Ok();
   thread_local std::vector<uint8_t> blocks;
@@ -155,7 +203,8 @@ Status PageEncoder::measure_runtime(const uint8_t* texels, const uint8_t* stored
     own = blocks.data();
   }
   return measure_runtime_error(*bc, spec_.semantic == LayerSemantic::kNormal, texels, stored, own,
-                               int(layer_.page_size()), int(layer_.texel_bytes()), out.runtime);
+                               int(layer_.page_size()), int(layer_.texel_bytes()), out.runtime,
+                               reference);
 }
 
 Status PageEncoder::decode(std::span<const uint8_t> data, uint8_t* texels) const {

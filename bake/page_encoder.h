@@ -22,8 +22,20 @@ namespace vt {
 // The codec a build asks for; the exact PageCodec and runtime format follow from the layer.
 enum class CodecKind : uint8_t { kDct = 0, kBc = 1, kRaw = 2 };
 
+// How a colour or data layer whose source holds floats (EXR, float TIFF, HDR) is stored.
+// Normal layers are 8-bit whatever the source.
+enum class FloatTexels : uint8_t {
+  kAuto = 0,   // 32-bit float with CodecKind::kRaw, else 8 bits in the codec asked for: values
+               // outside [0, 1] are clipped, counted and warned about (LayerSummary::clipped)
+  kHalf = 1,   // half float, raw + zstd whatever the codec (RGBA16F at run time)
+  kFloat = 2,  // 32-bit float, raw + zstd (RGBA32F at run time)
+};
+Expected<FloatTexels> parse_float_texels(const std::string& name);
+const char* to_string(FloatTexels v);
+
 struct PageEncoderOptions {
   CodecKind codec = CodecKind::kDct;
+  FloatTexels float_texels = FloatTexels::kAuto;
   int dct_quality = 75;
   bool dct_adaptive = false;  // DctSettings::adaptive: smaller pages, slower decoding
   BcQuality bc_quality = BcQuality::kNormal;
@@ -43,11 +55,14 @@ struct EncodedPage {
   PageState state = PageState::kStored;
   std::vector<uint8_t> bytes;  // kStored: the coded page
   uint8_t constant[16] = {};   // kConstant: the texel value
-  double squared_error = 0.0;  // lossy: sum over channels and texels, in 8-bit units
-  uint32_t max_error = 0;      // lossy: largest absolute channel error (8-bit units)
-  uint64_t samples = 0;        // channel values compared
-  uint8_t dct_mode = 0;        // DCT layers: the page mode chosen (format/dct_page_modes.h)
-  RuntimeError runtime;        // after the runtime BC format (layers that have one)
+  // Against the texels given (or their unclipped reference): the sum over channels and texels,
+  // in 8-bit units; 0 for a lossless page without a reference. A constant page is measured
+  // (samples > 0) only with a reference.
+  double squared_error = 0.0;
+  uint32_t max_error = 0;  // largest absolute channel error (8-bit units, rounded)
+  uint64_t samples = 0;    // channel values compared (every stored 8-bit page's)
+  uint8_t dct_mode = 0;    // DCT layers: the page mode chosen (format/dct_page_modes.h)
+  RuntimeError runtime;    // after the runtime BC format (layers that have one)
 };
 
 class PageEncoder {
@@ -57,8 +72,11 @@ class PageEncoder {
   static Expected<PageEncoder> create(LayerSpec& layer, const PageEncoderOptions& options,
                                       uint32_t page_size);
 
-  // Encodes page_size^2 texels of layer.texel_bytes() each. Thread-safe.
-  Status encode(const uint8_t* texels, EncodedPage& out) const;
+  // Encodes page_size^2 texels of layer.texel_bytes() each. Thread-safe. `reference`, when not
+  // null (8-bit layers), holds what the texels were before clipping (page_bytes() values in
+  // 8-bit code units, LayerPlan::store_page): the errors, stored and runtime, are measured
+  // against it, so a lossless page of clipped texels reports what clipping lost.
+  Status encode(const uint8_t* texels, EncodedPage& out, const float* reference = nullptr) const;
   // Decodes a stored page back to texels (tests and verification). Thread-safe.
   Status decode(std::span<const uint8_t> bytes, uint8_t* texels) const;
   // True when every texel of the page equals the first (such a page is stored as a constant).
@@ -83,7 +101,8 @@ class PageEncoder {
         spec_(spec),
         settings_{options.zstd_level, options.bc_quality, options.dct_page_modes,
                   options.min_psnr} {}
-  Status measure_runtime(const uint8_t* texels, const uint8_t* stored, EncodedPage& out) const;
+  Status measure_runtime(const uint8_t* texels, const uint8_t* stored, const float* reference,
+                         EncodedPage& out) const;
 
   LayerCodec layer_;
   LayerSpec spec_;  // the completed layer, for remaking layer_ with trained tables

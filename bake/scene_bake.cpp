@@ -125,8 +125,8 @@ std::string range_warning(const LayerRange& r) {
   std::string line =
       r.layer + ": " + with_thousands(r.texels_above_one) + " texels above 1.0 (max " + max + ")";
   return r.clipped ? line +
-                         " clipped: the layer stores 8 bits (HDR storage comes with BC6H; "
-                         "--codec raw keeps float)"
+                         " clipped: the layer stores 8 bits (--float-texels half or float "
+                         "keeps float)"
                    : line + " kept: the layer stores float";
 }
 
@@ -326,7 +326,10 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   summary.build = std::move(built).value();
   for (const std::string& w : summary.build.warnings) summary.warnings.push_back(w);
   mark_clipped(summary.build, summary.above_one);
-  for (const LayerRange& r : summary.above_one) summary.warnings.push_back(range_warning(r));
+  // A clipped layer has the build's own line (BuildSummary::warnings, with the clipped count
+  // and range); a layer that keeps its floats is said here.
+  for (const LayerRange& r : summary.above_one)
+    if (!r.clipped) summary.warnings.push_back(range_warning(r));
   summary.stages.push_back({"build", seconds_since(t0)});
 
   // The unwrapped scene beside it.

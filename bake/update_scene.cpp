@@ -97,6 +97,8 @@ void add_options(KeyStream& k, const SceneBakeOptions& o) {
   const BuildOptions& b = o.build;
   k.add(b.codec.codec), k.add(b.codec.dct_quality), k.add(b.codec.dct_adaptive);
   k.add(b.codec.bc_quality), k.add(b.codec.zstd_level);
+  k.add(b.codec.dct_page_modes), k.add(b.codec.min_psnr), k.add(b.codec.float_texels);
+  for (const auto& [name, db] : b.codec.layer_min_psnr) k.add(name), k.add(db);
   k.add(b.payload), k.add(b.border), k.add(b.filter), k.add(b.non_finite);
   k.add(b.alpha_coverage_reference);
   // The limit caps the atlas size the sources' density asks for; a given size it does not change

@@ -28,6 +28,14 @@ struct Case {
   std::vector<std::vector<uint8_t>> pages;
 };
 
+// The top `n` (<= 31) of Lcg64::next()'s 31 random bits: 0 .. 2^n - 1. (next() is s >> 33:
+// its bit 31 is always 0, so `next() >> 31` is always 0 and a shift of 32 or more is undefined;
+// GCC folded the first version's 64-bit shifts to 0, which made text/UI a blank panel and
+// pixel art black.)
+uint32_t bits(Lcg64& rng, int n) {
+  return rng.next() >> (31 - n);
+}
+
 void put(std::vector<uint8_t>& p, int size, int ch, int x, int y, const uint8_t* v) {
   std::copy(v, v + ch, &p[(size_t(y) * size + x) * ch]);
 }
@@ -50,10 +58,9 @@ std::vector<uint8_t> text_atlas(int size, int i) {
   Lcg64 rng{uint64_t(100 + i)};
   std::vector<uint8_t> p(size_t(size) * size * 3, 235);
   for (int b = 0; b < 3; ++b) {
-    const int x0 = int(rng.next() >> 26), y0 = int(rng.next() >> 26);
-    const int w = 24 + int(rng.next() >> 27), h = 12 + int(rng.next() >> 28);
-    const uint8_t fill[3] = {uint8_t(rng.next() >> 24), uint8_t(rng.next() >> 24),
-                             uint8_t(rng.next() >> 24)};
+    const int x0 = int(bits(rng, 6)), y0 = int(bits(rng, 6));
+    const int w = 24 + int(bits(rng, 5)), h = 12 + int(bits(rng, 4));
+    const uint8_t fill[3] = {uint8_t(bits(rng, 8)), uint8_t(bits(rng, 8)), uint8_t(bits(rng, 8))};
     const uint8_t edge[3] = {20, 20, 20};
     for (int y = y0; y < std::min(size, y0 + h); ++y)
       for (int x = x0; x < std::min(size, x0 + w); ++x)
@@ -62,11 +69,11 @@ std::vector<uint8_t> text_atlas(int size, int i) {
   }
   for (int cy = 2; cy + 8 <= size; cy += 10)
     for (int cx = 2; cx + 6 <= size; cx += 7) {
-      if (rng.next() >> 30 == 0) continue;  // spaces
+      if (bits(rng, 2) == 0) continue;  // spaces, one in four
       const uint8_t ink[3] = {15, 15, uint8_t(40 * (i % 3))};
       for (int s = 0; s < 3; ++s) {
-        const bool horizontal = rng.next() >> 31;
-        const int o = int(rng.next() >> 29) % (horizontal ? 8 : 6);
+        const bool horizontal = bits(rng, 1);
+        const int o = int(bits(rng, 3)) % (horizontal ? 8 : 6);
         for (int k = 0; k < (horizontal ? 6 : 8); ++k)
           put(p, size, 3, horizontal ? cx + k : cx + o, horizontal ? cy + o : cy + k, ink);
       }
@@ -96,11 +103,11 @@ std::vector<uint8_t> pixel_art(int size, int i) {
   Lcg64 rng{uint64_t(200 + i)};
   uint8_t palette[16][3];
   for (auto& c : palette)
-    for (int k = 0; k < 3; ++k) c[k] = (rng.next() >> 31) ? 255 : uint8_t((rng.next() >> 30) * 60);
+    for (int k = 0; k < 3; ++k) c[k] = bits(rng, 1) ? 255 : uint8_t(bits(rng, 2) * 60);
   std::vector<uint8_t> p(size_t(size) * size * 3);
   std::vector<int> cells(size_t(size / 4) * (size / 4));
   for (size_t k = 0; k < cells.size(); ++k)
-    cells[k] = (k > 0 && (rng.next() >> 30) != 0) ? cells[k - 1] : int(rng.next() >> 28);
+    cells[k] = (k > 0 && bits(rng, 2) != 0) ? cells[k - 1] : int(bits(rng, 4));
   for (int y = 0; y < size; ++y)
     for (int x = 0; x < size; ++x)
       put(p, size, 3, x, y, palette[cells[size_t(y / 4) * (size / 4) + x / 4]]);

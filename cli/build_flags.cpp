@@ -35,6 +35,16 @@ void add_build_flags(CLI::App& app, BuildOptions& o) {
       },
       "DCT error floor: no page below DB (PSNR over its channels, stored codec); DB for every "
       "layer or LAYER=DB, repeatable");
+  app.add_option_function<std::string>(
+      "--float-texels",
+      [&o](const std::string& name) {
+        auto kind = parse_float_texels(name);
+        throw_if_error("--float-texels", kind.status());
+        o.codec.float_texels = *kind;
+      },
+      "Float sources (EXR, HDR) of colour and data layers: auto (default: float with --codec "
+      "raw, else 8 bits in the codec, values outside [0, 1] clipped with a warning), half (half "
+      "float, raw + zstd whatever the codec; RGBA16F at run time) or float (32-bit, RGBA32F)");
   app.add_flag_callback(
       "--no-page-modes", [&o] { o.codec.dct_page_modes = false; },
       "DCT: every page in the tables' own mode (no per-page 4:4:4, finer or lossless choice)");

@@ -60,7 +60,7 @@ double RuntimeError::angle_p99_deg() const {
 
 Status measure_runtime_error(BcFormat format, bool normal, const uint8_t* source,
                              const uint8_t* stored, const uint8_t* bc_blocks, int size,
-                             int channels, RuntimeError& out) {
+                             int channels, RuntimeError& out, const float* reference) {
   out = RuntimeError{};
   thread_local std::vector<uint8_t> blocks, landed;
   if (!bc_blocks) {
@@ -73,15 +73,28 @@ Status measure_runtime_error(BcFormat format, bool normal, const uint8_t* source
   VT_RETURN_IF_ERROR(bc_decode_image(format, bc_blocks, size, size, channels, landed.data()));
   const int kept = std::min(channels, bc_format_channels(format));
   const size_t texels = size_t(size) * size;
-  uint64_t sse = 0;
-  for (size_t i = 0; i < texels; ++i) {
-    for (int c = 0; c < kept; ++c) {
-      const int d = int(source[i * channels + c]) - int(landed[i * channels + c]);
-      sse += uint64_t(d * d);
-      out.max_error = std::max<uint32_t>(out.max_error, uint32_t(std::abs(d)));
+  if (reference) {
+    double sse = 0, mx = 0;
+    for (size_t i = 0; i < texels; ++i) {
+      for (int c = 0; c < kept; ++c) {
+        const double d = double(reference[i * channels + c]) - double(landed[i * channels + c]);
+        sse += d * d;
+        mx = std::max(mx, std::abs(d));
+      }
     }
+    out.squared_error = sse;
+    out.max_error = uint32_t(std::min(std::round(mx), double(UINT32_MAX)));
+  } else {
+    uint64_t sse = 0;
+    for (size_t i = 0; i < texels; ++i) {
+      for (int c = 0; c < kept; ++c) {
+        const int d = int(source[i * channels + c]) - int(landed[i * channels + c]);
+        sse += uint64_t(d * d);
+        out.max_error = std::max<uint32_t>(out.max_error, uint32_t(std::abs(d)));
+      }
+    }
+    out.squared_error = double(sse);
   }
-  out.squared_error = double(sse);
   out.samples = texels * size_t(kept);
   if (normal && channels >= 2) {
     out.angle_histogram.assign(RuntimeError::kAngleBins, 0);

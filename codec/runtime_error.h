@@ -31,11 +31,13 @@ struct RuntimeError {
   double angle_p99_deg() const;
 };
 
-// `landed` receives nothing; `source` and `stored` are size x size texels of `channels` bytes
-// (stored: what the page decodes to). `bc_blocks`, when not null, are the page's own BC blocks
-// (a BC layer), used as they are instead of encoding `stored`.
+// `source` and `stored` are size x size texels of `channels` bytes (stored: what the page
+// decodes to). `bc_blocks`, when not null, are the page's own BC blocks (a BC layer), used as
+// they are instead of encoding `stored`. `reference`, when not null, is what the source was
+// before it was clipped to 8 bits (size * size * channels values in 8-bit code units): the
+// squared and largest errors are measured against it instead (the angles against `source`).
 Status measure_runtime_error(BcFormat format, bool normal, const uint8_t* source,
                              const uint8_t* stored, const uint8_t* bc_blocks, int size,
-                             int channels, RuntimeError& out);
+                             int channels, RuntimeError& out, const float* reference = nullptr);
 
 }  // namespace vt

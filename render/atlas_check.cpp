@@ -15,6 +15,7 @@
 #include "bake/transfer.h"
 #include "codec/bc.h"
 #include "codec/metrics.h"
+#include "common/half.h"
 #include "common/parallel.h"
 #include "format/runtime_format.h"
 #include "render/report.h"
@@ -125,6 +126,14 @@ void store_reference(const ReferenceLayer& r, float* t, size_t n, uint8_t* out) 
       for (int c = 0; c < 3; ++c) t[i * wc + c] = a > 0 ? t[i * wc + c] / a : 0.0f;
     }
   }
+  if (r.spec.texel_type == TexelType::kF16) {
+    if (r.to_storage) r.to_storage->apply(t, n, int(wc));
+    for (size_t i = 0; i < n * wc; ++i) {
+      const uint16_t h = float_to_half(t[i]);
+      std::memcpy(out + 2 * i, &h, 2);
+    }
+    return;
+  }
   if (r.spec.texel_type != TexelType::kU8) {
     if (r.to_storage) r.to_storage->apply(t, n, int(wc));
     std::memcpy(out, t, n * wc * sizeof(float));
@@ -174,6 +183,17 @@ Status measure_page(const ReferenceLayer& r, const uint8_t* ref, const uint8_t* 
   if (r.spec.texel_type != TexelType::kU8) {
     const float* a = reinterpret_cast<const float*>(ref);
     const float* b = reinterpret_cast<const float*>(test);
+    thread_local std::vector<float> ref_f, test_f;  // half pages, widened to float
+    if (r.spec.texel_type == TexelType::kF16) {
+      const size_t values = n * r.spec.channels;
+      ref_f.resize(values), test_f.resize(values);
+      for (size_t i = 0; i < values; ++i) {
+        uint16_t h[2];
+        std::memcpy(&h[0], ref + 2 * i, 2), std::memcpy(&h[1], test + 2 * i, 2);
+        ref_f[i] = half_to_float(h[0]), test_f[i] = half_to_float(h[1]);
+      }
+      a = ref_f.data(), b = test_f.data();
+    }
     e.psnr = float_psnr(a, b, n * r.spec.channels, &e.max_abs);
     e.mean_shift = mean_shift(a, b, n, r.spec.channels);
     return Status::Ok();
@@ -419,7 +439,11 @@ Status uploaded_texels(const PageSource& source, const LayerSpec& spec, const Pa
   const RuntimeFormatInfo& info = *runtime_format_info(source.upload_format(layer));
   if (info.bc) return bc_decode_image(*info.bc, upload.data(), ps, ps, spec.channels, out);
   if (info.is_float) {
-    std::memcpy(out, upload.data(), size_t(ps) * ps * spec.texel_bytes());
+    // The upload widens float texels to the format's channels (RGBA16F, RGBA32F): keep the
+    // layer's own.
+    const size_t n = size_t(ps) * ps, tb = spec.texel_bytes();
+    const size_t upload_tb = tb / std::max<uint32_t>(spec.channels, 1) * info.channels;
+    for (size_t t = 0; t < n; ++t) std::memcpy(out + t * tb, upload.data() + t * upload_tb, tb);
     return Status::Ok();
   }
   const size_t n = size_t(ps) * ps;

@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <OpenImageIO/imageio.h>
+
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "tests/cli/cli_test_util.h"
 
@@ -49,6 +52,47 @@ TEST_F(Reports, BuildJsonIsTheNestedSchema) {
   EXPECT_EQ(j["bytes"]["raw"], (300 * 200 + 150 * 100 + 75 * 50) * 3);  // 3 levels of RGB8
   EXPECT_TRUE(j["layers"][0]["psnr_db"].is_null());                     // raw is lossless
   EXPECT_GT(j["seconds"].size(), 0u);
+}
+
+// An HDR EXR in the default (8-bit DCT) layer: one warning naming the file, the JSON's clipped
+// counts, a PSNR that counts the clipping; --float-texels half keeps the values.
+TEST_F(Reports, ClippedHdrIsWarnedAboutAndHalfKeepsIt) {
+  const std::string exr = dir_ + "/hdr.exr";
+  {
+    std::vector<float> t(64 * 48 * 3, 0.25f);
+    for (int x = 0; x < 10; ++x) t[size_t(20 * 64 + x) * 3] = 8.0f;  // ten texels, red at 8
+    auto out = OIIO::ImageOutput::create(exr);
+    ASSERT_TRUE(out);
+    ASSERT_TRUE(out->open(exr, OIIO::ImageSpec(64, 48, 3, OIIO::TypeDesc::HALF)));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, t.data()));
+    ASSERT_TRUE(out->close());
+  }
+  auto r = run_vtbake("build " + exr + " --payload 24 -o " + dir_ + "/h.vtpf", true);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("warning: " + exr +
+                       ": layer 'albedo': 10 texels (10 values) outside [0, 1], "
+                       "up to 8, clipped by its 8-bit dct storage"),
+            std::string::npos)
+      << r.out;
+  r = run_vtbake("--json build " + exr + " --payload 24 -o " + dir_ + "/h.vtpf", false);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["warnings"].size(), 1u);
+  EXPECT_EQ(j["layers"][0]["clipped"]["texels"], 10);
+  EXPECT_EQ(j["layers"][0]["clipped"]["max"], 8.0);
+  EXPECT_LT(j["layers"][0]["psnr_db"].get<double>(), 40.0);  // sRGB(8) is code 626, not 255
+
+  r = run_vtbake("--json build " + exr + " --payload 24 --float-texels half -o " + dir_ + "/f.vtpf",
+                 false);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_FALSE(j.contains("warnings"));
+  EXPECT_EQ(j["layers"][0]["texel_type"], "f16");
+  EXPECT_EQ(j["layers"][0]["runtime_format"], "rgba16f");
+  EXPECT_EQ(j["layers"][0]["clipped"]["texels"], 0);
+  EXPECT_EQ(
+      run_vtbake("build " + exr + " --float-texels bc6h -o " + dir_ + "/g.vtpf", false).exit_code,
+      2);
 }
 
 TEST_F(Reports, SceneBakeNestsTheBuildSchema) {

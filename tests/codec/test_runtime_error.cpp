@@ -35,6 +35,20 @@ TEST(RuntimeError, MeasuresAgainstTheSourceNotTheStoredTexels) {
   EXPECT_GT(e.max_error, 0u);
 }
 
+TEST(RuntimeError, AnUnclippedReferenceCountsWhatClippingLost) {
+  // White stored (exact in BC1) where the source was brighter: code 400 before clipping.
+  std::vector<uint8_t> page(size_t(kSize) * kSize * 3, 255);
+  std::vector<float> reference(page.size(), 255.0f);
+  reference[0] = 400.0f;
+  RuntimeError e;
+  ASSERT_TRUE(measure_runtime_error(BcFormat::kBc1, false, page.data(), page.data(), nullptr, kSize,
+                                    3, e, reference.data())
+                  .ok());
+  EXPECT_EQ(e.squared_error, 145.0 * 145.0);
+  EXPECT_EQ(e.max_error, 145u);
+  EXPECT_EQ(e.samples, uint64_t(kSize) * kSize * 3);
+}
+
 TEST(RuntimeError, StoredBlocksAreUsedAsTheyAre) {
   std::vector<uint8_t> page(size_t(kSize) * kSize * 3, 0);
   // Blocks that decode to white everywhere: c0 = c1 = 0xFFFF, indices 0.

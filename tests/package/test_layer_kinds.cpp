@@ -42,10 +42,12 @@ std::shared_ptr<ImageSource> test_image(uint32_t channels, bool is_float) {
   return std::make_shared<MemoryImageSource>(info, std::move(texels));
 }
 
-std::string kind_name(LayerSemantic semantic, uint32_t channels, bool is_float, CodecKind codec) {
+std::string kind_name(LayerSemantic semantic, uint32_t channels, bool is_float, CodecKind codec,
+                      FloatTexels float_texels) {
   static const char* codecs[] = {"dct", "bc", "raw"};
   return std::string(to_string(semantic)) + "_" + std::to_string(channels) +
-         (is_float ? "ch_float_" : "ch_u8_") + codecs[int(codec)];
+         (is_float ? "ch_float_" : "ch_u8_") + codecs[int(codec)] +
+         (float_texels == FloatTexels::kHalf ? "_half" : "");
 }
 
 // Streams every level-0 page of `path` and checks uploads against the file's decoded texels
@@ -91,10 +93,14 @@ void expect_streams(const std::string& path, const std::string& kind) {
           if (c < layer.channels) {
             ASSERT_EQ(std::memcmp(got, texels.data() + t * layer.texel_bytes + c * cb, cb), 0)
                 << kind << " texel " << t << " channel " << c;
-          } else if (cb == 4) {  // the baker writes float, never half
+          } else if (cb == 4) {
             float v = 0;
             std::memcpy(&v, got, sizeof v);
             ASSERT_EQ(v, c == 3 ? 1.0f : 0.0f) << kind << " widened channel " << c;
+          } else {
+            uint16_t v = 0;
+            std::memcpy(&v, got, sizeof v);
+            ASSERT_EQ(v, c == 3 ? 0x3c00 : 0) << kind << " widened half channel " << c;
           }
         }
     }
@@ -116,37 +122,43 @@ TEST(LayerKinds, EveryLayerTheBakerWritesStreams) {
         LayerSemantic::kEmissive, LayerSemantic::kCustom})
     for (uint32_t channels = 1; channels <= 4; ++channels)
       for (bool is_float : {false, true})
-        for (CodecKind codec : {CodecKind::kDct, CodecKind::kBc, CodecKind::kRaw}) {
-          const std::string kind = kind_name(semantic, channels, is_float, codec);
-          BuildOptions o;
-          LayerInput in;
-          in.semantic = semantic;
-          in.source = test_image(channels, is_float);
-          o.layers.push_back(in);
-          o.payload = 8;
-          o.threads = 1;
-          o.codec.codec = codec;
-          o.output = (dir / (kind + ".vtpf")).string();
-          auto built = build_page_file(o);
-          if (!built.ok()) {
-            EXPECT_FALSE(built.status().message().empty()) << kind;
-            refused.insert(kind);
-            continue;
+        for (CodecKind codec : {CodecKind::kDct, CodecKind::kBc, CodecKind::kRaw})
+          for (FloatTexels float_texels : {FloatTexels::kAuto, FloatTexels::kHalf}) {
+            // Half storage is for float sources, and does not depend on the codec asked for.
+            if (float_texels == FloatTexels::kHalf && (!is_float || codec != CodecKind::kDct))
+              continue;
+            const std::string kind = kind_name(semantic, channels, is_float, codec, float_texels);
+            BuildOptions o;
+            LayerInput in;
+            in.semantic = semantic;
+            in.source = test_image(channels, is_float);
+            o.layers.push_back(in);
+            o.payload = 8;
+            o.threads = 1;
+            o.codec.codec = codec;
+            o.codec.float_texels = float_texels;
+            o.output = (dir / (kind + ".vtpf")).string();
+            auto built = build_page_file(o);
+            if (!built.ok()) {
+              EXPECT_FALSE(built.status().message().empty()) << kind;
+              refused.insert(kind);
+              continue;
+            }
+            const LayerSpec& spec = built->layers[0].spec;
+            const std::string layer_kind =
+                std::to_string(spec.channels) + "ch " + to_string(spec.texel_type) + " " +
+                to_string(spec.codec) + " -> " + to_string(spec.runtime_format);
+            written_kinds.insert(layer_kind);
+            expect_streams(o.output, kind + " (" + layer_kind + ")");
           }
-          const LayerSpec& spec = built->layers[0].spec;
-          const std::string layer_kind = std::to_string(spec.channels) + "ch " +
-                                         to_string(spec.texel_type) + " " + to_string(spec.codec) +
-                                         " -> " + to_string(spec.runtime_format);
-          written_kinds.insert(layer_kind);
-          expect_streams(o.output, kind + " (" + layer_kind + ")");
-        }
   // Only a one-channel normal map is refused (a normal needs x and y).
-  EXPECT_EQ(refused, (std::set<std::string>{"normal_1ch_u8_dct", "normal_1ch_u8_bc",
-                                            "normal_1ch_u8_raw", "normal_1ch_float_dct",
-                                            "normal_1ch_float_bc", "normal_1ch_float_raw"}));
+  EXPECT_EQ(refused,
+            (std::set<std::string>{"normal_1ch_u8_dct", "normal_1ch_u8_bc", "normal_1ch_u8_raw",
+                                   "normal_1ch_float_dct", "normal_1ch_float_bc",
+                                   "normal_1ch_float_raw", "normal_1ch_float_dct_half"}));
   // The kinds covered, so a new one the baker learns shows up here.
   for (const std::string& k : written_kinds) std::printf("layer kind: %s\n", k.c_str());
-  EXPECT_GE(written_kinds.size(), 15u);
+  EXPECT_GE(written_kinds.size(), 19u);
   fs::remove_all(dir);
 }
 

@@ -184,6 +184,44 @@ TEST_F(AtlasCheck, RawBakeMatchesItsReferenceExactly) {
   EXPECT_TRUE(r->passed()) << r->failures.front();
 }
 
+// An HDR emissive (strength 4) kept as half floats (--float-texels half) and as 32-bit floats
+// (raw codec): the float layers match their reference, stored and as uploaded (RGBA16F and
+// RGBA32F, widened from RGB).
+TEST_F(AtlasCheck, FloatEmissiveLayersMatchTheirReference) {
+  scene::Scene hdr = original_;
+  for (scene::Material& m : hdr.materials) m.emissive_strength = 4.0f;
+  for (FloatTexels kind : {FloatTexels::kHalf, FloatTexels::kFloat}) {
+    const std::string name = std::string("hdr_") + to_string(kind);
+    SceneBakeOptions o;
+    o.build.output = dir_ + "/" + name + ".vtpf";
+    o.build.codec.float_texels = kind;
+    o.unwrap.size_pages = 4;
+    auto baked = bake_scene(hdr, o);
+    ASSERT_TRUE(baked.ok()) << baked.status().message();
+    const LayerSummary* emissive = nullptr;
+    for (const LayerSummary& l : baked->build.layers)
+      if (l.spec.semantic == LayerSemantic::kEmissive) emissive = &l;
+    ASSERT_NE(emissive, nullptr);
+    EXPECT_EQ(emissive->spec.texel_type,
+              kind == FloatTexels::kHalf ? TexelType::kF16 : TexelType::kF32);
+    auto reader = PageFileReader::open(o.build.output);
+    ASSERT_TRUE(reader.ok());
+    auto unwrapped = scene::load_scene(dir_ + "/" + name + ".glb");
+    ASSERT_TRUE(unwrapped.ok()) << unwrapped.status().message();
+    for (bool stored : {true, false}) {
+      AtlasCheckOptions co;
+      co.stored_texels = stored;
+      auto again = PageFileReader::open(o.build.output);
+      ASSERT_TRUE(again.ok());
+      auto r = check_atlas_pages(std::move(again).value(), hdr, *unwrapped, co);
+      ASSERT_TRUE(r.ok()) << r.status().message();
+      const AtlasLayerReport& l = layer_report(*r, LayerSemantic::kEmissive);
+      EXPECT_EQ(l.pages_failed, 0u) << name << (stored ? " stored" : " uploaded");
+      EXPECT_EQ(l.min_psnr, kPsnrIdentical) << name << (stored ? " stored" : " uploaded");
+    }
+  }
+}
+
 TEST_F(AtlasCheck, UnchangedRewriteStillPasses) {
   AtlasCheckReport r = sabotage("copy", kSame, kNoEdit);
   EXPECT_TRUE(r.passed());

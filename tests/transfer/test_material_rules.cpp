@@ -385,15 +385,20 @@ TEST(TransferRules, SceneBakeReportsClippingMissesAndWarnings) {
   EXPECT_EQ(summary->warnings[1].rfind("material 'Lamp' baseColorTexture: cannot read image", 0),
             0u)
       << summary->warnings[1];
-  auto thousands = [](uint64_t n) {
-    std::string d = std::to_string(n), out;
-    for (size_t i = 0; i < d.size(); ++i)
-      out += (i && (d.size() - i) % 3 == 0 ? "," : "") + d.substr(i, 1);
-    return out;
-  };
-  EXPECT_EQ(summary->warnings[2], "emissive: " + thousands(covered) +
-                                      " texels above 1.0 (max 4) clipped: the layer stores 8 bits "
-                                      "(HDR storage comes with BC6H; --codec raw keeps float)");
+  // The clipped layer's line is the build's (red 4 and green 2 of each covered texel).
+  EXPECT_EQ(summary->warnings[2], "layer 'emissive': " + std::to_string(covered) + " texels (" +
+                                      std::to_string(2 * covered) +
+                                      " values) outside [0, 1], up to 4, clipped by its 8-bit dct "
+                                      "storage; its PSNR counts the clipping (--float-texels half "
+                                      "or float keeps the range)");
+  const LayerSummary* emissive = nullptr;
+  for (const LayerSummary& l : summary->build.layers)
+    if (l.name == "emissive") emissive = &l;
+  ASSERT_NE(emissive, nullptr);
+  EXPECT_EQ(emissive->clipped.texels, covered);
+  EXPECT_EQ(emissive->clipped.max_value, 4.0f);
+  // Against the unclipped values: sRGB(4) is code 465 where 255 is stored, so the PSNR is low.
+  EXPECT_LT(emissive->psnr_db, 20.0);
 
   nlohmann::json j = to_json(*summary);
   ASSERT_EQ(j["transfer"]["above_one"].size(), 1u);
@@ -416,6 +421,22 @@ TEST(TransferRules, SceneBakeReportsClippingMissesAndWarnings) {
   const int e = test::find_layer(**reader, LayerSemantic::kEmissive);
   ASSERT_GE(e, 0);
   test::Level0 level = test::read_level0(**reader, uint32_t(e));
+  EXPECT_EQ(*std::max_element(level.texels.begin(), level.texels.end()), 4.0f);
+
+  // Half-float storage keeps them too, whatever the codec (here the default DCT).
+  o.build.codec.codec = CodecKind::kDct;
+  o.build.codec.float_texels = FloatTexels::kHalf;
+  summary = bake_scene(s, o);
+  ASSERT_TRUE(summary.ok()) << summary.status().message();
+  ASSERT_EQ(summary->above_one.size(), 1u);
+  EXPECT_FALSE(summary->above_one[0].clipped);
+  reader = PageFileReader::open(o.build.output);
+  ASSERT_TRUE(reader.ok());
+  const int h = test::find_layer(**reader, LayerSemantic::kEmissive);
+  ASSERT_GE(h, 0);
+  EXPECT_EQ((*reader)->layers()[h].texel_type, TexelType::kF16);
+  EXPECT_EQ((*reader)->layers()[h].runtime_format, RuntimeFormat::kRgba16f);
+  level = test::read_level0(**reader, uint32_t(h));
   EXPECT_EQ(*std::max_element(level.texels.begin(), level.texels.end()), 4.0f);
 }
 

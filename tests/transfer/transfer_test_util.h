@@ -14,6 +14,7 @@
 
 #include "bake/transfer.h"
 #include "bake/unwrap/unwrap.h"
+#include "common/half.h"
 #include "format/page_file.h"
 #include "samples/sample_scene.h"
 #include "scene/scene.h"
@@ -116,6 +117,10 @@ inline Level0 read_level0(const PageFileReader& r, uint32_t layer) {
             float v;
             if (spec.texel_type == TexelType::kF32) {
               std::memcpy(&v, &page[src + 4 * c], 4);
+            } else if (spec.texel_type == TexelType::kF16) {
+              uint16_t half;
+              std::memcpy(&half, &page[src + 2 * c], 2);
+              v = half_to_float(half);
             } else {
               v = page[src + c] / 255.0f;
             }
