@@ -177,6 +177,13 @@ double mean_shift(const T* ref, const T* test, size_t n, uint32_t channels) {
   return worst;
 }
 
+// A page's PSNR over every channel (alpha and data channels count like colour).
+double all_channel_psnr(const ImageError& err) {
+  double mse = 0;
+  for (int c = 0; c < err.channels; ++c) mse += err.mse[c] / err.channels;
+  return psnr_from_mse(mse);
+}
+
 Status measure_page(const ReferenceLayer& r, const uint8_t* ref, const uint8_t* test, int ps,
                     AtlasPageError& e) {
   const size_t n = size_t(ps) * ps;
@@ -200,9 +207,7 @@ Status measure_page(const ReferenceLayer& r, const uint8_t* ref, const uint8_t* 
   }
   e.mean_shift = mean_shift(ref, test, n, r.spec.channels);
   VT_ASSIGN_OR_RETURN(ImageError err, compare_images(ref, test, ps, ps, r.spec.channels));
-  double mse = 0;
-  for (int c = 0; c < err.channels; ++c) mse += err.mse[c] / err.channels;
-  e.psnr = psnr_from_mse(mse);
+  e.psnr = all_channel_psnr(err);
   e.max_abs = err.max_abs_all;
   if (r.spec.semantic == LayerSemantic::kNormal) {
     VT_ASSIGN_OR_RETURN(AngularError a, normal_angular_error(ref, test, ps, ps, 2));
@@ -229,9 +234,7 @@ Expected<double> runtime_floor_psnr(const ReferenceLayer& r, BcFormat bc, BcQual
   VT_RETURN_IF_ERROR(bc_encode_image(bc, quality, ref, ps, ps, channels, blocks.data()));
   VT_RETURN_IF_ERROR(bc_decode_image(bc, blocks.data(), ps, ps, channels, decoded.data()));
   VT_ASSIGN_OR_RETURN(ImageError err, compare_images(ref, decoded.data(), ps, ps, channels));
-  double mse = 0;
-  for (int c = 0; c < err.channels; ++c) mse += err.mse[c] / err.channels;
-  return psnr_from_mse(mse);
+  return all_channel_psnr(err);
 }
 
 // How close a page is to failing: 0 well inside its bounds, 1 at a bound, above 1 failing.
