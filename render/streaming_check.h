@@ -54,12 +54,19 @@ struct StreamingBounds {
   double min_psnr = 0;               // channels 0-2, whole view
   double min_tile_psnr = 0;          // worst 16 x 16 tile with at least 32 compared pixels
   double max_coverage_mismatch = 0;  // pixels drawn by one render only (alpha test flips)
+  // Pixels whose taps read page borders (StreamingViewMetrics::border_pixels) are bounded apart:
+  // a border is its page's own encoding of the neighbour's texels, which the level texture holds
+  // only once (from the neighbour's payload), so the two differ by up to both pages' codec error.
+  int border_max_abs = 0;
+  double border_max_share_beyond = 0;  // share of border pixels off by more than `steps`
 };
 StreamingBounds default_streaming_bounds(RuntimeFormat cache_format);
 
 struct StreamingViewMetrics {
-  uint64_t pixels = 0;         // compared: drawn by both renders, wanting a level the texture holds
-  uint64_t excluded_fine = 0;  // wanted a dropped fine level
+  // Compared: drawn by both renders, wanting a level the texture holds. max_abs, share_beyond
+  // and pixels_beyond count the pixels that read no page border; psnr and the tiles all of them.
+  uint64_t pixels = 0;
+  uint64_t excluded_fine = 0;        // wanted a dropped fine level
   uint64_t excluded_coarse = 0;      // wanted a dropped coarse level
   uint64_t excluded_fallback = 0;    // sampled a coarser level than wanted (page not resident)
   uint64_t excluded_alpha_edge = 0;  // alpha-tested, alpha a few steps above the cutoff
@@ -70,6 +77,10 @@ struct StreamingViewMetrics {
   uint64_t pixels_beyond = 0;
   double worst_tile_psnr = 0;
   uint32_t worst_tile_x = 0, worst_tile_y = 0;  // its top-left pixel
+  // Compared pixels whose taps read page border texels (the page's own encoding of its
+  // neighbour's texels), with their own largest difference and count beyond `steps`.
+  uint64_t border_pixels = 0, border_beyond = 0;
+  int border_max_abs = 0;
 };
 
 // Compares the virtual-texture frame with the frame rendered from `levels` (same camera, size).

@@ -334,9 +334,11 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
     if (exact) frames.push_back(std::move(frame));
   }
   if (exact) {
-    VT_ASSIGN_OR_RETURN(report.exact,
-                        run_streaming_check(renderer, *source, options.layer, options.address_mode,
-                                            options.exact_meshes, cameras, frames, options.exact));
+    VT_ASSIGN_OR_RETURN(
+        report.exact,
+        run_streaming_check(renderer, options.exact_levels ? *options.exact_levels : *source,
+                            options.layer, options.address_mode, options.exact_meshes, cameras,
+                            frames, options.exact));
     for (size_t v = 0; v < report.exact.views.size(); ++v) {
       const auto& why = report.exact.views[v].failures;
       report.views[v].failures.insert(report.views[v].failures.end(), why.begin(), why.end());

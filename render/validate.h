@@ -178,6 +178,10 @@ struct ValidateOptions {
   // was given) is not empty; it leaves the renderer's reference set to the baked levels.
   StreamingCheckOptions exact;
   std::span<const MeshData> exact_meshes;
+  // The pages the exact check's level texture holds; unset: `source`, what the cache streams.
+  // Another source (the file as written, when the cache is fed from elsewhere) makes the check
+  // see a fault between the file and the cache.
+  std::shared_ptr<const PageSource> exact_levels;
 };
 
 // Validates one layer over `cameras`: per view a cold streamer over `source`, the loop to

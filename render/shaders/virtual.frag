@@ -11,8 +11,9 @@ layout(set = 0, binding = 1) uniform usampler2D u_page_table;
 
 layout(location = 0) in vec2 v_uv;
 layout(location = 0) out vec4 out_color;
-// bit 31 covered; bit 30 alpha-tested with alpha within kAlphaEdge of the cutoff; bits 0-7
-// wanted level; bits 8-15 coarsest level a fine tap sampled.
+// bit 31 covered; bit 30 alpha-tested with alpha within kAlphaEdge of the cutoff; bit 29 a tap
+// read page border texels; bit 28 a coarse-level tap read an ancestor; bits 0-7 wanted level;
+// bits 8-15 coarsest level a fine tap sampled.
 layout(location = 1) out uint out_status;
 
 void main() {
@@ -22,6 +23,7 @@ void main() {
   if (pc.tex.w >= 0.0 && c.a < pc.tex.w) discard;
   bool edge = pc.tex.w >= 0.0 && c.a < pc.tex.w + kAlphaEdge;
   out_color = c;
-  out_status = 0x80000000u | (edge ? 0x40000000u : 0u) | uint(int(floor(f.lod))) |
+  out_status = 0x80000000u | (edge ? 0x40000000u : 0u) |
+               (vt_border_read ? 0x20000000u : 0u) | (vt_coarse_fallback ? 0x10000000u : 0u) | uint(int(floor(f.lod))) |
                (uint(sampled) << 8);
 }
