@@ -96,6 +96,11 @@ struct BuildOptions {
   std::string tables_from;
   bool retrain_tables = false;
   uint64_t input_key = 0;
+  // Sharding over a build farm (bake/shard.h): when set, one flag per task of make_build_tasks.
+  // A band task not flagged still reads its rows and writes its share of the next level (every
+  // shard holds the whole pyramid), but encodes and emits none of its pages: they are another
+  // shard's. Its key is computed all the same.
+  std::shared_ptr<const std::vector<uint8_t>> task_subset;
   std::function<void(const BuildProgress&)> progress;
 };
 
@@ -162,6 +167,10 @@ struct BuildSummary {
   std::vector<StageTime> stages;
   uint64_t plan_hash = 0;           // BuildPlan::hash
   std::vector<uint64_t> task_keys;  // per task of make_build_tasks (0 for level tasks)
+  // Per task: its wall time (s) and, for band tasks, its pages with some coverage (those it
+  // encodes or would encode): the cost figures of a farm's task graph (bake/shard.h).
+  std::vector<double> task_seconds;
+  std::vector<uint32_t> task_pages;
   // What the build could not honour, e.g. a memory limit below its floor (BuildPlan), and one
   // line per layer whose values were clipped (LayerSummary::clipped).
   std::vector<std::string> warnings;

@@ -9,6 +9,7 @@
 
 #include "bake/build_summary_json.h"
 #include "bake/scene_bake.h"
+#include "bake/shard.h"
 #include "cli/build_flags.h"
 #include "cli/cli_util.h"
 #include "cli/command.h"
@@ -22,7 +23,81 @@ namespace {
 struct BakeArgs {
   std::string scene;
   vt::SceneBakeOptions options;
+  // Sharding over a build farm (bake/shard.h, docs/FARM.md).
+  std::string plan, work, shard;
+  std::vector<uint32_t> tasks;
 };
+
+// "I/N" -> (I, N) with 0 <= I < N.
+bool parse_shard(const std::string& text, uint32_t& index, uint32_t& count) {
+  unsigned i = 0, n = 0;
+  char end = 0;
+  if (std::sscanf(text.c_str(), "%u/%u%c", &i, &n, &end) != 2 || n == 0 || i >= n) return false;
+  index = i, count = n;
+  return true;
+}
+
+// `--plan` (and `--work` without a shard): step 1 of a farm bake.
+int run_plan(const BakeArgs& a, const vt::cli::GlobalOptions& global) {
+  auto s = vt::plan_bake(a.scene, a.options, a.work, a.plan);
+  if (!s.ok()) return vt::cli::report_error("bake", s.status());
+  if (global.json) {
+    nlohmann::json stages = nlohmann::json::object();
+    for (const auto& st : s->stages) stages[st.name] = st.seconds;
+    std::printf("%s\n", nlohmann::json{{"plan", s->plan_path},
+                                       {"work", s->work_dir},
+                                       {"plan_hash", s->plan_hash},
+                                       {"tasks", s->tasks},
+                                       {"band_tasks", s->band_tasks},
+                                       {"pages", s->pages},
+                                       {"seconds", stages},
+                                       {"total_seconds", s->seconds}}
+                            .dump(2)
+                            .c_str());
+    return vt::cli::kExitOk;
+  }
+  std::printf("planned %s: %u tasks (%u band tasks), %llu pages to encode%s%s\n",
+              s->plan_path.empty() ? a.work.c_str() : s->plan_path.c_str(), s->tasks, s->band_tasks,
+              (unsigned long long)s->pages, a.work.empty() ? "" : "; work folder ", a.work.c_str());
+  std::printf("  time      ");
+  for (const auto& st : s->stages) std::printf(" %s %.2f s,", st.name.c_str(), st.seconds);
+  std::printf(" total %.2f s\n", s->seconds);
+  return vt::cli::kExitOk;
+}
+
+// `--work DIR --shard I/N` or `--tasks LIST`: step 2.
+int run_shard(const BakeArgs& a, const vt::cli::GlobalOptions& global) {
+  vt::ShardOptions so;
+  so.work_dir = a.work;
+  so.build = a.options.build;
+  if (!a.shard.empty() && !parse_shard(a.shard, so.index, so.count)) {
+    std::fprintf(stderr, "vtbake bake: --shard %s: expected I/N with 0 <= I < N\n",
+                 a.shard.c_str());
+    return vt::cli::kExitBadInput;
+  }
+  so.tasks = a.tasks;
+  auto s = vt::run_shard(so);
+  if (!s.ok()) return vt::cli::report_error("bake", s.status());
+  if (global.json) {
+    nlohmann::json stages = nlohmann::json::object();
+    for (const auto& st : s->stages) stages[st.name] = st.seconds;
+    std::printf("%s\n", nlohmann::json{{"part", s->part},
+                                       {"tasks", s->tasks},
+                                       {"pages", s->pages},
+                                       {"stored", s->stored},
+                                       {"constant", s->constant},
+                                       {"stored_bytes", s->stored_bytes},
+                                       {"seconds", stages},
+                                       {"total_seconds", s->seconds}}
+                            .dump(2)
+                            .c_str());
+    return vt::cli::kExitOk;
+  }
+  std::printf("shard %s: %zu tasks, %llu pages (%llu stored, %llu constant), %.2f s\n",
+              s->part.c_str(), s->tasks.size(), (unsigned long long)s->pages,
+              (unsigned long long)s->stored, (unsigned long long)s->constant, s->seconds);
+  return vt::cli::kExitOk;
+}
 
 void print_summary(const vt::SceneBakeSummary& s) {
   const auto& g = s.build.geometry;
@@ -84,9 +159,27 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
   vt::cli::add_scene_load_flags(app, o.load);
   vt::cli::add_unwrap_flags(app, o.unwrap);
   vt::cli::add_build_flags(app, o.build);
+  auto* plan =
+      app.add_option("--plan", args->plan,
+                     "Build farm, step 1: write the task graph (tasks, keys, dependencies, "
+                     "cost) to this JSON file instead of baking; with --work, also the "
+                     "shards' inputs into DIR (docs/FARM.md)");
+  app.add_option("--work", args->work,
+                 "Build farm: the shared work folder of a sharded bake (with --plan, --shard or "
+                 "--tasks)");
+  auto* shard = app.add_option("--shard", args->shard,
+                               "Build farm, step 2: encode shard I of N (0 <= I < N) of the plan "
+                               "in --work into DIR/parts; then `vtbake merge DIR`")
+                    ->needs("--work");
+  app.add_option("--tasks", args->tasks, "Build farm, step 2: encode these band tasks of the plan")
+      ->delimiter(',')
+      ->needs("--work")
+      ->excludes(shard);
+  shard->excludes(plan);
   return [args](const vt::cli::GlobalOptions& global) -> int {
     vt::SceneBakeOptions& o = args->options;
     o.build.threads = global.threads;
+    if (!args->shard.empty() || !args->tasks.empty()) return run_shard(*args, global);
     // Stage, its fraction, elapsed time; redrawn at once when the stage changes.
     vt::cli::ProgressLine progress(global.quiet);
     std::string stage;
@@ -98,6 +191,11 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
     };
     if (vt::Status in = vt::check_input_file(args->scene); !in.ok())
       return vt::cli::report_error("bake", in);
+    if (!args->plan.empty() || !args->work.empty()) {
+      if (args->work.empty() == false && args->plan.empty())
+        args->plan = vt::work_plan_path(args->work);
+      return run_plan(*args, global);
+    }
     auto summary = vt::bake_scene(args->scene, o);
     progress.done();
     if (!summary.ok()) return vt::cli::report_error("bake", summary.status());
