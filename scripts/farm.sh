@@ -47,7 +47,7 @@ for ((i = 0; i < ${#bake_args[@]}; ++i)); do
   esac
 done
 [[ -n "$output" ]] || { echo "farm.sh: the bake command needs -o OUT.vtpf" >&2; exit 2; }
-mkdir -p "$work/logs"
+mkdir -p "$work/logs" "$(dirname "$output")"
 work=$(cd "$work" && pwd)
 
 sb=(sbatch --parsable --cpus-per-task="$cpus" --time="$time_limit" --chdir="$PWD")

@@ -30,6 +30,7 @@ echo "cluster up: $(sinfo -h -o '%N %c CPUs %T')"
 
 "$vtbake" -q sample-scene "$tmp/scene" --ground-cells 4 --sphere-segments 12 --texture-size 64
 flags=(--size 4 --supersample 1)
+mkdir -p "$tmp/local"
 "$vtbake" -q --threads 2 bake "$tmp/scene/scene.gltf" -o "$tmp/local/out.vtpf" "${flags[@]}"
 
 # The victim: shard 2's first run is killed (SIGKILL) once its part is staged, mid-work.
