@@ -5,23 +5,26 @@
 # resubmits only the shards whose part is missing (`vtbake merge DIR --missing N`) until every
 # shard is there, then merges.
 #
-#   scripts/farm.sh --work DIR [--shards N] [--partition P] [--cpus C] [--mem M] [--time T]
-#                   [--retries R] [--vtbake PATH] [--poll SECONDS] -- SCENE -o OUT.vtpf [FLAGS]
+#   scripts/farm.sh --work DIR [--shards N] [--partition P] [--cpus C] [--plan-cpus C] [--mem M]
+#                   [--time T] [--retries R] [--vtbake PATH] [--poll SECONDS]
+#                   -- SCENE -o OUT.vtpf [FLAGS]
+# --cpus: CPUs per shard and merge job (default 2); --plan-cpus: for the plan job (default --cpus).
 #
 # Everything after `--` is a `vtbake bake` command line; every job gets the same one. DIR and
 # OUT must be on storage every node sees. Exit 0 when OUT is merged; 1 when shards still fail
 # after the retries or the plan or merge job fails (the job logs are in DIR/logs).
 set -euo pipefail
 
-work="" shards=4 partition="" cpus=2 mem="" time_limit="1:00:00" retries=2 poll=1
+work="" shards=4 partition="" cpus=2 plan_cpus="" mem="" time_limit="1:00:00" retries=2 poll=1
 vtbake="${VTBAKE:-vtbake}"
-usage() { sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
+usage() { sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --work) work="$2"; shift 2 ;;
     --shards) shards="$2"; shift 2 ;;
     --partition) partition="$2"; shift 2 ;;
     --cpus) cpus="$2"; shift 2 ;;
+    --plan-cpus) plan_cpus="$2"; shift 2 ;;
     --mem) mem="$2"; shift 2 ;;
     --time) time_limit="$2"; shift 2 ;;
     --retries) retries="$2"; shift 2 ;;
@@ -50,6 +53,7 @@ done
 mkdir -p "$work/logs" "$(dirname "$output")"
 work=$(cd "$work" && pwd)
 
+[[ -n "$plan_cpus" ]] || plan_cpus="$cpus"
 sb=(sbatch --parsable --cpus-per-task="$cpus" --time="$time_limit" --chdir="$PWD")
 [[ -n "$partition" ]] && sb+=(--partition="$partition")
 [[ -n "$mem" ]] && sb+=(--mem="$mem")
@@ -75,7 +79,8 @@ finished() {  # true when no task of job $1 is pending or running
 }
 state_of() { job_states "$1" | awk 'NR == 1 {print $2}'; }
 
-plan_job=$("${sb[@]}" -J vtbake-plan -o "$work/logs/plan.out" --wrap "$bake_cmd --plan $(quote "$work/plan.json")")
+plan_cmd=$(quote "$vtbake" --threads "$plan_cpus" -q bake "${bake_args[@]}" --work "$work" --plan "$work/plan.json")
+plan_job=$("${sb[@]}" --cpus-per-task="$plan_cpus" -J vtbake-plan -o "$work/logs/plan.out" --wrap "$plan_cmd")
 echo "farm: plan job $plan_job"
 submit_shards() {  # $1 = array spec, $2 = dependency or ""
   local dep=()
