@@ -1,9 +1,14 @@
 // `vtbake bake SCENE -o OUT.vtpf`: the main job. Unwraps the scene, transfers its materials into
 // the atlas, builds the page file and writes the unwrapped scene beside it. Flags map onto
 // vt::SceneBakeOptions; the work is bake_scene() (bake/scene_bake.h).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -22,6 +27,10 @@ namespace {
 
 struct BakeArgs {
   std::string scene;
+  std::vector<std::string> scenes;  // positionals; several = a batch
+  // Batches: one output per scene under out_dir, scenes also from a list file.
+  std::string out_dir, list;
+  bool keep_going = false;
   vt::SceneBakeOptions options;
   // Sharding over a build farm (bake/shard.h, docs/FARM.md).
   std::string plan, work, shard;
@@ -137,10 +146,139 @@ void print_summary(const vt::SceneBakeSummary& s) {
   std::printf(" peak resident set at the end of each stage\n");
 }
 
+// The scenes of a batch: the positionals, then --list FILE's lines (blank lines and lines
+// starting with '#' skipped; relative paths from the list file's folder).
+vt::Expected<std::vector<std::string>> batch_scenes(const BakeArgs& a) {
+  std::vector<std::string> scenes = a.scenes;
+  if (!a.list.empty()) {
+    if (vt::Status s = vt::check_input_file(a.list); !s.ok()) return s.with_context("--list");
+    std::ifstream in(a.list);
+    const std::filesystem::path base = std::filesystem::path(a.list).parent_path();
+    for (std::string line; std::getline(in, line);) {
+      while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
+      const size_t start = line.find_first_not_of(' ');
+      if (start == std::string::npos || line[start] == '#') continue;
+      std::filesystem::path p(line.substr(start));
+      scenes.push_back(p.is_absolute() || base.empty() ? p.string() : (base / p).string());
+    }
+  }
+  return scenes;
+}
+
+// `vtbake bake A B ... --out-dir D` / `--list FILE`: every argument and input checked first,
+// then one bake per scene into D/STEM.vtpf (+ .glb), a line per scene on stderr, a summary
+// table (or one JSON line per scene with --json) on stdout.
+int run_batch(BakeArgs& a, const vt::cli::GlobalOptions& global) {
+  if (a.out_dir.empty()) return vt::cli::bad_usage("bake", "several scenes need --out-dir DIR");
+  if (!a.options.build.output.empty())
+    return vt::cli::bad_usage("bake", "-o names one output; a batch writes under --out-dir");
+  if (!a.plan.empty() || !a.work.empty() || !a.shard.empty() || !a.tasks.empty())
+    return vt::cli::bad_usage("bake", "--plan, --work, --shard and --tasks take one scene");
+  auto scenes = batch_scenes(a);
+  if (!scenes.ok()) return vt::cli::report_error("bake", scenes.status());
+  if (scenes->empty()) return vt::cli::bad_usage("bake", "--list " + a.list + ": no scenes");
+  struct Item {
+    std::string scene, output;
+    vt::Status status;
+    vt::SceneBakeSummary summary;
+    bool done = false;
+  };
+  std::vector<Item> items;
+  std::map<std::string, std::string> outputs;  // output -> scene: two scenes on one refused
+  bool bad_input = false;
+  for (const std::string& scene : *scenes) {
+    Item it;
+    it.scene = scene;
+    it.output =
+        (std::filesystem::path(a.out_dir) / std::filesystem::path(scene).stem()).string() + ".vtpf";
+    it.status = vt::check_input_file(scene);
+    if (auto [at, fresh] = outputs.emplace(it.output, scene); !fresh && it.status.ok()) {
+      it.status = vt::Error(vt::ErrorCode::kInvalidArgument,
+                            scene + ": would write " + it.output + " as " + at->second + " does");
+    }
+    if (!it.status.ok()) {
+      std::fprintf(stderr, "vtbake bake: %s\n", it.status.message().c_str());
+      bad_input = true;
+    }
+    items.push_back(std::move(it));
+  }
+  if (bad_input && !a.keep_going) {
+    std::fprintf(stderr, "vtbake bake: nothing baked (--keep-going bakes the other scenes)\n");
+    return vt::cli::kExitBadInput;
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(a.out_dir, ec);
+  if (ec) {
+    return vt::cli::report_error(
+        "bake", vt::Error(vt::ErrorCode::kIo, a.out_dir + ": cannot create: " + ec.message()));
+  }
+  size_t failed = 0, baked = 0;
+  for (size_t i = 0; i < items.size(); ++i) {
+    Item& it = items[i];
+    if (it.status.ok()) {
+      vt::SceneBakeOptions o = a.options;
+      o.build.output = it.output;
+      if (o.unwrapped != "-") o.unwrapped = "";  // beside each output
+      if (!global.quiet)
+        std::fprintf(stderr, "bake %zu/%zu %s -> %s\n", i + 1, items.size(), it.scene.c_str(),
+                     it.output.c_str());
+      auto s = vt::bake_scene(it.scene, o);
+      it.done = true;
+      if (s.ok()) {
+        it.summary = std::move(s).value();
+        ++baked;
+        for (const std::string& w : it.summary.warnings)
+          std::fprintf(stderr, "warning: %s: %s\n", it.scene.c_str(), w.c_str());
+      } else {
+        it.status = s.status();
+        std::fprintf(stderr, "vtbake bake: %s\n", it.status.message().c_str());
+      }
+    }
+    if (!it.status.ok()) ++failed;
+    if (global.json) {
+      nlohmann::json j = it.status.ok() ? vt::to_json(it.summary) : nlohmann::json::object();
+      j["scene"] = it.scene;
+      j["output"] = it.output;
+      j["status"] = it.status.ok() ? "ok" : "failed";
+      if (!it.status.ok()) j["error"] = it.status.message();
+      std::printf("%s\n", j.dump().c_str());
+      std::fflush(stdout);
+    }
+    if (!it.status.ok() && !a.keep_going) break;
+  }
+  if (!global.json) {
+    std::printf("%-40s %-8s %8s %12s %9s\n", "scene", "status", "pages", "bytes", "seconds");
+    for (const Item& it : items) {
+      const char* status = it.status.ok() ? (it.done ? "ok" : "skipped") : "failed";
+      if (it.status.ok() && it.done) {
+        std::printf("%-40s %-8s %8llu %12llu %9.2f\n", it.scene.c_str(), status,
+                    (unsigned long long)it.summary.build.pages,
+                    (unsigned long long)it.summary.build.file_bytes, it.summary.seconds);
+      } else {
+        std::printf("%-40s %-8s %8s %12s %9s\n", it.scene.c_str(), status, "-", "-", "-");
+      }
+    }
+    std::printf("%zu of %zu scenes baked\n", baked, items.size());
+  }
+  if (failed == 0) return vt::cli::kExitOk;
+  const bool ran_and_failed = std::any_of(
+      items.begin(), items.end(), [](const Item& it) { return it.done && !it.status.ok(); });
+  return ran_and_failed ? vt::cli::kExitFailure : vt::cli::kExitBadInput;
+}
+
 vt::cli::CommandRunner make_bake(CLI::App& app) {
   auto args = std::make_shared<BakeArgs>();
   vt::SceneBakeOptions& o = args->options;
-  app.add_option("scene", args->scene, "Scene to bake (.gltf, .glb, .obj, .ply, .drc)")->required();
+  app.add_option("scene", args->scenes,
+                 "Scene(s) to bake (.gltf, .glb, .obj, .ply, .drc); several = a batch (--out-dir)");
+  app.add_option("--out-dir", args->out_dir,
+                 "Batch: write each scene's page file (and .glb) as DIR/STEM.vtpf; parent folders "
+                 "are created");
+  app.add_option("--list", args->list,
+                 "Batch: also bake the scenes listed in FILE, one path a line (relative to FILE's "
+                 "folder; '#' lines skipped)");
+  app.add_flag("--keep-going", args->keep_going,
+               "Batch: bake the other scenes when one fails (exit 1 if any failed)");
   app.add_option("--unwrapped", o.unwrapped,
                  "Where to write the unwrapped scene (.glb; default OUT.glb; '-' = not written)");
   app.add_option("--supersample", o.supersample, "Transfer samples per texel: 1, 4 or 16")
@@ -159,6 +297,7 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
   vt::cli::add_scene_load_flags(app, o.load);
   vt::cli::add_unwrap_flags(app, o.unwrap);
   vt::cli::add_build_flags(app, o.build);
+  app.get_option("--output")->required(false);  // checked below: a batch has --out-dir instead
   auto* plan =
       app.add_option("--plan", args->plan,
                      "Build farm, step 1: write the task graph (tasks, keys, dependencies, "
@@ -179,6 +318,12 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
   return [args](const vt::cli::GlobalOptions& global) -> int {
     vt::SceneBakeOptions& o = args->options;
     o.build.threads = global.threads;
+    if (args->scenes.empty() && args->list.empty())
+      return vt::cli::bad_usage("bake", "no scene given");
+    if (args->scenes.size() != 1 || !args->out_dir.empty() || !args->list.empty())
+      return run_batch(*args, global);
+    args->scene = args->scenes[0];
+    if (o.build.output.empty()) return vt::cli::bad_usage("bake", "-o OUT.vtpf is required");
     if (!args->shard.empty() || !args->tasks.empty()) return run_shard(*args, global);
     // Stage, its fraction, elapsed time; redrawn at once when the stage changes.
     vt::cli::ProgressLine progress(global.quiet);
