@@ -313,7 +313,8 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
   app.add_option("--tasks", args->tasks, "Build farm, step 2: encode these band tasks of the plan")
       ->delimiter(',')
       ->needs("--work")
-      ->excludes(shard);
+      ->excludes(shard)
+      ->excludes(plan);
   shard->excludes(plan);
   return [args](const vt::cli::GlobalOptions& global) -> int {
     vt::SceneBakeOptions& o = args->options;

@@ -128,6 +128,20 @@ TEST_F(FarmCli, TaskListsAndAnyShardCountGiveTheSameBytes) {
   ASSERT_EQ(bake("tasks", "--tasks " + odd).exit_code, 0);
   ASSERT_EQ(merge("tasks").exit_code, 0);
   expect_same_as_local("tasks");
+  // --plan without --work: the task graph alone, the same tasks and keys.
+  const std::string dry = dir_ + "/tasks/dry.json";
+  ASSERT_EQ(run_vtbake("-q bake " + scene() + " -o " + dir_ + "/tasks/out.vtpf " + flags() +
+                           " --plan " + dry,
+                       true)
+                .exit_code,
+            0);
+  auto keys = [](const nlohmann::json& tasks) {
+    std::vector<std::string> k;
+    for (const auto& t : tasks) k.push_back(t["key"].get<std::string>());
+    return k;
+  };
+  EXPECT_EQ(keys(nlohmann::json::parse(read_file(dry))["tasks"]), keys(plan["tasks"]));
+  EXPECT_FALSE(fs::exists(dir_ + "/tasks/dry"));
   // One shard of one: the same again.
   ASSERT_EQ(bake("one", "--plan " + work("one") + "/plan.json").exit_code, 0);
   ASSERT_EQ(bake("one", "--shard 0/1").exit_code, 0);
