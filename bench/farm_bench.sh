@@ -4,18 +4,19 @@
 # 1 CPU at once, the plan job on 2), wall times as medians of RUNS; then the same steps by hand
 # with --json for what the farm's time is made of, and the per-core rates the 128K model uses
 # (bench/farm_model.py). Run as root, through `heavy`.
-#   bench/farm_bench.sh VTBAKE [SIZE_PAGES=16] [RUNS=3]
+#   bench/farm_bench.sh VTBAKE [SIZE_PAGES=16] [RUNS=3] [BAKE FLAGS...]   (e.g. --codec bc:high)
 set -euo pipefail
 vtbake=$(readlink -f "$1")
 size="${2:-16}"
 runs="${3:-3}"
+shift $(($# < 3 ? $# : 3))
 src=$(cd "$(dirname "$0")/.." && pwd)
 tmp=$(mktemp -d /tmp/vtbake-farm-bench.XXXXXX)
 source "$src/tests/farm/local_cluster.sh"
 trap 'stop_cluster; [[ -n "${VTBAKE_KEEP_BENCH:-}" ]] || rm -rf "$tmp"' EXIT
 echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
 "$vtbake" -q sample-scene "$tmp/scene"
-flags=(--size "$size")
+flags=(--size "$size" "$@")
 now() { date +%s.%N; }
 median() { sort -g | awk '{a[NR] = $1} END {print a[int((NR + 1) / 2)]}'; }
 
