@@ -27,6 +27,7 @@
 namespace vt {
 
 class ColorConfig;
+class LevelSource;
 
 // What happens to NaN/Inf inputs, and to negative values in colour layers.
 enum class NonFinitePolicy : uint8_t {
@@ -101,6 +102,10 @@ struct BuildOptions {
   // shard holds the whole pyramid), but encodes and emits none of its pages: they are another
   // shard's. Its key is computed all the same.
   std::shared_ptr<const std::vector<uint8_t>> task_subset;
+  // Sharding: level 0 of layer i in its working form, converted and dilated as open_level0 gives
+  // it (a farm's plan job wrote it), so that a shard does not redo that; a null result = open
+  // it from the layer's source as usual.
+  std::function<Expected<std::shared_ptr<LevelSource>>(size_t layer)> level0_from;
   std::function<void(const BuildProgress&)> progress;
 };
 

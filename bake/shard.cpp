@@ -18,6 +18,7 @@
 
 #include "bake/build_plan.h"
 #include "bake/build_tasks.h"
+#include "bake/level_source.h"
 #include "bake/unwrap/unwrap.h"
 #include "bake/update.h"
 #include "format/atomic_output.h"
@@ -93,6 +94,24 @@ class RawFileSource final : public ImageSource {
   ImageInfo info_;
 };
 
+// Level 0 in its working form as the plan wrote it (converted and dilated), read by rows.
+class FileLevel0 final : public LevelSource {
+ public:
+  FileLevel0(std::shared_ptr<RawFileSource> file, std::shared_ptr<const std::vector<uint8_t>> cov)
+      : file_(std::move(file)), coverage_(std::move(cov)) {}
+  uint32_t width() const override { return file_->info().width; }
+  uint32_t height() const override { return file_->info().height; }
+  uint32_t channels() const override { return file_->info().channels; }
+  Status read(uint32_t y0, uint32_t y1, float* out) override {
+    return file_->read_rows(y0, y1, out);
+  }
+  const uint8_t* coverage() const override { return coverage_ ? coverage_->data() : nullptr; }
+
+ private:
+  std::shared_ptr<RawFileSource> file_;
+  std::shared_ptr<const std::vector<uint8_t>> coverage_;
+};
+
 // A file written through a staged name: bytes appended with a running XXH3 of all of them.
 class HashedFile {
  public:
@@ -148,6 +167,21 @@ Status write_source(ImageSource& source, const std::string& path) {
   for (uint32_t y = 0; y < info.height; y += band) {
     const uint32_t y1 = std::min(info.height, y + band);
     VT_RETURN_IF_ERROR(source.read_rows(y, y1, rows.data()));
+    f.put(rows.data(), size_t(y1 - y) * row * sizeof(float));
+  }
+  return f.close();
+}
+
+Status write_level(LevelSource& level, const std::string& path) {
+  HashedFile f;
+  VT_RETURN_IF_ERROR(f.open(path));
+  const size_t row = level.row_floats();
+  const uint32_t band = uint32_t(std::clamp<size_t>((size_t(4) << 20) / std::max<size_t>(row, 1), 1,
+                                                    std::max(1u, level.height())));
+  std::vector<float> rows(row * band);
+  for (uint32_t y = 0; y < level.height(); y += band) {
+    const uint32_t y1 = std::min(level.height(), y + band);
+    VT_RETURN_IF_ERROR(level.read(y, y1, rows.data()));
     f.put(rows.data(), size_t(y1 - y) * row * sizeof(float));
   }
   return f.close();
@@ -343,6 +377,19 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
   VT_RETURN_IF_ERROR(drop_opaque_alpha(bo));
   VT_ASSIGN_OR_RETURN(BuildPlan plan, plan_build(bo));
   sum.stages.push_back({"plan", seconds_since(t0)});
+  // Level 0 in its working form (converted, dilated) for the shards, which would otherwise each
+  // redo it: for the layers whose held level 0 carries the input's coverage mask.
+  t0 = Clock::now();
+  for (size_t i = 0; i < plan.layers.size() && !dir.empty(); ++i) {
+    LevelSource& level0 = *plan.layers[i].level0;
+    if (!coverage || level0.coverage() != bo.layers[i].coverage->data()) continue;
+    const std::string file = "level0/" + plan.layers[i].spec.name + ".work.f32";
+    VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/" + file));
+    VT_RETURN_IF_ERROR(write_level(level0, staged));
+    layers[i]["work_file"] = file;
+    layers[i]["work_channels"] = level0.channels();
+  }
+  sum.stages.push_back({"write working level 0", seconds_since(t0)});
   t0 = Clock::now();
   const std::vector<BuildTask> tasks = make_build_tasks(plan);
   plan.options.task_subset = std::make_shared<const std::vector<uint8_t>>(tasks.size(), 0);
@@ -564,6 +611,21 @@ Expected<ShardSummary> run_shard(const ShardOptions& options) {
   bo.input_key = unhex(w.json["input_key"]);
   bo.update = false;
   bo.tables_from = w.dir + "/tables.vtpf";
+  // Level 0 as the plan converted and dilated it, where it wrote that.
+  std::vector<std::shared_ptr<LevelSource>> level0(bo.layers.size());
+  for (size_t i = 0; i < bo.layers.size() && i < w.json["layers"].size(); ++i) {
+    const auto& l = w.json["layers"][i];
+    const std::string file = l.value("work_file", "");
+    if (file.empty()) continue;
+    ImageInfo info;
+    info.width = l.value("width", 0u), info.height = l.value("height", 0u);
+    info.channels = l.value("work_channels", 0u);
+    VT_ASSIGN_OR_RETURN(auto raw, RawFileSource::open(w.dir + "/" + file, info));
+    level0[i] = std::make_shared<FileLevel0>(std::move(raw), bo.layers[i].coverage);
+  }
+  bo.level0_from = [level0](size_t i) -> Expected<std::shared_ptr<LevelSource>> {
+    return i < level0.size() ? level0[i] : nullptr;
+  };
   sum.stages.push_back({"read", seconds_since(t0)});
   t0 = Clock::now();
   VT_RETURN_IF_ERROR(drop_opaque_alpha(bo));
