@@ -126,7 +126,9 @@ class LayerRun {
   }
 
   // A band task: the pages of page row `row`, and the rows of the next level they cover.
-  Expected<uint64_t> run_band(uint32_t row, double& t_read, double& t_encode, double& t_pyramid) {
+  // Without `encode` the pages are another shard's (BuildOptions::task_subset): only counted.
+  Expected<uint64_t> run_band(uint32_t row, bool encode, uint32_t& pages, double& t_read,
+                              double& t_encode, double& t_pyramid) {
     const uint32_t P = g_.payload, m = plan_.margin, l = level_;
     auto t0 = Clock::now();
     VT_ASSIGN_OR_RETURN(RowBand band, window_->fetch(int64_t(row) * P - m, P + 2 * m));
@@ -134,7 +136,8 @@ class LayerRun {
     const uint64_t key = band_key(band, row);
     if (alpha_.active && l == 0) count_level0_alpha(band, row);
     t0 = Clock::now();
-    VT_RETURN_IF_ERROR(encode_row(band, row));
+    pages = present_pages(row);
+    if (encode) VT_RETURN_IF_ERROR(encode_row(band, row));
     t_encode += seconds_since(t0);
     if (next_) {
       t0 = Clock::now();
@@ -142,6 +145,14 @@ class LayerRun {
       t_pyramid += seconds_since(t0);
     }
     return key;
+  }
+
+  uint32_t present_pages(uint32_t row) const {
+    const uint8_t* coverage = current_->coverage();
+    uint32_t n = 0;
+    for (uint32_t x = 0; x < g_.pages_x(level_); ++x)
+      n += !coverage || page_has_coverage(g_, PageId{level_, x, row}, coverage);
+    return n;
   }
 
   // A level task: the level just written is complete; dilate it and settle its alpha scale.
@@ -447,6 +458,14 @@ Expected<BuildSummary> build_pages(const BuildPlan& plan, PageSink& sink) {
 
   const std::vector<BuildTask> tasks = make_build_tasks(plan);
   sum.task_keys.assign(tasks.size(), 0);
+  sum.task_seconds.assign(tasks.size(), 0.0);
+  sum.task_pages.assign(tasks.size(), 0);
+  const std::vector<uint8_t>* subset = plan.options.task_subset.get();
+  if (subset && subset->size() != tasks.size()) {
+    return Status(ErrorCode::kInvalidArgument, "task subset of " + std::to_string(subset->size()) +
+                                                   " flags for " + std::to_string(tasks.size()) +
+                                                   " tasks");
+  }
   std::vector<bool> done(tasks.size());
   std::unique_ptr<LayerRun> run;
   for (size_t i = 0; i < tasks.size(); ++i) {
@@ -454,6 +473,7 @@ Expected<BuildSummary> build_pages(const BuildPlan& plan, PageSink& sink) {
     for (uint32_t d : t.deps) {
       if (!done[d]) return Status(ErrorCode::kInternal, "build task run before its input");
     }
+    const auto t_task = Clock::now();
     if (!run || run->layer() != t.layer) {
       if (run) sum.layers.push_back(run->summary());
       run = std::make_unique<LayerRun>(plan, t.layer, sink, sum);
@@ -466,12 +486,15 @@ Expected<BuildSummary> build_pages(const BuildPlan& plan, PageSink& sink) {
       VT_RETURN_IF_ERROR(run->begin_level(t.level));
     } else {
       if (t.level != run->level()) VT_RETURN_IF_ERROR(run->begin_level(t.level));
-      VT_ASSIGN_OR_RETURN(sum.task_keys[i], run->run_band(t.row, t_read, t_encode, t_pyramid));
+      const bool encode = !subset || (*subset)[i];
+      VT_ASSIGN_OR_RETURN(sum.task_keys[i], run->run_band(t.row, encode, sum.task_pages[i], t_read,
+                                                          t_encode, t_pyramid));
       progress.layer = t.layer;
       progress.level = t.level;
       progress.pages_done += g.pages_x(t.level);
       if (plan.options.progress) plan.options.progress(progress);
     }
+    sum.task_seconds[i] = seconds_since(t_task);
     done[i] = true;
   }
   if (run) sum.layers.push_back(run->summary());

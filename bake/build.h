@@ -27,6 +27,7 @@
 namespace vt {
 
 class ColorConfig;
+class LevelSource;
 
 // What happens to NaN/Inf inputs, and to negative values in colour layers.
 enum class NonFinitePolicy : uint8_t {
@@ -96,6 +97,15 @@ struct BuildOptions {
   std::string tables_from;
   bool retrain_tables = false;
   uint64_t input_key = 0;
+  // Sharding over a build farm (bake/shard.h): when set, one flag per task of make_build_tasks.
+  // A band task not flagged still reads its rows and writes its share of the next level (every
+  // shard holds the whole pyramid), but encodes and emits none of its pages: they are another
+  // shard's. Its key is computed all the same.
+  std::shared_ptr<const std::vector<uint8_t>> task_subset;
+  // Sharding: level 0 of layer i in its working form, converted and dilated as open_level0 gives
+  // it (a farm's plan job wrote it), so that a shard does not redo that; a null result = open
+  // it from the layer's source as usual.
+  std::function<Expected<std::shared_ptr<LevelSource>>(size_t layer)> level0_from;
   std::function<void(const BuildProgress&)> progress;
 };
 
@@ -162,6 +172,10 @@ struct BuildSummary {
   std::vector<StageTime> stages;
   uint64_t plan_hash = 0;           // BuildPlan::hash
   std::vector<uint64_t> task_keys;  // per task of make_build_tasks (0 for level tasks)
+  // Per task: its wall time (s) and, for band tasks, its pages with some coverage (those it
+  // encodes or would encode): the cost figures of a farm's task graph (bake/shard.h).
+  std::vector<double> task_seconds;
+  std::vector<uint32_t> task_pages;
   // What the build could not honour, e.g. a memory limit below its floor (BuildPlan), and one
   // line per layer whose values were clipped (LayerSummary::clipped).
   std::vector<std::string> warnings;

@@ -564,7 +564,18 @@ Expected<BuildPlan> plan_build(const BuildOptions& options) {
   for (size_t i = 0; i < plan.layers.size(); ++i) {
     LayerPlan& layer = plan.layers[i];
     const LayerInput& in = options.layers[i];
-    VT_ASSIGN_OR_RETURN(layer.level0, open_level0(in, layer, options));
+    if (options.level0_from) {
+      VT_ASSIGN_OR_RETURN(layer.level0, options.level0_from(i));
+      if (layer.level0 && (layer.level0->channels() != layer.work_channels ||
+                           layer.level0->width() != in.source->info().width ||
+                           layer.level0->height() != in.source->info().height)) {
+        return Status(ErrorCode::kInvalidArgument,
+                      layer.spec.name + ": the given level 0 is not the layer's working form");
+      }
+    }
+    if (!layer.level0) {
+      VT_ASSIGN_OR_RETURN(layer.level0, open_level0(in, layer, options));
+    }
     layer.level_in_memory = choose_level_memory(plan, layer);
     if (!layer.encoder->wants_training()) continue;
     VT_RETURN_IF_ERROR(plan_tables(plan, in, layer, pinned.find(layer.spec.name)));

@@ -186,13 +186,11 @@ Expected<SceneBakeSummary> bake_scene(const std::string& scene_path,
   return summary;
 }
 
-Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBakeOptions& options) {
-  auto start = Clock::now();
-  auto report = [&](const char* stage, double f) {
-    if (options.progress) options.progress({stage, f});
-  };
-  const std::string& output = options.build.output;
-  if (output.empty()) return Error(ErrorCode::kInvalidArgument, "no output path");
+namespace {
+
+// The checks before any work, and the bake's content key.
+Expected<uint64_t> check_and_key(const scene::Scene& input, const SceneBakeOptions& options) {
+  if (options.build.output.empty()) return Error(ErrorCode::kInvalidArgument, "no output path");
   if (input.triangle_count() == 0) {
     return Error(ErrorCode::kInvalidArgument, "the scene has no triangles to bake");
   }
@@ -200,30 +198,17 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   VT_RETURN_IF_ERROR(check_texcoord_sets(input));
   // Damaged PNGs fail now, not after the unwrap (the transfer checks them again, from cache).
   VT_RETURN_IF_ERROR(check_scene_textures(input));
-  SceneBakeSummary summary;
-  summary.warnings = input.warnings;
-  summary.output = output;
-  summary.unwrapped = options.unwrapped.empty()  ? default_unwrapped(output)
-                      : options.unwrapped == "-" ? ""
-                                                 : options.unwrapped;
-  // Update mode: with the scene, its textures and the settings as the previous output was
-  // baked from, the outputs stay as they are.
-  VT_ASSIGN_OR_RETURN(const uint64_t input_key, scene_bake_key(input, options));
-  if (auto same = unchanged_bake(options, summary.unwrapped, input_key)) {
-    same->warnings = summary.warnings;
-    same->triangles = uint64_t(input.triangle_count());
-    same->seconds = seconds_since(start);
-    return *same;
-  }
-  // The page file and the unwrapped scene replace what was there as a pair, or not at all; a
-  // bad output path fails here, before the work.
-  OutputSet outputs;
-  VT_ASSIGN_OR_RETURN(std::string staged_pages, outputs.stage(output));
-  std::string staged_scene;
-  if (!summary.unwrapped.empty()) {
-    VT_ASSIGN_OR_RETURN(staged_scene, outputs.stage(summary.unwrapped));
-  }
+  return scene_bake_key(input, options);
+}
 
+// Unwrap and transfer; `prepared.summary` has its warnings and outputs set by the caller.
+Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& options,
+                           uint64_t input_key, PreparedBake& prepared) {
+  SceneBakeSummary& summary = prepared.summary;
+  const std::string& output = options.build.output;
+  auto report = [&](const char* stage, double f) {
+    if (options.progress) options.progress({stage, f});
+  };
   // Unwrap.
   auto t0 = Clock::now();
   report("unwrap", 0.0);
@@ -296,10 +281,9 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   summary.above_one = layer_ranges(transfer->layers);
   summary.stages.push_back({"transfer", seconds_since(t0)});
 
-  // Pyramid, paging, encode.
-  t0 = Clock::now();
-  BuildOptions bo = options.build;
-  bo.output = staged_pages;
+  // The build's options, as bake_scene runs them.
+  BuildOptions& bo = prepared.build;
+  bo = options.build;
   bo.layers = layer_inputs(*transfer);
   bo.address = AddressMode::kClamp;
   bo.update_from = output;
@@ -317,6 +301,59 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
       {"padding", options.unwrap.padding},
   };
   bo.metadata_json = meta.dump();
+  prepared.unwrapped = std::move(unwrapped).value();
+  return Status::Ok();
+}
+
+}  // namespace
+
+Expected<PreparedBake> prepare_scene_bake(const scene::Scene& input,
+                                          const SceneBakeOptions& options) {
+  VT_ASSIGN_OR_RETURN(const uint64_t input_key, check_and_key(input, options));
+  PreparedBake prepared;
+  prepared.summary.warnings = input.warnings;
+  prepared.summary.output = options.build.output;
+  VT_RETURN_IF_ERROR(unwrap_and_transfer(input, options, input_key, prepared));
+  return prepared;
+}
+
+Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBakeOptions& options) {
+  auto start = Clock::now();
+  auto report = [&](const char* stage, double f) {
+    if (options.progress) options.progress({stage, f});
+  };
+  const std::string& output = options.build.output;
+  VT_ASSIGN_OR_RETURN(const uint64_t input_key, check_and_key(input, options));
+  PreparedBake prepared;
+  SceneBakeSummary& summary = prepared.summary;
+  summary.warnings = input.warnings;
+  summary.output = output;
+  summary.unwrapped = options.unwrapped.empty()  ? default_unwrapped(output)
+                      : options.unwrapped == "-" ? ""
+                                                 : options.unwrapped;
+  // Update mode: with the scene, its textures and the settings as the previous output was
+  // baked from, the outputs stay as they are.
+  if (auto same = unchanged_bake(options, summary.unwrapped, input_key)) {
+    same->warnings = summary.warnings;
+    same->triangles = uint64_t(input.triangle_count());
+    same->seconds = seconds_since(start);
+    return *same;
+  }
+  // The page file and the unwrapped scene replace what was there as a pair, or not at all; a
+  // bad output path fails here, before the work.
+  OutputSet outputs;
+  VT_ASSIGN_OR_RETURN(std::string staged_pages, outputs.stage(output));
+  std::string staged_scene;
+  if (!summary.unwrapped.empty()) {
+    VT_ASSIGN_OR_RETURN(staged_scene, outputs.stage(summary.unwrapped));
+  }
+  VT_RETURN_IF_ERROR(unwrap_and_transfer(input, options, input_key, prepared));
+  const unwrap::UnwrapResult* unwrapped = &prepared.unwrapped;
+
+  // Pyramid, paging, encode.
+  auto t0 = Clock::now();
+  BuildOptions bo = prepared.build;
+  bo.output = staged_pages;
   bo.progress = [&](const BuildProgress& p) {
     report("build", p.pages_total ? double(p.pages_done) / double(p.pages_total) : 0.0);
   };

@@ -78,6 +78,18 @@ struct SceneBakeSummary {
   double seconds = 0;
 };
 
+// A bake up to its build, for callers that run the build elsewhere (bake/shard.h: a build farm):
+// the scene checked, unwrapped and its materials transferred, and the build's options filled
+// in as bake_scene runs them (layers, address mode, metadata, provenance, input key; output and
+// update_from are options.build.output). summary holds the stages so far.
+struct PreparedBake {
+  SceneBakeSummary summary;
+  BuildOptions build;
+  unwrap::UnwrapResult unwrapped;
+};
+Expected<PreparedBake> prepare_scene_bake(const scene::Scene& scene,
+                                          const SceneBakeOptions& options);
+
 // Loads `scene_path` (glTF, OBJ, PLY, Draco) and bakes it.
 Expected<SceneBakeSummary> bake_scene(const std::string& scene_path,
                                       const SceneBakeOptions& options);

@@ -1,14 +1,20 @@
 // `vtbake bake SCENE -o OUT.vtpf`: the main job. Unwraps the scene, transfers its materials into
 // the atlas, builds the page file and writes the unwrapped scene beside it. Flags map onto
 // vt::SceneBakeOptions; the work is bake_scene() (bake/scene_bake.h).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "bake/build_summary_json.h"
 #include "bake/scene_bake.h"
+#include "bake/shard.h"
 #include "cli/build_flags.h"
 #include "cli/cli_util.h"
 #include "cli/command.h"
@@ -21,8 +27,86 @@ namespace {
 
 struct BakeArgs {
   std::string scene;
+  std::vector<std::string> scenes;  // positionals; several = a batch
+  // Batches: one output per scene under out_dir, scenes also from a list file.
+  std::string out_dir, list;
+  bool keep_going = false;
   vt::SceneBakeOptions options;
+  // Sharding over a build farm (bake/shard.h, docs/FARM.md).
+  std::string plan, work, shard;
+  std::vector<uint32_t> tasks;
 };
+
+// "I/N" -> (I, N) with 0 <= I < N.
+bool parse_shard(const std::string& text, uint32_t& index, uint32_t& count) {
+  unsigned i = 0, n = 0;
+  char end = 0;
+  if (std::sscanf(text.c_str(), "%u/%u%c", &i, &n, &end) != 2 || n == 0 || i >= n) return false;
+  index = i, count = n;
+  return true;
+}
+
+// `--plan` (and `--work` without a shard): step 1 of a farm bake.
+int run_plan(const BakeArgs& a, const vt::cli::GlobalOptions& global) {
+  auto s = vt::plan_bake(a.scene, a.options, a.work, a.plan);
+  if (!s.ok()) return vt::cli::report_error("bake", s.status());
+  if (global.json) {
+    nlohmann::json stages = nlohmann::json::object();
+    for (const auto& st : s->stages) stages[st.name] = st.seconds;
+    std::printf("%s\n", nlohmann::json{{"plan", s->plan_path},
+                                       {"work", s->work_dir},
+                                       {"plan_hash", s->plan_hash},
+                                       {"tasks", s->tasks},
+                                       {"band_tasks", s->band_tasks},
+                                       {"pages", s->pages},
+                                       {"seconds", stages},
+                                       {"total_seconds", s->seconds}}
+                            .dump(2)
+                            .c_str());
+    return vt::cli::kExitOk;
+  }
+  std::printf("planned %s: %u tasks (%u band tasks), %llu pages to encode%s%s\n",
+              s->plan_path.empty() ? a.work.c_str() : s->plan_path.c_str(), s->tasks, s->band_tasks,
+              (unsigned long long)s->pages, a.work.empty() ? "" : "; work folder ", a.work.c_str());
+  std::printf("  time      ");
+  for (const auto& st : s->stages) std::printf(" %s %.2f s,", st.name.c_str(), st.seconds);
+  std::printf(" total %.2f s\n", s->seconds);
+  return vt::cli::kExitOk;
+}
+
+// `--work DIR --shard I/N` or `--tasks LIST`: step 2.
+int run_shard(const BakeArgs& a, const vt::cli::GlobalOptions& global) {
+  vt::ShardOptions so;
+  so.work_dir = a.work;
+  so.build = a.options.build;
+  if (!a.shard.empty() && !parse_shard(a.shard, so.index, so.count)) {
+    std::fprintf(stderr, "vtbake bake: --shard %s: expected I/N with 0 <= I < N\n",
+                 a.shard.c_str());
+    return vt::cli::kExitBadInput;
+  }
+  so.tasks = a.tasks;
+  auto s = vt::run_shard(so);
+  if (!s.ok()) return vt::cli::report_error("bake", s.status());
+  if (global.json) {
+    nlohmann::json stages = nlohmann::json::object();
+    for (const auto& st : s->stages) stages[st.name] = st.seconds;
+    std::printf("%s\n", nlohmann::json{{"part", s->part},
+                                       {"tasks", s->tasks},
+                                       {"pages", s->pages},
+                                       {"stored", s->stored},
+                                       {"constant", s->constant},
+                                       {"stored_bytes", s->stored_bytes},
+                                       {"seconds", stages},
+                                       {"total_seconds", s->seconds}}
+                            .dump(2)
+                            .c_str());
+    return vt::cli::kExitOk;
+  }
+  std::printf("shard %s: %zu tasks, %llu pages (%llu stored, %llu constant), %.2f s\n",
+              s->part.c_str(), s->tasks.size(), (unsigned long long)s->pages,
+              (unsigned long long)s->stored, (unsigned long long)s->constant, s->seconds);
+  return vt::cli::kExitOk;
+}
 
 void print_summary(const vt::SceneBakeSummary& s) {
   const auto& g = s.build.geometry;
@@ -62,10 +146,139 @@ void print_summary(const vt::SceneBakeSummary& s) {
   std::printf(" peak resident set at the end of each stage\n");
 }
 
+// The scenes of a batch: the positionals, then --list FILE's lines (blank lines and lines
+// starting with '#' skipped; relative paths from the list file's folder).
+vt::Expected<std::vector<std::string>> batch_scenes(const BakeArgs& a) {
+  std::vector<std::string> scenes = a.scenes;
+  if (!a.list.empty()) {
+    if (vt::Status s = vt::check_input_file(a.list); !s.ok()) return s.with_context("--list");
+    std::ifstream in(a.list);
+    const std::filesystem::path base = std::filesystem::path(a.list).parent_path();
+    for (std::string line; std::getline(in, line);) {
+      while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
+      const size_t start = line.find_first_not_of(' ');
+      if (start == std::string::npos || line[start] == '#') continue;
+      std::filesystem::path p(line.substr(start));
+      scenes.push_back(p.is_absolute() || base.empty() ? p.string() : (base / p).string());
+    }
+  }
+  return scenes;
+}
+
+// `vtbake bake A B ... --out-dir D` / `--list FILE`: every argument and input checked first,
+// then one bake per scene into D/STEM.vtpf (+ .glb), a line per scene on stderr, a summary
+// table (or one JSON line per scene with --json) on stdout.
+int run_batch(BakeArgs& a, const vt::cli::GlobalOptions& global) {
+  if (a.out_dir.empty()) return vt::cli::bad_usage("bake", "several scenes need --out-dir DIR");
+  if (!a.options.build.output.empty())
+    return vt::cli::bad_usage("bake", "-o names one output; a batch writes under --out-dir");
+  if (!a.plan.empty() || !a.work.empty() || !a.shard.empty() || !a.tasks.empty())
+    return vt::cli::bad_usage("bake", "--plan, --work, --shard and --tasks take one scene");
+  auto scenes = batch_scenes(a);
+  if (!scenes.ok()) return vt::cli::report_error("bake", scenes.status());
+  if (scenes->empty()) return vt::cli::bad_usage("bake", "--list " + a.list + ": no scenes");
+  struct Item {
+    std::string scene, output;
+    vt::Status status;
+    vt::SceneBakeSummary summary;
+    bool done = false;
+  };
+  std::vector<Item> items;
+  std::map<std::string, std::string> outputs;  // output -> scene: two scenes on one refused
+  bool bad_input = false;
+  for (const std::string& scene : *scenes) {
+    Item it;
+    it.scene = scene;
+    it.output =
+        (std::filesystem::path(a.out_dir) / std::filesystem::path(scene).stem()).string() + ".vtpf";
+    it.status = vt::check_input_file(scene);
+    if (auto [at, fresh] = outputs.emplace(it.output, scene); !fresh && it.status.ok()) {
+      it.status = vt::Error(vt::ErrorCode::kInvalidArgument,
+                            scene + ": would write " + it.output + " as " + at->second + " does");
+    }
+    if (!it.status.ok()) {
+      std::fprintf(stderr, "vtbake bake: %s\n", it.status.message().c_str());
+      bad_input = true;
+    }
+    items.push_back(std::move(it));
+  }
+  if (bad_input && !a.keep_going) {
+    std::fprintf(stderr, "vtbake bake: nothing baked (--keep-going bakes the other scenes)\n");
+    return vt::cli::kExitBadInput;
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(a.out_dir, ec);
+  if (ec) {
+    return vt::cli::report_error(
+        "bake", vt::Error(vt::ErrorCode::kIo, a.out_dir + ": cannot create: " + ec.message()));
+  }
+  size_t failed = 0, baked = 0;
+  for (size_t i = 0; i < items.size(); ++i) {
+    Item& it = items[i];
+    if (it.status.ok()) {
+      vt::SceneBakeOptions o = a.options;
+      o.build.output = it.output;
+      if (o.unwrapped != "-") o.unwrapped = "";  // beside each output
+      if (!global.quiet)
+        std::fprintf(stderr, "bake %zu/%zu %s -> %s\n", i + 1, items.size(), it.scene.c_str(),
+                     it.output.c_str());
+      auto s = vt::bake_scene(it.scene, o);
+      it.done = true;
+      if (s.ok()) {
+        it.summary = std::move(s).value();
+        ++baked;
+        for (const std::string& w : it.summary.warnings)
+          std::fprintf(stderr, "warning: %s: %s\n", it.scene.c_str(), w.c_str());
+      } else {
+        it.status = s.status();
+        std::fprintf(stderr, "vtbake bake: %s\n", it.status.message().c_str());
+      }
+    }
+    if (!it.status.ok()) ++failed;
+    if (global.json) {
+      nlohmann::json j = it.status.ok() ? vt::to_json(it.summary) : nlohmann::json::object();
+      j["scene"] = it.scene;
+      j["output"] = it.output;
+      j["status"] = it.status.ok() ? "ok" : "failed";
+      if (!it.status.ok()) j["error"] = it.status.message();
+      std::printf("%s\n", j.dump().c_str());
+      std::fflush(stdout);
+    }
+    if (!it.status.ok() && !a.keep_going) break;
+  }
+  if (!global.json) {
+    std::printf("%-40s %-8s %8s %12s %9s\n", "scene", "status", "pages", "bytes", "seconds");
+    for (const Item& it : items) {
+      const char* status = it.status.ok() ? (it.done ? "ok" : "skipped") : "failed";
+      if (it.status.ok() && it.done) {
+        std::printf("%-40s %-8s %8llu %12llu %9.2f\n", it.scene.c_str(), status,
+                    (unsigned long long)it.summary.build.pages,
+                    (unsigned long long)it.summary.build.file_bytes, it.summary.seconds);
+      } else {
+        std::printf("%-40s %-8s %8s %12s %9s\n", it.scene.c_str(), status, "-", "-", "-");
+      }
+    }
+    std::printf("%zu of %zu scenes baked\n", baked, items.size());
+  }
+  if (failed == 0) return vt::cli::kExitOk;
+  const bool ran_and_failed = std::any_of(
+      items.begin(), items.end(), [](const Item& it) { return it.done && !it.status.ok(); });
+  return ran_and_failed ? vt::cli::kExitFailure : vt::cli::kExitBadInput;
+}
+
 vt::cli::CommandRunner make_bake(CLI::App& app) {
   auto args = std::make_shared<BakeArgs>();
   vt::SceneBakeOptions& o = args->options;
-  app.add_option("scene", args->scene, "Scene to bake (.gltf, .glb, .obj, .ply, .drc)")->required();
+  app.add_option("scene", args->scenes,
+                 "Scene(s) to bake (.gltf, .glb, .obj, .ply, .drc); several = a batch (--out-dir)");
+  app.add_option("--out-dir", args->out_dir,
+                 "Batch: write each scene's page file (and .glb) as DIR/STEM.vtpf; parent folders "
+                 "are created");
+  app.add_option("--list", args->list,
+                 "Batch: also bake the scenes listed in FILE, one path a line (relative to FILE's "
+                 "folder; '#' lines skipped)");
+  app.add_flag("--keep-going", args->keep_going,
+               "Batch: bake the other scenes when one fails (exit 1 if any failed)");
   app.add_option("--unwrapped", o.unwrapped,
                  "Where to write the unwrapped scene (.glb; default OUT.glb; '-' = not written)");
   app.add_option("--supersample", o.supersample, "Transfer samples per texel: 1, 4 or 16")
@@ -84,9 +297,35 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
   vt::cli::add_scene_load_flags(app, o.load);
   vt::cli::add_unwrap_flags(app, o.unwrap);
   vt::cli::add_build_flags(app, o.build);
+  app.get_option("--output")->required(false);  // checked below: a batch has --out-dir instead
+  auto* plan =
+      app.add_option("--plan", args->plan,
+                     "Build farm, step 1: write the task graph (tasks, keys, dependencies, "
+                     "cost) to this JSON file instead of baking; with --work, also the "
+                     "shards' inputs into DIR (docs/FARM.md)");
+  app.add_option("--work", args->work,
+                 "Build farm: the shared work folder of a sharded bake (with --plan, --shard or "
+                 "--tasks)");
+  auto* shard = app.add_option("--shard", args->shard,
+                               "Build farm, step 2: encode shard I of N (0 <= I < N) of the plan "
+                               "in --work into DIR/parts; then `vtbake merge DIR`")
+                    ->needs("--work");
+  app.add_option("--tasks", args->tasks, "Build farm, step 2: encode these band tasks of the plan")
+      ->delimiter(',')
+      ->needs("--work")
+      ->excludes(shard)
+      ->excludes(plan);
+  shard->excludes(plan);
   return [args](const vt::cli::GlobalOptions& global) -> int {
     vt::SceneBakeOptions& o = args->options;
     o.build.threads = global.threads;
+    if (args->scenes.empty() && args->list.empty())
+      return vt::cli::bad_usage("bake", "no scene given");
+    if (args->scenes.size() != 1 || !args->out_dir.empty() || !args->list.empty())
+      return run_batch(*args, global);
+    args->scene = args->scenes[0];
+    if (o.build.output.empty()) return vt::cli::bad_usage("bake", "-o OUT.vtpf is required");
+    if (!args->shard.empty() || !args->tasks.empty()) return run_shard(*args, global);
     // Stage, its fraction, elapsed time; redrawn at once when the stage changes.
     vt::cli::ProgressLine progress(global.quiet);
     std::string stage;
@@ -98,6 +337,11 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
     };
     if (vt::Status in = vt::check_input_file(args->scene); !in.ok())
       return vt::cli::report_error("bake", in);
+    if (!args->plan.empty() || !args->work.empty()) {
+      if (args->work.empty() == false && args->plan.empty())
+        args->plan = vt::work_plan_path(args->work);
+      return run_plan(*args, global);
+    }
     auto summary = vt::bake_scene(args->scene, o);
     progress.done();
     if (!summary.ok()) return vt::cli::report_error("bake", summary.status());

@@ -14,6 +14,7 @@ packages=(
   libjpeg62-turbo-dev libstb-dev
   clang libclang-rt-14-dev
   help2man g++-mingw-w64-x86-64-posix
+  slurm-wlm munge
 )
 
 missing=()

@@ -1,0 +1,945 @@
+// A scene bake sharded over a build farm (see shard.h and docs/FARM.md).
+#include "bake/shard.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+#define XXH_STATIC_LINKING_ONLY  // XXH3_state_t as a member
+#include <xxhash.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "bake/build_plan.h"
+#include "bake/build_tasks.h"
+#include "bake/level_source.h"
+#include "bake/unwrap/unwrap.h"
+#include "bake/update.h"
+#include "format/atomic_output.h"
+
+#ifndef VTBAKE_VERSION
+#define VTBAKE_VERSION "unknown"
+#endif
+
+namespace vt {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+constexpr const char* kPlanSchema = "vtbake-plan/1";
+constexpr char kPartMagic[8] = {'V', 'T', 'P', 'A', 'R', 'T', '0', '1'};
+enum PartTag : uint8_t { kEnd = 0, kPage = 1, kTask = 2, kKey = 3 };
+
+// Keys go into JSON as 16 hex digits: JSON readers lose integers past 2^53.
+std::string hex(uint64_t v) {
+  char s[17];
+  std::snprintf(s, sizeof s, "%016llx", (unsigned long long)v);
+  return s;
+}
+uint64_t unhex(const nlohmann::json& j) {
+  return j.is_string() ? std::strtoull(j.get<std::string>().c_str(), nullptr, 16) : 0;
+}
+
+Status io_error(const std::string& path, const std::string& what) {
+  return Error(ErrorCode::kIo, path + ": " + what + ": " + std::strerror(errno));
+}
+
+// Level 0 of a layer as the plan wrote it: raw little-endian floats, row-major.
+class RawFileSource final : public ImageSource {
+ public:
+  static Expected<std::shared_ptr<RawFileSource>> open(const std::string& path, ImageInfo info) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return io_error(path, "cannot open");
+    auto s = std::shared_ptr<RawFileSource>(new RawFileSource(fd, path, std::move(info)));
+    const uint64_t want = uint64_t(s->info_.width) * s->info_.height * s->info_.channels * 4;
+    std::error_code ec;
+    if (fs::file_size(path, ec) != want) {
+      return Error(ErrorCode::kCorrupt, path + ": not the " + std::to_string(want) +
+                                            " bytes the plan says (a damaged work folder?)");
+    }
+    return s;
+  }
+  ~RawFileSource() override { ::close(fd_); }
+  const ImageInfo& info() const override { return info_; }
+  Status read_rows(uint32_t y0, uint32_t y1, float* out) override {
+    if (y0 > y1 || y1 > info_.height) return Error(ErrorCode::kInvalidArgument, path_ + ": rows");
+    const size_t row = size_t(info_.width) * info_.channels * sizeof(float);
+    size_t left = row * (y1 - y0);
+    off_t at = off_t(row * y0);
+    auto* p = reinterpret_cast<char*>(out);
+    while (left > 0) {
+      const ssize_t n = ::pread(fd_, p, left, at);
+      if (n <= 0) return io_error(path_, "read failed");
+      p += n, at += n, left -= size_t(n);
+    }
+    return Status::Ok();
+  }
+  std::string origin() const override { return path_; }
+
+ private:
+  RawFileSource(int fd, std::string path, ImageInfo info)
+      : fd_(fd), path_(std::move(path)), info_(std::move(info)) {}
+  int fd_;
+  std::string path_;
+  ImageInfo info_;
+};
+
+// Level 0 in its working form as the plan wrote it (converted and dilated), read by rows.
+class FileLevel0 final : public LevelSource {
+ public:
+  FileLevel0(std::shared_ptr<RawFileSource> file, std::shared_ptr<const std::vector<uint8_t>> cov)
+      : file_(std::move(file)), coverage_(std::move(cov)) {}
+  uint32_t width() const override { return file_->info().width; }
+  uint32_t height() const override { return file_->info().height; }
+  uint32_t channels() const override { return file_->info().channels; }
+  Status read(uint32_t y0, uint32_t y1, float* out) override {
+    return file_->read_rows(y0, y1, out);
+  }
+  const uint8_t* coverage() const override { return coverage_ ? coverage_->data() : nullptr; }
+
+ private:
+  std::shared_ptr<RawFileSource> file_;
+  std::shared_ptr<const std::vector<uint8_t>> coverage_;
+};
+
+// A file written through a staged name: bytes appended with a running XXH3 of all of them.
+class HashedFile {
+ public:
+  Status open(const std::string& path) {
+    path_ = path;
+    f_ = std::fopen(path.c_str(), "wb");
+    if (!f_) return io_error(path, "cannot write");
+    XXH3_64bits_reset(&state_);
+    return Status::Ok();
+  }
+  ~HashedFile() {
+    if (f_) std::fclose(f_);
+  }
+  void put(const void* data, size_t n) {
+    if (!ok_ || n == 0) return;
+    ok_ = std::fwrite(data, 1, n, f_) == n;
+    XXH3_64bits_update(&state_, data, n);
+  }
+  template <class T>
+  void put(T v) {
+    put(&v, sizeof v);
+  }
+  uint64_t digest() { return XXH3_64bits_digest(&state_); }
+  Status close() {
+    const bool closed = std::fclose(f_) == 0;
+    f_ = nullptr;
+    if (!ok_ || !closed) return io_error(path_, "write failed");
+    return Status::Ok();
+  }
+
+ private:
+  std::string path_;
+  std::FILE* f_ = nullptr;
+  bool ok_ = true;
+  XXH3_state_t state_;
+};
+
+Status write_text(const std::string& path, const std::string& text) {
+  HashedFile f;
+  VT_RETURN_IF_ERROR(f.open(path));
+  f.put(text.data(), text.size());
+  return f.close();
+}
+
+Status write_source(ImageSource& source, const std::string& path) {
+  const ImageInfo& info = source.info();
+  HashedFile f;
+  VT_RETURN_IF_ERROR(f.open(path));
+  const size_t row = size_t(info.width) * info.channels;
+  const uint32_t band = uint32_t(std::clamp<size_t>((size_t(4) << 20) / std::max<size_t>(row, 1), 1,
+                                                    std::max(1u, info.height)));
+  std::vector<float> rows(row * band);
+  for (uint32_t y = 0; y < info.height; y += band) {
+    const uint32_t y1 = std::min(info.height, y + band);
+    VT_RETURN_IF_ERROR(source.read_rows(y, y1, rows.data()));
+    f.put(rows.data(), size_t(y1 - y) * row * sizeof(float));
+  }
+  return f.close();
+}
+
+Status write_level(LevelSource& level, const std::string& path) {
+  HashedFile f;
+  VT_RETURN_IF_ERROR(f.open(path));
+  const size_t row = level.row_floats();
+  const uint32_t band = uint32_t(std::clamp<size_t>((size_t(4) << 20) / std::max<size_t>(row, 1), 1,
+                                                    std::max(1u, level.height())));
+  std::vector<float> rows(row * band);
+  for (uint32_t y = 0; y < level.height(); y += band) {
+    const uint32_t y1 = std::min(level.height(), y + band);
+    VT_RETURN_IF_ERROR(level.read(y, y1, rows.data()));
+    f.put(rows.data(), size_t(y1 - y) * row * sizeof(float));
+  }
+  return f.close();
+}
+
+Expected<nlohmann::json> read_json(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    return Error(ErrorCode::kNotFound,
+                 path +
+                     ": no plan here (run `vtbake bake SCENE --work DIR --plan DIR/plan.json` "
+                     "first)");
+  }
+  std::stringstream text;
+  text << in.rdbuf();
+  auto j = nlohmann::json::parse(text.str(), nullptr, false);
+  if (j.is_discarded() || !j.is_object() || j.value("schema", "") != kPlanSchema) {
+    return Error(ErrorCode::kCorrupt, path + ": not a vtbake plan (" + kPlanSchema + ")");
+  }
+  return j;
+}
+
+// A work folder's plan as the shards and the merge read it.
+struct WorkPlan {
+  std::string dir;
+  nlohmann::json json;
+  uint64_t hash = 0;
+  std::vector<BuildTask> tasks;
+  std::vector<uint64_t> keys;
+  std::vector<double> cost;
+};
+
+Expected<WorkPlan> load_plan(const std::string& work_dir) {
+  WorkPlan w;
+  w.dir = work_dir;
+  VT_ASSIGN_OR_RETURN(w.json, read_json(work_plan_path(work_dir)));
+  w.hash = unhex(w.json["plan_hash"]);
+  for (const auto& t : w.json["tasks"]) {
+    BuildTask task;
+    task.kind = t.value("kind", "") == "level" ? BuildTask::Kind::kLevel : BuildTask::Kind::kBand;
+    task.layer = t.value("layer", 0u), task.level = t.value("level", 0u);
+    task.row = t.value("row", 0u);
+    task.deps = t.value("deps", std::vector<uint32_t>{});
+    w.tasks.push_back(task);
+    w.keys.push_back(unhex(t["key"]));
+    w.cost.push_back(t.value("cost", 0.0));
+  }
+  return w;
+}
+
+nlohmann::json task_json(const std::vector<BuildTask>& tasks, const BuildSummary& keys,
+                         const BuildPlan& plan) {
+  nlohmann::json out = nlohmann::json::array();
+  for (size_t i = 0; i < tasks.size(); ++i) {
+    const BuildTask& t = tasks[i];
+    const bool band = t.kind == BuildTask::Kind::kBand;
+    // Estimated cost: pages to encode, in page encodes (kLevel tasks run in every shard).
+    out.push_back({{"id", i},
+                   {"kind", band ? "band" : "level"},
+                   {"layer", t.layer},
+                   {"layer_name", plan.layers[t.layer].spec.name},
+                   {"level", t.level},
+                   {"row", t.row},
+                   {"deps", t.deps},
+                   {"key", hex(keys.task_keys[i])},
+                   {"pages", band ? keys.task_pages[i] : 0},
+                   {"cost", band ? double(keys.task_pages[i]) : 0.0},
+                   {"pyramid_seconds", keys.task_seconds[i]}});
+  }
+  return out;
+}
+
+// Pages go nowhere: the plan's pass computes keys only.
+class NullSink final : public PageSink {
+ public:
+  Status add_page(const PageId&, uint32_t, std::span<const uint8_t>) override {
+    return Status::Ok();
+  }
+  Status add_constant_page(const PageId&, uint32_t, std::span<const uint8_t>) override {
+    return Status::Ok();
+  }
+};
+
+std::string default_glb(const std::string& output) {
+  fs::path p(output);
+  p.replace_extension(".glb");
+  return p.string();
+}
+
+std::string absolute(const std::string& path) {
+  std::error_code ec;
+  fs::path p = fs::absolute(path, ec);
+  return (ec ? fs::path(path) : p).lexically_normal().string();
+}
+
+// Moves `from` onto `to` (another folder, perhaps another file system).
+Status move_file(const std::string& from, const std::string& to) {
+  std::error_code ec;
+  fs::rename(from, to, ec);
+  if (!ec) return Status::Ok();
+  fs::copy_file(from, to, fs::copy_options::overwrite_existing, ec);
+  if (ec) return Error(ErrorCode::kIo, to + ": cannot copy " + from + ": " + ec.message());
+  fs::remove(from, ec);
+  return Status::Ok();
+}
+
+// Removes parts of another plan from DIR/parts (a plan made again into the same folder).
+void remove_stale_parts(const std::string& work_dir, uint64_t plan_hash);
+
+}  // namespace
+
+std::string work_plan_path(const std::string& work_dir) {
+  return (fs::path(work_dir) / "plan.json").string();
+}
+std::string shard_part_path(const std::string& work_dir, uint32_t index, uint32_t count) {
+  return (fs::path(work_dir) / "parts" /
+          ("shard-" + std::to_string(index) + "-of-" + std::to_string(count) + ".part"))
+      .string();
+}
+std::string tasks_part_path(const std::string& work_dir, const std::vector<uint32_t>& tasks) {
+  const uint64_t h = XXH3_64bits(tasks.data(), tasks.size() * sizeof(uint32_t));
+  return (fs::path(work_dir) / "parts" / ("tasks-" + hex(h) + ".part")).string();
+}
+
+Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOptions& opts,
+                                const std::string& work_dir, const std::string& plan_path) {
+  auto start = Clock::now();
+  PlanSummary sum;
+  sum.plan_path = plan_path;
+  sum.work_dir = work_dir;
+  SceneBakeOptions options = opts;
+  options.build.update = false;  // a farm bake is a clean bake (tables: --tables-from or trained)
+  const std::string output = options.build.output;
+  const std::string glb = options.unwrapped.empty()  ? default_glb(output)
+                          : options.unwrapped == "-" ? ""
+                                                     : options.unwrapped;
+  // Every output is staged before the work, so that a bad path fails first.
+  OutputSet outputs;
+  std::vector<std::string> staged_layers;
+  std::string staged_coverage, staged_tables, staged_glb;
+  const std::string dir = work_dir.empty() ? "" : absolute(work_dir);
+  if (!dir.empty()) {
+    std::error_code ec;
+    fs::create_directories(fs::path(dir) / "level0", ec);
+    fs::create_directories(fs::path(dir) / "parts", ec);
+    if (ec) return Error(ErrorCode::kIo, dir + ": cannot create the work folder: " + ec.message());
+  }
+
+  auto t0 = Clock::now();
+  auto loaded = scene::load_scene(scene_path, options.load);
+  if (!loaded.ok()) return loaded.status();
+  VT_RETURN_IF_ERROR(scene::validate_geometry(*loaded));
+  sum.stages.push_back({"load", seconds_since(t0)});
+  auto prepared = prepare_scene_bake(*loaded, options);
+  if (!prepared.ok()) return prepared.status().with_context(scene_path);
+  for (const StageTime& st : prepared->summary.stages) sum.stages.push_back(st);
+
+  // Level 0 as the transfer gave it (before drop_opaque_alpha, which each shard runs again:
+  // the plan hash is of the sources as the build sees them).
+  t0 = Clock::now();
+  BuildOptions bo = prepared->build;
+  nlohmann::json layers = nlohmann::json::array();
+  for (size_t i = 0; i < bo.layers.size(); ++i) {
+    const LayerInput& in = bo.layers[i];
+    const ImageInfo& info = in.source->info();
+    const std::string name = in.name.empty() ? to_string(in.semantic) : in.name;
+    const std::string file = "level0/" + name + ".f32";
+    if (!dir.empty()) {
+      VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/" + file));
+      VT_RETURN_IF_ERROR(write_source(*in.source, staged));
+    }
+    layers.push_back({{"name", name},
+                      {"semantic", int(in.semantic)},
+                      {"file", file},
+                      {"width", info.width},
+                      {"height", info.height},
+                      {"channels", info.channels},
+                      {"is_float", info.is_float},
+                      {"alpha_channel", info.alpha_channel},
+                      {"info_color_space", info.color_space},
+                      {"color_space", in.color_space}});
+  }
+  const bool coverage = !bo.layers.empty() && bo.layers[0].coverage;
+  if (!dir.empty() && coverage) {
+    VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/level0/coverage.u8"));
+    const auto& c = *bo.layers[0].coverage;
+    VT_RETURN_IF_ERROR(write_text(staged, std::string(c.begin(), c.end())));
+  }
+  sum.stages.push_back({"write level 0", seconds_since(t0)});
+
+  // The plan (tables trained once, here) and a pass over the pyramid for the task keys.
+  t0 = Clock::now();
+  VT_RETURN_IF_ERROR(drop_opaque_alpha(bo));
+  VT_ASSIGN_OR_RETURN(BuildPlan plan, plan_build(bo));
+  sum.stages.push_back({"plan", seconds_since(t0)});
+  // Level 0 in its working form (converted, dilated) for the shards, which would otherwise each
+  // redo it: for the layers whose held level 0 carries the input's coverage mask.
+  t0 = Clock::now();
+  for (size_t i = 0; i < plan.layers.size() && !dir.empty(); ++i) {
+    LevelSource& level0 = *plan.layers[i].level0;
+    if (!coverage || level0.coverage() != bo.layers[i].coverage->data()) continue;
+    const std::string file = "level0/" + plan.layers[i].spec.name + ".work.f32";
+    VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/" + file));
+    VT_RETURN_IF_ERROR(write_level(level0, staged));
+    layers[i]["work_file"] = file;
+    layers[i]["work_channels"] = level0.channels();
+  }
+  sum.stages.push_back({"write working level 0", seconds_since(t0)});
+  t0 = Clock::now();
+  const std::vector<BuildTask> tasks = make_build_tasks(plan);
+  plan.options.task_subset = std::make_shared<const std::vector<uint8_t>>(tasks.size(), 0);
+  NullSink none;
+  VT_ASSIGN_OR_RETURN(BuildSummary keys, build_pages(plan, none));
+  sum.stages.push_back({"keys", seconds_since(t0)});
+
+  t0 = Clock::now();
+  if (!dir.empty()) {
+    // The final header (tables included) as a page file without pages.
+    VT_ASSIGN_OR_RETURN(staged_tables, outputs.stage(dir + "/tables.vtpf"));
+    VT_ASSIGN_OR_RETURN(auto writer, PageFileWriter::create(staged_tables, plan.desc));
+    VT_RETURN_IF_ERROR(writer->finish().with_context(dir + "/tables.vtpf"));
+    if (!glb.empty()) {
+      // Written beside its final target so that its image paths are relative to that folder.
+      VT_ASSIGN_OR_RETURN(staged_glb, outputs.stage(dir + "/unwrapped.glb"));
+      VT_ASSIGN_OR_RETURN(StagingFile beside, create_staging_file(glb));
+      ::close(beside.fd);
+      Status saved = unwrap::save_unwrapped_glb(prepared->unwrapped, beside.path);
+      if (saved.ok()) saved = move_file(beside.path, staged_glb);
+      std::error_code ec;
+      fs::remove(beside.path, ec);
+      VT_RETURN_IF_ERROR(saved.with_context(glb));
+    }
+  }
+  nlohmann::json j = {
+      {"schema", kPlanSchema},
+      {"tool", VTBAKE_VERSION},
+      {"plan_hash", hex(plan.hash)},
+      {"settings_key", hex(plan.settings_key)},
+      {"input_key", hex(bo.input_key)},
+      {"scene", loaded->source_path.empty() ? "" : absolute(loaded->source_path)},
+      {"output", absolute(output)},
+      {"unwrapped", glb.empty() ? "" : absolute(glb)},
+      {"metadata", bo.metadata_json},
+      {"geometry",
+       {{"width", plan.desc.geometry.width},
+        {"height", plan.desc.geometry.height},
+        {"payload", plan.desc.geometry.payload},
+        {"border", plan.desc.geometry.border},
+        {"levels", plan.desc.geometry.level_count()}}},
+      {"layers", layers},
+      {"coverage", coverage ? "level0/coverage.u8" : ""},
+      {"tasks", task_json(tasks, keys, plan)},
+  };
+  for (const BuildTask& t : tasks) {
+    ++sum.tasks;
+    if (t.kind == BuildTask::Kind::kBand) ++sum.band_tasks;
+  }
+  for (uint32_t p : keys.task_pages) sum.pages += p;
+  if (!dir.empty()) {
+    VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/plan.json"));
+    VT_RETURN_IF_ERROR(write_text(staged, j.dump(1) + "\n"));
+  }
+  if (!plan_path.empty() && (dir.empty() || absolute(plan_path) != dir + "/plan.json")) {
+    VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(plan_path));
+    VT_RETURN_IF_ERROR(write_text(staged, j.dump(1) + "\n"));
+  }
+  VT_RETURN_IF_ERROR(outputs.commit());
+  if (!dir.empty()) remove_stale_parts(dir, plan.hash);
+  sum.stages.push_back({"write", seconds_since(t0)});
+  sum.plan_hash = plan.hash;
+  sum.seconds = seconds_since(start);
+  return sum;
+}
+
+namespace {
+
+std::vector<std::vector<uint32_t>> assign_shards(const WorkPlan& w, uint32_t count) {
+  std::vector<uint32_t> band;
+  for (uint32_t i = 0; i < w.tasks.size(); ++i)
+    if (w.tasks[i].kind == BuildTask::Kind::kBand) band.push_back(i);
+  std::stable_sort(band.begin(), band.end(),
+                   [&](uint32_t a, uint32_t b) { return w.cost[a] > w.cost[b]; });
+  std::vector<std::vector<uint32_t>> shards(count);
+  std::vector<double> load(count, 0.0);
+  for (uint32_t t : band) {
+    const size_t s = size_t(std::min_element(load.begin(), load.end()) - load.begin());
+    shards[s].push_back(t);
+    load[s] += w.cost[t] + 1e-3;  // empty tasks spread too
+  }
+  for (auto& s : shards) std::sort(s.begin(), s.end());
+  return shards;
+}
+
+}  // namespace
+
+Expected<std::vector<uint32_t>> shard_tasks(const std::string& work_dir, uint32_t index,
+                                            uint32_t count) {
+  if (count == 0 || index >= count) {
+    return Error(ErrorCode::kInvalidArgument, "shard " + std::to_string(index) + "/" +
+                                                  std::to_string(count) +
+                                                  ": expected I/N with 0 <= I < N");
+  }
+  VT_ASSIGN_OR_RETURN(const WorkPlan w, load_plan(work_dir));
+  return assign_shards(w, count)[index];
+}
+
+namespace {
+
+// The pages of a shard's tasks, streamed into its part as they come.
+class PartSink final : public PageSink {
+ public:
+  PartSink(HashedFile& f, const PageGeometry& g, const std::vector<BuildTask>& tasks)
+      : f_(f), g_(g) {
+    for (uint32_t i = 0; i < tasks.size(); ++i)
+      if (tasks[i].kind == BuildTask::Kind::kBand)
+        task_of_[{tasks[i].layer, tasks[i].level, tasks[i].row}] = i;
+  }
+  Status add_page(const PageId& id, uint32_t layer, std::span<const uint8_t> data) override {
+    return put(id, layer, PageState::kStored, data);
+  }
+  Status add_constant_page(const PageId& id, uint32_t layer,
+                           std::span<const uint8_t> texel) override {
+    return put(id, layer, PageState::kConstant, texel);
+  }
+  ShardSummary counts;
+
+ private:
+  Status put(const PageId& id, uint32_t layer, PageState state, std::span<const uint8_t> b) {
+    const auto it = task_of_.find({layer, id.level, id.y});
+    if (it == task_of_.end()) return Error(ErrorCode::kInternal, "page outside the plan's tasks");
+    f_.put(uint8_t(kPage));
+    f_.put(uint8_t(state));
+    f_.put(uint16_t(layer));
+    f_.put(it->second);
+    f_.put(id.level), f_.put(id.x), f_.put(id.y);
+    f_.put(uint32_t(b.size()));
+    f_.put(uint64_t(XXH3_64bits(b.data(), b.size())));
+    f_.put(b.data(), b.size());
+    ++counts.pages;
+    if (state == PageState::kStored) ++counts.stored, counts.stored_bytes += b.size();
+    if (state == PageState::kConstant) ++counts.constant;
+    (void)g_;
+    return Status::Ok();
+  }
+  HashedFile& f_;
+  const PageGeometry& g_;
+  std::map<std::tuple<uint32_t, uint32_t, uint32_t>, uint32_t> task_of_;
+};
+
+Expected<std::vector<LayerInput>> work_layers(const WorkPlan& w) {
+  std::shared_ptr<const std::vector<uint8_t>> coverage;
+  const std::string cov = w.json.value("coverage", "");
+  if (!cov.empty()) {
+    const std::string path = w.dir + "/" + cov;
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return io_error(path, "cannot open");
+    auto c = std::make_shared<std::vector<uint8_t>>(std::istreambuf_iterator<char>(in),
+                                                    std::istreambuf_iterator<char>());
+    coverage = std::move(c);
+  }
+  std::vector<LayerInput> layers;
+  for (const auto& l : w.json["layers"]) {
+    ImageInfo info;
+    info.width = l.value("width", 0u), info.height = l.value("height", 0u);
+    info.channels = l.value("channels", 0u);
+    info.is_float = l.value("is_float", false);
+    info.alpha_channel = l.value("alpha_channel", -1);
+    info.color_space = l.value("info_color_space", "");
+    if (coverage && coverage->size() != size_t(info.width) * info.height) {
+      return Error(ErrorCode::kCorrupt, w.dir + "/" + cov + ": not the atlas's size");
+    }
+    LayerInput in;
+    in.semantic = LayerSemantic(l.value("semantic", 0));
+    in.color_space = l.value("color_space", "");
+    in.coverage = coverage;
+    VT_ASSIGN_OR_RETURN(in.source,
+                        RawFileSource::open(w.dir + "/" + l.value("file", ""), std::move(info)));
+    layers.push_back(std::move(in));
+  }
+  return layers;
+}
+
+}  // namespace
+
+Expected<ShardSummary> run_shard(const ShardOptions& options) {
+  auto start = Clock::now();
+  ShardSummary sum;
+  auto t0 = Clock::now();
+  VT_ASSIGN_OR_RETURN(const WorkPlan w, load_plan(options.work_dir));
+  if (w.json.value("tool", "") != VTBAKE_VERSION) {
+    return Error(ErrorCode::kInvalidArgument, work_plan_path(w.dir) + ": made by vtbake " +
+                                                  w.json.value("tool", "") +
+                                                  ", this is " VTBAKE_VERSION " (plan again)");
+  }
+  std::vector<uint32_t> mine = options.tasks;
+  std::string part;
+  if (options.count > 0) {
+    if (options.index >= options.count) {
+      return Error(ErrorCode::kInvalidArgument, "--shard " + std::to_string(options.index) + "/" +
+                                                    std::to_string(options.count) +
+                                                    ": expected I/N with 0 <= I < N");
+    }
+    mine = assign_shards(w, options.count)[options.index];
+    part = shard_part_path(w.dir, options.index, options.count);
+  } else {
+    std::sort(mine.begin(), mine.end());
+    mine.erase(std::unique(mine.begin(), mine.end()), mine.end());
+    for (uint32_t t : mine)
+      if (t >= w.tasks.size() || w.tasks[t].kind != BuildTask::Kind::kBand) {
+        return Error(
+            ErrorCode::kInvalidArgument,
+            "--tasks: " + std::to_string(t) + " is not a band task of " + work_plan_path(w.dir));
+      }
+    part = tasks_part_path(w.dir, mine);
+  }
+  sum.part = part;
+  sum.tasks = mine;
+  // Staged now: a killed shard leaves only PART.tmp-*, which the merge does not read.
+  OutputSet outputs;
+  VT_ASSIGN_OR_RETURN(const std::string staged, outputs.stage(part));
+
+  BuildOptions bo = options.build;
+  VT_ASSIGN_OR_RETURN(bo.layers, work_layers(w));
+  bo.output = part;
+  bo.address = AddressMode::kClamp;
+  bo.metadata_json = w.json.value("metadata", "{}");
+  bo.input_key = unhex(w.json["input_key"]);
+  bo.update = false;
+  bo.tables_from = w.dir + "/tables.vtpf";
+  // Level 0 as the plan converted and dilated it, where it wrote that.
+  std::vector<std::shared_ptr<LevelSource>> level0(bo.layers.size());
+  for (size_t i = 0; i < bo.layers.size() && i < w.json["layers"].size(); ++i) {
+    const auto& l = w.json["layers"][i];
+    const std::string file = l.value("work_file", "");
+    if (file.empty()) continue;
+    ImageInfo info;
+    info.width = l.value("width", 0u), info.height = l.value("height", 0u);
+    info.channels = l.value("work_channels", 0u);
+    VT_ASSIGN_OR_RETURN(auto raw, RawFileSource::open(w.dir + "/" + file, info));
+    level0[i] = std::make_shared<FileLevel0>(std::move(raw), bo.layers[i].coverage);
+  }
+  bo.level0_from = [level0](size_t i) -> Expected<std::shared_ptr<LevelSource>> {
+    return i < level0.size() ? level0[i] : nullptr;
+  };
+  sum.stages.push_back({"read", seconds_since(t0)});
+  t0 = Clock::now();
+  VT_RETURN_IF_ERROR(drop_opaque_alpha(bo));
+  VT_ASSIGN_OR_RETURN(BuildPlan plan, plan_build(bo));
+  if (plan.hash != w.hash) {
+    return Error(ErrorCode::kInvalidArgument,
+                 work_plan_path(w.dir) + ": this shard's plan is " + hex(plan.hash) +
+                     ", the folder's is " + hex(w.hash) +
+                     ": give every shard the settings the plan was made with");
+  }
+  const std::vector<BuildTask> tasks = make_build_tasks(plan);
+  if (tasks.size() != w.tasks.size()) {
+    return Error(ErrorCode::kInternal, "shard: the plan's task graph differs from the folder's");
+  }
+  auto subset = std::make_shared<std::vector<uint8_t>>(tasks.size(), 0);
+  for (uint32_t t : mine) (*subset)[t] = 1;
+  plan.options.task_subset = subset;
+  sum.stages.push_back({"plan", seconds_since(t0)});
+
+  t0 = Clock::now();
+  HashedFile f;
+  VT_RETURN_IF_ERROR(f.open(staged));
+  f.put(kPartMagic, sizeof kPartMagic);
+  f.put(uint64_t(plan.hash));
+  const std::string label = fs::path(part).filename().string();
+  f.put(uint32_t(label.size()));
+  f.put(label.data(), label.size());
+  PartSink sink(f, plan.desc.geometry, tasks);
+  VT_ASSIGN_OR_RETURN(BuildSummary built, build_pages(plan, sink));
+  sum.stages.push_back({"build", seconds_since(t0)});
+  t0 = Clock::now();
+  for (uint32_t t : mine) {
+    if (built.task_keys[t] != w.keys[t]) {
+      return Error(ErrorCode::kInternal, "shard: task " + std::to_string(t) + " has key " +
+                                             hex(built.task_keys[t]) + ", the plan says " +
+                                             hex(w.keys[t]));
+    }
+    f.put(uint8_t(kTask));
+    f.put(t);
+    f.put(uint64_t(built.task_keys[t]));
+    f.put(double(built.task_seconds[t]));
+    f.put(uint32_t(built.task_pages[t]));
+  }
+  for (uint32_t li = 0; li < built.page_keys.size(); ++li)
+    for (uint32_t i = 0; i < built.page_keys[li].size(); ++i)
+      if (const uint64_t k = built.page_keys[li][i]) {
+        f.put(uint8_t(kKey));
+        f.put(uint16_t(li));
+        f.put(i);
+        f.put(k);
+      }
+  f.put(uint8_t(kEnd));
+  const uint64_t digest = f.digest();
+  f.put(digest);
+  VT_RETURN_IF_ERROR(f.close());
+  VT_RETURN_IF_ERROR(outputs.commit());
+  sum.stages.push_back({"write", seconds_since(t0)});
+  sum.pages = sink.counts.pages, sum.stored = sink.counts.stored;
+  sum.constant = sink.counts.constant, sum.stored_bytes = sink.counts.stored_bytes;
+  sum.seconds = seconds_since(start);
+  return sum;
+}
+
+namespace {
+
+struct PartPage {
+  uint32_t task, layer;
+  PageId id;
+  PageState state;
+  size_t offset, size;  // in Part::bytes
+};
+struct Part {
+  std::string path;
+  uint64_t plan_hash = 0;
+  std::vector<uint8_t> bytes;
+  std::vector<PartPage> pages;
+  std::map<uint32_t, uint64_t> task_keys;
+  std::vector<std::tuple<uint32_t, uint32_t, uint64_t>> page_keys;  // layer, index, key
+};
+
+// Reads and checks a part: complete (its final checksum over every byte) and well formed.
+Expected<Part> read_part(const std::string& path) {
+  Part p;
+  p.path = path;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return io_error(path, "cannot open");
+  p.bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  const auto& b = p.bytes;
+  auto bad = [&](const std::string& what) {
+    return Error(ErrorCode::kCorrupt, path + ": " + what + " (run this shard again)");
+  };
+  if (b.size() < 8 + 8 + 4 + 9 || std::memcmp(b.data(), kPartMagic, 8) != 0)
+    return bad("not a vtbake shard part");
+  uint64_t digest;
+  std::memcpy(&digest, b.data() + b.size() - 8, 8);
+  if (b[b.size() - 9] != kEnd || XXH3_64bits(b.data(), b.size() - 8) != digest)
+    return bad("checksum mismatch: truncated or damaged");
+  size_t at = 8;
+  const size_t end = b.size() - 9;
+  auto get = [&](auto& v) {
+    if (at + sizeof v > end) return false;
+    std::memcpy(&v, b.data() + at, sizeof v);
+    at += sizeof v;
+    return true;
+  };
+  uint32_t label = 0;
+  if (!get(p.plan_hash) || !get(label) || at + label > end) return bad("bad header");
+  at += label;
+  while (at < end) {
+    uint8_t tag = 0;
+    get(tag);
+    if (tag == kPage) {
+      uint8_t state = 0;
+      uint16_t layer = 0;
+      PartPage pg{};
+      uint32_t size = 0;
+      uint64_t sum = 0;
+      if (!get(state) || !get(layer) || !get(pg.task) || !get(pg.id.level) || !get(pg.id.x) ||
+          !get(pg.id.y) || !get(size) || !get(sum) || at + size > end)
+        return bad("bad page record");
+      if (XXH3_64bits(b.data() + at, size) != sum) return bad("page checksum mismatch");
+      pg.layer = layer, pg.state = PageState(state), pg.offset = at, pg.size = size;
+      at += size;
+      p.pages.push_back(pg);
+    } else if (tag == kTask) {
+      uint32_t t = 0, pages = 0;
+      uint64_t key = 0;
+      double seconds = 0;
+      if (!get(t) || !get(key) || !get(seconds) || !get(pages)) return bad("bad task record");
+      p.task_keys[t] = key;
+    } else if (tag == kKey) {
+      uint16_t layer = 0;
+      uint32_t index = 0;
+      uint64_t key = 0;
+      if (!get(layer) || !get(index) || !get(key)) return bad("bad key record");
+      p.page_keys.emplace_back(layer, index, key);
+    } else {
+      return bad("unknown record");
+    }
+  }
+  return p;
+}
+
+std::vector<std::string> list_parts(const std::string& work_dir) {
+  std::vector<std::string> parts;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(fs::path(work_dir) / "parts", ec))
+    if (e.is_regular_file() && e.path().extension() == ".part") parts.push_back(e.path().string());
+  std::sort(parts.begin(), parts.end());
+  return parts;
+}
+
+void remove_stale_parts(const std::string& work_dir, uint64_t plan_hash) {
+  for (const std::string& path : list_parts(work_dir)) {
+    std::ifstream in(path, std::ios::binary);
+    char head[16] = {};
+    in.read(head, sizeof head);
+    uint64_t h = 0;
+    std::memcpy(&h, head + 8, 8);
+    if (!in || std::memcmp(head, kPartMagic, 8) != 0 || h != plan_hash) {
+      std::error_code ec;
+      fs::remove(path, ec);
+    }
+  }
+}
+
+}  // namespace
+
+Expected<MergeSummary> merge_shards(const MergeOptions& options) {
+  auto start = Clock::now();
+  VT_ASSIGN_OR_RETURN(const WorkPlan w, load_plan(options.work_dir));
+  MergeSummary sum;
+  sum.output = options.output.empty() ? w.json.value("output", "") : options.output;
+  if (sum.output.empty()) return Error(ErrorCode::kInvalidArgument, "merge: no output path");
+  const std::string planned_glb = w.json.value("unwrapped", "");
+  sum.unwrapped = options.unwrapped.empty()  ? default_glb(sum.output)
+                  : options.unwrapped == "-" ? ""
+                                             : options.unwrapped;
+  if (!sum.unwrapped.empty() && planned_glb.empty()) {
+    return Error(ErrorCode::kInvalidArgument,
+                 work_plan_path(w.dir) + ": planned without an unwrapped scene (--unwrapped -)");
+  }
+  if (!sum.unwrapped.empty() &&
+      fs::path(absolute(sum.unwrapped)).parent_path() != fs::path(planned_glb).parent_path()) {
+    return Error(ErrorCode::kInvalidArgument,
+                 sum.unwrapped + ": the unwrapped scene's image paths were made relative to " +
+                     fs::path(planned_glb).parent_path().string() +
+                     " (the plan's -o folder); merge there or plan with this -o");
+  }
+  OutputSet outputs;
+  VT_ASSIGN_OR_RETURN(const std::string staged, outputs.stage(sum.output));
+  std::string staged_glb;
+  if (!sum.unwrapped.empty()) {
+    VT_ASSIGN_OR_RETURN(staged_glb, outputs.stage(sum.unwrapped));
+  }
+
+  // Which part gives each band task: the first (by name) that holds it.
+  std::vector<Part> parts;
+  std::vector<int> owner(w.tasks.size(), -1);
+  for (const std::string& path : list_parts(w.dir)) {
+    VT_ASSIGN_OR_RETURN(Part p, read_part(path));
+    if (p.plan_hash != w.hash) {
+      return Error(ErrorCode::kInvalidArgument,
+                   path + ": a shard of another plan (" + hex(p.plan_hash) + ", the folder's is " +
+                       hex(w.hash) + "); remove it or run that shard again");
+    }
+    bool used = false;
+    for (const auto& [t, key] : p.task_keys) {
+      if (t >= w.tasks.size() || key != w.keys[t]) {
+        return Error(ErrorCode::kCorrupt,
+                     path + ": task " + std::to_string(t) + " does not match the plan's key");
+      }
+      if (owner[t] < 0) owner[t] = int(parts.size()), used = true;
+    }
+    if (used) {
+      sum.parts.push_back(path);
+      parts.push_back(std::move(p));
+    }
+  }
+  std::string missing;
+  size_t n_missing = 0;
+  for (uint32_t t = 0; t < w.tasks.size(); ++t)
+    if (w.tasks[t].kind == BuildTask::Kind::kBand && owner[t] < 0) {
+      if (++n_missing <= 16) missing += (missing.empty() ? "" : " ") + std::to_string(t);
+    }
+  if (n_missing > 0) {
+    return Error(ErrorCode::kNotFound,
+                 w.dir + ": " + std::to_string(n_missing) + " band tasks have no shard part (" +
+                     missing + (n_missing > 16 ? " ..." : "") +
+                     "): run the missing shards (vtbake merge DIR --missing N lists them)");
+  }
+
+  VT_ASSIGN_OR_RETURN(auto header, PageFileReader::open(w.dir + "/tables.vtpf"));
+  PageFileDesc desc;
+  desc.geometry = header->geometry();
+  desc.layers = header->layers();
+  desc.metadata_json = header->metadata_json();
+  VT_ASSIGN_OR_RETURN(auto writer, PageFileWriter::create(staged, desc));
+  UpdateRecord record;
+  record.tool = VTBAKE_VERSION;
+  record.plan_hash = w.hash;
+  record.settings_key = unhex(w.json["settings_key"]);
+  record.input_key = unhex(w.json["input_key"]);
+  for (const LayerSpec& l : desc.layers) record.layer_names.push_back(l.name);
+  record.page_keys.assign(desc.layers.size(),
+                          std::vector<uint64_t>(desc.geometry.total_pages(), 0));
+  for (size_t pi = 0; pi < parts.size(); ++pi) {
+    const Part& p = parts[pi];
+    for (const PartPage& pg : p.pages) {
+      if (owner[pg.task] != int(pi)) continue;
+      if (pg.layer >= desc.layers.size() || !desc.geometry.contains(pg.id))
+        return Error(ErrorCode::kCorrupt, p.path + ": page outside the plan's grid");
+      const std::span<const uint8_t> data(p.bytes.data() + pg.offset, pg.size);
+      if (pg.state == PageState::kStored) {
+        VT_RETURN_IF_ERROR(writer->add_page(pg.id, pg.layer, data).with_context(p.path));
+        ++sum.stored, sum.stored_bytes += pg.size;
+      } else {
+        VT_RETURN_IF_ERROR(writer->add_constant_page(pg.id, pg.layer, data).with_context(p.path));
+        ++sum.constant;
+      }
+    }
+  }
+  // Page keys: each from the part that gave its task.
+  std::map<std::pair<uint32_t, uint32_t>, uint32_t> row_task;  // (layer, level, row) -> task
+  for (uint32_t t = 0; t < w.tasks.size(); ++t)
+    if (w.tasks[t].kind == BuildTask::Kind::kBand)
+      row_task[{w.tasks[t].layer, (w.tasks[t].level << 20) | w.tasks[t].row}] = t;
+  const PageGeometry& g = desc.geometry;
+  std::vector<uint64_t> level_start(g.level_count() + 1, 0);
+  for (uint32_t l = 0; l < g.level_count(); ++l)
+    level_start[l + 1] = level_start[l] + uint64_t(g.pages_x(l)) * g.pages_y(l);
+  for (size_t pi = 0; pi < parts.size(); ++pi)
+    for (const auto& [layer, index, key] : parts[pi].page_keys) {
+      if (layer >= record.page_keys.size() || index >= g.total_pages())
+        return Error(ErrorCode::kCorrupt, parts[pi].path + ": page key outside the grid");
+      const uint32_t level =
+          uint32_t(std::upper_bound(level_start.begin(), level_start.end(), index) -
+                   level_start.begin() - 1);
+      const uint32_t row = uint32_t((index - level_start[level]) / g.pages_x(level));
+      const auto it = row_task.find({layer, (level << 20) | row});
+      if (it != row_task.end() && owner[it->second] == int(pi))
+        record.page_keys[layer][index] = key;
+    }
+  const std::string scene = w.json.value("scene", "");
+  const std::string provenance =
+      nlohmann::json{{"scene", scene.empty() ? "" : path_for_metadata(scene, sum.output)}}.dump();
+  writer->set_metadata_json(
+      with_update_record(merge_metadata(desc.metadata_json, provenance), record));
+  VT_RETURN_IF_ERROR(writer->finish().with_context(sum.output));
+  if (!staged_glb.empty()) {
+    std::error_code ec;
+    fs::copy_file(w.dir + "/unwrapped.glb", staged_glb, fs::copy_options::overwrite_existing, ec);
+    if (ec) {
+      return Error(ErrorCode::kIo,
+                   sum.unwrapped + ": cannot copy " + w.dir + "/unwrapped.glb: " + ec.message());
+    }
+  }
+  VT_RETURN_IF_ERROR(outputs.commit());
+  sum.pages = g.total_pages() * desc.layers.size();
+  sum.absent = sum.pages - sum.stored - sum.constant;
+  std::error_code ec;
+  sum.file_bytes = fs::file_size(sum.output, ec);
+  sum.seconds = seconds_since(start);
+  return sum;
+}
+
+Expected<std::vector<uint32_t>> missing_shards(const std::string& work_dir, uint32_t count) {
+  VT_ASSIGN_OR_RETURN(const WorkPlan w, load_plan(work_dir));
+  std::vector<uint32_t> missing;
+  for (uint32_t i = 0; i < count; ++i) {
+    auto p = read_part(shard_part_path(w.dir, i, count));
+    if (!p.ok() || p->plan_hash != w.hash) missing.push_back(i);
+  }
+  return missing;
+}
+
+}  // namespace vt

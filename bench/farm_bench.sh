@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# Build farm figures (docs/BENCHMARKS.md, "Build farm"): the sample scene baked in one process
+# (--threads 2) and through Slurm (a one-node cluster, tests/farm/local_cluster.sh; 2 shards of
+# 1 CPU at once, the plan job on 2), wall times as medians of RUNS; then the same steps by hand
+# with --json for what the farm's time is made of, and the per-core rates the 128K model uses
+# (bench/farm_model.py). Run as root, through `heavy`.
+#   bench/farm_bench.sh VTBAKE [SIZE_PAGES=16] [RUNS=3] [BAKE FLAGS...]   (e.g. --codec bc:high)
+set -euo pipefail
+vtbake=$(readlink -f "$1")
+size="${2:-16}"
+runs="${3:-3}"
+shift $(($# < 3 ? $# : 3))
+src=$(cd "$(dirname "$0")/.." && pwd)
+tmp=$(mktemp -d /tmp/vtbake-farm-bench.XXXXXX)
+source "$src/tests/farm/local_cluster.sh"
+trap 'stop_cluster; [[ -n "${VTBAKE_KEEP_BENCH:-}" ]] || rm -rf "$tmp"' EXIT
+echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
+"$vtbake" -q sample-scene "$tmp/scene"
+flags=(--size "$size" "$@")
+now() { date +%s.%N; }
+median() { sort -g | awk '{a[NR] = $1} END {print a[int((NR + 1) / 2)]}'; }
+
+mkdir -p "$tmp/local"
+for r in $(seq "$runs"); do
+  t0=$(now)
+  "$vtbake" -q --threads 2 bake "$tmp/scene/scene.gltf" -o "$tmp/local/out.vtpf" "${flags[@]}" >/dev/null
+  echo "$(now) - $t0" | bc
+done >"$tmp/local.times"
+echo "one process (--threads 2): median $(median <"$tmp/local.times") s of $(paste -sd' ' "$tmp/local.times")"
+
+start_cluster "$tmp/cluster"
+for r in $(seq "$runs"); do
+  rm -rf "$tmp/farm"
+  t0=$(now)
+  PATH="$(dirname "$vtbake"):$PATH" "$src/scripts/farm.sh" --work "$tmp/farm/work" --shards 2 \
+    --cpus 1 --plan-cpus 2 --poll 0.2 --vtbake "$vtbake" \
+    -- "$tmp/scene/scene.gltf" -o "$tmp/farm/out.vtpf" "${flags[@]}" >/dev/null
+  echo "$(now) - $t0" | bc
+  cmp "$tmp/local/out.vtpf" "$tmp/farm/out.vtpf"
+done >"$tmp/farm.times"
+echo "Slurm, 2 shards x 1 CPU: median $(median <"$tmp/farm.times") s of $(paste -sd' ' "$tmp/farm.times") (merged file byte-identical)"
+stop_cluster
+
+# The steps by hand, with their stage times.
+w="$tmp/hand/work"
+mkdir -p "$tmp/hand"
+b=(bake "$tmp/scene/scene.gltf" -o "$tmp/hand/out.vtpf" "${flags[@]}" --work "$w")
+t0=$(now)
+"$vtbake" --json --threads 2 "${b[@]}" --plan "$w/plan.json" >"$tmp/plan.json.out"
+t1=$(now)
+"$vtbake" --json --threads 1 "${b[@]}" --shard 0/2 >"$tmp/shard0.json" &
+"$vtbake" --json --threads 1 "${b[@]}" --shard 1/2 >"$tmp/shard1.json"
+wait
+t2=$(now)
+"$vtbake" --json merge "$w" -o "$tmp/hand/out.vtpf" >"$tmp/merge.json"
+t3=$(now)
+cmp "$tmp/local/out.vtpf" "$tmp/hand/out.vtpf"
+echo "by hand: plan $(echo "$t1 - $t0" | bc) s, 2 shards at once $(echo "$t2 - $t1" | bc) s, merge $(echo "$t3 - $t2" | bc) s"
+# Per-core rates: one shard of one (every page) and the plan's key pass, at 1 thread.
+"$vtbake" --json --threads 1 "${b[@]}" --shard 0/1 >"$tmp/shard_all.json"
+mkdir -p "$tmp/hand1"
+"$vtbake" --json --threads 1 bake "$tmp/scene/scene.gltf" -o "$tmp/hand1/out.vtpf" "${flags[@]}" \
+  --work "$tmp/hand1/work" --plan "$tmp/hand1/work/plan.json" >"$tmp/plan1.json.out"
+python3 "$src/bench/farm_model.py" --plan "$tmp/plan.json.out" --plan1 "$tmp/plan1.json.out" \
+  --plan-graph "$w/plan.json" --shards "$tmp/shard0.json" "$tmp/shard1.json" \
+  --shard-all "$tmp/shard_all.json" --merge "$tmp/merge.json"
+echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -1,0 +1,213 @@
+// End-to-end: a scene bake sharded over a build farm (issue 17, bake/shard.h). `bake --plan
+// --work` then `bake --shard I/N` (or `--tasks`) then `merge` gives the bytes of a one-process
+// bake (page file and unwrapped scene); a killed or failed shard leaves nothing the merge takes;
+// running a shard again is safe; the merge refuses a part of another plan or a damaged one.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tests/cli/cli_test_util.h"
+
+namespace vt {
+namespace {
+
+using namespace vt::testing;
+namespace fs = std::filesystem;
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+class FarmCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = (fs::temp_directory_path() / ("vt_farm_cli_" + std::to_string(::getpid()))).string();
+    fs::remove_all(dir_);
+    RunResult s = run_vtbake("-q sample-scene " + dir_ +
+                                 "/scene --ground-cells 4 --sphere-segments 12 --texture-size 64",
+                             true);
+    setup_error_ = s.exit_code == 0 ? "" : "sample-scene failed: " + s.out;
+    if (!setup_error_.empty()) return;
+    fs::create_directories(dir_ + "/local");
+    for (const char* name : {"four", "tasks", "one", "kill", "a", "b"})
+      fs::create_directories(dir_ + "/" + name);
+    RunResult b =
+        run_vtbake("-q bake " + scene() + " -o " + dir_ + "/local/out.vtpf " + flags(), true);
+    if (b.exit_code != 0) setup_error_ = "bake failed: " + b.out;
+  }
+  static void TearDownTestSuite() {
+    if (!std::getenv("VTBAKE_KEEP_TEST_OUTPUT")) fs::remove_all(dir_);
+  }
+  void SetUp() override { ASSERT_TRUE(setup_error_.empty()) << setup_error_; }
+
+  static std::string scene() { return dir_ + "/scene/scene.gltf"; }
+  static std::string flags() { return "--size 4 --supersample 1"; }
+  // `vtbake bake SCENE -o NAME/out.vtpf FLAGS --work NAME/work ARGS`
+  static RunResult bake(const std::string& name, const std::string& args,
+                        const std::string& extra_flags = "") {
+    return run_vtbake("-q bake " + scene() + " -o " + dir_ + "/" + name + "/out.vtpf " + flags() +
+                          " " + extra_flags + " --work " + work(name) + " " + args,
+                      true);
+  }
+  static std::string work(const std::string& name) { return dir_ + "/" + name + "/work"; }
+  static RunResult merge(const std::string& name, const std::string& args = "") {
+    return run_vtbake("-q merge " + work(name) + " -o " + dir_ + "/" + name + "/out.vtpf " + args,
+                      true);
+  }
+  static void expect_same_as_local(const std::string& name) {
+    const std::string local = read_file(dir_ + "/local/out.vtpf");
+    ASSERT_FALSE(local.empty());
+    EXPECT_TRUE(read_file(dir_ + "/" + name + "/out.vtpf") == local)
+        << name << ": the merged page file differs from the one-process bake";
+    EXPECT_TRUE(read_file(dir_ + "/" + name + "/out.glb") == read_file(dir_ + "/local/out.glb"))
+        << name << ": the unwrapped scene differs";
+  }
+
+  static std::string dir_, setup_error_;
+};
+std::string FarmCli::dir_, FarmCli::setup_error_;
+
+TEST_F(FarmCli, ShardedBakeMergesToTheOneProcessBytes) {
+  RunResult p = bake("four", "--plan " + work("four") + "/plan.json");
+  ASSERT_EQ(p.exit_code, 0) << p.out;
+  auto plan = nlohmann::json::parse(read_file(work("four") + "/plan.json"));
+  ASSERT_TRUE(plan["tasks"].is_array());
+  size_t band = 0;
+  for (const auto& t : plan["tasks"]) {
+    EXPECT_EQ(t["key"].get<std::string>().size(), 16u);
+    EXPECT_TRUE(t.contains("deps") && t.contains("cost"));
+    band += t["kind"] == "band";
+  }
+  EXPECT_GE(band, 8u);
+  // Before every shard is there the merge fails, naming what is missing, and writes nothing.
+  for (int i = 0; i < 3; ++i) {
+    RunResult s = bake("four", "--shard " + std::to_string(i) + "/4");
+    ASSERT_EQ(s.exit_code, 0) << s.out;
+  }
+  RunResult early = merge("four");
+  EXPECT_NE(early.exit_code, 0);
+  EXPECT_NE(early.out.find("no shard part"), std::string::npos) << early.out;
+  EXPECT_FALSE(fs::exists(dir_ + "/four/out.vtpf"));
+  EXPECT_EQ(run_vtbake("merge " + work("four") + " --missing 4", true).out, "3\n");
+  ASSERT_EQ(bake("four", "--shard 3/4").exit_code, 0);
+  EXPECT_EQ(run_vtbake("merge " + work("four") + " --missing 4", true).out, "");
+  RunResult m = merge("four");
+  ASSERT_EQ(m.exit_code, 0) << m.out;
+  expect_same_as_local("four");
+
+  // Running a shard again replaces its part with the same pages (only the task times it records
+  // differ); the merge stays byte-identical.
+  const std::string part = work("four") + "/parts/shard-1-of-4.part";
+  const std::string before = read_file(part);
+  ASSERT_EQ(bake("four", "--shard 1/4").exit_code, 0);
+  EXPECT_EQ(read_file(part).size(), before.size());
+  ASSERT_EQ(merge("four").exit_code, 0);
+  expect_same_as_local("four");
+}
+
+TEST_F(FarmCli, TaskListsAndAnyShardCountGiveTheSameBytes) {
+  ASSERT_EQ(bake("tasks", "--plan " + work("tasks") + "/plan.json").exit_code, 0);
+  auto plan = nlohmann::json::parse(read_file(work("tasks") + "/plan.json"));
+  std::string even, odd;
+  int n = 0;
+  for (const auto& t : plan["tasks"]) {
+    if (t["kind"] != "band") continue;
+    std::string& list = n++ % 2 ? odd : even;
+    list += (list.empty() ? "" : ",") + std::to_string(t["id"].get<int>());
+  }
+  ASSERT_EQ(bake("tasks", "--tasks " + even).exit_code, 0);
+  ASSERT_EQ(bake("tasks", "--tasks " + odd).exit_code, 0);
+  ASSERT_EQ(merge("tasks").exit_code, 0);
+  expect_same_as_local("tasks");
+  // --plan without --work: the task graph alone, the same tasks and keys.
+  const std::string dry = dir_ + "/tasks/dry.json";
+  ASSERT_EQ(run_vtbake("-q bake " + scene() + " -o " + dir_ + "/tasks/out.vtpf " + flags() +
+                           " --plan " + dry,
+                       true)
+                .exit_code,
+            0);
+  auto keys = [](const nlohmann::json& tasks) {
+    std::vector<std::string> k;
+    for (const auto& t : tasks) k.push_back(t["key"].get<std::string>());
+    return k;
+  };
+  EXPECT_EQ(keys(nlohmann::json::parse(read_file(dry))["tasks"]), keys(plan["tasks"]));
+  EXPECT_FALSE(fs::exists(dir_ + "/tasks/dry"));
+  // One shard of one: the same again.
+  ASSERT_EQ(bake("one", "--plan " + work("one") + "/plan.json").exit_code, 0);
+  ASSERT_EQ(bake("one", "--shard 0/1").exit_code, 0);
+  ASSERT_EQ(merge("one").exit_code, 0);
+  expect_same_as_local("one");
+}
+
+TEST_F(FarmCli, KilledOrFailedShardsLeaveNothingTheMergeTakes) {
+  ASSERT_EQ(bake("kill", "--plan " + work("kill") + "/plan.json").exit_code, 0);
+  ASSERT_EQ(bake("kill", "--shard 0/2").exit_code, 0);
+  // A shard with other settings than the plan's fails before writing anything.
+  RunResult wrong = bake("kill", "--shard 1/2", "--codec dct:30");
+  EXPECT_NE(wrong.exit_code, 0);
+  EXPECT_NE(wrong.out.find("settings the plan was made with"), std::string::npos) << wrong.out;
+  const std::string part = work("kill") + "/parts/shard-1-of-2.part";
+  EXPECT_FALSE(fs::exists(part));
+  // A shard killed while it works (its part staged, not complete) leaves only the staging file.
+  const std::string command = std::string(VTBAKE_BINARY) + " -q --threads 1 bake " + scene() +
+                              " -o " + dir_ + "/kill/out.vtpf " + flags() + " --work " +
+                              work("kill") + " --shard 1/2";
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::execl("/bin/sh", "sh", "-c", ("exec " + command + " >/dev/null 2>&1").c_str(), nullptr);
+    ::_exit(127);
+  }
+  bool staged = false;
+  for (int i = 0; i < 2000 && !staged; ++i) {
+    for (const auto& e : fs::directory_iterator(work("kill") + "/parts"))
+      staged |= e.path().filename().string().rfind("shard-1-of-2.part.tmp-", 0) == 0;
+    if (!staged) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  EXPECT_TRUE(staged) << "the shard's part was never staged";
+  EXPECT_FALSE(fs::exists(part));
+  EXPECT_EQ(run_vtbake("merge " + work("kill") + " --missing 2", true).out, "1\n");
+  EXPECT_NE(merge("kill").exit_code, 0);
+  // A damaged part (cut short) is refused, naming it.
+  ASSERT_EQ(bake("kill", "--shard 1/2").exit_code, 0);
+  const std::string whole = read_file(part);
+  { std::ofstream(part, std::ios::binary).write(whole.data(), std::streamsize(whole.size() / 2)); }
+  EXPECT_EQ(run_vtbake("merge " + work("kill") + " --missing 2", true).out, "1\n");
+  RunResult cut = merge("kill");
+  EXPECT_NE(cut.exit_code, 0);
+  EXPECT_NE(cut.out.find("shard-1-of-2.part"), std::string::npos) << cut.out;
+  EXPECT_FALSE(fs::exists(dir_ + "/kill/out.vtpf"));
+  // Running it again mends the folder.
+  ASSERT_EQ(bake("kill", "--shard 1/2").exit_code, 0);
+  ASSERT_EQ(merge("kill").exit_code, 0);
+  expect_same_as_local("kill");
+}
+
+TEST_F(FarmCli, MergeRefusesPartsOfAnotherPlan) {
+  ASSERT_EQ(bake("a", "--plan " + work("a") + "/plan.json").exit_code, 0);
+  ASSERT_EQ(bake("b", "--plan " + work("b") + "/plan.json", "--codec dct:30").exit_code, 0);
+  ASSERT_EQ(bake("a", "--shard 0/2").exit_code, 0);
+  ASSERT_EQ(bake("b", "--shard 1/2", "--codec dct:30").exit_code, 0);
+  fs::copy_file(work("b") + "/parts/shard-1-of-2.part", work("a") + "/parts/shard-1-of-2.part");
+  RunResult m = merge("a");
+  EXPECT_NE(m.exit_code, 0);
+  EXPECT_NE(m.out.find("another plan"), std::string::npos) << m.out;
+  EXPECT_FALSE(fs::exists(dir_ + "/a/out.vtpf"));
+  EXPECT_EQ(run_vtbake("merge " + work("a") + " --missing 2", true).out, "1\n");
+}
+
+}  // namespace
+}  // namespace vt
