@@ -73,6 +73,7 @@ struct ErrorSum {
   uint64_t samples = 0;
   uint32_t max_error = 0;
   RuntimeError runtime;
+  HdrError hdr;
   uint64_t dct_modes[kDctModeKinds] = {};
 };
 
@@ -179,6 +180,7 @@ class LayerRun {
     ls.spec = layer_.spec;
     ls.max_error = error_.max_error;
     ls.runtime = error_.runtime;
+    ls.hdr = error_.hdr;
     std::copy(std::begin(error_.dct_modes), std::end(error_.dct_modes), ls.dct_modes);
     ls.psnr_db = error_.samples == 0 || error_.sse == 0
                      ? std::numeric_limits<double>::infinity()
@@ -302,6 +304,7 @@ class LayerRun {
       error_.samples += e.samples;
       error_.max_error = std::max(error_.max_error, e.max_error);
       error_.runtime.add(e.runtime);
+      error_.hdr.add(e.hdr);
       if (layer_.spec.codec == PageCodec::kDct) ++error_.dct_modes[e.dct_mode];
       VT_RETURN_IF_ERROR(sink_.add_page(id, li_, e.bytes));
     }

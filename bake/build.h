@@ -148,6 +148,9 @@ struct LayerSummary {
   // the stored pages per DCT page mode (format/dct_page_modes.h).
   RuntimeError runtime;
   uint64_t dct_modes[kDctModeKinds] = {};
+  // Half-float layers stored lossy (BC6H blocks): the stored pages' HDR error (psnr_db is then
+  // infinite: 8-bit figures do not apply). Lossless half layers have no samples.
+  HdrError hdr;
   NonFiniteReport non_finite;
   // Out-of-range values the storage clipped. In an 8-bit layer psnr_db, max_error and the
   // runtime figures are then measured against the unclipped values (clipping counts as error).

@@ -18,6 +18,15 @@ nlohmann::json finite_or_null(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
 
+// HDR error figures (codec/hdr_metrics.h): "log2_error_mean", "log2_error_max",
+// "tonemapped_psnr_db" (null when exact), "relative_error_max".
+nlohmann::json hdr_json(const HdrError& e) {
+  return {{"log2_error_mean", e.log_abs_mean()},
+          {"log2_error_max", e.log_abs_max},
+          {"tonemapped_psnr_db", finite_or_null(e.tonemapped_psnr_db())},
+          {"relative_error_max", e.relative_max}};
+}
+
 // The error after the runtime format ("runtime": PSNR, max error, normal angles) and the DCT
 // page modes chosen ("dct_modes": pages per mode name).
 void add_runtime_json(const LayerSummary& l, nlohmann::json& j) {
@@ -26,6 +35,11 @@ void add_runtime_json(const LayerSummary& l, nlohmann::json& j) {
     j["runtime"] = {{"format", to_string(l.spec.runtime_format)},
                     {"psnr_db", finite_or_null(r.psnr_db())},
                     {"max_error", r.max_error}};
+  } else if (r.hdr.samples > 0) {
+    j["runtime"] = {{"format", to_string(l.spec.runtime_format)}};
+  }
+  if (r.hdr.samples > 0) j["runtime"]["hdr"] = hdr_json(r.hdr);
+  if (r.samples > 0) {
     if (r.normals > 0)
       j["runtime"]["normal_error_deg"] = {
           {"mean", r.angle_mean_deg()}, {"p99", r.angle_p99_deg()}, {"max", r.angle_max_deg}};
@@ -52,6 +66,7 @@ nlohmann::json layer_json(const LayerSummary& l) {
                       {"non_finite", l.non_finite.non_finite},
                       {"negative", l.non_finite.negative}};
   add_runtime_json(l, j);
+  if (l.hdr.samples > 0) j["hdr"] = hdr_json(l.hdr);  // lossy half storage (BC6H blocks)
   if (l.non_finite.any()) {
     j["first_bad_texel"] = {{"x", l.non_finite.first_x},
                             {"y", l.non_finite.first_y},

@@ -56,6 +56,17 @@ const char* to_string(FloatTexels v) {
   return "?";
 }
 
+Expected<HalfRuntime> parse_half_runtime(const std::string& name) {
+  if (name == "bc6h") return HalfRuntime::kBc6h;
+  if (name == "rgba16f") return HalfRuntime::kRgba16f;
+  return Status(ErrorCode::kInvalidArgument,
+                "unknown half-float runtime format '" + name + "' (expected bc6h or rgba16f)");
+}
+
+const char* to_string(HalfRuntime v) {
+  return v == HalfRuntime::kBc6h ? "bc6h" : "rgba16f";
+}
+
 BcFormat bc_format_for(LayerSemantic semantic, uint32_t channels) {
   if (semantic == LayerSemantic::kNormal) return BcFormat::kBc5;
   switch (channels) {
@@ -82,6 +93,13 @@ Expected<PageEncoder> PageEncoder::create(LayerSpec& layer, const PageEncoderOpt
     layer.codec = PageCodec::kRawZstd;
     layer.runtime_format =
         layer.texel_type == TexelType::kF16 ? RuntimeFormat::kRgba16f : RuntimeFormat::kRgba32f;
+    if (layer.texel_type == TexelType::kF16 && layer.channels <= 3 &&
+        options.half_runtime == HalfRuntime::kBc6h) {
+      layer.runtime_format = layer.semantic == LayerSemantic::kCustom ? RuntimeFormat::kBc6hSf16
+                                                                      : RuntimeFormat::kBc6hUf16;
+      // --codec bc stores the blocks (offline quality, no transcode at load).
+      if (options.codec == CodecKind::kBc) layer.codec = PageCodec::kBcZstd;
+    }
   } else {
     layer.runtime_format = runtime_format_of(bc_format_for(layer.semantic, layer.channels));
     switch (options.codec) {
@@ -157,6 +175,7 @@ Status PageEncoder::encode(const uint8_t* texels, EncodedPage& out, const float*
   out.samples = 0;
   out.dct_mode = 0;
   out.runtime = RuntimeError{};
+  out.hdr = HdrError{};
   if (is_constant(texels)) {
     out.state = PageState::kConstant;
     std::memset(out.constant, 0, sizeof(out.constant));
@@ -183,6 +202,13 @@ Status PageEncoder::encode(const uint8_t* texels, EncodedPage& out, const float*
   thread_local std::vector<uint8_t> back;
   back.resize(page_bytes());
   VT_RETURN_IF_ERROR(layer_.encode(texels, settings_, out.bytes, back.data(), &out.dct_mode));
+  if (spec_.texel_type == TexelType::kF16) {
+    // BC6H blocks of half texels: the HDR metrics, not 8-bit units.
+    out.hdr = HdrError{};
+    add_hdr_error(texels, back.data(), size_t(layer_.page_size()) * layer_.page_size(),
+                  int(spec_.channels), std::min(int(spec_.channels), 3), out.hdr);
+    return measure_runtime(texels, back.data(), reference, out);
+  }
   if (reference) {
     measure(reference, back.data(), back.size(), out);
   } else {
@@ -194,7 +220,8 @@ Status PageEncoder::encode(const uint8_t* texels, EncodedPage& out, const float*
 Status PageEncoder::measure_runtime(const uint8_t* texels, const uint8_t* stored,
                                     const float* reference, EncodedPage& out) const {
   const std::optional<BcFormat> bc = layer_.bc_format();
-  if (!bc || spec_.texel_type != TexelType::kU8) return Status::Ok();
+  const bool hdr = bc && bc_is_bc6h(*bc) && spec_.texel_type == TexelType::kF16;
+  if (!bc || (spec_.texel_type != TexelType::kU8 && !hdr)) return Status::Ok();
   thread_local std::vector<uint8_t> blocks;
   const uint8_t* own = nullptr;
   if (codec() == PageCodec::kBcZstd) {
@@ -202,6 +229,9 @@ Status PageEncoder::measure_runtime(const uint8_t* texels, const uint8_t* stored
     VT_RETURN_IF_ERROR(layer_.bc_blocks(out.bytes, blocks));
     own = blocks.data();
   }
+  if (hdr)
+    return measure_runtime_hdr_error(*bc, texels, stored, own, int(layer_.page_size()),
+                                     int(spec_.channels), out.runtime);
   return measure_runtime_error(*bc, spec_.semantic == LayerSemantic::kNormal, texels, stored, own,
                                int(layer_.page_size()), int(layer_.texel_bytes()), out.runtime,
                                reference);

@@ -27,15 +27,23 @@ enum class CodecKind : uint8_t { kDct = 0, kBc = 1, kRaw = 2 };
 enum class FloatTexels : uint8_t {
   kAuto = 0,   // 32-bit float with CodecKind::kRaw, else 8 bits in the codec asked for: values
                // outside [0, 1] are clipped, counted and warned about (LayerSummary::clipped)
-  kHalf = 1,   // half float, raw + zstd whatever the codec (RGBA16F at run time)
+  kHalf = 1,   // half float, raw + zstd (BC6H blocks + zstd with CodecKind::kBc); BC6H at run
+               // time for 1-3 channels (RGBA16F with alpha, or with HalfRuntime::kRgba16f)
   kFloat = 2,  // 32-bit float, raw + zstd (RGBA32F at run time)
 };
 Expected<FloatTexels> parse_float_texels(const std::string& name);
 const char* to_string(FloatTexels v);
 
+// The runtime format of half-float layers of 1-3 channels (four channels keep RGBA16F: BC6H has
+// no alpha). BC6H is unsigned (0..65504) but for custom layers, which may hold signed data.
+enum class HalfRuntime : uint8_t { kBc6h = 0, kRgba16f = 1 };
+Expected<HalfRuntime> parse_half_runtime(const std::string& name);
+const char* to_string(HalfRuntime v);
+
 struct PageEncoderOptions {
   CodecKind codec = CodecKind::kDct;
   FloatTexels float_texels = FloatTexels::kAuto;
+  HalfRuntime half_runtime = HalfRuntime::kBc6h;
   int dct_quality = 75;
   bool dct_adaptive = false;  // DctSettings::adaptive: smaller pages, slower decoding
   BcQuality bc_quality = BcQuality::kNormal;
@@ -63,6 +71,7 @@ struct EncodedPage {
   uint64_t samples = 0;    // channel values compared (every stored 8-bit page's)
   uint8_t dct_mode = 0;    // DCT layers: the page mode chosen (format/dct_page_modes.h)
   RuntimeError runtime;    // after the runtime BC format (layers that have one)
+  HdrError hdr;  // lossy half-float pages (BC6H blocks): the stored page against its texels
 };
 
 class PageEncoder {

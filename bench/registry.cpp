@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "bench/bc6h_bench.h"
 #include "bench/codec_bench.h"
 #include "bench/hard_content_bench.h"
 
@@ -12,6 +13,7 @@ const std::vector<BenchKind>& bench_kinds() {
   static const std::vector<BenchKind> kinds = {
       codec_bench_kind(),
       hard_content_bench_kind(),
+      bc6h_bench_kind(),
   };
   return kinds;
 }

@@ -71,6 +71,8 @@ void print_text(const vt::BuildOptions& o, const vt::BuildSummary& s, double wal
                 vt::to_string(l.spec.runtime_format));
     if (s.update.unchanged) {
       std::printf("unchanged");
+    } else if (l.hdr.samples > 0) {
+      std::printf("stored %s", vt::cli::hdr_error_text(l.hdr).c_str());
     } else if (std::isfinite(l.psnr_db)) {
       std::printf("PSNR %.2f dB, max error %u", l.psnr_db, l.max_error);
     } else {

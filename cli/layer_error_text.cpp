@@ -7,10 +7,23 @@
 
 namespace vt::cli {
 
+std::string hdr_error_text(const HdrError& e) {
+  char buf[160];
+  const double psnr = e.tonemapped_psnr_db();
+  if (!std::isfinite(psnr)) return "exact";
+  std::snprintf(buf, sizeof buf, "log2 error mean %.4f max %.3f, tone-mapped PSNR %.2f dB",
+                e.log_abs_mean(), e.log_abs_max, psnr);
+  return buf;
+}
+
 std::string runtime_error_text(const LayerSummary& l) {
   std::string text;
   char buf[160];
   const RuntimeError& r = l.runtime;
+  if (r.hdr.samples > 0) {
+    text +=
+        ", after " + std::string(to_string(l.spec.runtime_format)) + ": " + hdr_error_text(r.hdr);
+  }
   if (r.samples > 0) {
     const double psnr = r.psnr_db();
     if (std::isfinite(psnr)) {

@@ -6,12 +6,18 @@
 // Specification, "BPTC"; identical to the Direct3D 11 BC7 tables).
 #include "codec/bc7.h"
 
+#include "codec/bptc_tables.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 
 namespace vt {
 namespace {
+
+using bptc::kAnchor2;
+using bptc::kPartition2;
+using bptc::weights;
 
 struct ModeInfo {
   int subsets, partition_bits, rotation_bits, index_sel_bits, colour_bits, alpha_bits;
@@ -24,15 +30,6 @@ constexpr ModeInfo kModes[8] = {
     {1, 0, 0, 0, 7, 7, 1, 0, 4, 0}, {2, 6, 0, 0, 5, 5, 1, 0, 2, 0},
 };
 
-// Two subsets: bit i set when texel i is in subset 1.
-constexpr uint16_t kPartition2[64] = {
-    0xcccc, 0x8888, 0xeeee, 0xecc8, 0xc880, 0xfeec, 0xfec8, 0xec80, 0xc800, 0xffec, 0xfe80,
-    0xe800, 0xffe8, 0xff00, 0xfff0, 0xf000, 0xf710, 0x008e, 0x7100, 0x08ce, 0x008c, 0x7310,
-    0x3100, 0x8cce, 0x088c, 0x3110, 0x6666, 0x366c, 0x17e8, 0x0ff0, 0x718e, 0x399c, 0xaaaa,
-    0xf0f0, 0x5a5a, 0x33cc, 0x3c3c, 0x55aa, 0x9696, 0xa55a, 0x73ce, 0x13c8, 0x324c, 0x3bdc,
-    0x6996, 0xc33c, 0x9966, 0x0660, 0x0272, 0x04e4, 0x4e40, 0x2720, 0xc936, 0x936c, 0x39c6,
-    0x639c, 0x9336, 0x9cc6, 0x817e, 0xe718, 0xccf0, 0x0fcc, 0x7744, 0xee22};
-
 // Three subsets: bits 2i..2i+1 give the subset of texel i.
 constexpr uint32_t kPartition3[64] = {
     0xaa685050, 0x6a5a5040, 0x5a5a4200, 0x5450a0a8, 0xa5a50000, 0xa0a05050, 0x5555a0a0, 0x5a5a5050,
@@ -44,11 +41,7 @@ constexpr uint32_t kPartition3[64] = {
     0xaa444444, 0x54a854a8, 0x95809580, 0x96969600, 0xa85454a8, 0x80959580, 0xaa141414, 0x96960000,
     0xaaaa1414, 0xa05050a0, 0xa0a5a5a0, 0x96000000, 0x40804080, 0xa9a8a9a8, 0xaaaaaa44, 0x2a4a5254};
 
-// Anchor texel of subset 1 (two subsets), and of subsets 1 and 2 (three subsets).
-constexpr uint8_t kAnchor2[64] = {15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15,
-                                  15, 2,  8,  2,  2,  8,  8,  15, 2,  8,  2,  2,  8,  8,  2,  2,
-                                  15, 15, 6,  8,  2,  8,  15, 15, 2,  8,  2,  2,  2,  15, 15, 6,
-                                  6,  2,  6,  8,  15, 15, 2,  2,  15, 15, 15, 15, 15, 2,  2,  15};
+// Anchor texels of subsets 1 and 2 (three subsets); two subsets: bptc::kAnchor2.
 constexpr uint8_t kAnchor3a[64] = {3, 3,  15, 15, 8, 3,  15, 15, 8,  8,  6,  6,  6,  5,  3,  3,
                                    3, 3,  8,  15, 3, 3,  6,  10, 5,  8,  8,  6,  8,  5,  15, 15,
                                    8, 15, 3,  5,  6, 10, 8,  15, 15, 3,  15, 5,  15, 15, 15, 15,
@@ -57,14 +50,6 @@ constexpr uint8_t kAnchor3b[64] = {15, 8, 8,  3,  15, 15, 3,  8,  15, 15, 15, 15
                                    15, 8, 15, 3,  15, 8,  15, 8,  3,  15, 6,  10, 15, 15, 10, 8,
                                    15, 3, 15, 10, 10, 8,  9,  10, 6,  15, 8,  15, 3,  6,  6,  8,
                                    15, 3, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 3,  15, 15, 8};
-
-constexpr int kWeights2[4] = {0, 21, 43, 64};
-constexpr int kWeights3[8] = {0, 9, 18, 27, 37, 46, 55, 64};
-constexpr int kWeights4[16] = {0, 4, 9, 13, 17, 21, 26, 30, 34, 38, 43, 47, 51, 55, 60, 64};
-
-inline const int* weights(int bits) {
-  return bits == 2 ? kWeights2 : bits == 3 ? kWeights3 : kWeights4;
-}
 
 inline int subset_of(int subsets, int partition, int texel) {
   if (subsets == 2) return (kPartition2[partition] >> texel) & 1;

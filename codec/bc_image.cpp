@@ -8,6 +8,7 @@
 #include "codec/bc1.h"
 #include "codec/bc3.h"
 #include "codec/bc4.h"
+#include "codec/bc6h.h"
 #include "codec/bc7.h"
 
 namespace vt {
@@ -15,7 +16,7 @@ namespace {
 
 Status check_image(BcFormat format, const void* a, const void* b, int width, int height,
                    int channels) {
-  if (int(format) > int(BcFormat::kBc7)) {
+  if (int(format) > int(BcFormat::kBc6hSf16)) {
     return Error(ErrorCode::kInvalidArgument, "unknown BC format " + std::to_string(int(format)));
   }
   if (a == nullptr || b == nullptr) {
@@ -45,7 +46,7 @@ void bc4_decode_rgba(const uint8_t* block, uint8_t* rgba) {
   for (int i = 0; i < 16; ++i) rgba[4 * i + 1] = rgba[4 * i + 2] = 0, rgba[4 * i + 3] = 255;
 }
 
-// Indexed by BcFormat (check_image rejects any other value).
+// Indexed by BcFormat up to BC7 (BC6H texels are halves: codec/bc6h.cpp).
 constexpr BlockDecoder kBlockDecoders[] = {bc1_decode_rgba, bc3_decode_block, bc4_decode_rgba,
                                            bc5_decode_block, bc7_decode_block};
 static_assert(std::size(kBlockDecoders) == size_t(BcFormat::kBc7) + 1);
@@ -63,6 +64,9 @@ int bc_format_channels(BcFormat f) {
       return 1;
     case BcFormat::kBc5:
       return 2;
+    case BcFormat::kBc6hUf16:
+    case BcFormat::kBc6hSf16:
+      return 3;
   }
   return 0;
 }
@@ -70,6 +74,10 @@ int bc_format_channels(BcFormat f) {
 Status bc_encode_image(BcFormat format, BcQuality quality, const uint8_t* texels, int width,
                        int height, int channels, uint8_t* out) {
   VT_RETURN_IF_ERROR(check_image(format, texels, out, width, height, channels));
+  if (bc_is_bc6h(format)) {
+    return bc6h_encode_image(format == BcFormat::kBc6hSf16, quality, texels, width, height,
+                             channels, out);
+  }
   const size_t block_bytes = bc_block_bytes(format);
   const size_t row_stride = size_t(width) * size_t(channels);
   const int blocks_x = width / 4;
@@ -129,6 +137,9 @@ Status bc_encode_image(BcFormat format, BcQuality quality, const uint8_t* texels
         case BcFormat::kBc7:
           bc7_encode_block(rgba, quality, block, /*ignore_alpha=*/channels < 4);
           break;
+        case BcFormat::kBc6hUf16:
+        case BcFormat::kBc6hSf16:
+          break;  // handled above
       }
     }
   }
@@ -138,6 +149,10 @@ Status bc_encode_image(BcFormat format, BcQuality quality, const uint8_t* texels
 Status bc_decode_image(BcFormat format, const uint8_t* blocks, int width, int height, int channels,
                        uint8_t* texels) {
   VT_RETURN_IF_ERROR(check_image(format, blocks, texels, width, height, channels));
+  if (bc_is_bc6h(format)) {
+    return bc6h_decode_image(format == BcFormat::kBc6hSf16, blocks, width, height, channels,
+                             texels);
+  }
   const size_t block_bytes = bc_block_bytes(format);
   const size_t row_stride = size_t(width) * size_t(channels);
   const BlockDecoder decode_block = kBlockDecoders[int(format)];

@@ -36,6 +36,7 @@ void RuntimeError::add(const RuntimeError& o) {
   normals += o.normals;
   angle_sum_deg += o.angle_sum_deg;
   angle_max_deg = std::max(angle_max_deg, o.angle_max_deg);
+  hdr.add(o.hdr);
   if (!o.angle_histogram.empty()) {
     angle_histogram.resize(kAngleBins);
     for (int i = 0; i < kAngleBins; ++i) angle_histogram[size_t(i)] += o.angle_histogram[size_t(i)];
@@ -107,6 +108,26 @@ Status measure_runtime_error(BcFormat format, bool normal, const uint8_t* source
     }
     out.normals = texels;
   }
+  return Status::Ok();
+}
+
+Status measure_runtime_hdr_error(BcFormat format, const uint8_t* source, const uint8_t* stored,
+                                 const uint8_t* bc_blocks, int size, int channels,
+                                 RuntimeError& out) {
+  out = RuntimeError{};
+  if (!bc_is_bc6h(format))
+    return Error(ErrorCode::kInvalidArgument, "HDR runtime error: not a BC6H format");
+  thread_local std::vector<uint8_t> blocks, landed;
+  if (!bc_blocks) {
+    blocks.resize(bc_image_bytes(format, size, size));
+    VT_RETURN_IF_ERROR(
+        bc_encode_image(format, BcQuality::kRealtime, stored, size, size, channels, blocks.data()));
+    bc_blocks = blocks.data();
+  }
+  landed.resize(size_t(size) * size * size_t(channels) * 2);
+  VT_RETURN_IF_ERROR(bc_decode_image(format, bc_blocks, size, size, channels, landed.data()));
+  add_hdr_error(source, landed.data(), size_t(size) * size, channels, std::min(channels, 3),
+                out.hdr);
   return Status::Ok();
 }
 

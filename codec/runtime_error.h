@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "codec/bc.h"
+#include "codec/hdr_metrics.h"
 #include "common/status.h"
 
 namespace vt {
@@ -24,6 +25,9 @@ struct RuntimeError {
   uint64_t normals = 0;
   double angle_sum_deg = 0, angle_max_deg = 0;
   std::vector<uint32_t> angle_histogram;
+  // Half-float layers (BC6H): log-space and tone-mapped errors (codec/hdr_metrics.h) instead of
+  // the 8-bit figures above, which then have no samples.
+  HdrError hdr;
 
   void add(const RuntimeError& other);
   double psnr_db() const;  // infinite when nothing differs
@@ -39,5 +43,11 @@ struct RuntimeError {
 Status measure_runtime_error(BcFormat format, bool normal, const uint8_t* source,
                              const uint8_t* stored, const uint8_t* bc_blocks, int size,
                              int channels, RuntimeError& out, const float* reference = nullptr);
+
+// The same for half-float pages and BC6H (`format` kBc6hUf16 or kBc6hSf16): `source` and
+// `stored` are size x size texels of `channels` halves; fills out.hdr over the RGB channels.
+Status measure_runtime_hdr_error(BcFormat format, const uint8_t* source, const uint8_t* stored,
+                                 const uint8_t* bc_blocks, int size, int channels,
+                                 RuntimeError& out);
 
 }  // namespace vt

@@ -108,12 +108,19 @@ inline std::string layer_problem(const LayerSpec& l) {
   if (uint8_t(l.address_mode) > uint8_t(AddressMode::kWrap)) return "unknown address mode";
   if (l.name.size() > 255) return "name longer than 255 bytes";
   if (l.codec_tables.size() > kMaxCodecTablesBytes) return "codec tables larger than 16 MiB";
-  if ((l.codec == PageCodec::kDct || l.codec == PageCodec::kBcZstd) &&
-      l.texel_type != TexelType::kU8)
-    return std::string(to_string(l.codec)) + " needs 8-bit texels";
+  if (l.codec == PageCodec::kDct && l.texel_type != TexelType::kU8) return "dct needs 8-bit texels";
   if (l.codec == PageCodec::kDct && l.codec_tables.empty()) return "dct layer without codec tables";
-  if (l.codec == PageCodec::kBcZstd && !runtime_bc_format(l.runtime_format))
-    return "bc+zstd layer needs a BC runtime format";
+  if (l.codec == PageCodec::kBcZstd) {
+    const std::optional<BcFormat> bc = runtime_bc_format(l.runtime_format);
+    if (!bc) return "bc+zstd layer needs a BC runtime format";
+    // BC6H blocks code half floats, every other BC format 8-bit texels.
+    if (bc_is_bc6h(*bc) && l.texel_type != TexelType::kF16)
+      return "bc+zstd with a BC6H runtime format needs half-float texels";
+    if (!bc_is_bc6h(*bc) && l.texel_type != TexelType::kU8) return "bc+zstd needs 8-bit texels";
+  }
+  if (runtime_bc_format(l.runtime_format) && bc_is_bc6h(*runtime_bc_format(l.runtime_format)) &&
+      l.texel_type != TexelType::kF16)
+    return "a BC6H runtime format needs half-float texels";
   return {};
 }
 

@@ -8,9 +8,12 @@ namespace vt {
 
 namespace {
 
+constexpr RuntimeFormat kLastRuntimeFormat = RuntimeFormat::kBc6hSf16;
+
 RuntimeFormatInfo bc_row(RuntimeFormat format, const char* name, BcFormat bc) {
-  return {format, name, uint32_t(bc_block_bytes(bc) * 8 / 16), uint32_t(bc_format_channels(bc)),
-          false,  bc};
+  return {
+      format,         name, uint32_t(bc_block_bytes(bc) * 8 / 16), uint32_t(bc_format_channels(bc)),
+      bc_is_bc6h(bc), bc};
 }
 
 // Indexed by RuntimeFormat value.
@@ -26,15 +29,17 @@ const RuntimeFormatInfo* table() {
       {RuntimeFormat::kRg8, "rg8", 16, 2, false, std::nullopt},
       {RuntimeFormat::kRgba16f, "rgba16f", 64, 4, true, std::nullopt},
       {RuntimeFormat::kRgba32f, "rgba32f", 128, 4, true, std::nullopt},
+      bc_row(RuntimeFormat::kBc6hUf16, "bc6h_uf16", BcFormat::kBc6hUf16),
+      bc_row(RuntimeFormat::kBc6hSf16, "bc6h_sf16", BcFormat::kBc6hSf16),
   };
-  static_assert(std::size(rows) == size_t(RuntimeFormat::kRgba32f) + 1);
+  static_assert(std::size(rows) == size_t(kLastRuntimeFormat) + 1);
   return rows;
 }
 
 }  // namespace
 
 const RuntimeFormatInfo* runtime_format_info(RuntimeFormat format) {
-  if (uint8_t(format) > uint8_t(RuntimeFormat::kRgba32f)) return nullptr;
+  if (uint8_t(format) > uint8_t(kLastRuntimeFormat)) return nullptr;
   return &table()[uint8_t(format)];
 }
 
@@ -49,7 +54,7 @@ std::optional<BcFormat> runtime_bc_format(RuntimeFormat format) {
 }
 
 RuntimeFormat runtime_format_of(BcFormat format) {
-  for (uint8_t f = 0; f <= uint8_t(RuntimeFormat::kRgba32f); ++f)
+  for (uint8_t f = 0; f <= uint8_t(kLastRuntimeFormat); ++f)
     if (table()[f].bc == format) return RuntimeFormat(f);
   return RuntimeFormat::kRgba8;  // not reached: every BcFormat has a row
 }

@@ -23,6 +23,8 @@ enum class RuntimeFormat : uint8_t {
   kRg8 = 7,
   kRgba16f = 8,
   kRgba32f = 9,
+  kBc6hUf16 = 10,  // HDR RGB, 0..65504 (half-float layers)
+  kBc6hSf16 = 11,  // signed HDR RGB (custom half-float data)
 };
 
 struct RuntimeFormatInfo {
@@ -30,7 +32,7 @@ struct RuntimeFormatInfo {
   const char* name;            // as docs/FORMAT.md and `vtbake info --json` spell it
   uint32_t bits_per_texel;     // BC formats: block bytes * 8 / 16 texels
   uint32_t channels;           // channels a sampler reads (BC1: RGB, BC4: R, BC5: RG)
-  bool is_float;               // 16- or 32-bit float channels (bits_per_texel / channels)
+  bool is_float;               // float channels: 16 or 32 bits each, or BC6H's half floats
   std::optional<BcFormat> bc;  // the codec/bc.h format of a block-compressed format
 };
 

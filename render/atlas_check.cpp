@@ -229,10 +229,15 @@ Expected<double> runtime_floor_psnr(const ReferenceLayer& r, BcFormat bc, BcQual
                                     const uint8_t* ref, int ps) {
   thread_local std::vector<uint8_t> blocks, decoded;
   blocks.resize(bc_image_bytes(bc, ps, ps));
-  decoded.resize(size_t(ps) * ps * r.spec.channels);
+  decoded.resize(size_t(ps) * ps * r.spec.texel_bytes());
   const int channels = int(r.spec.channels);
   VT_RETURN_IF_ERROR(bc_encode_image(bc, quality, ref, ps, ps, channels, blocks.data()));
   VT_RETURN_IF_ERROR(bc_decode_image(bc, blocks.data(), ps, ps, channels, decoded.data()));
+  if (r.spec.texel_type != TexelType::kU8) {  // BC6H of half texels: the float PSNR
+    AtlasPageError e;
+    VT_RETURN_IF_ERROR(measure_page(r, ref, decoded.data(), ps, e));
+    return e.psnr;
+  }
   VT_ASSIGN_OR_RETURN(ImageError err, compare_images(ref, decoded.data(), ps, ps, channels));
   return all_channel_psnr(err);
 }

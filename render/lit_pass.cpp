@@ -167,7 +167,10 @@ Expected<LitLayers> find_lit_layers(std::span<const LayerSpec> layers,
     for (uint32_t i = 0; i < layers.size() && i < upload_formats.size(); ++i) {
       if (layers[i].semantic != kLitSemantics[k]) continue;
       if (k > 0 && named && *named != i) continue;
-      if (cache_vk_format(upload_formats[i]) == VK_FORMAT_UNDEFINED) {
+      // Float layers (RGBA16F, BC6H) upload to the cache, but the lit shaders take 8-bit
+      // inputs: still skipped here.
+      const RuntimeFormatInfo* info = runtime_format_info(upload_formats[i]);
+      if (cache_vk_format(upload_formats[i]) == VK_FORMAT_UNDEFINED || !info || info->is_float) {
         out.skipped.push_back(layers[i].name + ": runtime format " + to_string(upload_formats[i]) +
                               " cannot be rendered");
       } else {

@@ -129,7 +129,10 @@ VkFormat cache_vk_format(RuntimeFormat f) {
       {RuntimeFormat::kBc3, VK_FORMAT_BC3_UNORM_BLOCK},
       {RuntimeFormat::kBc4, VK_FORMAT_BC4_UNORM_BLOCK},
       {RuntimeFormat::kBc5, VK_FORMAT_BC5_UNORM_BLOCK},
-      {RuntimeFormat::kBc7, VK_FORMAT_BC7_UNORM_BLOCK}};
+      {RuntimeFormat::kBc7, VK_FORMAT_BC7_UNORM_BLOCK},
+      {RuntimeFormat::kRgba16f, VK_FORMAT_R16G16B16A16_SFLOAT},
+      {RuntimeFormat::kBc6hUf16, VK_FORMAT_BC6H_UFLOAT_BLOCK},
+      {RuntimeFormat::kBc6hSf16, VK_FORMAT_BC6H_SFLOAT_BLOCK}};
   for (const auto& [runtime, vk] : kFormats) {
     if (runtime == f) return vk;
   }

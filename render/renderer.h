@@ -71,8 +71,9 @@ struct ReferenceTexture {
 std::vector<std::vector<uint8_t>> box_mip_chain(const uint8_t* rgba, uint32_t width,
                                                 uint32_t height, bool srgb = false);
 
-// The Vulkan format of a physical cache holding `f` (RGBA8, R8, RG8, BC1/3/4/5/7; float
-// formats are not rendered); VK_FORMAT_UNDEFINED otherwise.
+// The Vulkan format of a physical cache holding `f` (RGBA8, R8, RG8, BC1/3/4/5/7, and for
+// half-float layers RGBA16F and BC6H unsigned/signed); VK_FORMAT_UNDEFINED otherwise (RGBA32F).
+// The frame is RGBA8: an HDR layer shows clamped to [0, 1].
 VkFormat cache_vk_format(RuntimeFormat f);
 // Bytes of one page_size^2 page in the cache format (0 for an unsupported format).
 size_t cache_page_bytes(RuntimeFormat f, uint32_t page_size);

@@ -141,9 +141,19 @@ Expected<std::unique_ptr<PageSource>> make_page_file_source(
     plan.upload = spec.runtime_format;
     if (plan.upload == RuntimeFormat::kBc7 && options.bc7_as_rgba8)
       plan.upload = RuntimeFormat::kRgba8;
+    const std::optional<BcFormat> bc = runtime_bc_format(plan.upload);
+    const bool bc6h = bc && bc_is_bc6h(*bc);
+    if (bc6h && options.bc6h_as_rgba16f) plan.upload = RuntimeFormat::kRgba16f;
     const RuntimeFormatInfo* upload = runtime_format_info(plan.upload);
     if (!upload) return Error(ErrorCode::kCorrupt, where + ": unknown runtime format");
-    if (spec.texel_type != TexelType::kU8) {
+    if (bc6h && plan.upload != RuntimeFormat::kRgba16f) {
+      // Half texels encoded to BC6H at load (or stored BC6H blocks passed through).
+      if (spec.texel_type != TexelType::kF16)
+        return Error(ErrorCode::kUnsupported, where + ": " + upload->name +
+                                                  " needs half-float texels, the layer has " +
+                                                  to_string(spec.texel_type));
+      plan.channel_bytes = 2;
+    } else if (spec.texel_type != TexelType::kU8) {
       // Float texels go to the cache as they are, in a float format of their channel size with
       // at least their channels (RGBA16F for half, RGBA32F for float; fewer channels widened).
       plan.channel_bytes = spec.texel_bytes() / std::max<uint32_t>(spec.channels, 1);

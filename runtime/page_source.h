@@ -24,8 +24,9 @@ class PageSource {
 
   virtual const PageGeometry& geometry() const = 0;
   virtual uint32_t layer_count() const = 0;
-  // Format of the bytes load() writes for a layer: a BC format, kRgba8, kR8, kRg8, kRgba16f or
-  // kRgba32f, always covering page_size x page_size texels (borders included).
+  // Format of the bytes load() writes for a layer: a BC format (BC6H for half-float layers),
+  // kRgba8, kR8, kRg8, kRgba16f or kRgba32f, always covering page_size x page_size texels
+  // (borders included).
   virtual RuntimeFormat upload_format(uint32_t layer) const = 0;
   // Bytes load() writes for a layer (one physical slot of that layer).
   virtual size_t upload_bytes(uint32_t layer) const = 0;
@@ -48,11 +49,15 @@ struct PageFileSourceOptions {
   BcQuality bc_quality = BcQuality::kRealtime;  // used when a page must be (re)encoded to BC
   // Lavapipe samples BC7 very slowly: optionally upload BC7 layers as RGBA8 instead.
   bool bc7_as_rgba8 = false;
+  // For a GPU without BC6H (or a reference render): upload BC6H layers as RGBA16F, the stored
+  // half texels as they are (BC6H blocks stored in the file are decoded).
+  bool bc6h_as_rgba16f = false;
   Allocator allocator;  // a page's decode scratch (decoded texels before the BC encode)
 };
 
 // Adapts a page file. Checks up front that every layer can be delivered (8-bit layers to any
-// format; float layers only to their own float format) and builds the presence map (one bit per
+// 8-bit format; half layers to RGBA16F or BC6H, encoded at load with bc_quality unless stored
+// as BC6H blocks; float layers to RGBA32F) and builds the presence map (one bit per
 // page; at most 4096 x 4096 pages at level 0, the feedback format's limit). Errors name the file.
 Expected<std::unique_ptr<PageSource>> make_page_file_source(
     std::shared_ptr<const PageFileReader> reader, const PageFileSourceOptions& options = {});

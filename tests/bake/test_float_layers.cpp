@@ -168,11 +168,21 @@ TEST(FloatLayers, HalfStorageKeepsTheRange) {
     ASSERT_TRUE(b);
     const LayerSummary& l = b->summary.layers[0];
     EXPECT_EQ(l.spec.texel_type, TexelType::kF16);
-    EXPECT_EQ(l.spec.codec, PageCodec::kRawZstd);
-    EXPECT_EQ(l.spec.runtime_format, RuntimeFormat::kRgba16f);
+    // RGB half: BC6H at run time; --codec bc stores the BC6H blocks (lossy), else raw + zstd.
+    EXPECT_EQ(l.spec.codec, codec == CodecKind::kBc ? PageCodec::kBcZstd : PageCodec::kRawZstd);
+    EXPECT_EQ(l.spec.runtime_format, RuntimeFormat::kBc6hUf16);
     EXPECT_EQ(l.spec.color_space, ColorSpace::kLinear);
     EXPECT_FALSE(l.clipped.any());
     EXPECT_TRUE(b->summary.warnings.empty());
+    // The HDR error after BC6H is reported (log space and tone-mapped).
+    EXPECT_GT(l.runtime.hdr.samples, 0u);
+    EXPECT_GT(l.runtime.hdr.tonemapped_psnr_db(), 30.0);
+    if (codec == CodecKind::kBc) {
+      EXPECT_GT(l.hdr.samples, 0u);  // stored lossy: its own error
+      EXPECT_GT(l.hdr.tonemapped_psnr_db(), 30.0);
+      continue;
+    }
+    EXPECT_EQ(l.hdr.samples, 0u);
     // Level 0 is the source rounded to half, texel for texel.
     const std::vector<float> src = hdr_rgb();
     auto level = test::reassemble_level(*b, 0, 0, test::encoder_for(*b, 0, o));

@@ -34,7 +34,7 @@ LayerSpec dct_layer(uint8_t channels, int table_channels, int table_size) {
 }
 
 TEST(RuntimeFormat, TableAgreesWithTheBlockFormats) {
-  for (uint8_t v = 0; v <= uint8_t(RuntimeFormat::kRgba32f); ++v) {
+  for (uint8_t v = 0; v <= uint8_t(RuntimeFormat::kBc6hSf16); ++v) {
     const RuntimeFormat f = RuntimeFormat(v);
     const RuntimeFormatInfo* info = runtime_format_info(f);
     ASSERT_NE(info, nullptr);
@@ -45,7 +45,7 @@ TEST(RuntimeFormat, TableAgreesWithTheBlockFormats) {
       EXPECT_EQ(runtime_format_page_bytes(f, 128), bc_image_bytes(*info->bc, 128, 128));
       EXPECT_EQ(info->channels, uint32_t(bc_format_channels(*info->bc)));
       EXPECT_EQ(runtime_format_of(*info->bc), f);
-      EXPECT_FALSE(info->is_float);
+      EXPECT_EQ(info->is_float, bc_is_bc6h(*info->bc));  // BC6H: half floats
     } else {
       EXPECT_EQ(runtime_format_page_bytes(f, 128),
                 size_t(128) * 128 * info->channels * (info->is_float ? (v == 8 ? 2 : 4) : 1));
@@ -54,10 +54,12 @@ TEST(RuntimeFormat, TableAgreesWithTheBlockFormats) {
   EXPECT_EQ(runtime_format_page_bytes(RuntimeFormat::kBc1, 128), 8192u);
   EXPECT_EQ(runtime_format_page_bytes(RuntimeFormat::kRg8, 4), 32u);
   EXPECT_STREQ(to_string(RuntimeFormat::kRgba16f), "rgba16f");
-  EXPECT_EQ(runtime_format_info(RuntimeFormat(10)), nullptr);
+  EXPECT_STREQ(to_string(RuntimeFormat::kBc6hUf16), "bc6h_uf16");
+  EXPECT_STREQ(to_string(RuntimeFormat::kBc6hSf16), "bc6h_sf16");
+  EXPECT_EQ(runtime_format_info(RuntimeFormat(12)), nullptr);
   EXPECT_EQ(runtime_format_page_bytes(RuntimeFormat(200), 128), 0u);
   EXPECT_FALSE(runtime_bc_format(RuntimeFormat(200)));
-  EXPECT_STREQ(to_string(RuntimeFormat(10)), "unknown");
+  EXPECT_STREQ(to_string(RuntimeFormat(12)), "unknown");
 }
 
 TEST(ZstdFrame, DecompressesOnlyToTheExactSize) {

@@ -185,8 +185,8 @@ TEST_F(AtlasCheck, RawBakeMatchesItsReferenceExactly) {
 }
 
 // An HDR emissive (strength 4) kept as half floats (--float-texels half) and as 32-bit floats
-// (raw codec): the float layers match their reference, stored and as uploaded (RGBA16F and
-// RGBA32F, widened from RGB).
+// (raw codec): the float layers match their reference, stored and as uploaded (BC6H for RGB
+// half, within its floor; RGBA32F widened from RGB, exactly).
 TEST_F(AtlasCheck, FloatEmissiveLayersMatchTheirReference) {
   scene::Scene hdr = original_;
   for (scene::Material& m : hdr.materials) m.emissive_strength = 4.0f;
@@ -217,7 +217,13 @@ TEST_F(AtlasCheck, FloatEmissiveLayersMatchTheirReference) {
       ASSERT_TRUE(r.ok()) << r.status().message();
       const AtlasLayerReport& l = layer_report(*r, LayerSemantic::kEmissive);
       EXPECT_EQ(l.pages_failed, 0u) << name << (stored ? " stored" : " uploaded");
-      EXPECT_EQ(l.min_psnr, kPsnrIdentical) << name << (stored ? " stored" : " uploaded");
+      if (kind == FloatTexels::kHalf && !stored) {
+        // RGB half uploads as BC6H (lossy): measured 24.54 dB on the float PSNR (peak 1, so
+        // values up to 4 weigh in as they are), passing on BC6H's own floor.
+        EXPECT_GT(l.min_psnr, 23.5) << name << " uploaded";
+      } else {
+        EXPECT_EQ(l.min_psnr, kPsnrIdentical) << name << (stored ? " stored" : " uploaded");
+      }
     }
   }
 }

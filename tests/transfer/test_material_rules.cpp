@@ -435,7 +435,7 @@ TEST(TransferRules, SceneBakeReportsClippingMissesAndWarnings) {
   const int h = test::find_layer(**reader, LayerSemantic::kEmissive);
   ASSERT_GE(h, 0);
   EXPECT_EQ((*reader)->layers()[h].texel_type, TexelType::kF16);
-  EXPECT_EQ((*reader)->layers()[h].runtime_format, RuntimeFormat::kRgba16f);
+  EXPECT_EQ((*reader)->layers()[h].runtime_format, RuntimeFormat::kBc6hUf16);  // RGB half
   level = test::read_level0(**reader, uint32_t(h));
   EXPECT_EQ(*std::max_element(level.texels.begin(), level.texels.end()), 4.0f);
 }

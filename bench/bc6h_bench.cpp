@@ -1,0 +1,227 @@
+// The BC6H bench (see bc6h_bench.h).
+#include "bench/bc6h_bench.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "codec/bc.h"
+#include "codec/bc6h.h"
+#include "codec/hdr_metrics.h"
+#include "common/half.h"
+#include "format/zstd_frame.h"
+
+namespace vt::bench {
+namespace {
+
+struct HdrPage {
+  std::vector<uint16_t> rgb;  // page^2 texels of 3 halves
+};
+
+struct HdrSet {
+  std::string name;
+  std::vector<HdrPage> pages;
+};
+
+// Cuts an image (first three channels, half floats) into whole pages.
+Expected<HdrSet> load_image(const std::string& path, int page) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) return Error(ErrorCode::kIo, path + ": " + OIIO::geterror());
+  const OIIO::ImageSpec spec = in->spec();
+  std::vector<float> px(size_t(spec.width) * spec.height * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()))
+    return Error(ErrorCode::kIo, path + ": " + in->geterror());
+  HdrSet set;
+  set.name = path.substr(path.find_last_of('/') + 1);
+  for (int py = 0; py + page <= spec.height; py += page) {
+    for (int px0 = 0; px0 + page <= spec.width; px0 += page) {
+      HdrPage p;
+      p.rgb.resize(size_t(page) * page * 3);
+      for (int y = 0; y < page; ++y)
+        for (int x = 0; x < page; ++x)
+          for (int c = 0; c < 3; ++c) {
+            const int sc = std::min(c, spec.nchannels - 1);
+            p.rgb[(size_t(y) * page + x) * 3 + c] = float_to_half(
+                px[(size_t(py + y) * spec.width + size_t(px0 + x)) * spec.nchannels + sc]);
+          }
+      set.pages.push_back(std::move(p));
+    }
+  }
+  if (set.pages.empty()) return Error(ErrorCode::kInvalidArgument, path + ": smaller than a page");
+  return set;
+}
+
+// Synthetic HDR: exponential ramps over 2^-10..2^16 with sine modulation, noise and edges.
+HdrSet synthetic(int page, int count) {
+  HdrSet set;
+  set.name = "synthetic";
+  uint32_t s = 12345;
+  auto rnd = [&] {
+    s ^= s << 13, s ^= s >> 17, s ^= s << 5;
+    return double(s % 10001) / 10000.0;
+  };
+  for (int k = 0; k < count; ++k) {
+    HdrPage p;
+    p.rgb.resize(size_t(page) * page * 3);
+    const double l0 = -10.0 + 26.0 * k / std::max(1, count - 1) - 3.0;
+    for (int y = 0; y < page; ++y)
+      for (int x = 0; x < page; ++x)
+        for (int c = 0; c < 3; ++c) {
+          double v = std::exp2(l0 + 6.0 * x / page) *
+                     (0.55 + 0.45 * std::sin(0.05 * y + 1.3 * c + k)) * (0.98 + 0.04 * rnd());
+          if (((x / 24) + (y / 24)) % 5 == 0) v *= 0.2;
+          p.rgb[(size_t(y) * page + x) * 3 + c] = float_to_half(float(std::min(v, 60000.0)));
+        }
+    set.pages.push_back(std::move(p));
+  }
+  return set;
+}
+
+double thread_seconds() {
+  timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+struct Row {
+  std::string set, level;
+  int pages = 0;
+  double encode_mtex_s = 0, decode_mtex_s = 0;
+  double raw_zstd_bpt = 0, bc6h_zstd_bpt = 0;  // stored bits per texel: half + zstd, BC6H + zstd
+  HdrError err;
+  int modes[15] = {};
+};
+
+Row run_level(const HdrSet& set, int page, BcQuality q, int repeats, int max_pages) {
+  Row r;
+  r.set = set.name;
+  r.level = q == BcQuality::kRealtime ? "realtime" : q == BcQuality::kNormal ? "normal" : "high";
+  const int n =
+      max_pages > 0 ? std::min<int>(max_pages, int(set.pages.size())) : int(set.pages.size());
+  r.pages = n;
+  const size_t bytes = bc_image_bytes(BcFormat::kBc6hUf16, page, page);
+  std::vector<uint8_t> blocks(bytes * size_t(n));
+  std::vector<double> enc, dec;
+  std::vector<uint16_t> back(size_t(page) * page * 3);
+  for (int pass = 0; pass < repeats; ++pass) {
+    double t0 = thread_seconds();
+    for (int i = 0; i < n; ++i)
+      (void)bc6h_encode_image(false, q, set.pages[size_t(i)].rgb.data(), page, page, 3,
+                              &blocks[size_t(i) * bytes]);
+    enc.push_back(thread_seconds() - t0);
+    t0 = thread_seconds();
+    for (int i = 0; i < n; ++i)
+      (void)bc6h_decode_image(false, &blocks[size_t(i) * bytes], page, page, 3, back.data());
+    dec.push_back(thread_seconds() - t0);
+  }
+  std::sort(enc.begin(), enc.end());
+  std::sort(dec.begin(), dec.end());
+  const double texels = double(n) * page * page;
+  r.encode_mtex_s = texels / std::max(1e-9, enc[enc.size() / 2]) / 1e6;
+  r.decode_mtex_s = texels / std::max(1e-9, dec[dec.size() / 2]) / 1e6;
+  size_t raw_bytes = 0, bc_bytes = 0;
+  std::vector<uint8_t> z;
+  for (int i = 0; i < n; ++i) {
+    const auto& rgb = set.pages[size_t(i)].rgb;
+    (void)zstd_compress(
+        std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(rgb.data()), rgb.size() * 2), 3,
+        z);
+    raw_bytes += z.size();
+    (void)zstd_compress(std::span<const uint8_t>(&blocks[size_t(i) * bytes], bytes), 3, z);
+    bc_bytes += z.size();
+  }
+  r.raw_zstd_bpt = 8.0 * double(raw_bytes) / texels;
+  r.bc6h_zstd_bpt = 8.0 * double(bc_bytes) / texels;
+  for (int i = 0; i < n; ++i) {
+    (void)bc6h_decode_image(false, &blocks[size_t(i) * bytes], page, page, 3, back.data());
+    add_hdr_error(set.pages[size_t(i)].rgb.data(), back.data(), size_t(page) * page, 3, 3, r.err);
+    for (size_t b = 0; b < bytes; b += 16)
+      ++r.modes[bc6h_block_mode(&blocks[size_t(i) * bytes + b])];
+  }
+  return r;
+}
+
+}  // namespace
+
+BenchKind bc6h_bench_kind() {
+  BenchKind k;
+  k.name = "bc6h";
+  k.description =
+      "BC6H (unsigned) encoder levels on HDR pages: Mtexel/s per core, log2 error and tone-mapped "
+      "PSNR after BC6H, modes used";
+  k.inputs_help = "EXR/HDR images (none: a synthetic HDR set)";
+  k.options = {{"page-size", "Page edge in texels", "128"},
+               {"repeats", "Timed passes per level (median)", "3"},
+               {"high-pages", "Pages per image for the slow levels (normal, high); 0 = all", "8"}};
+  k.run = [](const BenchRequest& req) -> Expected<BenchReport> {
+    VT_ASSIGN_OR_RETURN(int page, option_int(req, "page-size", 4, 4096));
+    if (page % 4) return Error(ErrorCode::kInvalidArgument, "--page-size: a multiple of 4");
+    VT_ASSIGN_OR_RETURN(int repeats, option_int(req, "repeats", 1, 100));
+    VT_ASSIGN_OR_RETURN(int slow_pages, option_int(req, "high-pages", 0, 1 << 20));
+    std::vector<HdrSet> sets;
+    for (const std::string& path : req.inputs) {
+      VT_ASSIGN_OR_RETURN(HdrSet s, load_image(path, page));
+      sets.push_back(std::move(s));
+    }
+    if (sets.empty()) sets.push_back(synthetic(page, 16));
+    std::ostringstream text;
+    nlohmann::json json = nlohmann::json::array();
+    char line[320];
+    text << "BC6H unsigned, pages of " << page << "x" << page
+         << ", one thread (thread CPU time, median of " << repeats
+         << "); error vs the half-float page: log2(1+x) mean/max, tone-mapped PSNR "
+            "(srgb(x/(1+x)), peak 1), largest relative error\n";
+    text << "  set                 level     pages  enc Mtex/s  dec Mtex/s  log2 mean  log2 max  "
+            "TM PSNR dB  half+zstd b/t  bc6h+zstd b/t  modes (1-14)\n";
+    HdrError total[3];
+    for (const HdrSet& s : sets) {
+      for (BcQuality q : {BcQuality::kRealtime, BcQuality::kNormal, BcQuality::kHigh}) {
+        if (req.progress) req.progress(s.name + " " + std::to_string(int(q)));
+        const int cap = q == BcQuality::kRealtime ? 0 : slow_pages;
+        const Row r = run_level(s, page, q, q == BcQuality::kRealtime ? repeats : 1, cap);
+        total[int(q)].add(r.err);
+        std::string modes;
+        for (int m = 1; m <= 14; ++m)
+          if (r.modes[m]) modes += std::to_string(m) + ":" + std::to_string(r.modes[m]) + " ";
+        std::snprintf(
+            line, sizeof line,
+            "  %-19s %-9s %5d  %10.2f  %10.1f  %9.5f  %8.4f  %10.2f  %13.2f  %13.2f  %s\n",
+            r.set.c_str(), r.level.c_str(), r.pages, r.encode_mtex_s, r.decode_mtex_s,
+            r.err.log_abs_mean(), r.err.log_abs_max, r.err.tonemapped_psnr_db(), r.raw_zstd_bpt,
+            r.bc6h_zstd_bpt, modes.c_str());
+        text << line;
+        json.push_back({{"set", r.set},
+                        {"level", r.level},
+                        {"pages", r.pages},
+                        {"encode_mtexel_s", r.encode_mtex_s},
+                        {"decode_mtexel_s", r.decode_mtex_s},
+                        {"log2_error_mean", r.err.log_abs_mean()},
+                        {"log2_error_max", r.err.log_abs_max},
+                        {"tonemapped_psnr_db", r.err.tonemapped_psnr_db()},
+                        {"relative_error_max", r.err.relative_max},
+                        {"half_zstd_bits_per_texel", r.raw_zstd_bpt},
+                        {"bc6h_zstd_bits_per_texel", r.bc6h_zstd_bpt}});
+      }
+    }
+    if (sets.size() > 1) {
+      const char* names[3] = {"realtime", "normal", "high"};
+      for (int q = 0; q < 3; ++q) {
+        std::snprintf(line, sizeof line, "  %-19s %-9s %5s  %10s  %10s  %9.5f  %8.4f  %10.2f\n",
+                      "all (pooled)", names[q], "", "", "", total[q].log_abs_mean(),
+                      total[q].log_abs_max, total[q].tonemapped_psnr_db());
+        text << line;
+      }
+    }
+    return BenchReport{text.str(), json.dump(2)};
+  };
+  return k;
+}
+
+}  // namespace vt::bench
