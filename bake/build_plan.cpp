@@ -290,6 +290,8 @@ std::string build_metadata(const BuildOptions& options, const std::vector<LayerP
   // Recorded only when set, so that earlier files' metadata (and plans) stay as they were.
   if (options.codec.float_texels != FloatTexels::kAuto)
     meta["build"]["float_texels"] = to_string(options.codec.float_texels);
+  if (options.codec.half_runtime != HalfRuntime::kBc6h)
+    meta["build"]["half_runtime"] = to_string(options.codec.half_runtime);
   if (options.color_config && !options.color_config->is_builtin()) {
     meta["build"]["color_config"] = {{"path", options.color_config->path()},
                                      {"working_space", options.color_config->working_space()},
@@ -310,7 +312,10 @@ std::string settings_text(const BuildPlan& plan) {
                       {"non_finite", int(o.non_finite)},
                       {"alpha_coverage", o.alpha_coverage_reference},
                       {"bc_quality", int(o.codec.bc_quality)},
-                      {"zstd_level", o.codec.zstd_level}};
+                      {"zstd_level", o.codec.zstd_level},
+                      // Half layers' runtime format (BC6H since issue 19's HDR step): a file made
+                      // before it, with RGBA16F, is not the output of these settings.
+                      {"half_runtime", to_string(o.codec.half_runtime)}};
   for (const LayerInput& in : o.layers)
     j["layers"].push_back({{"semantic", int(in.semantic)}, {"color_space", in.color_space}});
   return j.dump();

@@ -98,6 +98,7 @@ void add_options(KeyStream& k, const SceneBakeOptions& o) {
   k.add(b.codec.codec), k.add(b.codec.dct_quality), k.add(b.codec.dct_adaptive);
   k.add(b.codec.bc_quality), k.add(b.codec.zstd_level);
   k.add(b.codec.dct_page_modes), k.add(b.codec.min_psnr), k.add(b.codec.float_texels);
+  k.add(b.codec.half_runtime);  // BC6H or RGBA16F for half layers (keys of earlier bakes change)
   for (const auto& [name, db] : b.codec.layer_min_psnr) k.add(name), k.add(db);
   k.add(b.payload), k.add(b.border), k.add(b.filter), k.add(b.non_finite);
   k.add(b.alpha_coverage_reference);

@@ -44,7 +44,18 @@ void add_build_flags(CLI::App& app, BuildOptions& o) {
       },
       "Float sources (EXR, HDR) of colour and data layers: auto (default: float with --codec "
       "raw, else 8 bits in the codec, values outside [0, 1] clipped with a warning), half (half "
-      "float, raw + zstd whatever the codec; RGBA16F at run time) or float (32-bit, RGBA32F)");
+      "float, raw + zstd, or BC6H blocks with --codec bc; BC6H at run time, see --half-runtime) "
+      "or float (32-bit, RGBA32F)");
+  app.add_option_function<std::string>(
+      "--half-runtime",
+      [&o](const std::string& name) {
+        auto kind = parse_half_runtime(name);
+        throw_if_error("--half-runtime", kind.status());
+        o.codec.half_runtime = *kind;
+      },
+      "Runtime format of half-float layers of 1-3 channels: bc6h (default; signed for custom "
+      "layers, encoded at load unless --codec bc stored the blocks) or rgba16f; 4-channel half "
+      "layers are always rgba16f");
   app.add_flag_callback(
       "--no-page-modes", [&o] { o.codec.dct_page_modes = false; },
       "DCT: every page in the tables' own mode (no per-page 4:4:4, finer or lossless choice)");

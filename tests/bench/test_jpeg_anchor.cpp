@@ -119,5 +119,30 @@ TEST(VtbakeBench, CodecKindReportsJpegAgainstDct) {
       2);
 }
 
+TEST(VtbakeBench, Bc6hKindReportsEveryLevel) {
+  const std::string dir = ::testing::TempDir() + "vt_bench_bc6h/";
+  std::filesystem::create_directories(dir);
+  const std::string out = dir + "report.json";
+  // The synthetic HDR set, small pages: three rows, the levels in order of quality.
+  const std::string cmd =
+      std::string(VTBAKE_BENCH_BINARY) + " --quiet --json bc6h --repeats 1 --page-size 16 > " + out;
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  std::ifstream in(out);
+  const auto report = nlohmann::json::parse(in);
+  ASSERT_EQ(report.size(), 3u);
+  EXPECT_EQ(report[0]["level"], "realtime");
+  EXPECT_EQ(report[2]["level"], "high");
+  EXPECT_GT(report[0]["encode_mtexel_s"].get<double>(), 0.0);
+  EXPECT_GT(report[0]["tonemapped_psnr_db"].get<double>(), 35.0);
+  EXPECT_GE(report[2]["tonemapped_psnr_db"].get<double>(),
+            report[0]["tonemapped_psnr_db"].get<double>());
+  EXPECT_LT(report[1]["bc6h_zstd_bits_per_texel"].get<double>(),
+            report[1]["half_zstd_bits_per_texel"].get<double>());
+  EXPECT_EQ(
+      std::system((std::string(VTBAKE_BENCH_BINARY) + " bc6h --page-size 6 2>/dev/null").c_str()) >>
+          8,
+      2);
+}
+
 }  // namespace
 }  // namespace vt::bench

@@ -97,6 +97,27 @@ TEST_F(Reports, ClippedHdrIsWarnedAboutAndHalfKeepsIt) {
   EXPECT_EQ(
       run_vtbake("build " + exr + " --float-texels bc6h -o " + dir_ + "/g.vtpf", false).exit_code,
       2);
+  // --half-runtime rgba16f keeps the halves as they are at run time: no HDR error to report.
+  r = run_vtbake("--json build " + exr +
+                     " --payload 24 --float-texels half --half-runtime rgba16f "
+                     "-o " +
+                     dir_ + "/r.vtpf",
+                 false);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["layers"][0]["runtime_format"], "rgba16f");
+  EXPECT_FALSE(j["layers"][0].contains("runtime"));
+  // --codec bc stores BC6H blocks: the text summary gives the stored HDR error.
+  r = run_vtbake(
+      "build " + exr + " --payload 24 --float-texels half --codec bc -o " + dir_ + "/b.vtpf", true);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("bc+zstd -> bc6h_uf16, stored log2 error mean"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("tone-mapped PSNR"), std::string::npos) << r.out;
+  EXPECT_EQ(
+      run_vtbake("build " + exr + " --float-texels half --half-runtime bc7 -o " + dir_ + "/x.vtpf",
+                 false)
+          .exit_code,
+      2);
 }
 
 TEST_F(Reports, SceneBakeNestsTheBuildSchema) {
