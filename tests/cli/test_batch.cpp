@@ -18,11 +18,6 @@ namespace {
 using namespace vt::testing;
 namespace fs = std::filesystem;
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
 class BatchCli : public ::testing::Test {
  protected:
   // One sample scene as two glTF files (a.gltf, b.gltf share scene.bin and the textures).

@@ -22,11 +22,6 @@ namespace {
 using namespace vt::testing;
 namespace fs = std::filesystem;
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
 class FarmCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
