@@ -52,14 +52,10 @@ std::map<std::string, DocumentedKeys> documented_keys() {
 class JsonSchema : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = (fs::temp_directory_path() / ("vt_json_schema_" + std::to_string(::getpid()))).string();
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = fresh_test_dir("json_schema");
     documented_ = documented_keys();
   }
-  static void TearDownTestSuite() {
-    if (!std::getenv("VTBAKE_KEEP_TEST_OUTPUT")) fs::remove_all(dir_);
-  }
+  static void TearDownTestSuite() { remove_test_dir(dir_); }
 
   // Runs `vtbake --json ARGS`, checks the exit status, one line of output, the envelope and the
   // documented keys of `row`; returns the object.
@@ -169,11 +165,7 @@ TEST_F(JsonSchema, SceneAndFarmCommands) {
 }
 
 TEST_F(JsonSchema, ValidateAtlasOnly) {
-  ASSERT_EQ(run_vtbake("-q sample-scene " + dir_ +
-                           "/vscene --ground-cells 2 --sphere-segments 8 --texture-size 32",
-                       false)
-                .exit_code,
-            0);
+  ASSERT_EQ(write_sample_scene(dir_ + "/vscene"), "");
   const std::string gltf = dir_ + "/vscene/scene.gltf";
   ASSERT_EQ(run_vtbake("-q bake " + gltf + " -o " + dir_ + "/v.vtpf --size 2 --payload 56", false)
                 .exit_code,

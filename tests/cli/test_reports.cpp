@@ -17,6 +17,7 @@ namespace vt {
 namespace {
 
 using vt::testing::run_vtbake;
+using vt::testing::write_sample_scene;
 
 std::set<std::string> keys(const nlohmann::json& j) {
   std::set<std::string> k;
@@ -122,11 +123,7 @@ TEST_F(Reports, ClippedHdrIsWarnedAboutAndHalfKeepsIt) {
 }
 
 TEST_F(Reports, SceneBakeNestsTheBuildSchema) {
-  ASSERT_EQ(run_vtbake("-q sample-scene " + dir_ +
-                           "/scene --ground-cells 2 --sphere-segments 8 --texture-size 32",
-                       false)
-                .exit_code,
-            0);
+  ASSERT_EQ(write_sample_scene(dir_ + "/scene"), "");
   auto r = run_vtbake("--json bake " + dir_ + "/scene/scene.gltf -o " + dir_ +
                           "/s.vtpf --size 2 --payload 56 --unwrapped -",
                       false);
