@@ -366,9 +366,12 @@ void encode_realtime_lanes(const uint32_t (&texels)[16][kLanes], uint16_t c0_out
   // Endpoints as 565 levels (floats holding integers), decoded palette, indices, error. Every
   // value truncated below is non-negative, so int conversion is floor (and vectorises).
   float q0[3][kLanes], q1[3][kLanes];
+  // The clamp as std::min(std::max(x, 0), 255) computes it (NaN passes through), on values so
+  // that the loops if-convert into SIMD (with codec/CMakeLists.txt's flags for this file).
   auto quantise_lanes = [](float x, float levels) {
-    const float q = float(int(std::min(std::max(x, 0.0f), 255.0f) * (levels / 255.0f) + 0.5f));
-    return q;
+    const float lo = x < 0.0f ? 0.0f : x;
+    const float c = 255.0f < lo ? 255.0f : lo;
+    return float(int(c * (levels / 255.0f) + 0.5f));
   };
   for (int l = 0; l < kLanes; ++l) {
     const float inset = (tmax[l] - tmin[l]) * (1.0f / 16.0f);
