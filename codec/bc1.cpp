@@ -570,6 +570,68 @@ void bc1_encode_block(const uint8_t rgba[64], BcQuality quality, uint8_t out[8],
   emit(best, out);
 }
 
+namespace {
+
+// encode_single_colour's bytes without its Candidate: every index 2 (3 once the endpoints swap,
+// 0 when they are equal), as emit() orders them.
+inline void single_colour_block(int r, int g, int b, uint8_t* dst) {
+  const SingleColourTables& t = single_colour_tables();
+  uint16_t c0 = pack565(t.e5[r][0], t.e6[g][0], t.e5[b][0]);
+  uint16_t c1 = pack565(t.e5[r][1], t.e6[g][1], t.e5[b][1]);
+  uint32_t bits = c0 == c1 ? 0u : c0 < c1 ? 0xFFFFFFFFu : 0xAAAAAAAAu;
+  if (c0 < c1) std::swap(c0, c1);
+  dst[0] = uint8_t(c0), dst[1] = uint8_t(c0 >> 8);
+  dst[2] = uint8_t(c1), dst[3] = uint8_t(c1 >> 8);
+  for (int i = 0; i < 4; ++i) dst[4 + i] = uint8_t(bits >> (8 * i));
+}
+
+// Runs the kernel on lanes gathered by the caller and writes the first n blocks.
+inline void finish_lanes(const uint32_t (&texels)[16][kLanes], size_t n, uint8_t* out,
+                         size_t out_stride) {
+  uint16_t c0[kLanes], c1[kLanes];
+  uint32_t bits[kLanes];
+  bool constant[kLanes];
+  encode_realtime_lanes(texels, c0, c1, bits, constant);
+  for (size_t l = 0; l < n; ++l) {
+    uint8_t* dst = out + l * out_stride;
+    if (constant[l]) {
+      const uint32_t w = texels[0][l];
+      single_colour_block(int(w & 255u), int((w >> 8) & 255u), int((w >> 16) & 255u), dst);
+      continue;
+    }
+    dst[0] = uint8_t(c0[l]), dst[1] = uint8_t(c0[l] >> 8);
+    dst[2] = uint8_t(c1[l]), dst[3] = uint8_t(c1[l] >> 8);
+    for (int i = 0; i < 4; ++i) dst[4 + i] = uint8_t(bits[l] >> (8 * i));
+  }
+}
+
+}  // namespace
+
+void bc1_encode_rows_realtime(const uint8_t* texels, size_t row_stride, int channels, size_t count,
+                              uint8_t* out) {
+  alignas(64) uint32_t lanes[16][kLanes];
+  const size_t cs = size_t(channels);
+  for (size_t first = 0; first < count; first += kLanes) {
+    const size_t n = std::min<size_t>(kLanes, count - first);
+    // Straight from the image into the kernel's texel-major lanes (R in the low byte, missing
+    // colour channels 0): no RGBA copy of the row in between. Idle lanes repeat the last block.
+    for (int y = 0; y < 4; ++y) {
+      const uint8_t* row = texels + size_t(y) * row_stride;
+      for (size_t l = 0; l < size_t(kLanes); ++l) {
+        const uint8_t* src = row + (first + std::min(l, n - 1)) * 4 * cs;
+        for (int x = 0; x < 4; ++x) {
+          const uint8_t* t = src + size_t(x) * cs;
+          uint32_t w = t[0];
+          if (channels > 1) w |= uint32_t(t[1]) << 8;
+          if (channels > 2) w |= uint32_t(t[2]) << 16;
+          lanes[4 * y + x][l] = w;
+        }
+      }
+    }
+    finish_lanes(lanes, n, out + first * 8, 8);
+  }
+}
+
 void bc1_encode_blocks_realtime(const uint8_t* rgba, size_t count, uint8_t* out,
                                 size_t out_stride) {
   uint32_t texels[16][kLanes];
@@ -589,21 +651,7 @@ void bc1_encode_blocks_realtime(const uint8_t* rgba, size_t count, uint8_t* out,
         }
       }
     }
-    uint16_t c0[kLanes], c1[kLanes];
-    uint32_t bits[kLanes];
-    bool constant[kLanes];
-    encode_realtime_lanes(texels, c0, c1, bits, constant);
-    for (size_t l = 0; l < n; ++l) {
-      const uint8_t* px = rgba + (first + l) * 64;
-      uint8_t* dst = out + (first + l) * out_stride;
-      if (constant[l]) {
-        encode_single_colour(px[0], px[1], px[2], dst);
-        continue;
-      }
-      dst[0] = uint8_t(c0[l]), dst[1] = uint8_t(c0[l] >> 8);
-      dst[2] = uint8_t(c1[l]), dst[3] = uint8_t(c1[l] >> 8);
-      for (int i = 0; i < 4; ++i) dst[4 + i] = uint8_t(bits[l] >> (8 * i));
-    }
+    finish_lanes(texels, n, out + first * out_stride, out_stride);
   }
 }
 
