@@ -607,26 +607,62 @@ inline void finish_lanes(const uint32_t (&texels)[16][kLanes], size_t n, uint8_t
 
 }  // namespace
 
+namespace {
+
+// Lanes of `n` (1..kLanes) blocks side by side from image rows (R in the low byte, missing colour
+// channels 0); idle lanes repeat the last block. `last_in_row`: the last lane's block ends its
+// image row, so its last texel may not be read as a 4-byte word (3 channels: the image may end
+// there).
+template <int kChannels>
+inline void gather_lanes(const uint8_t* texels, size_t row_stride, size_t n, bool last_in_row,
+                         uint32_t (&lanes)[16][kLanes]) {
+  for (int y = 0; y < 4; ++y) {
+    const uint8_t* row = texels + size_t(y) * row_stride;
+    for (size_t l = 0; l < size_t(kLanes); ++l) {
+      const size_t blk = std::min(l, n - 1);
+      const uint8_t* src = row + blk * 4 * kChannels;
+      for (int x = 0; x < 4; ++x) {
+        const uint8_t* t = src + x * kChannels;
+        uint32_t w;
+        if constexpr (kChannels >= 3 && std::endian::native == std::endian::little) {
+          if (kChannels == 4 || x < 3 || !last_in_row || blk + 1 < n) {
+            std::memcpy(&w, t, 4);  // one load; the kernel reads only the low three bytes
+          } else {
+            w = uint32_t(t[0]) | (uint32_t(t[1]) << 8) | (uint32_t(t[2]) << 16);
+          }
+        } else {
+          w = t[0];
+          if constexpr (kChannels > 1) w |= uint32_t(t[1]) << 8;
+          if constexpr (kChannels > 2) w |= uint32_t(t[2]) << 16;
+        }
+        lanes[4 * y + x][l] = w;
+      }
+    }
+  }
+}
+
+}  // namespace
+
 void bc1_encode_rows_realtime(const uint8_t* texels, size_t row_stride, int channels, size_t count,
                               uint8_t* out) {
   alignas(64) uint32_t lanes[16][kLanes];
-  const size_t cs = size_t(channels);
   for (size_t first = 0; first < count; first += kLanes) {
     const size_t n = std::min<size_t>(kLanes, count - first);
-    // Straight from the image into the kernel's texel-major lanes (R in the low byte, missing
-    // colour channels 0): no RGBA copy of the row in between. Idle lanes repeat the last block.
-    for (int y = 0; y < 4; ++y) {
-      const uint8_t* row = texels + size_t(y) * row_stride;
-      for (size_t l = 0; l < size_t(kLanes); ++l) {
-        const uint8_t* src = row + (first + std::min(l, n - 1)) * 4 * cs;
-        for (int x = 0; x < 4; ++x) {
-          const uint8_t* t = src + size_t(x) * cs;
-          uint32_t w = t[0];
-          if (channels > 1) w |= uint32_t(t[1]) << 8;
-          if (channels > 2) w |= uint32_t(t[2]) << 16;
-          lanes[4 * y + x][l] = w;
-        }
-      }
+    const bool last = first + n == count;
+    const uint8_t* src = texels + first * 4 * size_t(channels);
+    switch (channels) {
+      case 1:
+        gather_lanes<1>(src, row_stride, n, last, lanes);
+        break;
+      case 2:
+        gather_lanes<2>(src, row_stride, n, last, lanes);
+        break;
+      case 3:
+        gather_lanes<3>(src, row_stride, n, last, lanes);
+        break;
+      default:
+        gather_lanes<4>(src, row_stride, n, last, lanes);
+        break;
     }
     finish_lanes(lanes, n, out + first * 8, 8);
   }

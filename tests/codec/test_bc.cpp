@@ -462,5 +462,38 @@ TEST(Bc, RealtimeOutputIsPinned) {
   }
 }
 
+// The real-time BC1 path gathers blocks straight from 1-4 channel rows (bc1_encode_rows_realtime):
+// the same bytes as the RGBA blocks through bc1_encode_blocks_realtime, at every row length
+// (partial batches of 16, a row's last texel read without running past the image).
+TEST(Bc1, RealtimeRowsMatchRgbaBlocks) {
+  for (int w : {4, 8, 20, 64, 68, 132}) {
+    const int h = 8;
+    for (int channels = 1; channels <= 4; ++channels) {
+      const std::vector<uint8_t> img = pinned_page(std::max(w, h), channels, uint32_t(w));
+      // The top-left w x h of the page, rows packed, in a buffer of exactly that size.
+      const size_t stride = size_t(std::max(w, h)) * channels;
+      std::vector<uint8_t> sub(size_t(w) * h * channels);
+      for (int y = 0; y < h; ++y)
+        std::memcpy(&sub[size_t(y) * w * channels], &img[y * stride], size_t(w) * channels);
+      std::vector<uint8_t> got(bc_image_bytes(BcFormat::kBc1, w, h));
+      ASSERT_TRUE(bc_encode_image(BcFormat::kBc1, BcQuality::kRealtime, sub.data(), w, h, channels,
+                                  got.data())
+                      .ok());
+      std::vector<uint8_t> rgba(size_t(w / 4) * 64), want(got.size());
+      for (int by = 0; by < h / 4; ++by) {
+        for (int bx = 0; bx < w / 4; ++bx) {
+          for (int i = 0; i < 16; ++i) {
+            const uint8_t* t = &sub[((size_t(by) * 4 + i / 4) * w + bx * 4 + i % 4) * channels];
+            for (int c = 0; c < 4; ++c)
+              rgba[size_t(bx) * 64 + 4 * i + c] = c < channels ? t[c] : (c == 3 ? 255 : 0);
+          }
+        }
+        bc1_encode_blocks_realtime(rgba.data(), size_t(w / 4), &want[size_t(by) * (w / 4) * 8], 8);
+      }
+      ASSERT_EQ(got, want) << w << " wide, " << channels << " channels";
+    }
+  }
+}
+
 }  // namespace
 }  // namespace vt
