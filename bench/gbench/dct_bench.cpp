@@ -551,16 +551,20 @@ int transcode(int rounds, const std::string& basis_dir) {
     }
     for (Page& p : pages) folds[i % 2].push_back(std::move(p));
   }
-  std::vector<Page> tex[2];
-  for (const auto& f : list_pngs(g_texture_dir, "baseColor")) {
+  // Game textures: colour maps, and the other maps (normal, ORM) read as RGB pages too.
+  std::vector<Page> tex[2], other[2];
+  for (const auto& f : list_pngs(g_texture_dir)) {
     auto pages = load_pages(f, 3);
-    for (size_t i = 0; i < pages.size(); i++) tex[i % 2].push_back(std::move(pages[i]));
+    auto& to = f.find("baseColor") != std::string::npos ? tex : other;
+    for (size_t i = 0; i < pages.size(); i++) to[i % 2].push_back(std::move(pages[i]));
   }
   if (folds[0].empty()) return 1;
   std::vector<TranscodeSet> sets;
   sets.push_back(make_transcode_set("Kodak fold 0", std::move(folds[0]), folds[1]));
   if (!tex[0].empty())
     sets.push_back(make_transcode_set("PBR baseColor maps", std::move(tex[0]), tex[1]));
+  if (!other[0].empty())
+    sets.push_back(make_transcode_set("PBR normal + ORM maps", std::move(other[0]), other[1]));
   const double basis_psnr = basis_files.empty() ? 0 : basis_bc1_psnr(sets[0].pages, basis_files);
 
   std::printf(
@@ -571,6 +575,10 @@ int transcode(int rounds, const std::string& basis_dir) {
     Page out(set.pages[0].size());
     std::vector<uint8_t> bc(bc_image_bytes(BcFormat::kBc1, kPage, kPage));
     JpegPageDecoder jd = jpeg_decoder(set.jpeg.tables);
+    // libjpeg-turbo's speed here is bimodal with where malloc puts its per-image buffers (its
+    // AVX2 fancy upsampler's stores stall in some layouts): the same binary and pages give
+    // 15,000 or 21,800 Kodak pages/s depending on what was allocated before. Aligning our
+    // buffers does not move it; compare ratios across builds with care (docs/BENCHMARKS.md).
     std::vector<double> td, tj, tt;
     for (int r = 0; r < rounds; r++) {
       const double t0 = now_s();
