@@ -4,8 +4,8 @@
 //   dct_bench --report [KODAK_DIR [TEXTURE_DIR]]   rate-distortion and speed table (markdown)
 //   dct_bench --speed [KODAK_DIR]                   decode speed against JPEG, interleaved
 //   dct_bench --runtime [KODAK_DIR]                 DCT decode + BC1 real-time, pages/s
-//   dct_bench --transcode [ROUNDS [BASIS_BC1_DIR]]  issue 22: decode vs JPEG and DCT + BC1 on
-//                                                   Kodak and PBR colour maps, interleaved
+//   dct_bench --transcode [ROUNDS [BASIS_BC1_DIR [SET]]]  issue 22: decode vs JPEG and DCT + BC1
+//                                       on Kodak and PBR maps, interleaved (SET: a name's part)
 //   dct_bench [google benchmark flags]             per-page decode / encode timings
 //
 // Report: bits per texel, PSNR (RGB, per page), single-thread encode / decode Mtexel/s (median
@@ -532,12 +532,15 @@ double basis_bc1_psnr(const std::vector<Page>& pages, const std::vector<std::str
   return psnr_from(se, double(pages.size()) * kPage * kPage * 3);
 }
 
-// `dct_bench --transcode ROUNDS [BASIS_BC1_DIR]`: per page set (Kodak fold 0, 288 pages: the
-// pages bench/transcode_vs_basis.sh gives Basis; the PBR colour maps), DCT decode, JPEG decode
-// and DCT decode + BC1 real-time, passes alternating, medians of thread CPU time over ROUNDS.
-// With BASIS_BC1_DIR (kodimNN_unpacked_rgb_BC1_RGB_PPPP.png from `basisu -unpack`) also
-// Basis's PSNR after BC1 on the same Kodak pages.
-int transcode(int rounds, const std::string& basis_dir) {
+// `dct_bench --transcode ROUNDS [BASIS_BC1_DIR [SET]]`: per page set (Kodak fold 0, 288 pages:
+// the pages bench/transcode_vs_basis.sh gives Basis; the PBR colour maps; the PBR normal and ORM
+// maps, read as RGB), DCT decode, JPEG decode and DCT decode + BC1 real-time, passes alternating,
+// medians of thread CPU time over ROUNDS. Both codecs code the same RGB pages at about equal
+// PSNR: DCT q50 4:2:0 (tables trained on the other fold), JPEG q75 4:2:0. With BASIS_BC1_DIR
+// (kodimNN_unpacked_rgb_BC1_RGB_PPPP.png from `basisu -unpack`) also Basis's PSNR after BC1 on
+// the same Kodak pages. SET (part of a set's name) runs that set alone: see the note on
+// libjpeg-turbo's speed below.
+int transcode(int rounds, const std::string& basis_dir, const std::string& only) {
   std::vector<Page> folds[2];
   const auto files = list_pngs(g_kodak_dir);
   std::vector<std::string> basis_files;
@@ -558,14 +561,17 @@ int transcode(int rounds, const std::string& basis_dir) {
     auto& to = f.find("baseColor") != std::string::npos ? tex : other;
     for (size_t i = 0; i < pages.size(); i++) to[i % 2].push_back(std::move(pages[i]));
   }
-  if (folds[0].empty()) return 1;
   std::vector<TranscodeSet> sets;
-  sets.push_back(make_transcode_set("Kodak fold 0", std::move(folds[0]), folds[1]));
-  if (!tex[0].empty())
-    sets.push_back(make_transcode_set("PBR baseColor maps", std::move(tex[0]), tex[1]));
-  if (!other[0].empty())
-    sets.push_back(make_transcode_set("PBR normal + ORM maps", std::move(other[0]), other[1]));
-  const double basis_psnr = basis_files.empty() ? 0 : basis_bc1_psnr(sets[0].pages, basis_files);
+  auto add = [&](const char* name, std::vector<Page>(&f)[2]) {
+    if (!f[0].empty() && (only.empty() || std::strstr(name, only.c_str())))
+      sets.push_back(make_transcode_set(name, std::move(f[0]), f[1]));
+  };
+  add("Kodak fold 0", folds);
+  add("PBR baseColor maps", tex);
+  add("PBR normal + ORM maps", other);
+  if (sets.empty()) return 1;
+  const bool with_basis = !basis_files.empty() && sets[0].name == "Kodak fold 0";
+  const double basis_psnr = with_basis ? basis_bc1_psnr(sets[0].pages, basis_files) : 0;
 
   std::printf(
       "| pages | n | DCT q50 b/t | DCT PSNR | JPEG q75 b/t | JPEG PSNR | DCT decode pages/s | "
@@ -700,7 +706,8 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (argc > 1 && std::strcmp(argv[1], "--transcode") == 0) {
-    return transcode(argc > 2 ? std::atoi(argv[2]) : 7, argc > 3 ? argv[3] : "");
+    return transcode(argc > 2 ? std::atoi(argv[2]) : 7, argc > 3 ? argv[3] : "",
+                     argc > 4 ? argv[4] : "");
   }
   if (argc > 1 && std::strcmp(argv[1], "--speed") == 0) {
     if (argc > 2) g_kodak_dir = argv[2];
