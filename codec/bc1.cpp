@@ -294,14 +294,17 @@ VT_BC1_CLONES
 void encode_realtime_lanes(const uint32_t (&texels)[16][kLanes], uint16_t c0_out[kLanes],
                            uint16_t c1_out[kLanes], uint32_t bits_out[kLanes],
                            bool constant_out[kLanes]) {
-  float r[16][kLanes], g[16][kLanes], b[16][kLanes], xx[16][kLanes];
+  float r[16][kLanes], g[16][kLanes], b[16][kLanes];
+  int32_t xx[16][kLanes];  // |x|^2 - 3 * 255^2 (select's bias), exact
   for (int i = 0; i < 16; ++i) {
     for (int l = 0; l < kLanes; ++l) {
       const uint32_t w = texels[i][l];
       r[i][l] = float(int(w & 255u));
       g[i][l] = float(int((w >> 8) & 255u));
       b[i][l] = float(int((w >> 16) & 255u));
-      xx[i][l] = r[i][l] * r[i][l] + g[i][l] * g[i][l] + b[i][l] * b[i][l];
+      const int32_t ri = int32_t(w & 255u), gi = int32_t((w >> 8) & 255u),
+                    bi = int32_t((w >> 16) & 255u);
+      xx[i][l] = ri * ri + gi * gi + bi * bi - 3 * 255 * 255;
     }
   }
   float mr[kLanes], mg[kLanes], mb[kLanes];
@@ -417,7 +420,11 @@ void encode_realtime_lanes(const uint32_t (&texels)[16][kLanes], uint16_t c0_out
         for (int ch = 0; ch < 3; ++ch) m8[k][ch][l] = -8.0f * p[k][ch][l];
       }
     }
-    for (int l = 0; l < kLanes; ++l) e[l] = 0, out[l] = 0;
+    // Each texel's error |x - p|^2 is an integer and the block's sum stays below 2^24, so the
+    // sum is exact in any order and type: it accumulates in int32 (one-cycle adds, no
+    // conversion; a float chain here was the kernel's longest latency) and converts once.
+    int32_t ei[kLanes];
+    for (int l = 0; l < kLanes; ++l) ei[l] = 0, out[l] = 0;
     for (int i = 0; i < 16; ++i) {
       float best[kLanes];
       for (int l = 0; l < kLanes; ++l) {
@@ -433,9 +440,10 @@ void encode_realtime_lanes(const uint32_t (&texels)[16][kLanes], uint16_t c0_out
       for (int l = 0; l < kLanes; ++l) {
         const int s = int(best[l]);
         out[l] |= uint32_t(s & 3) << (2 * i);
-        e[l] += float(s >> 2) + (xx[i][l] - kBias);
+        ei[l] += (s >> 2) + xx[i][l];
       }
     }
+    for (int l = 0; l < kLanes; ++l) e[l] = float(ei[l]);
   };
   select(q0, q1, idx, err);
 
