@@ -73,7 +73,7 @@ basis_round() {
 }
 # One dct_bench round (3 inner passes, median): the Kodak row's DCT + BC1 pages/s.
 ours_round() {
-  "$1" --transcode 3 "" Kodak | awk -F'|' '/Kodak fold 0/ {gsub(/ /, "", $11); print $11}'
+  "$1" --transcode 3 "" Kodak | awk -F'|' '/^\| Kodak fold 0 \|/ {gsub(/ /, "", $11); print $11}'
 }
 median() { sort -g | awk '{a[NR] = $1} END {print a[int((NR + 1) / 2)]}'; }
 
