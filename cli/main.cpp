@@ -1,19 +1,19 @@
 // vtbake: offline virtual-texture baking. Each subcommand lives in its own cli/cmd_*.cpp.
-// The executable holds the light commands (info, verify, extract, version: page-file readers,
-// nothing of the bake stack); the rest are in the commands module, loaded only when the command
+// The executable holds the light commands (info, verify, version: page-file readers, nothing
+// of the bake stack); the rest are in the commands module, loaded only when the command
 // line names one of them or asks for the full list (docs/ARCHITECTURE.md, "Start-up").
 #include <dlfcn.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
-#include <cstring>
 #include <exception>
 #include <map>
 #include <string>
 #include <string_view>
 
 #include "cli/command.h"
+#include "cli/json_output.h"
 
 namespace vt::cli {
 
@@ -69,11 +69,15 @@ std::string module_path() {
 
 // Loads the heavy commands; their static registrations join registered_commands(). Never
 // unloaded: their factories and runners live in it.
-bool load_commands_module() {
+bool load_commands_module(int argc, char** argv) {
   const std::string path = module_path();
   if (dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)) return true;
-  std::fprintf(stderr, "vtbake: cannot load the bake commands module %s: %s\n", path.c_str(),
-               dlerror());
+  const std::string message = "cannot load the bake commands module " + path + ": " + dlerror();
+  std::fprintf(stderr, "vtbake: %s\n", message.c_str());
+  // --json is not parsed yet; a pipeline that asked for it still gets its error object.
+  if (std::any_of(argv + 1, argv + argc,
+                  [](const char* a) { return std::string_view(a) == "--json"; }))
+    print_json_error("vtbake", kExitFailure, {{"code", "internal"}, {"message", message}});
   return false;
 }
 
@@ -84,14 +88,15 @@ int main(int argc, char** argv) {
   using namespace vt::cli;
   // A light command runs without the module; anything else (a bake command, an unknown word,
   // the top-level help) needs the full list.
-  if (!is_registered(subcommand_word(argc, argv)) && !load_commands_module()) return kExitFailure;
+  if (!is_registered(subcommand_word(argc, argv)) && !load_commands_module(argc, argv))
+    return kExitFailure;
 
   CLI::App app{
       "vtbake " VTBAKE_VERSION
       " - offline virtual-texture baking: scenes and images into tiled page files (.vtpf)"};
   app.footer(
       "Exit status: 0 the work succeeded; 1 the work ran and failed (a write, a memory limit, a "
-      "bad page, a threshold missed); 2 bad usage or bad input (docs/REPORTS.md).\n"
+      "bad page, a threshold missed); 2 bad usage or bad input (docs/JSON.md).\n"
       "Outputs (-o): written under a temporary name beside the target and renamed into place "
       "when complete; a symlink at the path is written through (its target is replaced in the "
       "target's folder, the link stays); a directory, device, FIFO or socket there is refused "
@@ -119,9 +124,21 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    int code = app.exit(e);
-    return code == 0 ? kExitOk : kExitBadInput;
+    const int code = app.exit(e) == 0 ? kExitOk : kExitBadInput;
+    // --json was not parsed, but a pipeline that asked for it still gets its error object.
+    if (code != kExitOk && std::any_of(argv + 1, argv + argc, [](const char* a) {
+          return std::string_view(a) == "--json";
+        })) {
+      const auto named = std::find_if(argv + 1, argv + argc, [&](const char* a) {
+        return std::any_of(commands.begin(), commands.end(),
+                           [&](const auto& c) { return c.name == a; });
+      });
+      print_json_error(named == argv + argc ? "vtbake" : *named, code,
+                       {{"code", "usage"}, {"message", e.what()}});
+    }
+    return code;
   }
+  set_json_output(global.json);
 
   for (CLI::App* sub : app.get_subcommands()) {
     auto it = runners.find(sub);
@@ -130,6 +147,9 @@ int main(int argc, char** argv) {
       return it->second(global);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "vtbake %s: internal error: %s\n", sub->get_name().c_str(), e.what());
+      if (global.json)
+        print_json_error(sub->get_name().c_str(), kExitFailure,
+                         {{"code", "internal"}, {"message", e.what()}});
       return kExitFailure;
     }
   }

@@ -84,12 +84,16 @@ TEST_F(BatchCli, ListJsonLinesAndKeepGoing) {
     js.push_back(j);
   }
   ASSERT_EQ(js.size(), 3u) << r.out;
-  EXPECT_EQ(js[0]["status"], "ok");
+  EXPECT_EQ(js[0]["ok"], true);
+  EXPECT_EQ(js[0]["schema"], 1);
+  EXPECT_TRUE(js[0]["input"].get<std::string>().ends_with("/a.gltf")) << js[0]["input"];
   EXPECT_EQ(js[0]["output"], dir_ + "/go/a.vtpf");
   EXPECT_TRUE(js[0].contains("build"));
-  EXPECT_EQ(js[1]["status"], "failed");
-  EXPECT_NE(js[1]["error"].get<std::string>().find("broken.gltf"), std::string::npos);
-  EXPECT_EQ(js[2]["status"], "ok");
+  EXPECT_EQ(js[1]["ok"], false);
+  EXPECT_EQ(js[1]["exit"], 2);
+  EXPECT_EQ(js[1]["error"]["code"], "corrupt");
+  EXPECT_NE(js[1]["error"]["message"].get<std::string>().find("broken.gltf"), std::string::npos);
+  EXPECT_EQ(js[2]["ok"], true);
   EXPECT_TRUE(fs::exists(dir_ + "/go/b.vtpf"));
 }
 
