@@ -1,8 +1,15 @@
 // vtbake: offline virtual-texture baking. Each subcommand lives in its own cli/cmd_*.cpp.
+// The executable holds the light commands (info, verify, version: page-file readers, nothing
+// of the bake stack); the rest are in the commands module, loaded only when the command
+// line names one of them or asks for the full list (docs/ARCHITECTURE.md, "Start-up").
+#include <dlfcn.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <map>
+#include <string>
 #include <string_view>
 
 #include "cli/command.h"
@@ -20,10 +27,70 @@ CommandRegistration::CommandRegistration(std::string name, std::string descripti
   registered_commands().push_back({std::move(name), std::move(description), std::move(factory)});
 }
 
+namespace {
+
+// The subcommand the command line names: its first word that is not a global flag or a flag's
+// value; empty when there is none (`vtbake --help`, `vtbake`).
+std::string_view subcommand_word(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view arg = argv[i];
+    if (arg == "--") return i + 1 < argc ? std::string_view(argv[i + 1]) : std::string_view();
+    if (arg == "--threads") {
+      ++i;  // its value
+      continue;
+    }
+    if (!arg.empty() && arg[0] == '-') continue;
+    return arg;
+  }
+  return {};
+}
+
+bool is_registered(std::string_view name) {
+  for (const auto& command : registered_commands())
+    if (command.name == name) return true;
+  return false;
+}
+
+// The module's path: beside the executable in the build tree, else in the installed layout
+// (VTBAKE_MODULE_RELDIR is lib/vtbake relative to bin/).
+std::string module_path() {
+  char exe[4096];
+  const ssize_t n = readlink("/proc/self/exe", exe, sizeof(exe) - 1);
+  std::string dir = ".";
+  if (n > 0) {
+    exe[n] = '\0';
+    dir.assign(exe);
+    dir.erase(dir.rfind('/'));
+  }
+  const std::string beside = dir + "/" VTBAKE_MODULE_NAME;
+  if (access(beside.c_str(), F_OK) == 0) return beside;
+  return dir + "/" VTBAKE_MODULE_RELDIR "/" VTBAKE_MODULE_NAME;
+}
+
+// Loads the heavy commands; their static registrations join registered_commands(). Never
+// unloaded: their factories and runners live in it.
+bool load_commands_module(int argc, char** argv) {
+  const std::string path = module_path();
+  if (dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)) return true;
+  const std::string message = "cannot load the bake commands module " + path + ": " + dlerror();
+  std::fprintf(stderr, "vtbake: %s\n", message.c_str());
+  // --json is not parsed yet; a pipeline that asked for it still gets its error object.
+  if (std::any_of(argv + 1, argv + argc,
+                  [](const char* a) { return std::string_view(a) == "--json"; }))
+    print_json_error("vtbake", kExitFailure, {{"code", "internal"}, {"message", message}});
+  return false;
+}
+
+}  // namespace
 }  // namespace vt::cli
 
 int main(int argc, char** argv) {
   using namespace vt::cli;
+  // A light command runs without the module; anything else (a bake command, an unknown word,
+  // the top-level help) needs the full list.
+  if (!is_registered(subcommand_word(argc, argv)) && !load_commands_module(argc, argv))
+    return kExitFailure;
+
   CLI::App app{
       "vtbake " VTBAKE_VERSION
       " - offline virtual-texture baking: scenes and images into tiled page files (.vtpf)"};

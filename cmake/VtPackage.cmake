@@ -107,6 +107,9 @@ endfunction()
 # when help2man is missing, scripts/setup.sh installs it).
 function(vt_install_tools)
   install(TARGETS vtbake RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT tools)
+  # The bake commands, loaded by vtbake from ../LIBDIR/vtbake (cli/CMakeLists.txt).
+  install(TARGETS vtbake_commands LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/vtbake
+          COMPONENT tools)
   find_program(HELP2MAN help2man)
   if(NOT HELP2MAN)
     message(WARNING "help2man not found: no man page for vtbake (scripts/setup.sh installs it)")
