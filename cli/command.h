@@ -10,6 +10,10 @@
 #include <string>
 #include <vector>
 
+#include "common/status.h"
+#include "format/page_file.h"
+#include "format/page_file_inspect.h"
+
 namespace vt::cli {
 
 // Exit codes, documented in `vtbake --help`.
@@ -41,5 +45,17 @@ struct CommandRegistration {
   CommandRegistration(std::string name, std::string description, CommandFactory factory);
 };
 std::vector<RegisteredCommand>& registered_commands();
+
+// Loads the commands module (libvtbake-commands.so: the bake stack and its commands) if it is
+// not loaded yet; its static registrations join registered_commands(). An error names the
+// module's path and the loader's reason. main() calls it for every command the executable does
+// not hold; a light command calls it when it needs the module after all.
+Status load_commands_module();
+
+// Writes an extracted level as an image in any format OpenImageIO writes; set by the module
+// (cli/image_writer_oiio.cpp), null until it is loaded.
+using ImageWriter = Status (*)(const std::string& path, const LevelImage& image,
+                               const LayerSpec& layer);
+ImageWriter& module_image_writer();
 
 }  // namespace vt::cli

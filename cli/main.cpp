@@ -67,29 +67,40 @@ std::string module_path() {
   return dir + "/" VTBAKE_MODULE_RELDIR "/" VTBAKE_MODULE_NAME;
 }
 
-// Loads the heavy commands; their static registrations join registered_commands(). Never
-// unloaded: their factories and runners live in it.
-bool load_commands_module(int argc, char** argv) {
-  const std::string path = module_path();
-  if (dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)) return true;
-  const std::string message = "cannot load the bake commands module " + path + ": " + dlerror();
-  std::fprintf(stderr, "vtbake: %s\n", message.c_str());
-  // --json is not parsed yet; a pipeline that asked for it still gets its error object.
-  if (std::any_of(argv + 1, argv + argc,
-                  [](const char* a) { return std::string_view(a) == "--json"; }))
-    print_json_error("vtbake", kExitFailure, {{"code", "internal"}, {"message", message}});
-  return false;
+}  // namespace
+
+// Never unloaded: the module's factories and runners live in it.
+Status load_commands_module() {
+  static const Status loaded = [] {
+    const std::string path = module_path();
+    if (dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)) return Status::Ok();
+    return Error(ErrorCode::kInternal,
+                 "cannot load the bake commands module " + path + ": " + dlerror());
+  }();
+  return loaded;
 }
 
-}  // namespace
+ImageWriter& module_image_writer() {
+  static ImageWriter writer = nullptr;
+  return writer;
+}
+
 }  // namespace vt::cli
 
 int main(int argc, char** argv) {
   using namespace vt::cli;
   // A light command runs without the module; anything else (a bake command, an unknown word,
   // the top-level help) needs the full list.
-  if (!is_registered(subcommand_word(argc, argv)) && !load_commands_module(argc, argv))
-    return kExitFailure;
+  if (!is_registered(subcommand_word(argc, argv))) {
+    if (vt::Status loaded = load_commands_module(); !loaded.ok()) {
+      std::fprintf(stderr, "vtbake: %s\n", loaded.message().c_str());
+      // --json is not parsed yet; a pipeline that asked for it still gets its error object.
+      if (std::any_of(argv + 1, argv + argc,
+                      [](const char* a) { return std::string_view(a) == "--json"; }))
+        print_json_error("vtbake", kExitFailure, error_json(loaded));
+      return kExitFailure;
+    }
+  }
 
   CLI::App app{
       "vtbake " VTBAKE_VERSION

@@ -1,4 +1,4 @@
-// The light commands (info, verify, version) start without the bake stack: the executable
+// The light commands (info, verify, version, clean, extract to PNG) start without the bake stack: the executable
 // links the runtime side only and loads the bake commands module for the other commands
 // (docs/ARCHITECTURE.md, "Start-up"). The dynamic loader's own log (LD_DEBUG=libs) says which
 // shared objects a process loaded.
@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -46,7 +47,9 @@ std::string small_page_file() {
 TEST(CliStartup, LightCommandsLoadNoBakeLibrary) {
   const std::string file = small_page_file();
   for (const std::string& args : std::vector<std::string>{
-           "info " + file, "--json info " + file, "verify " + file, "version", "info --help"}) {
+           "info " + file, "--json info " + file, "verify " + file, "version", "info --help",
+           "clean " + std::filesystem::path(file).parent_path().string(),
+           "extract " + file + " --level 0 -o " + file + ".png"}) {
     SCOPED_TRACE(args);
     const auto r = loader_log(args);
     EXPECT_EQ(r.exit_code, 0) << r.out;
@@ -58,7 +61,10 @@ TEST(CliStartup, LightCommandsLoadNoBakeLibrary) {
 
 // The same check sees the bake stack where it is loaded: a bake command and the full --help.
 TEST(CliStartup, BakeCommandsLoadTheModule) {
-  for (const std::string& args : std::vector<std::string>{"sample --help", "--help"}) {
+  const std::string file = small_page_file();
+  // extract writes 8-bit PNG itself; EXR (and every other format) is OpenImageIO's.
+  for (const std::string& args : std::vector<std::string>{
+           "sample --help", "--help", "extract " + file + " --level 0 -o " + file + ".exr"}) {
     SCOPED_TRACE(args);
     const auto r = loader_log(args);
     EXPECT_EQ(r.exit_code, 0) << r.out;

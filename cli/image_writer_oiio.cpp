@@ -1,0 +1,56 @@
+// The commands module's image writer for `vtbake extract` (every format OpenImageIO writes:
+// EXR, TIFF, 16-bit and float images); the light executable writes 8-bit PNG itself.
+#include <OpenImageIO/imageio.h>
+
+#include "cli/command.h"
+#include "format/atomic_output.h"
+
+namespace {
+
+OIIO::TypeDesc oiio_type(vt::TexelType type) {
+  switch (type) {
+    case vt::TexelType::kU8:
+      return OIIO::TypeDesc::UINT8;
+    case vt::TexelType::kF16:
+      return OIIO::TypeDesc::HALF;
+    case vt::TexelType::kF32:
+      return OIIO::TypeDesc::FLOAT;
+  }
+  return OIIO::TypeDesc::UINT8;
+}
+
+// The image spec that makes OpenImageIO write the layer's texels unchanged.
+OIIO::ImageSpec output_spec(const vt::LevelImage& image, const vt::LayerSpec& layer) {
+  OIIO::ImageSpec spec(int(image.width), int(image.height), int(image.channels),
+                       oiio_type(image.texel_type));
+  const bool colour = layer.semantic == vt::LayerSemantic::kAlbedo ||
+                      layer.semantic == vt::LayerSemantic::kEmissive;
+  const bool alpha = colour && (image.channels == 2 || image.channels == 4);
+  spec.alpha_channel = alpha ? int(image.channels) - 1 : -1;
+  if (!alpha && image.channels == 4) spec.channelnames[3] = "W";  // data, not an alpha
+  // The page file never premultiplies: without this, the PNG writer divides colour by the last
+  // channel of every 2- and 4-channel image, taking it for associated alpha.
+  spec.attribute("oiio:UnassociatedAlpha", 1);
+  return spec;
+}
+
+vt::Status write_image_oiio(const std::string& path, const vt::LevelImage& image,
+                            const vt::LayerSpec& layer) {
+  // The writer is chosen by the final name; the texels go to a staging file beside it (never
+  // through a FIFO or onto a device, never truncated under the final name).
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out)
+    return vt::Error(vt::ErrorCode::kInvalidArgument,
+                     path + ": cannot write this kind of image: " + OIIO::geterror());
+  const OIIO::TypeDesc type = oiio_type(image.texel_type);
+  const OIIO::ImageSpec spec = output_spec(image, layer);
+  return vt::write_output(path, [&](const std::string& temp) -> vt::Status {
+    if (!out->open(temp, spec) || !out->write_image(type, image.texels.data()) || !out->close())
+      return vt::Error(vt::ErrorCode::kIo, path + ": " + out->geterror());
+    return vt::Status::Ok();
+  });
+}
+
+const bool kRegistered = (vt::cli::module_image_writer() = &write_image_oiio, true);
+
+}  // namespace
