@@ -186,6 +186,7 @@ void BM_SampleScene(benchmark::State& state) {
   state.counters["rays_per_s"] =
       benchmark::Counter(double(rays), benchmark::Counter::kIsIterationInvariantRate);
   state.counters["bvh_MiB"] = double(bvh) / (1 << 20);
+  state.counters["rays"] = double(rays);
 }
 BENCHMARK(BM_SampleScene)->Arg(0)->Arg(3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
