@@ -17,7 +17,9 @@
 #include "bake/lighting.h"
 #include "bake/scene_bake.h"
 #include "bake/transfer.h"
+#include "bake/unwrap/unwrap.h"
 #include "format/page_file.h"
+#include "samples/sample_scene.h"
 #include "tests/transfer/transfer_test_util.h"
 
 namespace vt {
@@ -335,6 +337,46 @@ TEST(Lighting, ExtremeValuesGiveFiniteTexels) {
     }
     EXPECT_EQ(r.stats.lighting.clamped + r.stats.lighting.non_finite > 0, c.clamped)
         << int(c.type) << " " << c.intensity;
+  }
+}
+
+// The shadow terminator and acne on a low-poly sphere (12 segments, smooth normals, degenerate
+// pole triangles), at tiny, unit and huge scales: rays start half a texel footprint off the
+// surface, so shadow rays change nothing where the triangles face the light, and every texel is
+// finite whatever the scale.
+TEST(Lighting, LowPolySphereHasNoAcneAtAnyScale) {
+  for (double scale : {1e-3, 1.0, 1e4}) {
+    SCOPED_TRACE(scale);
+    scene::Scene s = test::single_mesh_scene(make_uv_sphere(1, 12), scene::Material{});
+    for (int i = 0; i < 3; ++i) s.nodes[0].local[5 * i] = scale;
+    add_light(s, light_of(scene::LightType::kDirectional, 10), turned_about_x(0.6));
+    unwrap::UnwrapOptions uo;
+    uo.size_pages = 1;
+    auto un = unwrap::unwrap_scene(s, uo);
+    ASSERT_TRUE(un.ok()) << un.status().message();
+    TransferOptions o = test::atlas_transfer_options(un->stats);
+    o.threads = 2;
+    auto lit = transfer_materials(un->scene, o);
+    o.lighting.shadows = false;
+    auto open = transfer_materials(un->scene, o);
+    ASSERT_TRUE(lit.ok() && open.ok());
+    const TransferLayer *a = lighting_layer(*lit), *b = lighting_layer(*open);
+    ASSERT_TRUE(a && b);
+    int facing = 0, terminator = 0;
+    for (size_t i = 0; i < a->texels.size(); i += 3) {
+      ASSERT_TRUE(std::isfinite(a->texels[i]));
+      // Shading cosine above 0.8: within 37 degrees of the light, where 30-degree facets
+      // face it too (no triangle of a convex sphere can shadow them).
+      if (b->texels[i] > 8.0f) {
+        ASSERT_EQ(a->texels[i], b->texels[i]) << "texel " << i / 3;
+        ++facing;
+      } else if (a->texels[i] != b->texels[i]) {
+        ++terminator;
+      }
+    }
+    EXPECT_GT(facing, 500);
+    // Shadowed texels lie where the smooth normal still sees the light but the facet does not.
+    EXPECT_LT(terminator, facing);
   }
 }
 
