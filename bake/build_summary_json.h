@@ -1,4 +1,4 @@
-// The one JSON form of a build's summary (docs/REPORTS.md): `vtbake build --json` prints it and
+// The one JSON form of a build's summary (docs/JSON.md): `vtbake build --json` prints it and
 // the scene bake's report nests it under "build", so a build farm reads both with one schema.
 #pragma once
 
@@ -16,7 +16,7 @@ uint64_t raw_texel_bytes(const BuildSummary& summary);
 double compression_ratio(const BuildSummary& summary);
 
 // {"width", "height", "payload", "border", "pages": {...}, "bytes": {...}, "levels": [...],
-//  "layers": [...], "seconds": {...}}, documented key by key in docs/REPORTS.md.
+//  "layers": [...], "seconds": {...}}, documented key by key in docs/JSON.md.
 nlohmann::json to_json(const BuildSummary& summary);
 
 }  // namespace vt

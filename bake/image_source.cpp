@@ -11,6 +11,7 @@
 #include <map>
 
 #include "bake/png_check.h"
+#include "format/atomic_output.h"
 
 namespace vt {
 
@@ -189,20 +190,23 @@ Status write_image_file(ImageSource& source, const std::string& path, uint32_t t
   if (tiled) {
     spec.tile_width = spec.tile_height = int(tile);
   }
-  if (!out->open(path, spec)) return Error(ErrorCode::kIo, path + ": " + out->geterror());
-  size_t row = size_t(info.width) * info.channels;
-  uint32_t band = tiled ? tile : 64;
-  std::vector<float> rows(row * band);
-  for (uint32_t y = 0; y < info.height; y += band) {
-    uint32_t y1 = std::min(info.height, y + band);
-    VT_RETURN_IF_ERROR(source.read_rows(y, y1, rows.data()));
-    bool ok = tiled ? out->write_tiles(0, int(info.width), int(y), int(y1), 0, 1,
+  return write_output(path, [&](const std::string& temp) -> Status {
+    if (!out->open(temp, spec)) return Error(ErrorCode::kIo, path + ": " + out->geterror());
+    size_t row = size_t(info.width) * info.channels;
+    uint32_t band = tiled ? tile : 64;
+    std::vector<float> rows(row * band);
+    for (uint32_t y = 0; y < info.height; y += band) {
+      uint32_t y1 = std::min(info.height, y + band);
+      VT_RETURN_IF_ERROR(source.read_rows(y, y1, rows.data()));
+      bool ok = tiled
+                    ? out->write_tiles(0, int(info.width), int(y), int(y1), 0, 1,
                                        OIIO::TypeDesc::FLOAT, rows.data())
                     : out->write_scanlines(int(y), int(y1), 0, OIIO::TypeDesc::FLOAT, rows.data());
-    if (!ok) return Error(ErrorCode::kIo, path + ": " + out->geterror());
-  }
-  if (!out->close()) return Error(ErrorCode::kIo, path + ": " + out->geterror());
-  return Status::Ok();
+      if (!ok) return Error(ErrorCode::kIo, path + ": " + out->geterror());
+    }
+    if (!out->close()) return Error(ErrorCode::kIo, path + ": " + out->geterror());
+    return Status::Ok();
+  });
 }
 
 namespace {

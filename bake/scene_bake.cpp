@@ -406,6 +406,7 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
 nlohmann::json to_json(const SceneBakeSummary& s) {
   nlohmann::json stages = nlohmann::json::object();
   for (const StageTime& st : s.stages) stages[st.name] = st.seconds;
+  stages["total"] = s.seconds;
   nlohmann::json peak_rss = nlohmann::json::object();
   for (const auto& [stage, bytes] : s.peak_rss) peak_rss[stage] = bytes;
   const unwrap::UnwrapStats& u = s.unwrap;
@@ -449,7 +450,6 @@ nlohmann::json to_json(const SceneBakeSummary& s) {
         {"missing_textures", missing}}},
       {"build", to_json(s.build)},
       {"seconds", stages},
-      {"total_seconds", s.seconds},
       {"peak_rss_bytes", peak_rss},
       {"warnings", s.warnings},
   };

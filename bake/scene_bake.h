@@ -98,7 +98,7 @@ Expected<SceneBakeSummary> bake_scene(const std::string& scene_path,
 // Bakes a scene already in memory.
 Expected<SceneBakeSummary> bake_scene(const scene::Scene& scene, const SceneBakeOptions& options);
 
-// The summary as one JSON object (for --json and build farms, docs/REPORTS.md); the build part
+// The summary as one JSON object (for --json and build farms, docs/JSON.md); the build part
 // is to_json(summary.build) under "build".
 nlohmann::json to_json(const SceneBakeSummary& summary);
 

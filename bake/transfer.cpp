@@ -409,13 +409,7 @@ Status Transfer::setup_images() {
         img.embedded() ? "embedded image " + std::to_string(i) + " '" + img.name + "'" : img.path;
     if (img.embedded()) {
       // OpenImageIO's texture cache reads by file name: a private copy is the robust way.
-      std::string ext = ".png";
-      if (img.mime_type == "image/jpeg")
-        ext = ".jpg";
-      else if (img.mime_type == "image/x-exr")
-        ext = ".exr";
-      else if (img.mime_type == "image/webp")
-        ext = ".webp";
+      const std::string ext = img.embedded_extension();
       // Unique per process and per call, so concurrent transfers never share a copy.
       static std::atomic<uint64_t> calls{0};
       path = (scratch / ("vtbake-transfer-" + std::to_string(getpid()) + "-" +

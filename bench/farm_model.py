@@ -46,7 +46,7 @@ def main():
     transfer_s_per_texel = plan1["transfer"] / texels
     keys_s_per_texel = plan1["keys"] / texels  # the pyramid pass without encoding
     encode_s_per_page = max(shard_all["build"] - plan1["keys"], 0.0) / pages
-    merge_s_per_page = merge["total_seconds"] / pages
+    merge_s_per_page = merge["seconds"]["total"] / pages
     tables_s = plan1["plan"]
     print("measured on the sample scene (%dx%d atlas, %d layers, %d pages to encode):"
           % (g["width"], g["height"], len(graph["layers"]), pages))
@@ -54,11 +54,11 @@ def main():
     print("  plan at 1 thread:  " + ", ".join("%s %.2f s" % kv for kv in plan1.items()))
     for s in o.shards:
         st, j = stages(s)
-        print("  shard %s at 1 thread: %s" % (j["part"].split("/")[-1],
+        print("  shard %s at 1 thread: %s" % (j["output"].split("/")[-1],
                                               ", ".join("%s %.2f s" % kv for kv in st.items())))
     print("  all tasks in one shard at 1 thread: " +
           ", ".join("%s %.2f s" % kv for kv in shard_all.items()))
-    print("  merge %.3f s" % merge["total_seconds"])
+    print("  merge %.3f s" % merge["seconds"]["total"])
     print("  per core: transfer %.1f ns/texel, pyramid pass %.1f ns/texel, encode %.2f ms/page, "
           "merge %.3f ms/page, tables %.2f s" %
           (transfer_s_per_texel * 1e9, keys_s_per_texel * 1e9, encode_s_per_page * 1e3,

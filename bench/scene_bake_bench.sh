@@ -29,7 +29,7 @@ s = j["seconds"]
 tr = j["transfer"]
 print(f"| {sys.argv[3]} | {j['triangles']:,} | {j['atlas']['width']}x{j['atlas']['height']} | {sys.argv[4]} "
       f"| {tr['covered_texels']:,} | {s['transfer']:.2f} | {tr['texels_per_second']/1e6:.2f} "
-      f"| {s['unwrap']:.2f} | {s['build']:.2f} | {j['total_seconds']:.2f} | {j['build']['bytes']['file']:,} "
+      f"| {s['unwrap']:.2f} | {s['build']:.2f} | {j['seconds']['total']:.2f} | {j['build']['bytes']['file']:,} "
       f"| {j['build']['bytes']['ratio']:.1f} | {rss/1024:.0f} |")
 EOF
 }

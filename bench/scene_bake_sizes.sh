@@ -20,7 +20,7 @@ j = json.load(open(sys.argv[1])); rss = int(open(sys.argv[2]).read().split()[-1]
 s = j["seconds"]; a = j["atlas"]; t = j["transfer"]; mib = 1 << 20
 print("%-6s %-13s %9.1f %9.1f %9.1f %9.1f %8.0fM %8.0fM %10d %12.0f %12.1f" % (
     sys.argv[3], "%dx%d" % (a["width"], a["height"]), s.get("unwrap", 0), s.get("transfer", 0),
-    s.get("build", 0), j["total_seconds"], j["peak_rss_bytes"].get("unwrap", 0) / mib, rss / mib,
+    s.get("build", 0), j["seconds"]["total"], j["peak_rss_bytes"].get("unwrap", 0) / mib, rss / mib,
     t["covered_texels"], t["texels_per_second"] / 2, j["build"]["bytes"]["file"] / mib))
 PY
   rm -f "$out/bake_$n.vtpf"

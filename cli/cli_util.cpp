@@ -8,6 +8,7 @@
 #include <cstdlib>
 
 #include "cli/command.h"
+#include "cli/json_output.h"
 
 namespace vt::cli {
 
@@ -25,11 +26,15 @@ int exit_code_for(const Status& status) {
 
 int report_error(const char* command, const Status& status) {
   std::fprintf(stderr, "vtbake %s: %s\n", command, status.message().c_str());
-  return exit_code_for(status);
+  const int exit_code = exit_code_for(status);
+  if (json_output()) print_json_error(command, exit_code, error_json(status));
+  return exit_code;
 }
 
 int bad_usage(const char* command, const std::string& message) {
   std::fprintf(stderr, "vtbake %s: %s\n", command, message.c_str());
+  if (json_output())
+    print_json_error(command, kExitBadInput, {{"code", "usage"}, {"message", message}});
   return kExitBadInput;
 }
 

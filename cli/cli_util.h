@@ -18,11 +18,13 @@ namespace vt::cli {
 // a view below its bounds) is kExitFailure too, chosen by the command.
 int exit_code_for(const Status& status);
 
-// Prints "vtbake COMMAND: MESSAGE" on stderr and returns exit_code_for(status). Every command
-// reports a failed Status through this.
+// Prints "vtbake COMMAND: MESSAGE" on stderr (and, with --json, the error object on stdout:
+// cli/json_output.h) and returns exit_code_for(status). Every command reports a failed Status
+// through this, and prints nothing else for that failure.
 int report_error(const char* command, const Status& status);
 
-// Prints "vtbake COMMAND: MESSAGE" on stderr and returns kExitBadInput (a wrong flag or input).
+// Prints "vtbake COMMAND: MESSAGE" on stderr (with --json, an error object with code "usage"
+// on stdout) and returns kExitBadInput (a wrong flag or input).
 int bad_usage(const char* command, const std::string& message);
 
 // One status line on stderr, redrawn in place at most 5 times a second. Silent with --quiet

@@ -18,6 +18,7 @@
 #include "cli/build_flags.h"
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/json_output.h"
 #include "cli/layer_error_text.h"
 #include "cli/scene_load_flags.h"
 #include "cli/unwrap_flags.h"
@@ -53,16 +54,16 @@ int run_plan(const BakeArgs& a, const vt::cli::GlobalOptions& global) {
   if (global.json) {
     nlohmann::json stages = nlohmann::json::object();
     for (const auto& st : s->stages) stages[st.name] = st.seconds;
-    std::printf("%s\n", nlohmann::json{{"plan", s->plan_path},
-                                       {"work", s->work_dir},
-                                       {"plan_hash", s->plan_hash},
-                                       {"tasks", s->tasks},
-                                       {"band_tasks", s->band_tasks},
-                                       {"pages", s->pages},
-                                       {"seconds", stages},
-                                       {"total_seconds", s->seconds}}
-                            .dump(2)
-                            .c_str());
+    stages["total"] = s->seconds;
+    vt::cli::print_json("bake", vt::cli::kExitOk,
+                        {{"input", a.scene},
+                         {"output", s->plan_path},
+                         {"work", s->work_dir},
+                         {"plan_hash", s->plan_hash},
+                         {"tasks", s->tasks},
+                         {"band_tasks", s->band_tasks},
+                         {"pages", {{"total", s->pages}}},
+                         {"seconds", stages}});
     return vt::cli::kExitOk;
   }
   std::printf("planned %s: %u tasks (%u band tasks), %llu pages to encode%s%s\n",
@@ -80,9 +81,7 @@ int run_shard(const BakeArgs& a, const vt::cli::GlobalOptions& global) {
   so.work_dir = a.work;
   so.build = a.options.build;
   if (!a.shard.empty() && !parse_shard(a.shard, so.index, so.count)) {
-    std::fprintf(stderr, "vtbake bake: --shard %s: expected I/N with 0 <= I < N\n",
-                 a.shard.c_str());
-    return vt::cli::kExitBadInput;
+    return vt::cli::bad_usage("bake", "--shard " + a.shard + ": expected I/N with 0 <= I < N");
   }
   so.tasks = a.tasks;
   auto s = vt::run_shard(so);
@@ -90,16 +89,15 @@ int run_shard(const BakeArgs& a, const vt::cli::GlobalOptions& global) {
   if (global.json) {
     nlohmann::json stages = nlohmann::json::object();
     for (const auto& st : s->stages) stages[st.name] = st.seconds;
-    std::printf("%s\n", nlohmann::json{{"part", s->part},
-                                       {"tasks", s->tasks},
-                                       {"pages", s->pages},
-                                       {"stored", s->stored},
-                                       {"constant", s->constant},
-                                       {"stored_bytes", s->stored_bytes},
-                                       {"seconds", stages},
-                                       {"total_seconds", s->seconds}}
-                            .dump(2)
-                            .c_str());
+    stages["total"] = s->seconds;
+    vt::cli::print_json(
+        "bake", vt::cli::kExitOk,
+        {{"input", a.work},
+         {"output", s->part},
+         {"tasks", s->tasks},
+         {"pages", {{"total", s->pages}, {"stored", s->stored}, {"constant", s->constant}}},
+         {"bytes", {{"stored", s->stored_bytes}}},
+         {"seconds", stages}});
     return vt::cli::kExitOk;
   }
   std::printf("shard %s: %zu tasks, %llu pages (%llu stored, %llu constant), %.2f s\n",
@@ -210,7 +208,17 @@ int run_batch(BakeArgs& a, const vt::cli::GlobalOptions& global) {
     items.push_back(std::move(it));
   }
   if (bad_input && !a.keep_going) {
-    std::fprintf(stderr, "vtbake bake: nothing baked (--keep-going bakes the other scenes)\n");
+    const char* message = "nothing baked (--keep-going bakes the other scenes)";
+    std::fprintf(stderr, "vtbake bake: %s\n", message);
+    if (global.json) {
+      nlohmann::json bad = nlohmann::json::array();
+      for (const Item& it : items)
+        if (!it.status.ok())
+          bad.push_back({{"input", it.scene}, {"error", vt::cli::error_json(it.status)}});
+      vt::cli::print_json(
+          "bake", vt::cli::kExitBadInput,
+          {{"error", {{"code", "invalid_argument"}, {"message", message}}}, {"scenes", bad}});
+    }
     return vt::cli::kExitBadInput;
   }
   std::error_code ec;
@@ -244,12 +252,10 @@ int run_batch(BakeArgs& a, const vt::cli::GlobalOptions& global) {
     if (!it.status.ok()) ++failed;
     if (global.json) {
       nlohmann::json j = it.status.ok() ? vt::to_json(it.summary) : nlohmann::json::object();
-      j["scene"] = it.scene;
+      j["input"] = it.scene;
       j["output"] = it.output;
-      j["status"] = it.status.ok() ? "ok" : "failed";
-      if (!it.status.ok()) j["error"] = it.status.message();
-      std::printf("%s\n", j.dump().c_str());
-      std::fflush(stdout);
+      if (!it.status.ok()) j["error"] = vt::cli::error_json(it.status);
+      vt::cli::print_json("bake", it.status.ok() ? 0 : vt::cli::exit_code_for(it.status), j);
     }
     if (!it.status.ok() && !a.keep_going) break;
   }
@@ -366,7 +372,9 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
     if (!summary.ok()) return vt::cli::report_error("bake", summary.status());
     for (const std::string& w : summary->warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     if (global.json) {
-      std::printf("%s\n", vt::to_json(*summary).dump(2).c_str());
+      nlohmann::json j = vt::to_json(*summary);
+      j["input"] = args->scene;
+      vt::cli::print_json("bake", vt::cli::kExitOk, j);
     } else {
       print_summary(*summary);
     }

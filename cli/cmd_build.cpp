@@ -12,6 +12,7 @@
 #include "cli/build_flags.h"
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/json_output.h"
 #include "cli/layer_error_text.h"
 #include "format/atomic_output.h"
 #include "samples/procedural.h"
@@ -118,13 +119,14 @@ int run_build(BuildArgs& f, const vt::cli::GlobalOptions& global) {
     uint32_t pw = 0, ph = 0;
     if (path.rfind("procedural:", 0) == 0) {
       if (vt::Status s = vt::cli::parse_procedural_size(path, &pw, &ph); !s.ok())
-        return bad(s.message());
+        return vt::cli::report_error("build", s);
       auto pattern =
           name == "normal" ? vt::ProceduralPattern::kNormal : vt::ProceduralPattern::kAlbedo;
       in.source = std::make_shared<vt::ProceduralImageSource>(pattern, pw, ph, 3, 1);
     } else {
       if (!vt::is_udim_pattern(path)) {
-        if (vt::Status s = vt::check_input_file(path); !s.ok()) return bad(s.message());
+        if (vt::Status s = vt::check_input_file(path); !s.ok())
+          return vt::cli::report_error("build", s);
       }
       auto src = vt::is_udim_pattern(path) ? vt::open_udim_image(path) : vt::open_image_file(path);
       if (!src.ok()) return vt::cli::report_error("build", src.status());
@@ -166,10 +168,10 @@ int run_build(BuildArgs& f, const vt::cli::GlobalOptions& global) {
   if (!summary.ok()) return vt::cli::report_error("build", summary.status());
   for (const std::string& w : summary->warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   if (global.json) {
-    nlohmann::json j = {{"output", o.output}};
-    j.update(vt::to_json(*summary));
-    j["wall_seconds"] = wall;
-    std::printf("%s\n", j.dump(2).c_str());
+    nlohmann::json j = vt::to_json(*summary);
+    j["output"] = o.output;
+    j["seconds"]["total"] = wall;
+    vt::cli::print_json("build", kExitOk, j);
   } else if (!global.quiet) {
     print_text(o, *summary, wall);
   }

@@ -6,9 +6,11 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cstdio>
+#include <filesystem>
 
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/json_output.h"
 #include "format/atomic_output.h"
 #include "format/page_file.h"
 #include "format/page_file_inspect.h"
@@ -60,9 +62,8 @@ vt::cli::CommandRunner make_extract(CLI::App& sub) {
     if (!reader.ok()) return vt::cli::report_error("extract", reader.status());
     auto image = vt::extract_level(**reader, opt->level, opt->layer);
     if (!image.ok()) return vt::cli::report_error("extract", image.status());
-    // Never through a FIFO or onto a device: OpenImageIO would block or replace it.
-    auto target = vt::resolve_output_path(opt->output);
-    if (!target.ok()) return vt::cli::report_error("extract", target.status());
+    // The writer is chosen by the final name; the texels go to a staging file beside it
+    // (never through a FIFO or onto a device, never truncated under the final name).
     auto out = OIIO::ImageOutput::create(opt->output);
     if (!out) {
       return vt::cli::bad_usage(
@@ -70,12 +71,30 @@ vt::cli::CommandRunner make_extract(CLI::App& sub) {
     }
     const OIIO::TypeDesc type = oiio_type(image->texel_type);
     const OIIO::ImageSpec spec = output_spec(*image, (*reader)->layers()[opt->layer]);
-    if (!out->open(*target, spec) || !out->write_image(type, image->texels.data()) ||
-        !out->close()) {
-      return vt::cli::report_error(
-          "extract", vt::Error(vt::ErrorCode::kIo, opt->output + ": " + out->geterror()));
-    }
-    if (!global.quiet)
+    vt::Status written = vt::write_output(opt->output, [&](const std::string& temp) -> vt::Status {
+      if (!out->open(temp, spec) || !out->write_image(type, image->texels.data()) ||
+          !out->close()) {
+        return vt::Error(vt::ErrorCode::kIo, opt->output + ": " + out->geterror());
+      }
+      return vt::Status::Ok();
+    });
+    if (!written.ok()) return vt::cli::report_error("extract", written);
+    if (global.json) {
+      std::error_code ec;
+      const auto bytes = std::filesystem::file_size(opt->output, ec);
+      vt::cli::print_json("extract", vt::cli::kExitOk,
+                          {{"input", opt->path},
+                           {"output", opt->output},
+                           {"level", opt->level},
+                           {"layer", opt->layer},
+                           {"width", image->width},
+                           {"height", image->height},
+                           {"channels", image->channels},
+                           {"pages",
+                            {{"filled_from_ancestor", image->filled_from_ancestor},
+                             {"filled_with_zero", image->filled_with_zero}}},
+                           {"bytes", {{"file", ec ? 0 : bytes}}}});
+    } else if (!global.quiet)
       std::printf(
           "%s: level %u layer %u, %u x %u texels, %u channels (%llu absent pages filled "
           "from a coarser level, %llu left zero)\n",

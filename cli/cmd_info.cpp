@@ -5,6 +5,7 @@
 
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/json_output.h"
 #include "format/page_file.h"
 #include "format/page_file_inspect.h"
 
@@ -13,9 +14,8 @@ namespace {
 nlohmann::json info_json(const vt::PageFileReader& r, const vt::PageFileStats& stats) {
   const vt::PageGeometry& g = r.geometry();
   nlohmann::json j;
-  j["file"] = r.path();
+  j["input"] = r.path();
   j["version"] = r.version();
-  j["file_size"] = r.file_size();
   j["width"] = g.width;
   j["height"] = g.height;
   j["payload"] = g.payload;
@@ -43,14 +43,22 @@ nlohmann::json info_json(const vt::PageFileReader& r, const vt::PageFileStats& s
                            {"height", g.level_height(s.level)},
                            {"pages_x", s.pages_x},
                            {"pages_y", s.pages_y},
-                           {"stored_pages", s.stored_pages},
-                           {"constant_pages", s.constant_pages},
-                           {"absent_pages", s.absent_pages},
+                           {"stored", s.stored_pages},
+                           {"constant", s.constant_pages},
+                           {"absent", s.absent_pages},
                            {"bytes", s.bytes},
-                           {"raw_bytes", s.raw_bytes}});
-  j["stored_bytes"] = stats.stored_bytes;
-  j["raw_bytes"] = stats.raw_bytes;
-  j["compression_ratio"] = stats.compression_ratio;
+                           {"pages_raw", s.raw_bytes}});
+  uint64_t stored = 0, constant = 0, absent = 0;
+  for (const vt::LevelStats& s : stats.levels)
+    stored += s.stored_pages, constant += s.constant_pages, absent += s.absent_pages;
+  j["pages"] = {{"total", stored + constant + absent},
+                {"stored", stored},
+                {"constant", constant},
+                {"absent", absent}};
+  j["bytes"] = {{"file", r.file_size()},
+                {"stored", stats.stored_bytes},
+                {"pages_raw", stats.raw_bytes},
+                {"pages_ratio", stats.compression_ratio}};
   // Metadata is JSON by contract; a file whose metadata does not parse still gets described.
   auto meta = nlohmann::json::parse(r.metadata_json(), nullptr, /*allow_exceptions=*/false);
   j["metadata"] = meta.is_discarded() ? nlohmann::json(r.metadata_json()) : meta;
@@ -95,7 +103,7 @@ vt::cli::CommandRunner make_info(CLI::App& sub) {
     if (!reader.ok()) return vt::cli::report_error("info", reader.status());
     const vt::PageFileStats stats = vt::page_file_stats(**reader);
     if (global.json)
-      std::printf("%s\n", info_json(**reader, stats).dump().c_str());
+      vt::cli::print_json("info", vt::cli::kExitOk, info_json(**reader, stats));
     else
       print_text(**reader, stats);
     return int(vt::cli::kExitOk);

@@ -10,6 +10,7 @@
 #include "bake/shard.h"
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/json_output.h"
 
 namespace {
 
@@ -34,7 +35,8 @@ vt::cli::CommandRunner make_merge(CLI::App& app) {
       auto m = vt::missing_shards(args->options.work_dir, args->missing);
       if (!m.ok()) return vt::cli::report_error("merge", m.status());
       if (global.json) {
-        std::printf("%s\n", nlohmann::json{{"missing", *m}}.dump().c_str());
+        vt::cli::print_json("merge", vt::cli::kExitOk,
+                            {{"input", args->options.work_dir}, {"missing", *m}});
       } else {
         for (uint32_t i : *m) std::printf("%u\n", i);
       }
@@ -43,18 +45,18 @@ vt::cli::CommandRunner make_merge(CLI::App& app) {
     auto s = vt::merge_shards(args->options);
     if (!s.ok()) return vt::cli::report_error("merge", s.status());
     if (global.json) {
-      std::printf("%s\n", nlohmann::json{{"output", s->output},
-                                         {"unwrapped", s->unwrapped},
-                                         {"parts", s->parts},
-                                         {"pages", s->pages},
-                                         {"stored", s->stored},
-                                         {"constant", s->constant},
-                                         {"absent", s->absent},
-                                         {"stored_bytes", s->stored_bytes},
-                                         {"file_bytes", s->file_bytes},
-                                         {"total_seconds", s->seconds}}
-                              .dump(2)
-                              .c_str());
+      vt::cli::print_json("merge", vt::cli::kExitOk,
+                          {{"input", args->options.work_dir},
+                           {"output", s->output},
+                           {"unwrapped", s->unwrapped},
+                           {"parts", s->parts},
+                           {"pages",
+                            {{"total", s->pages},
+                             {"stored", s->stored},
+                             {"constant", s->constant},
+                             {"absent", s->absent}}},
+                           {"bytes", {{"file", s->file_bytes}, {"stored", s->stored_bytes}}},
+                           {"seconds", {{"total", s->seconds}}}});
       return vt::cli::kExitOk;
     }
     std::printf("merged %s from %zu parts (unwrapped scene: %s)\n", s->output.c_str(),

@@ -6,6 +6,7 @@
 
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/json_output.h"
 #include "samples/procedural.h"
 
 namespace {
@@ -29,6 +30,7 @@ int run_sample(const SampleFlags& f, const vt::cli::GlobalOptions& global) {
     const char* file;
     vt::ProceduralPattern pattern;
   };
+  std::vector<std::string> outputs;
   for (const Item& item : {Item{"albedo", vt::ProceduralPattern::kAlbedo},
                            Item{"normal", vt::ProceduralPattern::kNormal}}) {
     if (f.albedo_only && item.pattern != vt::ProceduralPattern::kAlbedo) continue;
@@ -40,7 +42,12 @@ int run_sample(const SampleFlags& f, const vt::cli::GlobalOptions& global) {
     if (!global.quiet && !global.json) {
       std::printf("%s: %u x %u\n", path.c_str(), f.width, f.height);
     }
+    outputs.push_back(path);
   }
+  if (global.json)
+    vt::cli::print_json(
+        "sample", vt::cli::kExitOk,
+        {{"output", f.dir}, {"outputs", outputs}, {"width", f.width}, {"height", f.height}});
   return vt::cli::kExitOk;
 }
 

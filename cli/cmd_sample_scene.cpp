@@ -4,6 +4,7 @@
 
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/json_output.h"
 #include "samples/sample_scene.h"
 
 namespace {
@@ -23,7 +24,7 @@ vt::cli::CommandRunner make_sample_scene(CLI::App& app) {
     vt::Status s = vt::write_sample_scene(*dir, *opt);
     if (!s.ok()) return vt::cli::report_error("sample-scene", s);
     if (global.json) {
-      std::printf("{\"scene\":\"%s/scene.gltf\"}\n", dir->c_str());
+      vt::cli::print_json("sample-scene", vt::cli::kExitOk, {{"output", *dir + "/scene.gltf"}});
     } else if (!global.quiet) {
       std::printf("wrote %s/scene.gltf\n", dir->c_str());
     }

@@ -2,13 +2,13 @@
 // unwrap report (JSON) and a picture of the atlas (PNG) beside the output.
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <string>
 #include <thread>
 
 #include "bake/unwrap/unwrap.h"
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/json_output.h"
 #include "cli/scene_load_flags.h"
 #include "cli/unwrap_flags.h"
 #include "format/atomic_output.h"
@@ -61,12 +61,19 @@ vt::cli::CommandRunner make_unwrap(CLI::App& sub) {
     vt::Status st = vt::unwrap::save_unwrapped_glb(*result, a.output);
     if (!st.ok()) return vt::cli::report_error("unwrap", st);
     std::string report = vt::unwrap::report_json(result->stats);
-    std::ofstream(a.report) << report << "\n";
+    st = vt::write_output_bytes(a.report, report + "\n");
+    if (!st.ok()) return vt::cli::report_error("unwrap", st);
     st = vt::unwrap::write_atlas_picture(*result, a.picture);
     if (!st.ok()) std::fprintf(stderr, "vtbake unwrap: warning: %s\n", st.message().c_str());
     const auto& s = result->stats;
+    bool valid = s.flipped_triangles == 0 && s.overlapping_triangles == 0 &&
+                 s.overlapping_texels == 0 && s.unmapped_faces == 0;
     if (global.json) {
-      std::printf("%s\n", report.c_str());
+      nlohmann::json j = nlohmann::json::parse(report);
+      j["input"] = a.input;
+      j["output"] = a.output;
+      j["outputs"] = {a.output, a.report, a.picture};
+      vt::cli::print_json("unwrap", valid ? vt::cli::kExitOk : vt::cli::kExitFailure, j);
     } else if (!global.quiet) {
       std::printf(
           "%s: %lld faces, %lld charts, atlas %dx%d (%dx%d pages), %.3f texels/unit\n"
@@ -81,8 +88,6 @@ vt::cli::CommandRunner make_unwrap(CLI::App& sub) {
           static_cast<long long>(s.overlapping_texels), s.seconds.segment, s.seconds.parameterize,
           s.seconds.pack, s.seconds.output, s.seconds.check, a.report.c_str(), a.picture.c_str());
     }
-    bool valid = s.flipped_triangles == 0 && s.overlapping_triangles == 0 &&
-                 s.overlapping_texels == 0 && s.unmapped_faces == 0;
     return valid ? vt::cli::kExitOk : vt::cli::kExitFailure;
   };
 }

@@ -8,6 +8,7 @@
 
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/json_output.h"
 #include "cli/scene_load_flags.h"
 #include "render/report.h"
 #include "render/validate.h"
@@ -82,7 +83,10 @@ int run(ValidateArgs& a, const vt::cli::GlobalOptions& global) {
   auto report = vt::render::validate_bake(o);
   if (!report.ok()) return vt::cli::report_error("validate", report.status());
   if (global.json) {
-    std::printf("%s\n", vt::render::report_json(*report).c_str());
+    nlohmann::json j = nlohmann::json::parse(vt::render::report_json(*report));
+    j["input"] = o.page_file;
+    j["output"] = report->out_dir;
+    vt::cli::print_json("validate", report->passed() ? vt::cli::kExitOk : vt::cli::kExitFailure, j);
   } else if (!global.quiet) {
     print_text(*report);
   }

@@ -5,6 +5,7 @@
 
 #include "cli/cli_util.h"
 #include "cli/command.h"
+#include "cli/json_output.h"
 #include "format/page_file.h"
 #include "format/page_file_inspect.h"
 
@@ -16,13 +17,7 @@ vt::cli::CommandRunner make_verify(CLI::App& sub) {
   return [path](const vt::cli::GlobalOptions& global) {
     // Opening checks the header, index and metadata checksums and every offset and size.
     auto reader = vt::PageFileReader::open(*path);
-    if (!reader.ok()) {
-      if (global.json) {
-        nlohmann::json j = {{"file", *path}, {"ok", false}, {"error", reader.status().message()}};
-        std::printf("%s\n", j.dump().c_str());
-      }
-      return vt::cli::report_error("verify", reader.status());
-    }
+    if (!reader.ok()) return vt::cli::report_error("verify", reader.status());
     const vt::VerifyReport report = vt::verify_pages(**reader, global.threads);
     const bool ok = report.bad_pages.empty();
     if (global.json) {
@@ -33,9 +28,11 @@ vt::cli::CommandRunner make_verify(CLI::App& sub) {
                        {"y", b.id.y},
                        {"layer", b.layer},
                        {"error", b.status.message()}});
-      nlohmann::json j = {
-          {"file", *path}, {"ok", ok}, {"pages_checked", report.pages_checked}, {"bad_pages", bad}};
-      std::printf("%s\n", j.dump().c_str());
+      vt::cli::print_json(
+          "verify", ok ? vt::cli::kExitOk : vt::cli::kExitFailure,
+          {{"input", *path},
+           {"pages", {{"checked", report.pages_checked}, {"bad", report.bad_pages.size()}}},
+           {"bad_pages", bad}});
     } else {
       for (const vt::BadPage& b : report.bad_pages)
         std::fprintf(stderr, "vtbake verify: %s\n", b.status.message().c_str());

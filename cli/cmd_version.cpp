@@ -2,13 +2,14 @@
 #include <cstdio>
 
 #include "cli/command.h"
+#include "cli/json_output.h"
 
 namespace {
 
 vt::cli::CommandRunner make_version(CLI::App&) {
   return [](const vt::cli::GlobalOptions& global) {
     if (global.json) {
-      std::printf("{\"version\":\"%s\"}\n", VTBAKE_VERSION);
+      vt::cli::print_json("version", vt::cli::kExitOk, {{"version", VTBAKE_VERSION}});
     } else {
       std::printf("vtbake %s\n", VTBAKE_VERSION);
     }

@@ -3,8 +3,10 @@
 #include <cstdio>
 #include <exception>
 #include <map>
+#include <string_view>
 
 #include "cli/command.h"
+#include "cli/json_output.h"
 
 namespace vt::cli {
 
@@ -27,7 +29,7 @@ int main(int argc, char** argv) {
       " - offline virtual-texture baking: scenes and images into tiled page files (.vtpf)"};
   app.footer(
       "Exit status: 0 the work succeeded; 1 the work ran and failed (a write, a memory limit, a "
-      "bad page, a threshold missed); 2 bad usage or bad input (docs/REPORTS.md).\n"
+      "bad page, a threshold missed); 2 bad usage or bad input (docs/JSON.md).\n"
       "Outputs (-o): written under a temporary name beside the target and renamed into place "
       "when complete; a symlink at the path is written through (its target is replaced in the "
       "target's folder, the link stays); a directory, device, FIFO or socket there is refused "
@@ -55,9 +57,21 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    int code = app.exit(e);
-    return code == 0 ? kExitOk : kExitBadInput;
+    const int code = app.exit(e) == 0 ? kExitOk : kExitBadInput;
+    // --json was not parsed, but a pipeline that asked for it still gets its error object.
+    if (code != kExitOk && std::any_of(argv + 1, argv + argc, [](const char* a) {
+          return std::string_view(a) == "--json";
+        })) {
+      const auto named = std::find_if(argv + 1, argv + argc, [&](const char* a) {
+        return std::any_of(commands.begin(), commands.end(),
+                           [&](const auto& c) { return c.name == a; });
+      });
+      print_json_error(named == argv + argc ? "vtbake" : *named, code,
+                       {{"code", "usage"}, {"message", e.what()}});
+    }
+    return code;
   }
+  set_json_output(global.json);
 
   for (CLI::App* sub : app.get_subcommands()) {
     auto it = runners.find(sub);
@@ -66,6 +80,9 @@ int main(int argc, char** argv) {
       return it->second(global);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "vtbake %s: internal error: %s\n", sub->get_name().c_str(), e.what());
+      if (global.json)
+        print_json_error(sub->get_name().c_str(), kExitFailure,
+                         {{"code", "internal"}, {"message", e.what()}});
       return kExitFailure;
     }
   }

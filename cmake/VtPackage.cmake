@@ -148,7 +148,7 @@ function(vt_install_package)
           COMPONENT runtime OPTIONAL)
   if(TARGET vtbake)
     vt_install_tools()
-    install(FILES docs/REPORTS.md docs/ARCHITECTURE.md DESTINATION ${CMAKE_INSTALL_DOCDIR}
+    install(FILES docs/JSON.md docs/ARCHITECTURE.md DESTINATION ${CMAKE_INSTALL_DOCDIR}
             COMPONENT tools OPTIONAL)
   endif()
 endfunction()

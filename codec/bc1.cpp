@@ -294,14 +294,17 @@ VT_BC1_CLONES
 void encode_realtime_lanes(const uint32_t (&texels)[16][kLanes], uint16_t c0_out[kLanes],
                            uint16_t c1_out[kLanes], uint32_t bits_out[kLanes],
                            bool constant_out[kLanes]) {
-  float r[16][kLanes], g[16][kLanes], b[16][kLanes], xx[16][kLanes];
+  float r[16][kLanes], g[16][kLanes], b[16][kLanes];
+  int32_t xx[16][kLanes];  // |x|^2 - 3 * 255^2 (select's bias), exact
   for (int i = 0; i < 16; ++i) {
     for (int l = 0; l < kLanes; ++l) {
       const uint32_t w = texels[i][l];
       r[i][l] = float(int(w & 255u));
       g[i][l] = float(int((w >> 8) & 255u));
       b[i][l] = float(int((w >> 16) & 255u));
-      xx[i][l] = r[i][l] * r[i][l] + g[i][l] * g[i][l] + b[i][l] * b[i][l];
+      const int32_t ri = int32_t(w & 255u), gi = int32_t((w >> 8) & 255u),
+                    bi = int32_t((w >> 16) & 255u);
+      xx[i][l] = ri * ri + gi * gi + bi * bi - 3 * 255 * 255;
     }
   }
   float mr[kLanes], mg[kLanes], mb[kLanes];
@@ -366,9 +369,12 @@ void encode_realtime_lanes(const uint32_t (&texels)[16][kLanes], uint16_t c0_out
   // Endpoints as 565 levels (floats holding integers), decoded palette, indices, error. Every
   // value truncated below is non-negative, so int conversion is floor (and vectorises).
   float q0[3][kLanes], q1[3][kLanes];
+  // The clamp as std::min(std::max(x, 0), 255) computes it (NaN passes through), on values so
+  // that the loops if-convert into SIMD (with codec/CMakeLists.txt's flags for this file).
   auto quantise_lanes = [](float x, float levels) {
-    const float q = float(int(std::min(std::max(x, 0.0f), 255.0f) * (levels / 255.0f) + 0.5f));
-    return q;
+    const float lo = x < 0.0f ? 0.0f : x;
+    const float c = 255.0f < lo ? 255.0f : lo;
+    return float(int(c * (levels / 255.0f) + 0.5f));
   };
   for (int l = 0; l < kLanes; ++l) {
     const float inset = (tmax[l] - tmin[l]) * (1.0f / 16.0f);
@@ -414,7 +420,11 @@ void encode_realtime_lanes(const uint32_t (&texels)[16][kLanes], uint16_t c0_out
         for (int ch = 0; ch < 3; ++ch) m8[k][ch][l] = -8.0f * p[k][ch][l];
       }
     }
-    for (int l = 0; l < kLanes; ++l) e[l] = 0, out[l] = 0;
+    // Each texel's error |x - p|^2 is an integer and the block's sum stays below 2^24, so the
+    // sum is exact in any order and type: it accumulates in int32 (one-cycle adds, no
+    // conversion; a float chain here was the kernel's longest latency) and converts once.
+    int32_t ei[kLanes];
+    for (int l = 0; l < kLanes; ++l) ei[l] = 0, out[l] = 0;
     for (int i = 0; i < 16; ++i) {
       float best[kLanes];
       for (int l = 0; l < kLanes; ++l) {
@@ -430,9 +440,10 @@ void encode_realtime_lanes(const uint32_t (&texels)[16][kLanes], uint16_t c0_out
       for (int l = 0; l < kLanes; ++l) {
         const int s = int(best[l]);
         out[l] |= uint32_t(s & 3) << (2 * i);
-        e[l] += float(s >> 2) + (xx[i][l] - kBias);
+        ei[l] += (s >> 2) + xx[i][l];
       }
     }
+    for (int l = 0; l < kLanes; ++l) e[l] = float(ei[l]);
   };
   select(q0, q1, idx, err);
 
@@ -567,6 +578,104 @@ void bc1_encode_block(const uint8_t rgba[64], BcQuality quality, uint8_t out[8],
   emit(best, out);
 }
 
+namespace {
+
+// encode_single_colour's bytes without its Candidate: every index 2 (3 once the endpoints swap,
+// 0 when they are equal), as emit() orders them.
+inline void single_colour_block(int r, int g, int b, uint8_t* dst) {
+  const SingleColourTables& t = single_colour_tables();
+  uint16_t c0 = pack565(t.e5[r][0], t.e6[g][0], t.e5[b][0]);
+  uint16_t c1 = pack565(t.e5[r][1], t.e6[g][1], t.e5[b][1]);
+  uint32_t bits = c0 == c1 ? 0u : c0 < c1 ? 0xFFFFFFFFu : 0xAAAAAAAAu;
+  if (c0 < c1) std::swap(c0, c1);
+  dst[0] = uint8_t(c0), dst[1] = uint8_t(c0 >> 8);
+  dst[2] = uint8_t(c1), dst[3] = uint8_t(c1 >> 8);
+  for (int i = 0; i < 4; ++i) dst[4 + i] = uint8_t(bits >> (8 * i));
+}
+
+// Runs the kernel on lanes gathered by the caller and writes the first n blocks.
+inline void finish_lanes(const uint32_t (&texels)[16][kLanes], size_t n, uint8_t* out,
+                         size_t out_stride) {
+  uint16_t c0[kLanes], c1[kLanes];
+  uint32_t bits[kLanes];
+  bool constant[kLanes];
+  encode_realtime_lanes(texels, c0, c1, bits, constant);
+  for (size_t l = 0; l < n; ++l) {
+    uint8_t* dst = out + l * out_stride;
+    if (constant[l]) {
+      const uint32_t w = texels[0][l];
+      single_colour_block(int(w & 255u), int((w >> 8) & 255u), int((w >> 16) & 255u), dst);
+      continue;
+    }
+    dst[0] = uint8_t(c0[l]), dst[1] = uint8_t(c0[l] >> 8);
+    dst[2] = uint8_t(c1[l]), dst[3] = uint8_t(c1[l] >> 8);
+    for (int i = 0; i < 4; ++i) dst[4 + i] = uint8_t(bits[l] >> (8 * i));
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// Lanes of `n` (1..kLanes) blocks side by side from image rows (R in the low byte, missing colour
+// channels 0); idle lanes repeat the last block. `last_in_row`: the last lane's block ends its
+// image row, so its last texel may not be read as a 4-byte word (3 channels: the image may end
+// there).
+template <int kChannels>
+inline void gather_lanes(const uint8_t* texels, size_t row_stride, size_t n, bool last_in_row,
+                         uint32_t (&lanes)[16][kLanes]) {
+  for (int y = 0; y < 4; ++y) {
+    const uint8_t* row = texels + size_t(y) * row_stride;
+    for (size_t l = 0; l < size_t(kLanes); ++l) {
+      const size_t blk = std::min(l, n - 1);
+      const uint8_t* src = row + blk * 4 * kChannels;
+      for (int x = 0; x < 4; ++x) {
+        const uint8_t* t = src + x * kChannels;
+        uint32_t w;
+        if constexpr (kChannels >= 3 && std::endian::native == std::endian::little) {
+          if (kChannels == 4 || x < 3 || !last_in_row || blk + 1 < n) {
+            std::memcpy(&w, t, 4);  // one load; the kernel reads only the low three bytes
+          } else {
+            w = uint32_t(t[0]) | (uint32_t(t[1]) << 8) | (uint32_t(t[2]) << 16);
+          }
+        } else {
+          w = t[0];
+          if constexpr (kChannels > 1) w |= uint32_t(t[1]) << 8;
+          if constexpr (kChannels > 2) w |= uint32_t(t[2]) << 16;
+        }
+        lanes[4 * y + x][l] = w;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void bc1_encode_rows_realtime(const uint8_t* texels, size_t row_stride, int channels, size_t count,
+                              uint8_t* out) {
+  alignas(64) uint32_t lanes[16][kLanes];
+  for (size_t first = 0; first < count; first += kLanes) {
+    const size_t n = std::min<size_t>(kLanes, count - first);
+    const bool last = first + n == count;
+    const uint8_t* src = texels + first * 4 * size_t(channels);
+    switch (channels) {
+      case 1:
+        gather_lanes<1>(src, row_stride, n, last, lanes);
+        break;
+      case 2:
+        gather_lanes<2>(src, row_stride, n, last, lanes);
+        break;
+      case 3:
+        gather_lanes<3>(src, row_stride, n, last, lanes);
+        break;
+      default:
+        gather_lanes<4>(src, row_stride, n, last, lanes);
+        break;
+    }
+    finish_lanes(lanes, n, out + first * 8, 8);
+  }
+}
+
 void bc1_encode_blocks_realtime(const uint8_t* rgba, size_t count, uint8_t* out,
                                 size_t out_stride) {
   uint32_t texels[16][kLanes];
@@ -586,21 +695,7 @@ void bc1_encode_blocks_realtime(const uint8_t* rgba, size_t count, uint8_t* out,
         }
       }
     }
-    uint16_t c0[kLanes], c1[kLanes];
-    uint32_t bits[kLanes];
-    bool constant[kLanes];
-    encode_realtime_lanes(texels, c0, c1, bits, constant);
-    for (size_t l = 0; l < n; ++l) {
-      const uint8_t* px = rgba + (first + l) * 64;
-      uint8_t* dst = out + (first + l) * out_stride;
-      if (constant[l]) {
-        encode_single_colour(px[0], px[1], px[2], dst);
-        continue;
-      }
-      dst[0] = uint8_t(c0[l]), dst[1] = uint8_t(c0[l] >> 8);
-      dst[2] = uint8_t(c1[l]), dst[3] = uint8_t(c1[l] >> 8);
-      for (int i = 0; i < 4; ++i) dst[4 + i] = uint8_t(bits[l] >> (8 * i));
-    }
+    finish_lanes(texels, n, out + first * out_stride, out_stride);
   }
 }
 

@@ -27,6 +27,12 @@ void bc1_encode_block(const uint8_t rgba[64], BcQuality quality, uint8_t out[8],
 // BC1, 16 with offset 8 for BC3 colour halves). Always 4-colour; the same bytes as
 // bc1_encode_block(..., kRealtime, ...) block by block, on every machine.
 void bc1_encode_blocks_realtime(const uint8_t* rgba, size_t count, uint8_t* out, size_t out_stride);
+// The same for `count` blocks side by side in an image row of blocks: `texels` points at the
+// first block's top-left texel, rows `row_stride` bytes apart, `channels` (1..4) interleaved 8-bit
+// channels (missing colour channels read as 0); block i goes to out + 8 * i. The same bytes as
+// gathering the blocks as RGBA for bc1_encode_blocks_realtime, without the copy.
+void bc1_encode_rows_realtime(const uint8_t* texels, size_t row_stride, int channels, size_t count,
+                              uint8_t* out);
 
 // Decodes one block into 16 RGBA texels. `force_four_colour` decodes as the colour half of a
 // BC3 block does (always 4-colour, whatever the endpoint order).

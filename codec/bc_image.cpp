@@ -81,6 +81,14 @@ Status bc_encode_image(BcFormat format, BcQuality quality, const uint8_t* texels
   const size_t block_bytes = bc_block_bytes(format);
   const size_t row_stride = size_t(width) * size_t(channels);
   const int blocks_x = width / 4;
+  if (quality == BcQuality::kRealtime && format == BcFormat::kBc1) {
+    // The runtime transcode's hot path: the kernel gathers straight from the rows.
+    for (int by = 0; by < height / 4; ++by) {
+      bc1_encode_rows_realtime(texels + size_t(by) * 4 * row_stride, row_stride, channels,
+                               size_t(blocks_x), out + size_t(by) * size_t(blocks_x) * block_bytes);
+    }
+    return Status::Ok();
+  }
   std::vector<uint8_t> row(size_t(blocks_x) * 64);
   for (int by = 0; by < height / 4; ++by) {
     // Gather one row of blocks as RGBA.

@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
@@ -280,6 +281,70 @@ Status OutputSet::commit() {
   drop_backups();
   for (const Staged& s : staged_) sync_dir(dir_of(s.target));
   return Status::Ok();
+}
+
+Status write_output(const std::string& path,
+                    const std::function<Status(const std::string& temp)>& write) {
+  OutputSet outputs;
+  VT_ASSIGN_OR_RETURN(std::string temp, outputs.stage(path));
+  VT_RETURN_IF_ERROR(write(temp));
+  return outputs.commit();
+}
+
+Status write_output_bytes(const std::string& path, std::string_view bytes) {
+  return write_output(path, [&](const std::string& temp) -> Status {
+    const int fd = ::open(temp.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
+    if (fd < 0) return Error(ErrorCode::kIo, path + ": cannot open for writing: " + errno_text());
+    size_t done = 0;
+    while (done < bytes.size()) {
+      const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        const std::string err = errno_text();
+        ::close(fd);
+        return Error(ErrorCode::kIo, path + ": write failed: " + err);
+      }
+      done += size_t(n);
+    }
+    if (::close(fd) != 0) return Error(ErrorCode::kIo, path + ": write failed: " + errno_text());
+    return Status::Ok();
+  });
+}
+
+Expected<std::vector<std::string>> sweep_stale_staging_in(const std::string& dir) {
+  DIR* d = ::opendir(dir.c_str());
+  if (!d) {
+    const ErrorCode code = errno == ENOENT ? ErrorCode::kNotFound : ErrorCode::kIo;
+    return Error(code, dir + ": cannot read the folder: " + errno_text());
+  }
+  // The targets: every name with its first staging suffix cut off.
+  std::vector<std::string> before, targets;
+  while (const dirent* e = ::readdir(d)) {
+    const std::string_view name = e->d_name;
+    for (size_t at = name.find(".tmp-"), old = name.find(".old-");
+         at != std::string_view::npos || old != std::string_view::npos;) {
+      const size_t cut = std::min(at, old);
+      StagingOwner owner;
+      size_t pos = cut;
+      // Every cut that parses is a candidate (a target's own name may hold ".tmp-"); the
+      // sweep of each decides by the whole name.
+      if (cut > 0 && parse_staging_suffix(name, pos, owner))
+        targets.push_back(dir + "/" + std::string(name.substr(0, cut)));
+      at = name.find(".tmp-", cut + 1), old = name.find(".old-", cut + 1);
+    }
+    before.push_back(std::string(name));
+  }
+  ::closedir(d);
+  std::sort(targets.begin(), targets.end());
+  targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
+  for (const std::string& t : targets) sweep_stale_staging(t);
+  std::vector<std::string> removed;
+  for (const std::string& name : before) {
+    struct stat st;
+    const std::string path = dir + "/" + name;
+    if (name != "." && name != ".." && ::lstat(path.c_str(), &st) != 0) removed.push_back(path);
+  }
+  return removed;
 }
 
 }  // namespace vt

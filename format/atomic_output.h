@@ -5,7 +5,9 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "common/status.h"
@@ -45,6 +47,10 @@ Expected<StagingFile> create_staging_file(const std::string& target, const char*
 constexpr int64_t kStaleStagingSeconds = 24 * 3600;
 int sweep_stale_staging(const std::string& target);
 
+// sweep_stale_staging for every target in `dir` (not below it): `vtbake clean DIR`. Returns
+// the paths removed; kNotFound/kIo when the folder cannot be read.
+Expected<std::vector<std::string>> sweep_stale_staging_in(const std::string& dir);
+
 // Outputs staged under temporary names beside their final targets and renamed into place
 // together by commit(): both or neither for an error anywhere before or during commit. What
 // stays: a kill in the few microseconds between two renames of commit() leaves the first
@@ -74,5 +80,14 @@ class OutputSet {
   std::vector<Staged> staged_;
   bool committed_ = false;
 };
+
+// The one way a single output file is written: `write` fills the temporary path it is given
+// (beside the target, OutputSet::stage); when it succeeds the file is synced and renamed over
+// `path`, else the temporary is removed and `path` keeps what it had. A full disk or a kill
+// never leaves a truncated file under the final name.
+Status write_output(const std::string& path,
+                    const std::function<Status(const std::string& temp)>& write);
+// write_output of `bytes`, every write checked.
+Status write_output_bytes(const std::string& path, std::string_view bytes);
 
 }  // namespace vt

@@ -116,7 +116,7 @@ Expected<AtlasCheckReport> check_atlas_pages(std::shared_ptr<const PageFileReade
 Status uploaded_texels(const PageSource& source, const LayerSpec& spec, const PageId& id,
                        uint32_t layer, std::vector<uint8_t>& upload, uint8_t* out);
 
-// The report as report.json's "atlas" object (docs/REPORTS.md).
+// The report as report.json's "atlas" object (docs/JSON.md).
 nlohmann::json to_json(const AtlasCheckReport& report);
 
 }  // namespace vt::render

@@ -9,9 +9,8 @@ namespace vt::render {
 
 Expected<FloatImage> load_float_image(const scene::Image& image) {
   OIIO::Filesystem::IOMemReader mem(image.bytes.data(), image.bytes.size());
-  const std::string name = image.embedded()
-                               ? (image.mime_type == "image/jpeg" ? "embedded.jpg" : "embedded.png")
-                               : image.path;
+  const std::string name =
+      image.embedded() ? std::string("embedded") + image.embedded_extension() : image.path;
   std::unique_ptr<OIIO::ImageInput> in =
       image.embedded() ? OIIO::ImageInput::open(name, nullptr, &mem) : OIIO::ImageInput::open(name);
   if (!in) {

@@ -3,8 +3,9 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
-#include <fstream>
 #include <nlohmann/json.hpp>
+
+#include "format/atomic_output.h"
 
 namespace vt::render {
 
@@ -66,11 +67,13 @@ Status write_png(const std::string& path, const Rgba8Image& image) {
   // zlib level 1: a third of the default's encode time for ~10% more bytes; validate writes
   // four 1280x720 images per view (docs/BENCHMARKS.md).
   spec.attribute("png:compressionLevel", 1);
-  if (!out->open(path, spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) ||
-      !out->close()) {
-    return Error(ErrorCode::kIo, path + ": " + out->geterror());
-  }
-  return Status::Ok();
+  return write_output(path, [&](const std::string& temp) -> Status {
+    if (!out->open(temp, spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) ||
+        !out->close()) {
+      return Error(ErrorCode::kIo, path + ": " + out->geterror());
+    }
+    return Status::Ok();
+  });
 }
 
 Expected<Rgba8Image> read_png(const std::string& path) {
@@ -224,12 +227,7 @@ std::string report_json(const ValidationReport& r) {
 }
 
 Status write_report_json(const std::string& path, const ValidationReport& r) {
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  if (!f) return Error(ErrorCode::kIo, path + ": cannot open for writing");
-  f << report_json(r) << '\n';
-  f.close();
-  if (!f) return Error(ErrorCode::kIo, path + ": write failed");
-  return Status::Ok();
+  return write_output_bytes(path, report_json(r) + "\n");
 }
 
 }  // namespace vt::render

@@ -29,7 +29,7 @@ Expected<Rgba8Image> read_png(const std::string& path);
 // (level, x, y). Empty when it passed.
 std::vector<std::string> failure_lines(const ValidationReport& report);
 
-// The report as JSON (docs/REPORTS.md): what report.json holds and `vtbake validate --json` prints.
+// The report as JSON (docs/JSON.md): what report.json holds and `vtbake validate --json` prints.
 std::string report_json(const ValidationReport& report);
 Status write_report_json(const std::string& path, const ValidationReport& report);
 

@@ -123,7 +123,7 @@ Expected<StreamingCheckReport> run_streaming_check(Renderer& renderer, const Pag
                                                    std::span<const VirtualFrame> frames,
                                                    const StreamingCheckOptions& options);
 
-// The report as report.json's "exact" object (docs/REPORTS.md).
+// The report as report.json's "exact" object (docs/JSON.md).
 nlohmann::json to_json(const StreamingCheckReport& report);
 
 }  // namespace vt::render

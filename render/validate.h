@@ -114,7 +114,7 @@ struct LitViewReport {
   std::optional<EmissiveMetrics> emissive;  // with an emissive layer (emissive_check.h)
   double emissive_ms = 0;                   // both emissive-only passes
 };
-// A view's "lit" object in report.json (docs/REPORTS.md).
+// A view's "lit" object in report.json (docs/JSON.md).
 nlohmann::json to_json(const LitViewReport& lit);
 
 struct ViewReport {

@@ -3,9 +3,9 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 
 #include "bake/image_source.h"
+#include "format/atomic_output.h"
 #include "scene/gltf_export.h"
 
 namespace vt {
@@ -387,9 +387,7 @@ Status write_sample_scene(const std::string& dir, const SampleSceneOptions& o) {
   // 52 x 53 pages (the bricks' 427 texels per unit); 16 keeps the main job within its few
   // minutes and its output as it always was.
   const std::string density = (fs::path(dir) / "scene.density.json").string();
-  std::ofstream(density) << "{\"size_pages\": 16}\n";
-  if (!fs::exists(density, ec)) return Error(ErrorCode::kIo, density + ": cannot write");
-  return Status::Ok();
+  return write_output_bytes(density, "{\"size_pages\": 16}\n");
 }
 
 }  // namespace vt

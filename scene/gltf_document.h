@@ -17,6 +17,13 @@
 
 namespace vt::scene::detail {
 
+// The asset.version of a glTF document as text ("" when absent): 1.0 files often write it as a
+// number.
+std::string gltf_version_text(const nlohmann::json& doc);
+// glTF 1.0 or a 0.x draft: top-level collections in objects keyed by id (2.0 uses arrays), or
+// an asset.version of 1.x or 0.x. The own importer reads 2.0 only; assimp reads 1.0.
+bool is_gltf1_document(const nlohmann::json& doc);
+
 struct Gltf {
   std::string path;
   SceneLoadOptions options;

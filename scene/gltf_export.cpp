@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "format/atomic_output.h"
 #include "scene/scene_io_util.h"
 #include "scene/tangent_frame.h"
 
@@ -278,24 +279,17 @@ struct Bytes {
   size_t size;
 };
 
-// Writes `parts` to PATH.tmp and renames it into place: PATH is never half-written.
+// Writes `parts` as the whole of PATH through the atomic writer: PATH is never half-written.
 Status write_file(const std::string& path, std::initializer_list<Bytes> parts) {
-  std::string tmp = path + ".tmp";
-  std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(tmp.c_str(), "wb"), &std::fclose);
-  if (!f) return Error(ErrorCode::kIo, path + ": cannot create file");
-  bool ok = true;
-  for (const Bytes& part : parts)
-    ok = ok && (part.size == 0 || std::fwrite(part.data, 1, part.size, f.get()) == part.size);
-  ok = std::fclose(f.release()) == 0 && ok;
-  if (!ok) {
-    std::remove(tmp.c_str());
-    return Error(ErrorCode::kIo, path + ": write failed");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    return Error(ErrorCode::kIo, path + ": cannot rename into place");
-  }
-  return Status::Ok();
+  return write_output(path, [&](const std::string& temp) -> Status {
+    std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(temp.c_str(), "wb"), &std::fclose);
+    if (!f) return Error(ErrorCode::kIo, path + ": cannot create file");
+    bool ok = true;
+    for (const Bytes& part : parts)
+      ok = ok && (part.size == 0 || std::fwrite(part.data, 1, part.size, f.get()) == part.size);
+    ok = std::fclose(f.release()) == 0 && ok;
+    return ok ? Status::Ok() : Error(ErrorCode::kIo, path + ": write failed");
+  });
 }
 
 }  // namespace

@@ -85,15 +85,32 @@ const ExtensionRule* find_rule(const std::string& name) {
 
 }  // namespace
 
+std::string gltf_version_text(const json& doc) {
+  const auto asset = doc.find("asset");
+  if (asset == doc.end() || !asset->is_object()) return "";
+  const auto v = asset->find("version");
+  if (v == asset->end()) return "";
+  return v->is_string() ? v->get<std::string>() : v->dump();
+}
+
+bool is_gltf1_document(const json& doc) {
+  if (!doc.is_object()) return false;
+  for (const char* key : {"meshes", "materials", "nodes", "accessors", "buffers", "scenes"}) {
+    auto it = doc.find(key);
+    if (it != doc.end() && it->is_object()) return true;
+  }
+  const std::string v = gltf_version_text(doc);
+  return v.rfind("1", 0) == 0 || v.rfind("0.", 0) == 0;
+}
+
 Status check_version(const Gltf& g, Warnings* warnings) {
   const char* kConvert =
       " (convert it to glTF 2.0, e.g. with `assimp export FILE out.glb -f glb2` from Debian's "
       "assimp-utils, or `gltf-pipeline -i FILE -o out.glb`)";
-  // glTF 1.0 keeps its top-level collections in objects keyed by id; 2.0 uses arrays.
-  for (const char* key : {"meshes", "materials", "nodes", "accessors", "buffers", "scenes"}) {
-    auto it = g.doc.find(key);
-    if (it != g.doc.end() && it->is_object())
-      return Error(ErrorCode::kUnsupported, g.path + ": glTF 1.0 is not supported" + kConvert);
+  if (is_gltf1_document(g.doc)) {
+    const std::string v = gltf_version_text(g.doc);
+    return Error(ErrorCode::kUnsupported,
+                 g.path + ": glTF " + (v.empty() ? "1.0" : v) + " is not supported" + kConvert);
   }
   auto asset = g.doc.find("asset");
   const json* version = nullptr;
@@ -103,11 +120,7 @@ Status check_version(const Gltf& g, Warnings* warnings) {
     warnings->push_back(g.path + ": asset.version is missing; read as glTF 2.0");
     return Status::Ok();
   }
-  // 1.0 files often write the version as a number.
-  std::string v = version->is_string() ? version->get<std::string>() : version->dump();
-  if (v.rfind("1", 0) == 0 || v.rfind("0.", 0) == 0)
-    return Error(ErrorCode::kUnsupported, g.path + ": glTF " + v + " is not supported" + kConvert);
-  if (!version->is_string() || v.rfind("2", 0) != 0)
+  if (!version->is_string() || gltf_version_text(g.doc).rfind("2", 0) != 0)
     return Error(ErrorCode::kUnsupported, g.path + ": asset.version " + version->dump() +
                                               " is not supported (vtbake reads glTF 2.x)");
   return Status::Ok();

@@ -1,11 +1,26 @@
 // Scene hierarchy flattening, geometry validation and matrix helpers.
 #include "scene/scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <string>
 
 namespace vt::scene {
+
+const char* Image::embedded_extension() const {
+  const auto starts = [&](std::initializer_list<uint8_t> magic, size_t at = 0) {
+    if (bytes.size() < at + magic.size()) return false;
+    return std::equal(magic.begin(), magic.end(), bytes.begin() + std::ptrdiff_t(at));
+  };
+  if (mime_type == "image/jpeg" || starts({0xFF, 0xD8})) return ".jpg";
+  if (mime_type == "image/x-exr" || starts({0x76, 0x2F, 0x31, 0x01})) return ".exr";
+  if (mime_type == "image/webp" ||
+      (starts({'R', 'I', 'F', 'F'}) && starts({'W', 'E', 'B', 'P'}, 8)))
+    return ".webp";
+  return ".png";
+}
 
 std::array<double, 6> TextureTransform::matrix() const {
   double c = std::cos(double(rotation)), s = std::sin(double(rotation));

@@ -87,6 +87,9 @@ struct Image {
   std::string mime_type;       // "image/png", "image/jpeg", ... (may be empty for files)
   std::vector<uint8_t> bytes;  // embedded data; empty for files
   bool embedded() const { return path.empty(); }
+  // The file extension embedded bytes are read as (".png", ".jpg", ".exr", ".webp"): readers
+  // pick their decoder by name. The MIME type, else the bytes' magic, else ".png".
+  const char* embedded_extension() const;
 };
 
 // Indexed triangles with per-vertex attributes. Every attribute array is either empty or has

@@ -8,6 +8,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "scene/gltf_document.h"
 #include "scene/scene.h"
 #include "scene/scene_io_util.h"
 
@@ -241,7 +242,7 @@ Scene single_mesh_scene(const std::string& path, std::string name, std::vector<P
 
 namespace {
 
-// glTF 1.0 (a .glb header of version 1, or asset.version "1.x"): the own importer reads 2.0
+// glTF 1.0 (a .glb header of version 1, or a 1.0 JSON document): the own importer reads 2.0
 // only, assimp reads 1.0.
 bool is_gltf1(const std::string& path) {
   std::ifstream f(path, std::ios::binary | std::ios::ate);
@@ -260,10 +261,7 @@ bool is_gltf1(const std::string& path) {
   }
   f.clear();
   f.seekg(0);
-  nlohmann::json doc = nlohmann::json::parse(f, nullptr, false);
-  if (!doc.is_object() || !doc.contains("asset") || !doc["asset"].is_object()) return false;
-  const auto& v = doc["asset"].value("version", nlohmann::json());
-  return v.is_string() && v.get<std::string>().rfind("1", 0) == 0;
+  return detail::is_gltf1_document(nlohmann::json::parse(f, nullptr, false));
 }
 
 // "material 'Body' baseColorTexture image 2 'brick'": the first material slot using the

@@ -7,6 +7,7 @@
 
 #include "bake/unwrap/atlas_raster.h"
 #include "bake/unwrap/unwrap.h"
+#include "format/atomic_output.h"
 #include "scene/gltf_export.h"
 
 namespace vt::unwrap {
@@ -132,10 +133,12 @@ Status write_atlas_picture(const UnwrapResult& result, const std::string& path, 
   if (!out)
     return Error(ErrorCode::kIo, path + ": cannot create image writer: " + OIIO::geterror());
   OIIO::ImageSpec spec(pw, h, 3, OIIO::TypeDesc::UINT8);
-  if (!out->open(path, spec)) return Error(ErrorCode::kIo, path + ": " + out->geterror());
-  if (!out->write_image(OIIO::TypeDesc::UINT8, pixels.data()) || !out->close())
-    return Error(ErrorCode::kIo, path + ": " + out->geterror());
-  return Status::Ok();
+  return write_output(path, [&](const std::string& temp) -> Status {
+    if (!out->open(temp, spec) || !out->write_image(OIIO::TypeDesc::UINT8, pixels.data()) ||
+        !out->close())
+      return Error(ErrorCode::kIo, path + ": " + out->geterror());
+    return Status::Ok();
+  });
 }
 
 Status save_unwrapped_glb(const UnwrapResult& result, const std::string& path) {

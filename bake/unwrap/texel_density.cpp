@@ -18,14 +18,9 @@ namespace {
 
 namespace OIIO = OIIO_NAMESPACE;
 
-// A name OpenImageIO can pick a reader by for embedded bytes: the MIME type, else the magic.
+// A name OpenImageIO can pick a reader by for embedded bytes.
 std::string embedded_name(const scene::Image& image) {
-  const auto& b = image.bytes;
-  if (image.mime_type == "image/jpeg" || (b.size() > 2 && b[0] == 0xFF && b[1] == 0xD8))
-    return "embedded.jpg";
-  if (image.mime_type == "image/x-exr") return "embedded.exr";
-  if (image.mime_type == "image/webp") return "embedded.webp";
-  return "embedded.png";
+  return std::string("embedded") + image.embedded_extension();
 }
 
 std::string image_label(const scene::Image& image, size_t index) {

@@ -4,6 +4,8 @@
 //   dct_bench --report [KODAK_DIR [TEXTURE_DIR]]   rate-distortion and speed table (markdown)
 //   dct_bench --speed [KODAK_DIR]                   decode speed against JPEG, interleaved
 //   dct_bench --runtime [KODAK_DIR]                 DCT decode + BC1 real-time, pages/s
+//   dct_bench --transcode [ROUNDS [BASIS_BC1_DIR [SET]]]  issue 22: decode vs JPEG and DCT + BC1
+//                                       on Kodak and PBR maps, interleaved (SET: a name's part)
 //   dct_bench [google benchmark flags]             per-page decode / encode timings
 //
 // Report: bits per texel, PSNR (RGB, per page), single-thread encode / decode Mtexel/s (median
@@ -462,6 +464,207 @@ int speed(int rounds) {
   return 0;
 }
 
+// ---- Issue 22: the runtime transcode side by side ----
+
+// A page set for the transcode run: its pages, DCT q50 4:2:0 pages coded with tables trained on
+// the other fold (`training`), and JPEG q75 4:2:0 abbreviated pages (about DCT q50's PSNR).
+struct TranscodeSet {
+  std::string name;
+  std::vector<Page> pages;
+  DctTablesPtr tables;
+  std::vector<std::vector<uint8_t>> dct;
+  JpegCoded jpeg;
+  double dct_bpt = 0, jpeg_bpt = 0, dct_psnr = 0, jpeg_psnr = 0, bc1_psnr = 0;
+};
+
+TranscodeSet make_transcode_set(std::string name, std::vector<Page> pages,
+                                const std::vector<Page>& training_pages) {
+  TranscodeSet set;
+  set.name = std::move(name);
+  set.pages = std::move(pages);
+  DctSettings s;
+  s.quality = 50;
+  s.channels = 3;
+  s.layout = DctPlaneLayout::kYCoCg420;
+  std::vector<std::span<const uint8_t>> training(training_pages.begin(), training_pages.end());
+  auto tables = dct_make_tables(s, kPage, kPage, training);
+  if (!tables.ok()) die(tables.status());
+  set.tables = std::move(tables).value();
+  set.dct.resize(set.pages.size());
+  set.jpeg = jpeg_encode(set.pages, 75, true);
+  JpegPageDecoder jd = jpeg_decoder(set.jpeg.tables);
+  Page out(set.pages[0].size()), bc_rgb(out.size());
+  std::vector<uint8_t> bc(bc_image_bytes(BcFormat::kBc1, kPage, kPage));
+  double db = 0, jb = 0, dse = 0, jse = 0, bse = 0;
+  for (size_t i = 0; i < set.pages.size(); i++) {
+    (void)dct_encode_page(*set.tables, set.pages[i].data(), kPage, kPage, set.dct[i]);
+    if (!dct_decode_page(*set.tables, set.dct[i], kPage, kPage, out.data()).ok()) std::exit(2);
+    dse += squared_error(set.pages[i], out);
+    (void)bc_encode_image(BcFormat::kBc1, BcQuality::kRealtime, out.data(), kPage, kPage, 3,
+                          bc.data());
+    (void)bc_decode_image(BcFormat::kBc1, bc.data(), kPage, kPage, 3, bc_rgb.data());
+    bse += squared_error(set.pages[i], bc_rgb);
+    (void)jd.decode(set.jpeg.pages[i], out.data());
+    jse += squared_error(set.pages[i], out);
+    db += double(set.dct[i].size());
+    jb += double(set.jpeg.pages[i].size());
+  }
+  const double texels = double(set.pages.size()) * kPage * kPage;
+  set.dct_bpt = db * 8 / texels, set.jpeg_bpt = jb * 8 / texels;
+  set.dct_psnr = psnr_from(dse, texels * 3), set.jpeg_psnr = psnr_from(jse, texels * 3);
+  set.bc1_psnr = psnr_from(bse, texels * 3);
+  return set;
+}
+
+// PSNR against `pages` of Basis's BC1 output unpacked to PNG: `files[i]` is page i.
+double basis_bc1_psnr(const std::vector<Page>& pages, const std::vector<std::string>& files) {
+  double se = 0;
+  for (size_t i = 0; i < pages.size(); i++) {
+    int w, h, c;
+    uint8_t* img = stbi_load(files[i].c_str(), &w, &h, &c, 3);
+    if (!img || w != kPage || h != kPage) {
+      std::fprintf(stderr, "bad Basis output %s\n", files[i].c_str());
+      std::exit(1);
+    }
+    se += squared_error(pages[i], Page(img, img + size_t(kPage) * kPage * 3));
+    stbi_image_free(img);
+  }
+  return psnr_from(se, double(pages.size()) * kPage * kPage * 3);
+}
+
+// `dct_bench --transcode ROUNDS [BASIS_BC1_DIR [SET]]`: per page set (Kodak fold 0, 288 pages:
+// the pages bench/transcode_vs_basis.sh gives Basis; the PBR colour maps; the PBR normal and ORM
+// maps, read as RGB), DCT decode, JPEG decode and DCT decode + BC1 real-time, passes alternating,
+// medians of thread CPU time over ROUNDS. Both codecs code the same RGB pages at about equal
+// PSNR: DCT q50 4:2:0 (tables trained on the other fold), JPEG q75 4:2:0. With BASIS_BC1_DIR
+// (kodimNN_unpacked_rgb_BC1_RGB_PPPP.png from `basisu -unpack`) also Basis's PSNR after BC1 on
+// the same Kodak pages. SET (part of a set's name) runs that set alone: see the note on
+// libjpeg-turbo's speed below.
+int transcode(int rounds, const std::string& basis_dir, const std::string& only) {
+  std::vector<Page> folds[2];
+  const auto files = list_pngs(g_kodak_dir);
+  std::vector<std::string> basis_files;
+  for (size_t i = 0; i < files.size(); i++) {
+    auto pages = load_pages(files[i], 3);
+    for (size_t p = 0; p < pages.size() && i % 2 == 0 && !basis_dir.empty(); p++) {
+      char name[64];
+      std::snprintf(name, sizeof name, "_unpacked_rgb_BC1_RGB_%04zu.png", p);
+      basis_files.push_back(basis_dir + "/" + std::filesystem::path(files[i]).stem().string() +
+                            name);
+    }
+    for (Page& p : pages) folds[i % 2].push_back(std::move(p));
+  }
+  // Game textures: colour maps, and the other maps (normal, ORM) read as RGB pages too.
+  std::vector<Page> tex[2], other[2];
+  for (const auto& f : list_pngs(g_texture_dir)) {
+    auto pages = load_pages(f, 3);
+    auto& to = f.find("baseColor") != std::string::npos ? tex : other;
+    for (size_t i = 0; i < pages.size(); i++) to[i % 2].push_back(std::move(pages[i]));
+  }
+  std::vector<TranscodeSet> sets;
+  auto add = [&](const char* name, std::vector<Page>(&f)[2]) {
+    if (!f[0].empty() && (only.empty() || std::strstr(name, only.c_str())))
+      sets.push_back(make_transcode_set(name, std::move(f[0]), f[1]));
+  };
+  add("Kodak fold 0", folds);
+  add("PBR baseColor maps", tex);
+  add("PBR normal + ORM maps", other);
+  if (sets.empty()) return 1;
+  const bool with_basis = !basis_files.empty() && sets[0].name == "Kodak fold 0";
+  const double basis_psnr = with_basis ? basis_bc1_psnr(sets[0].pages, basis_files) : 0;
+
+  std::printf(
+      "| pages | n | DCT q50 b/t | DCT PSNR | JPEG q75 b/t | JPEG PSNR | DCT decode pages/s | "
+      "JPEG decode pages/s | DCT / JPEG | DCT + BC1 pages/s | PSNR after BC1 |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const TranscodeSet& set : sets) {
+    Page out(set.pages[0].size());
+    std::vector<uint8_t> bc(bc_image_bytes(BcFormat::kBc1, kPage, kPage));
+    JpegPageDecoder jd = jpeg_decoder(set.jpeg.tables);
+    // libjpeg-turbo's speed here is bimodal with where malloc puts its per-image buffers (its
+    // AVX2 fancy upsampler's stores stall in some layouts): the same binary and pages give
+    // 15,000 or 21,800 Kodak pages/s depending on what was allocated before. Aligning our
+    // buffers does not move it; compare ratios across builds with care (docs/BENCHMARKS.md).
+    std::vector<double> td, tj, tt;
+    for (int r = 0; r < rounds; r++) {
+      const double t0 = now_s();
+      for (const auto& c : set.dct) (void)dct_decode_page(*set.tables, c, kPage, kPage, out.data());
+      const double t1 = now_s();
+      for (const auto& c : set.jpeg.pages) (void)jd.decode(c, out.data());
+      const double t2 = now_s();
+      for (const auto& c : set.dct) {
+        (void)dct_decode_page(*set.tables, c, kPage, kPage, out.data());
+        (void)bc_encode_image(BcFormat::kBc1, BcQuality::kRealtime, out.data(), kPage, kPage, 3,
+                              bc.data());
+      }
+      const double t3 = now_s();
+      td.push_back(t1 - t0), tj.push_back(t2 - t1), tt.push_back(t3 - t2);
+    }
+    for (auto* v : {&td, &tj, &tt}) std::sort(v->begin(), v->end());
+    const double n = double(set.pages.size());
+    const double dps = n / td[td.size() / 2], jps = n / tj[tj.size() / 2];
+    std::printf("| %s | %zu | %.3f | %.2f | %.3f | %.2f | %.0f | %.0f | %.2f | %.0f | %.2f |\n",
+                set.name.c_str(), set.pages.size(), set.dct_bpt, set.dct_psnr, set.jpeg_bpt,
+                set.jpeg_psnr, dps, jps, dps / jps, n / tt[tt.size() / 2], set.bc1_psnr);
+  }
+  // The other runtime formats' real-time encoders on the first set's pages (the texels a
+  // transcode hands them): BC3 and BC7 with alpha taken from G (content, not a constant),
+  // BC4 from R, BC5 from R and G; pages/s per core and PSNR over the channels coded.
+  struct Fmt {
+    const char* name;
+    BcFormat format;
+    int channels;
+  };
+  const Fmt fmts[] = {{"BC1 (RGB)", BcFormat::kBc1, 3},
+                      {"BC3 (RGBA, alpha = G)", BcFormat::kBc3, 4},
+                      {"BC4 (R)", BcFormat::kBc4, 1},
+                      {"BC5 (RG)", BcFormat::kBc5, 2},
+                      {"BC7 (RGBA, alpha = G)", BcFormat::kBc7, 4}};
+  constexpr size_t kFmts = sizeof(fmts) / sizeof(fmts[0]);
+  const TranscodeSet& first = sets[0];
+  std::printf("\n| %s: real-time encoder | pages/s | PSNR dB |\n|---|---|---|\n",
+              first.name.c_str());
+  std::vector<std::vector<Page>> inputs;
+  for (const Fmt& f : fmts) {
+    std::vector<Page> in;
+    for (const Page& p : first.pages) {
+      Page q(size_t(kPage) * kPage * f.channels);
+      for (size_t t = 0; t < size_t(kPage) * kPage; t++)
+        for (int c = 0; c < f.channels; c++) q[t * f.channels + c] = p[t * 3 + (c == 3 ? 1 : c)];
+      in.push_back(std::move(q));
+    }
+    inputs.push_back(std::move(in));
+  }
+  std::vector<std::vector<double>> times(kFmts);
+  std::vector<uint8_t> blocks(bc_image_bytes(BcFormat::kBc7, kPage, kPage));
+  for (int r = 0; r < rounds; r++) {
+    for (size_t fi = 0; fi < kFmts; fi++) {
+      const double t0 = now_s();
+      for (const Page& p : inputs[fi])
+        (void)bc_encode_image(fmts[fi].format, BcQuality::kRealtime, p.data(), kPage, kPage,
+                              fmts[fi].channels, blocks.data());
+      times[fi].push_back(now_s() - t0);
+    }
+  }
+  for (size_t fi = 0; fi < kFmts; fi++) {
+    double se = 0;
+    Page back(inputs[fi][0].size());
+    for (const Page& p : inputs[fi]) {
+      (void)bc_encode_image(fmts[fi].format, BcQuality::kRealtime, p.data(), kPage, kPage,
+                            fmts[fi].channels, blocks.data());
+      (void)bc_decode_image(fmts[fi].format, blocks.data(), kPage, kPage, fmts[fi].channels,
+                            back.data());
+      se += squared_error(p, back);
+    }
+    std::sort(times[fi].begin(), times[fi].end());
+    std::printf("| %s | %.0f | %.2f |\n", fmts[fi].name,
+                double(inputs[fi].size()) / times[fi][times[fi].size() / 2],
+                psnr_from(se, double(inputs[fi].size()) * kPage * kPage * fmts[fi].channels));
+  }
+  if (with_basis) std::printf("\nBasis ETC1S -> BC1 PSNR on Kodak fold 0: %.2f\n", basis_psnr);
+  return 0;
+}
+
 // ---- Google Benchmark timings: one page at a time ----
 
 struct Fixture {
@@ -554,6 +757,10 @@ int main(int argc, char** argv) {
     }
     runtime_path(kodak);
     return 0;
+  }
+  if (argc > 1 && std::strcmp(argv[1], "--transcode") == 0) {
+    return transcode(argc > 2 ? std::atoi(argv[2]) : 7, argc > 3 ? argv[3] : "",
+                     argc > 4 ? argv[4] : "");
   }
   if (argc > 1 && std::strcmp(argv[1], "--speed") == 0) {
     if (argc > 2) g_kodak_dir = argv[2];

@@ -1,4 +1,4 @@
-// The one JSON form of a build summary (bake/build_summary_json.h, docs/REPORTS.md) and the
+// The one JSON form of a build summary (bake/build_summary_json.h, docs/JSON.md) and the
 // numbers it derives: raw texel bytes and the compression ratio.
 #include <gtest/gtest.h>
 
@@ -92,7 +92,7 @@ TEST(BuildSummaryJson, NestedSchema) {
   EXPECT_EQ(e["non_finite"], 2);
   EXPECT_EQ(e["first_bad_texel"], nlohmann::json({{"x", 7}, {"y", 3}, {"channel", 1}}));
   EXPECT_EQ(j["seconds"], nlohmann::json({{"pyramid+encode", 1.5}, {"finish", 0.25}}));
-  // Nothing else: the schema is exactly what docs/REPORTS.md lists.
+  // Nothing else: the schema is exactly what docs/JSON.md lists.
   EXPECT_EQ(j.size(), 9u);
 }
 

@@ -3,7 +3,11 @@
 
 #include <sys/wait.h>
 
+#include <unistd.h>
+
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -34,6 +38,29 @@ inline RunResult run_vtbake(const std::string& args, bool merge_stderr) {
 inline std::string read_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// An empty folder for one test suite: TMP/vt_NAME_PID.
+inline std::string fresh_test_dir(const std::string& name) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("vt_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+// Removes a suite's folder; VTBAKE_KEEP_TEST_OUTPUT=1 keeps the scenes, bakes, images and
+// reports for inspection.
+inline void remove_test_dir(const std::string& dir) {
+  if (!std::getenv("VTBAKE_KEEP_TEST_OUTPUT")) std::filesystem::remove_all(dir);
+}
+
+// The small sample scenes of the CLI tests: `vtbake sample-scene DIR` with 2 ground cells, 8
+// sphere segments and 32-texel textures (or `flags`). "" on success, else what went wrong.
+inline std::string write_sample_scene(
+    const std::string& dir,
+    const std::string& flags = "--ground-cells 2 --sphere-segments 8 --texture-size 32") {
+  const RunResult s = run_vtbake("-q sample-scene " + dir + " " + flags, true);
+  return s.exit_code == 0 ? "" : "sample-scene failed: " + s.out;
 }
 
 }  // namespace vt::testing

@@ -22,20 +22,14 @@ class BatchCli : public ::testing::Test {
  protected:
   // One sample scene as two glTF files (a.gltf, b.gltf share scene.bin and the textures).
   static void SetUpTestSuite() {
-    dir_ = (fs::temp_directory_path() / ("vt_batch_cli_" + std::to_string(::getpid()))).string();
-    fs::remove_all(dir_);
-    RunResult s = run_vtbake("-q sample-scene " + dir_ +
-                                 "/scenes --ground-cells 2 --sphere-segments 8 --texture-size 32",
-                             true);
-    setup_error_ = s.exit_code == 0 ? "" : "sample-scene failed: " + s.out;
+    dir_ = fresh_test_dir("batch_cli");
+    setup_error_ = write_sample_scene(dir_ + "/scenes");
     if (!setup_error_.empty()) return;
     fs::copy_file(dir_ + "/scenes/scene.gltf", dir_ + "/scenes/a.gltf");
     fs::copy_file(dir_ + "/scenes/scene.gltf", dir_ + "/scenes/b.gltf");
     std::ofstream(dir_ + "/scenes/broken.gltf") << "{ not gltf";
   }
-  static void TearDownTestSuite() {
-    if (!std::getenv("VTBAKE_KEEP_TEST_OUTPUT")) fs::remove_all(dir_);
-  }
+  static void TearDownTestSuite() { remove_test_dir(dir_); }
   void SetUp() override { ASSERT_TRUE(setup_error_.empty()) << setup_error_; }
   static std::string scene(const std::string& name) { return dir_ + "/scenes/" + name; }
   static std::string flags() { return " --size 2 --payload 56 --supersample 1"; }
@@ -84,12 +78,16 @@ TEST_F(BatchCli, ListJsonLinesAndKeepGoing) {
     js.push_back(j);
   }
   ASSERT_EQ(js.size(), 3u) << r.out;
-  EXPECT_EQ(js[0]["status"], "ok");
+  EXPECT_EQ(js[0]["ok"], true);
+  EXPECT_EQ(js[0]["schema"], 1);
+  EXPECT_TRUE(js[0]["input"].get<std::string>().ends_with("/a.gltf")) << js[0]["input"];
   EXPECT_EQ(js[0]["output"], dir_ + "/go/a.vtpf");
   EXPECT_TRUE(js[0].contains("build"));
-  EXPECT_EQ(js[1]["status"], "failed");
-  EXPECT_NE(js[1]["error"].get<std::string>().find("broken.gltf"), std::string::npos);
-  EXPECT_EQ(js[2]["status"], "ok");
+  EXPECT_EQ(js[1]["ok"], false);
+  EXPECT_EQ(js[1]["exit"], 2);
+  EXPECT_EQ(js[1]["error"]["code"], "corrupt");
+  EXPECT_NE(js[1]["error"]["message"].get<std::string>().find("broken.gltf"), std::string::npos);
+  EXPECT_EQ(js[2]["ok"], true);
   EXPECT_TRUE(fs::exists(dir_ + "/go/b.vtpf"));
 }
 

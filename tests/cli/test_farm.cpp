@@ -25,12 +25,9 @@ namespace fs = std::filesystem;
 class FarmCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = (fs::temp_directory_path() / ("vt_farm_cli_" + std::to_string(::getpid()))).string();
-    fs::remove_all(dir_);
-    RunResult s = run_vtbake("-q sample-scene " + dir_ +
-                                 "/scene --ground-cells 4 --sphere-segments 12 --texture-size 64",
-                             true);
-    setup_error_ = s.exit_code == 0 ? "" : "sample-scene failed: " + s.out;
+    dir_ = fresh_test_dir("farm_cli");
+    setup_error_ = write_sample_scene(dir_ + "/scene",
+                                      "--ground-cells 4 --sphere-segments 12 --texture-size 64");
     if (!setup_error_.empty()) return;
     fs::create_directories(dir_ + "/local");
     for (const char* name : {"four", "tasks", "one", "kill", "a", "b"})
@@ -39,9 +36,7 @@ class FarmCli : public ::testing::Test {
         run_vtbake("-q bake " + scene() + " -o " + dir_ + "/local/out.vtpf " + flags(), true);
     if (b.exit_code != 0) setup_error_ = "bake failed: " + b.out;
   }
-  static void TearDownTestSuite() {
-    if (!std::getenv("VTBAKE_KEEP_TEST_OUTPUT")) fs::remove_all(dir_);
-  }
+  static void TearDownTestSuite() { remove_test_dir(dir_); }
   void SetUp() override { ASSERT_TRUE(setup_error_.empty()) << setup_error_; }
 
   static std::string scene() { return dir_ + "/scene/scene.gltf"; }

@@ -5,6 +5,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "format/page_file.h"
@@ -89,15 +90,19 @@ TEST(CliInfo, JsonDescribesTheFile) {
   ASSERT_EQ(j["levels"].size(), 3u);
   EXPECT_EQ(j["levels"][0]["pages_x"], 4);
   EXPECT_EQ(j["levels"][0]["pages_y"], 3);
-  EXPECT_EQ(j["levels"][0]["stored_pages"], 24);  // 12 pages x 2 layers
-  EXPECT_EQ(j["levels"][1]["stored_pages"], 6);   // 4 height + 2 albedo
-  EXPECT_EQ(j["levels"][1]["constant_pages"], 1);
-  EXPECT_EQ(j["levels"][1]["absent_pages"], 1);
+  EXPECT_EQ(j["levels"][0]["stored"], 24);  // 12 pages x 2 layers
+  EXPECT_EQ(j["levels"][1]["stored"], 6);   // 4 height + 2 albedo
+  EXPECT_EQ(j["levels"][1]["constant"], 1);
+  EXPECT_EQ(j["levels"][1]["absent"], 1);
   EXPECT_EQ(j["levels"][1]["bytes"].get<uint64_t>() > 3 * 16 * 16 * 4, true);
   EXPECT_EQ(j["metadata"]["settings"]["quality"], 75);
   uint64_t bytes = 0;
   for (auto& level : j["levels"]) bytes += level["bytes"].get<uint64_t>();
-  EXPECT_EQ(j["stored_bytes"].get<uint64_t>(), bytes);
+  EXPECT_EQ(j["bytes"]["stored"].get<uint64_t>(), bytes);
+  EXPECT_EQ(j["bytes"]["file"].get<uint64_t>(), std::filesystem::file_size(t.path));
+  EXPECT_EQ(j["pages"]["total"].get<uint64_t>(), j["pages"]["stored"].get<uint64_t>() +
+                                                     j["pages"]["constant"].get<uint64_t>() +
+                                                     j["pages"]["absent"].get<uint64_t>());
 
   RunResult text = run("info " + t.path);
   EXPECT_EQ(text.exit_code, 0);
@@ -113,7 +118,8 @@ TEST(CliVerify, ExitStatusSaysTheResult) {
   ASSERT_EQ(json.exit_code, 0);
   auto j = nlohmann::json::parse(json.out);
   EXPECT_EQ(j["ok"], true);
-  EXPECT_EQ(j["pages_checked"], 24 + 6 + 2);
+  EXPECT_EQ(j["pages"]["checked"], 24 + 6 + 2);
+  EXPECT_EQ(j["pages"]["bad"], 0);
 
   // One flipped data byte: a bad page, exit 1, and the page is named.
   std::vector<uint8_t> bytes = read_bytes(t.path);

@@ -26,7 +26,10 @@
 namespace vt {
 namespace {
 
+using vt::testing::fresh_test_dir;
+using vt::testing::remove_test_dir;
 using vt::testing::RunResult;
+using vt::testing::write_sample_scene;
 RunResult run(const std::string& args) {
   return vt::testing::run_vtbake(args, true);
 }
@@ -82,22 +85,15 @@ class ValidateCli : public ::testing::Test {
  protected:
   // One scene and one bake for the whole suite: baking is the slow part.
   static void SetUpTestSuite() {
-    dir_ =
-        (std::filesystem::temp_directory_path() / ("vt_validate_cli_" + std::to_string(::getpid())))
-            .string();
-    std::filesystem::remove_all(dir_);
-    RunResult s = run("sample-scene " + dir_ +
-                      " --ground-cells 4 --sphere-segments 12 --texture-size 64 --quiet");
-    setup_error_ = s.exit_code == 0 ? "" : "sample-scene failed: " + s.out;
+    dir_ = fresh_test_dir("validate_cli");
+    setup_error_ =
+        write_sample_scene(dir_, "--ground-cells 4 --sphere-segments 12 --texture-size 64");
     if (!setup_error_.empty()) return;
     RunResult b = run("bake " + dir_ + "/scene.gltf -o " + dir_ +
                       "/bake.vtpf --size 4 --supersample 1 --quiet");
     if (b.exit_code != 0) setup_error_ = "bake failed: " + b.out;
   }
-  // VTBAKE_KEEP_TEST_OUTPUT=1 keeps the scene, bakes, images and reports for inspection.
-  static void TearDownTestSuite() {
-    if (!std::getenv("VTBAKE_KEEP_TEST_OUTPUT")) std::filesystem::remove_all(dir_);
-  }
+  static void TearDownTestSuite() { remove_test_dir(dir_); }
 
   void SetUp() override { ASSERT_TRUE(setup_error_.empty()) << setup_error_; }
 
@@ -166,7 +162,14 @@ TEST_F(ValidateCli, JsonPrintsTheReportOnStdout) {
   ASSERT_EQ(r.exit_code, 0) << r.out;
   const nlohmann::json printed = nlohmann::json::parse(r.out, nullptr, false);
   ASSERT_TRUE(printed.is_object()) << r.out;
-  EXPECT_EQ(printed, read_json(out + "/report.json"));
+  // The printed object is report.json opened by the envelope (docs/JSON.md).
+  EXPECT_EQ(printed["schema"], 1);
+  EXPECT_EQ(printed["command"], "validate");
+  EXPECT_EQ(printed["ok"], true);
+  EXPECT_EQ(printed["output"], out);
+  nlohmann::json body = printed;
+  for (const char* key : {"schema", "command", "ok", "exit", "input", "output"}) body.erase(key);
+  EXPECT_EQ(body, read_json(out + "/report.json"));
   EXPECT_EQ(printed["views"].size(), 1u);
 }
 

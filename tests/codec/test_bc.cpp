@@ -408,5 +408,92 @@ TEST(Bc, BadArgumentsAreErrors) {
   EXPECT_EQ(bc_image_bytes(BcFormat::kBc7, 128, 128), size_t(16384));
 }
 
+// ---- pinned real-time output ----
+
+// A page of integer-only content (no libm: the same texels on every platform): smooth
+// gradients, noise, hard edges and flat patches by 16x16 region, as pages mix them.
+std::vector<uint8_t> pinned_page(int size, int channels, uint32_t seed) {
+  std::vector<uint8_t> img(size_t(size) * size * channels);
+  Rng rng(seed);
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      const int region = ((y / 16) * 7 + (x / 16) * 3) % 4;
+      for (int c = 0; c < channels; ++c) {
+        int v = 0;
+        if (region == 0) v = (x * (2 + c) + y * (3 - c / 2)) & 255;       // gradient
+        if (region == 1) v = 96 + 32 * c + rng.below(64) - 32;            // noise
+        if (region == 2) v = ((x ^ y) & 4) ? 40 + 50 * c : 220 - 30 * c;  // edges
+        if (region == 3) v = 17 + 61 * c;                                 // flat
+        img[(size_t(y) * size + x) * channels + c] = uint8_t(std::clamp(v, 0, 255));
+      }
+    }
+  }
+  return img;
+}
+
+uint64_t fnv1a(const std::vector<uint8_t>& bytes) {
+  uint64_t h = 1469598103934665603ull;
+  for (uint8_t b : bytes) h = (h ^ b) * 1099511628211ull;
+  return h;
+}
+
+// The real-time encoders' bytes, pinned: the runtime transcode (bc1.cpp's SIMD kernel in its
+// AVX-512, AVX2 and baseline builds, whichever this machine runs) must give these exact blocks,
+// so a speed change that moves one byte shows here. Digests from the encoders before issue 22's
+// work.
+TEST(Bc, RealtimeOutputIsPinned) {
+  struct Case {
+    BcFormat format;
+    int channels;
+    uint64_t digest;
+  };
+  const Case cases[] = {
+      {BcFormat::kBc1, 3, 0x2589bfc49b54a1a6ull}, {BcFormat::kBc1, 4, 0x6d589166b84d63d6ull},
+      {BcFormat::kBc3, 4, 0x5a72a59de87aacbaull}, {BcFormat::kBc4, 1, 0xd6d1fcc9d72b9c2eull},
+      {BcFormat::kBc5, 2, 0x8b90291667ba48b6ull}, {BcFormat::kBc7, 4, 0xe7e1f2b61228b999ull}};
+  for (const Case& c : cases) {
+    const std::vector<uint8_t> page = pinned_page(128, c.channels, 2026);
+    std::vector<uint8_t> blocks(bc_image_bytes(c.format, 128, 128));
+    ASSERT_TRUE(bc_encode_image(c.format, BcQuality::kRealtime, page.data(), 128, 128, c.channels,
+                                blocks.data())
+                    .ok());
+    EXPECT_EQ(fnv1a(blocks), c.digest) << "format " << int(c.format) << ", " << c.channels
+                                       << " channels: 0x" << std::hex << fnv1a(blocks);
+  }
+}
+
+// The real-time BC1 path gathers blocks straight from 1-4 channel rows (bc1_encode_rows_realtime):
+// the same bytes as the RGBA blocks through bc1_encode_blocks_realtime, at every row length
+// (partial batches of 16, a row's last texel read without running past the image).
+TEST(Bc1, RealtimeRowsMatchRgbaBlocks) {
+  for (int w : {4, 8, 20, 64, 68, 132}) {
+    const int h = 8;
+    for (int channels = 1; channels <= 4; ++channels) {
+      const std::vector<uint8_t> img = pinned_page(std::max(w, h), channels, uint32_t(w));
+      // The top-left w x h of the page, rows packed, in a buffer of exactly that size.
+      const size_t stride = size_t(std::max(w, h)) * channels;
+      std::vector<uint8_t> sub(size_t(w) * h * channels);
+      for (int y = 0; y < h; ++y)
+        std::memcpy(&sub[size_t(y) * w * channels], &img[y * stride], size_t(w) * channels);
+      std::vector<uint8_t> got(bc_image_bytes(BcFormat::kBc1, w, h));
+      ASSERT_TRUE(bc_encode_image(BcFormat::kBc1, BcQuality::kRealtime, sub.data(), w, h, channels,
+                                  got.data())
+                      .ok());
+      std::vector<uint8_t> rgba(size_t(w / 4) * 64), want(got.size());
+      for (int by = 0; by < h / 4; ++by) {
+        for (int bx = 0; bx < w / 4; ++bx) {
+          for (int i = 0; i < 16; ++i) {
+            const uint8_t* t = &sub[((size_t(by) * 4 + i / 4) * w + bx * 4 + i % 4) * channels];
+            for (int c = 0; c < 4; ++c)
+              rgba[size_t(bx) * 64 + 4 * i + c] = c < channels ? t[c] : (c == 3 ? 255 : 0);
+          }
+        }
+        bc1_encode_blocks_realtime(rgba.data(), size_t(w / 4), &want[size_t(by) * (w / 4) * 8], 8);
+      }
+      ASSERT_EQ(got, want) << w << " wide, " << channels << " channels";
+    }
+  }
+}
+
 }  // namespace
 }  // namespace vt

@@ -144,5 +144,46 @@ TEST(StagingSweep, UnknownOwnersOnlyByAgeOthersNever) {
   EXPECT_EQ(kept.count("t.vtpf.tmp-DiR000"), 1u);
 }
 
+TEST(StagingSweep, CleanSweepsEveryTargetInTheFolder) {
+  const std::string dir = fs::path(temp_path("x")).parent_path().string();
+  const int64_t old = kStaleStagingSeconds + 60;
+  touch(dir + "/a.vtpf.tmp-AbC123", old);
+  touch(dir + "/b.png.tmp-42@other-host-QwErTy", old);
+  touch(dir + "/c.tmp-abcdef.glb.tmp-XyZ789", old);  // a target whose name holds ".tmp-"
+  touch(dir + "/d.vtpf.tmp-Zz9900", 60);             // fresh: maybe a live writer elsewhere
+  touch(dir + "/e.vtpf", old);
+  auto removed = sweep_stale_staging_in(dir);
+  ASSERT_TRUE(removed.ok()) << removed.status().message();
+  std::set<std::string> gone;
+  for (const std::string& p : *removed) gone.insert(fs::path(p).filename().string());
+  EXPECT_EQ(gone, (std::set<std::string>{"a.vtpf.tmp-AbC123", "b.png.tmp-42@other-host-QwErTy",
+                                         "c.tmp-abcdef.glb.tmp-XyZ789"}));
+  EXPECT_EQ(names_in(dir), (std::set<std::string>{"d.vtpf.tmp-Zz9900", "e.vtpf"}));
+  EXPECT_EQ(sweep_stale_staging_in(dir + "/missing").status().code(), ErrorCode::kNotFound);
+}
+
+TEST(AtomicWriter, AFailedWriteKeepsThePreviousFileAndLeavesNothing) {
+  const std::string target = temp_path("out.png");
+  const std::string dir = fs::path(target).parent_path().string();
+  write_bytes(target, {'o', 'l', 'd'});
+  // The writer fails half-way (a full disk): the old file stays whole, no temporary stays.
+  Status s = write_output(target, [](const std::string& temp) -> Status {
+    write_bytes(temp, {'h', 'a'});
+    return Error(ErrorCode::kIo, "disk full");
+  });
+  EXPECT_EQ(s.code(), ErrorCode::kIo);
+  EXPECT_EQ(read_bytes(target), std::vector<uint8_t>({'o', 'l', 'd'}));
+  EXPECT_EQ(names_in(dir), std::set<std::string>{"out.png"});
+  ASSERT_TRUE(write_output_bytes(target, "new bytes").ok());
+  EXPECT_EQ(read_bytes(target).size(), 9u);
+  EXPECT_EQ(names_in(dir), std::set<std::string>{"out.png"});
+  // A folder that does not exist: an i/o error naming the path, nothing created.
+  s = write_output_bytes(dir + "/no/such/folder/x.json", "{}");
+  EXPECT_EQ(s.code(), ErrorCode::kIo);
+  EXPECT_NE(s.message().find("no/such/folder/x.json"), std::string::npos) << s.message();
+  // A directory at the path is never replaced.
+  EXPECT_EQ(write_output_bytes(dir, "{}").code(), ErrorCode::kInvalidArgument);
+}
+
 }  // namespace
 }  // namespace vt

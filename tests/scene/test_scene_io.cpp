@@ -412,5 +412,28 @@ TEST(SceneIo, UnwrappedSceneSurvivesGlbRoundTrip) {
   EXPECT_EQ(a.indices, b.indices);
 }
 
+// Embedded images are read by a name whose extension picks the decoder: MIME type first, then
+// the bytes' magic (a .glb image with a missing or wrong mimeType), PNG last.
+TEST(EmbeddedImage, ExtensionFromMimeTypeThenMagic) {
+  scene::Image img;
+  img.mime_type = "image/jpeg";
+  EXPECT_STREQ(img.embedded_extension(), ".jpg");
+  img.mime_type = "image/webp";
+  EXPECT_STREQ(img.embedded_extension(), ".webp");
+  img.mime_type = "image/x-exr";
+  EXPECT_STREQ(img.embedded_extension(), ".exr");
+  img.mime_type.clear();
+  img.bytes = {0xFF, 0xD8, 0xFF, 0xE0};
+  EXPECT_STREQ(img.embedded_extension(), ".jpg");
+  img.bytes = {0x76, 0x2F, 0x31, 0x01, 2, 0, 0, 0};
+  EXPECT_STREQ(img.embedded_extension(), ".exr");
+  img.bytes = {'R', 'I', 'F', 'F', 0, 0, 0, 0, 'W', 'E', 'B', 'P'};
+  EXPECT_STREQ(img.embedded_extension(), ".webp");
+  img.bytes = {'R', 'I', 'F', 'F', 0, 0, 0, 0, 'W', 'A', 'V', 'E'};  // RIFF, but not WebP
+  EXPECT_STREQ(img.embedded_extension(), ".png");
+  img.bytes = {0xFF};  // too short for any magic
+  EXPECT_STREQ(img.embedded_extension(), ".png");
+}
+
 }  // namespace
 }  // namespace vt::test
