@@ -55,6 +55,9 @@ Expected<LayerPlan> plan_layer(const LayerInput& in, const BuildOptions& options
         break;
     }
   }
+  // Lighting is HDR by nature: half float unless 32-bit float is asked.
+  if (in.semantic == LayerSemantic::kLighting && info.is_float && float_type == TexelType::kU8)
+    float_type = TexelType::kF16;
   const bool want_float = float_type != TexelType::kU8;
   if (in.semantic == LayerSemantic::kNormal) {
     if (info.channels < 2) {

@@ -76,7 +76,8 @@ auto guarded(const char* stage, Fn&& fn) -> decltype(fn()) {
 // Bytes of the transfer's layer stores for a W x H atlas of `scene`'s materials.
 uint64_t transfer_store_bytes(const scene::Scene& scene, uint32_t W, uint32_t H) {
   uint64_t channels = 0;
-  for (LayerSemantic l : layers_used(scene)) channels += l == LayerSemantic::kAlbedo ? 4 : 3;
+  for (LayerSemantic l : layers_used(scene))  // lighting: 4 at most (with AO)
+    channels += l == LayerSemantic::kAlbedo || l == LayerSemantic::kLighting ? 4 : 3;
   return uint64_t(W) * H * channels * sizeof(float);
 }
 
@@ -100,7 +101,8 @@ std::string with_thousands(uint64_t n) {
 std::vector<LayerRange> layer_ranges(const std::vector<TransferLayer>& transferred) {
   std::vector<LayerRange> out;
   for (const TransferLayer& t : transferred) {
-    if (t.texels_above_one == 0) continue;
+    // Irradiance above 1 is what lighting is: nothing to report, and the layer is half float.
+    if (t.texels_above_one == 0 || t.semantic == LayerSemantic::kLighting) continue;
     LayerRange r;
     r.semantic = t.semantic;
     r.layer = to_string(t.semantic);
@@ -154,6 +156,9 @@ std::vector<LayerInput> layer_inputs(TransferResult& transfer) {
         info.color_space = "linear";
         in.color_space = "linear";
         info.alpha_channel = layer.channels == 4 ? 3 : -1;
+        break;
+      case LayerSemantic::kLighting:
+        info.is_float = true;  // irradiance in lux: HDR, stored as half (build_plan.cpp)
         break;
       default:
         info.is_float = layer.hdr;
@@ -261,6 +266,7 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
   for (const unwrap::AtlasTriangle& t : unwrapped->triangles) to.charts.push_back(t.chart);
   to.threads = options.build.threads;
   to.color_config = options.build.color_config;
+  to.lighting = options.lighting;
   to.scratch_dir = options.build.scratch_dir.empty()
                        ? std::filesystem::path(output).parent_path().string()
                        : options.build.scratch_dir;
@@ -279,6 +285,12 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
   for (const MissingTexture& m : summary.missing_textures)
     summary.warnings.push_back(m.message() + " (baked from the factor alone)");
   summary.above_one = layer_ranges(transfer->layers);
+  if (const LightingStats& l = summary.transfer.lighting; l.clamped + l.non_finite > 0) {
+    summary.warnings.push_back("lighting: " + with_thousands(l.clamped) + " samples above " +
+                               std::to_string(int(kMaxIrradiance)) + " lux clamped to it, " +
+                               with_thousands(l.non_finite) +
+                               " non-finite (NaN stored as 0, infinity as the maximum)");
+  }
   summary.stages.push_back({"transfer", seconds_since(t0)});
 
   // The build's options, as bake_scene runs them.
@@ -300,6 +312,13 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
       {"unwrap_method", options.unwrap.method == unwrap::Method::kArap ? "arap" : "lscm"},
       {"padding", options.unwrap.padding},
   };
+  // Only a lit bake says how it was lit: the metadata of light-less bakes stays as it was.
+  if (scene_has_lights(input)) {
+    meta["lighting"] = {{"lights", input.placed_lights().size()},
+                        {"shadows", options.lighting.shadows},
+                        {"ao_samples", options.lighting.ao_samples},
+                        {"ao_distance", options.lighting.ao_distance}};
+  }
   bo.metadata_json = meta.dump();
   prepared.unwrapped = std::move(unwrapped).value();
   return Status::Ok();
@@ -409,7 +428,7 @@ nlohmann::json to_json(const SceneBakeSummary& s) {
                        {"path", m.path},
                        {"reason", m.reason}});
   }
-  return {
+  nlohmann::json out = {
       {"output", s.output},
       {"unwrapped", s.unwrapped},
       {"triangles", s.triangles},
@@ -434,6 +453,17 @@ nlohmann::json to_json(const SceneBakeSummary& s) {
       {"peak_rss_bytes", peak_rss},
       {"warnings", s.warnings},
   };
+  // Only a lit bake has the lighting figures (the reports of others stay as they were).
+  if (t.lighting.samples > 0) {
+    out["transfer"]["lighting"] = {{"samples", t.lighting.samples},
+                                   {"shadow_rays", t.lighting.shadow_rays},
+                                   {"ao_rays", t.lighting.ao_rays},
+                                   {"clamped", t.lighting.clamped},
+                                   {"non_finite", t.lighting.non_finite},
+                                   {"structure_bytes", t.lighting.bvh_bytes},
+                                   {"structure_seconds", t.lighting.build_seconds}};
+  }
+  return out;
 }
 
 }  // namespace vt

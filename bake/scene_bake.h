@@ -34,6 +34,8 @@ struct SceneBakeOptions {
   std::string unwrapped;         // the unwrapped scene (.glb); "" = output with .glb, "-" = none
   unwrap::UnwrapOptions unwrap;  // page_payload and threads are taken from `build`
   int supersample = 1;           // 1, 4 or 16 transfer samples per texel
+  // The lighting layer, baked only when the scene places a light (TransferOptions::lighting).
+  LightingOptions lighting;
   MissingTextures missing_textures = MissingTextures::kError;  // see TransferOptions
   scene::SceneLoadOptions load;  // how the scene file is read (bake_scene(path, ...) only)
   // Atlas rows the transfer rasterises and samples at a time (TransferOptions::band_rows;

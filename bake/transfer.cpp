@@ -3,6 +3,7 @@
 #include "bake/transfer.h"
 #include "bake/color.h"
 #include "bake/level_store.h"
+#include "bake/lighting.h"
 #include "bake/png_check.h"
 #include "bake/unwrap/atlas_raster.h"
 #include "common/parallel.h"
@@ -78,7 +79,8 @@ struct BandRaster {
 };
 
 // Rasterises `tri` (index t, chart `chart`) into the band. on_sample(texel index in band,
-// lambda) is called for each sub-sample inside the triangle. Returns sub-samples claimed twice.
+// lambda, sub-sample index) is called for each sub-sample inside the triangle. Returns sub-samples
+// claimed twice.
 template <class OnSample>
 uint64_t raster_triangle(const RasterTriangle& tri, int32_t t, int32_t chart, BandRaster& band,
                          const std::vector<std::array<double, 2>>& pattern, uint32_t height,
@@ -101,7 +103,7 @@ uint64_t raster_triangle(const RasterTriangle& tri, int32_t t, int32_t chart, Ba
       band.claimed[i] |= uint16_t(1u << s);
       band.inside[i]++;
       any = true;
-      on_sample(i, lambda);
+      on_sample(i, lambda, uint32_t(s));
     }
     double d = any ? 0.0 : tri.distance2_to(x + 0.5, y + 0.5);
     if (d < band.best_dist[i]) band.best_dist[i] = d, band.best_tri[i] = t;
@@ -135,8 +137,9 @@ struct PrimInfo {
   const scene::Primitive* prim = nullptr;
   const scene::Material* mat = nullptr;
   int atlas_set = 0;
-  std::vector<Vec3> normals;   // given or area-weighted from faces
-  std::vector<Vec4> tangents;  // for the normal map's UV set: given or computed
+  std::vector<Vec3> normals;             // given or area-weighted from faces
+  std::vector<Vec4> tangents;            // for the normal map's UV set: given or computed
+  scene::Mat4 world = scene::kIdentity;  // its mesh's (first) instance: where the lights see it
 };
 
 // Per-triangle quantities for material evaluation.
@@ -146,12 +149,15 @@ struct TriEval {
   std::vector<std::array<double, 4>> duv;  // per UV set: ds/dx, dt/dx, ds/dy, dt/dy per texel
   Vec3d dpdx, dpdy;                        // object-space position per atlas texel
   Vec3d face_normal;
+  // Lighting: the triangle in world space (its own winding) and a texel's world size there.
+  Vec3d world_normal;
+  double footprint = 0;
 };
 
 // The layers transfer fills. Accumulators, samples and want_ are indexed by a layer's slot,
 // never by LayerSemantic's value; the result lists layers in slot order, which must be
 // LayerSemantic order (transfer.h promises it; checked below).
-enum Slot { kAlbedoSlot, kNormalSlot, kOrmSlot, kEmissiveSlot, kSlots };
+enum Slot { kAlbedoSlot, kNormalSlot, kOrmSlot, kEmissiveSlot, kLightingSlot, kSlots };
 struct SlotInfo {
   LayerSemantic semantic;
   uint32_t channels;  // accumulated (albedo keeps alpha until the texels show it is not needed)
@@ -159,7 +165,8 @@ struct SlotInfo {
 constexpr SlotInfo kSlotInfo[kSlots] = {{LayerSemantic::kAlbedo, 4},
                                         {LayerSemantic::kNormal, 3},
                                         {LayerSemantic::kOrm, 3},
-                                        {LayerSemantic::kEmissive, 3}};
+                                        {LayerSemantic::kEmissive, 3},
+                                        {LayerSemantic::kLighting, 3}};  // 4 with AO
 constexpr bool slots_in_semantic_order() {
   for (int l = 1; l < kSlots; ++l)
     if (!(kSlotInfo[l - 1].semantic < kSlotInfo[l].semantic)) return false;
@@ -172,6 +179,7 @@ struct Sample {
   float normal[3];
   float orm[3];
   float emissive[3];
+  float lighting[4];
   const float* of(int slot) const {
     switch (slot) {
       case kAlbedoSlot:
@@ -180,11 +188,28 @@ struct Sample {
         return normal;
       case kOrmSlot:
         return orm;
-      default:
+      case kEmissiveSlot:
         return emissive;
+      default:
+        return lighting;
     }
   }
 };
+
+// Object space to world space: a point, and a direction through the linear part (a normal by
+// the inverse transpose unless `as_normal` is false), unit length unless it collapses.
+Vec3d world_point(const scene::Mat4& m, const Vec3d& p) {
+  return {m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12],
+          m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
+          m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14]};
+}
+Vec3d world_vector(const scene::Mat4& m, const Vec3d& v, bool as_normal = true) {
+  if (!as_normal)
+    return {m[0] * v.x + m[4] * v.y + m[8] * v.z, m[1] * v.x + m[5] * v.y + m[9] * v.z,
+            m[2] * v.x + m[6] * v.y + m[10] * v.z};
+  const auto d = scene::transform_direction(m, {float(v.x), float(v.y), float(v.z)});
+  return {d[0], d[1], d[2]};
+}
 
 Vec3d lerp3(const std::vector<Vec3>& a, const uint32_t v[3], const double l[3]) {
   return v3(a[v[0]]) * l[0] + v3(a[v[1]]) * l[1] + v3(a[v[2]]) * l[2];
@@ -293,7 +318,7 @@ class Transfer {
   bool sample_texture(OIIO::TextureSystem::Perthread* pt, const scene::TextureRef& ref,
                       const TriEval& te, const double l[3], float out[4]) const;
   void evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, const double l[3],
-                Sample& s) const;
+                uint64_t seed, Sample& s) const;
   void make_eval(uint32_t t, TriEval& te) const;
   void transfer_rows(uint32_t r0, uint32_t r1, std::vector<float> (&acc)[kSlots],
                      std::vector<uint8_t>& coverage, RowCounts& counts,
@@ -316,7 +341,9 @@ class Transfer {
   std::vector<int32_t> chart_;                          // per triangle
   std::vector<std::pair<uint32_t, uint32_t>> tri_src_;  // (prim info, face)
   scene::Material default_material_;
-  bool want_[kSlots] = {};  // by slot
+  bool want_[kSlots] = {};          // by slot
+  uint32_t channels_[kSlots] = {};  // accumulated channels by slot (kSlotInfo; lighting: + AO)
+  std::unique_ptr<LightingBaker> lighting_;  // only when the scene has lights
   double sub_scale_ = 1.0;
   mutable std::atomic<bool> lookup_failed_{false};
   mutable std::mutex error_mutex_;
@@ -468,6 +495,12 @@ Status Transfer::check_missing_textures() {
 
 Status Transfer::setup_prims() {
   VT_RETURN_IF_ERROR(check_texcoord_sets(scene_));
+  // Lighting sees each mesh where its first instance puts it (an unwrapped scene gives every
+  // instance a mesh of its own); a mesh no node shows stays where it is.
+  std::vector<const scene::Mat4*> mesh_world(scene_.meshes.size(), nullptr);
+  const std::vector<scene::Instance> instances = scene_.instances();
+  for (const scene::Instance& inst : instances)
+    if (!mesh_world[inst.mesh]) mesh_world[inst.mesh] = &inst.world;
   bool any_normal = false, any_orm = false, any_emissive = false;
   for (size_t m = 0; m < scene_.meshes.size(); ++m) {
     const scene::Mesh& mesh = scene_.meshes[m];
@@ -489,6 +522,7 @@ Status Transfer::setup_prims() {
                      where + ": material " + std::to_string(p.material) + " does not exist");
       }
       info.mat = p.material >= 0 ? &scene_.materials[p.material] : &default_material_;
+      if (mesh_world[m]) info.world = *mesh_world[m];
       const scene::Material& mat = *info.mat;
       for (uint32_t idx : p.indices) {
         if (idx >= p.positions.size())
@@ -510,6 +544,12 @@ Status Transfer::setup_prims() {
   want_[kNormalSlot] = any_normal;
   want_[kOrmSlot] = any_orm;
   want_[kEmissiveSlot] = any_emissive;
+  want_[kLightingSlot] = scene_has_lights(scene_);
+  for (int l = 0; l < kSlots; ++l) channels_[l] = kSlotInfo[l].channels;
+  if (want_[kLightingSlot]) {
+    VT_ASSIGN_OR_RETURN(lighting_, LightingBaker::create(scene_, opt_.lighting, opt_.threads));
+    channels_[kLightingSlot] = lighting_->channels();
+  }
   return setup_raster();
 }
 
@@ -575,6 +615,14 @@ void Transfer::make_eval(uint32_t t, TriEval& te) const {
   grad(P0.y, P1.y, P2.y, te.dpdx.y, te.dpdy.y);
   grad(P0.z, P1.z, P2.z, te.dpdx.z, te.dpdy.z);
   te.face_normal = normalized(cross(P1 - P0, P2 - P0), {0, 0, 1});
+  if (want_[kLightingSlot]) {
+    const scene::Mat4& w = pi.world;
+    auto point = [&](uint32_t k) { return world_point(w, v3(p.positions[p.indices[3 * f + k]])); };
+    const Vec3d A = point(0), B = point(1), C = point(2);
+    te.world_normal = normalized(cross(B - A, C - A), world_vector(w, te.face_normal));
+    te.footprint =
+        std::max(length(world_vector(w, te.dpdx, false)), length(world_vector(w, te.dpdy, false)));
+  }
 }
 
 bool Transfer::sample_texture(OIIO::TextureSystem::Perthread* pt, const scene::TextureRef& ref,
@@ -629,7 +677,7 @@ bool Transfer::sample_texture(OIIO::TextureSystem::Perthread* pt, const scene::T
 }
 
 void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, const double l[3],
-                        Sample& s) const {
+                        uint64_t seed, Sample& s) const {
   const scene::Material& m = *te.p->mat;
   const scene::Primitive& p = *te.p->prim;
   float tex[4];
@@ -666,10 +714,11 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
     }
     s.orm[0] = occ, s.orm[1] = rough, s.orm[2] = metal;
   }
-  if (want_[kNormalSlot]) {
+  if (want_[kNormalSlot] || want_[kLightingSlot]) {
     Vec3d n = normalized(lerp3(te.p->normals, te.v, l), te.face_normal);
     Vec3d world = n;
-    if (m.normal_texture.valid() && sample_texture(pt, m.normal_texture, te, l, tex)) {
+    if (want_[kNormalSlot] && m.normal_texture.valid() &&
+        sample_texture(pt, m.normal_texture, te, l, tex)) {
       const auto& tg = te.p->tangents;
       Vec3d t = {tg[te.v[0]][0] * l[0] + tg[te.v[1]][0] * l[1] + tg[te.v[2]][0] * l[2],
                  tg[te.v[0]][1] * l[0] + tg[te.v[1]][1] * l[1] + tg[te.v[2]][1] * l[2],
@@ -694,6 +743,15 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
     s.normal[0] = float(dot(world, ta));
     s.normal[1] = float(dot(world, ba));
     s.normal[2] = float(dot(world, n));
+    if (want_[kLightingSlot]) {
+      LightingSample ls;
+      ls.position = world_point(te.p->world, lerp3(te.p->prim->positions, te.v, l));
+      ls.geometric_normal = te.world_normal;
+      ls.shading_normal = normalized(world_vector(te.p->world, world), te.world_normal);
+      ls.footprint = te.footprint;
+      ls.seed = seed;
+      lighting_->evaluate(ls, s.lighting);
+    }
   }
 }
 
@@ -703,7 +761,7 @@ void Transfer::finish_rows(std::vector<float> (&acc)[kSlots], const uint8_t* cov
   for (int l = 0; l < kSlots; ++l) {
     if (!want_[l]) continue;
     LayerFacts& f = facts[l];
-    const uint32_t channels = kSlotInfo[l].channels;
+    const uint32_t channels = channels_[l];
     if (l == kNormalSlot) {
       for (size_t i = 0; i < n; ++i) {
         float* v = &acc[l][3 * i];
@@ -713,8 +771,9 @@ void Transfer::finish_rows(std::vector<float> (&acc)[kSlots], const uint8_t* cov
       }
       continue;
     }
-    // Channels 0-2 of albedo are colour, 3 is alpha (counted before alpha is dropped).
-    const uint32_t counted = l == kAlbedoSlot ? 3 : channels;
+    // Channels 0-2 of albedo are colour, 3 is alpha (counted before alpha is dropped); those
+    // of lighting are irradiance, 3 is AO.
+    const uint32_t counted = l == kAlbedoSlot || l == kLightingSlot ? 3 : channels;
     for (size_t i = 0; i < n; ++i) {
       const float* v = &acc[l][i * channels];
       for (uint32_t c = 0; c < counted; ++c) f.hdr |= v[c] > 1.0f;
@@ -737,10 +796,10 @@ std::vector<TransferLayer> Transfer::make_layers(std::shared_ptr<LevelStore> (&s
     const LayerFacts& f = facts[l];
     TransferLayer layer;
     layer.semantic = kSlotInfo[l].semantic;
-    layer.channels = kSlotInfo[l].channels;
+    layer.channels = channels_[l];
     layer.texels_above_one = f.texels_above_one;
     layer.max_value = f.max_value;
-    layer.hdr = l != kNormalSlot && f.hdr;
+    layer.hdr = (l != kNormalSlot && f.hdr) || l == kLightingSlot;  // lighting: half always
     if (l == kAlbedoSlot) {
       layer.hdr |= f.alpha && f.alpha_hdr;
       if (!f.alpha) layer.channels = 3;
@@ -772,7 +831,7 @@ void Transfer::transfer_rows(uint32_t r0, uint32_t r1, std::vector<float> (&acc)
   auto store = [&](size_t texel, const Sample& s, float weight, bool add) {
     for (int l = 0; l < kSlots; ++l) {
       if (!want_[l]) continue;
-      const uint32_t channels = kSlotInfo[l].channels;
+      const uint32_t channels = channels_[l];
       const float* src = s.of(l);
       float* d = &acc[l][texel * channels];
       for (uint32_t c = 0; c < channels; ++c) d[c] = add ? d[c] + src[c] * weight : src[c];
@@ -793,8 +852,8 @@ void Transfer::transfer_rows(uint32_t r0, uint32_t r1, std::vector<float> (&acc)
     for (uint32_t t : bins_[b]) {
       make_eval(t, te);
       raster_triangle(tris_[t], int32_t(t), chart_[t], band, pattern, H,
-                      [&](size_t i, const double* l) {
-                        evaluate(pt, te, l, s);
+                      [&](size_t i, const double* l, uint32_t sub) {
+                        evaluate(pt, te, l, (uint64_t(y0) * W + i) * 32 + sub, s);
                         store(base + i, s, weight, true);
                         ++n_samples;
                       });
@@ -812,7 +871,7 @@ void Transfer::transfer_rows(uint32_t r0, uint32_t r1, std::vector<float> (&acc)
         if (scale != 1.0f) {
           for (int l = 0; l < kSlots; ++l) {
             if (!want_[l]) continue;
-            const uint32_t channels = kSlotInfo[l].channels;
+            const uint32_t channels = channels_[l];
             for (uint32_t c = 0; c < channels; ++c) acc[l][texel * channels + c] *= scale;
           }
         }
@@ -824,7 +883,7 @@ void Transfer::transfer_rows(uint32_t r0, uint32_t r1, std::vector<float> (&acc)
       make_eval(t, te);
       double l[3];
       tris_[t].closest_barycentrics((i % W) + 0.5, (y0 + i / W) + 0.5, l);
-      evaluate(pt, te, l, s);
+      evaluate(pt, te, l, (uint64_t(y0) * W + i) * 32 + 16, s);
       store(texel, s, 1.0f, false);
       ++n_samples;
     }
@@ -841,7 +900,7 @@ uint32_t Transfer::rows_per_pass() const {
   if (rows == 0) {
     uint64_t per_row = 0;
     for (int l = 0; l < kSlots; ++l)
-      if (want_[l]) per_row += uint64_t(opt_.width) * kSlotInfo[l].channels * sizeof(float);
+      if (want_[l]) per_row += uint64_t(opt_.width) * channels_[l] * sizeof(float);
     rows = opt_.band_memory / std::max<uint64_t>(per_row, 1);
   }
   rows = std::max<uint64_t>(kBandRows, rows / kBandRows * kBandRows);
@@ -868,8 +927,8 @@ Expected<TransferResult> Transfer::run() {
   std::shared_ptr<LevelStore> stores[kSlots];
   for (int l = 0; l < kSlots; ++l) {
     if (!want_[l]) continue;
-    VT_ASSIGN_OR_RETURN(stores[l], LevelStore::create(W, H, kSlotInfo[l].channels,
-                                                      opt_.stores_in_memory, opt_.scratch_dir));
+    VT_ASSIGN_OR_RETURN(
+        stores[l], LevelStore::create(W, H, channels_[l], opt_.stores_in_memory, opt_.scratch_dir));
   }
   auto coverage = std::make_shared<std::vector<uint8_t>>(size_t(W) * H, 0);
   bins_ = bin_by_rows(tris_, H, kBandRows);
@@ -881,7 +940,7 @@ Expected<TransferResult> Transfer::run() {
     const uint32_t r1 = std::min(H, r0 + pass);
     const size_t n = size_t(r1 - r0) * W;
     for (int l = 0; l < kSlots; ++l)
-      if (want_[l]) acc[l].assign(n * kSlotInfo[l].channels, 0.0f);
+      if (want_[l]) acc[l].assign(n * channels_[l], 0.0f);
     std::function<void(double)> progress;
     if (opt_.progress)
       progress = [&](double f) { opt_.progress((double(r0) + f * double(r1 - r0)) / double(H)); };
@@ -905,6 +964,7 @@ Expected<TransferResult> Transfer::run() {
   result.stats.covered_texels = counts.sampled + counts.edge_only;
   result.stats.contested_texels = counts.contested;
   result.stats.samples = counts.samples;
+  if (lighting_) result.stats.lighting = lighting_->stats();
   result.stats.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
@@ -997,6 +1057,7 @@ std::vector<LayerSemantic> layers_used(const scene::Scene& scene) {
   if (normal) out.push_back(LayerSemantic::kNormal);
   if (orm) out.push_back(LayerSemantic::kOrm);
   if (emissive) out.push_back(LayerSemantic::kEmissive);
+  if (scene_has_lights(scene)) out.push_back(LayerSemantic::kLighting);
   return out;
 }
 
@@ -1033,8 +1094,9 @@ AtlasRaster rasterize_atlas(const std::vector<std::array<double, 6>>& triangles,
     uint32_t y0 = b * kBandRows, y1 = std::min(height, y0 + kBandRows);
     band.reset(width, y0, y1);
     for (uint32_t t : bins[b]) {
-      out.double_sampled += raster_triangle(tris[t], int32_t(t), t < chart.size() ? chart[t] : 0,
-                                            band, pattern, height, [](size_t, const double*) {});
+      out.double_sampled +=
+          raster_triangle(tris[t], int32_t(t), t < chart.size() ? chart[t] : 0, band, pattern,
+                          height, [](size_t, const double*, uint32_t) {});
     }
     for (size_t i = 0; i < band.best_tri.size(); ++i) {
       out.owner[size_t(y0) * width + i] = band.best_tri[i];

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "bake/lighting.h"
 #include "common/status.h"
 #include "format/page_file.h"
 #include "scene/scene.h"
@@ -68,19 +69,23 @@ struct TransferOptions {
   // Base colour and emissive textures are converted from their colour space (file rules,
   // metadata, else sRGB/float linear) to this config's working space. Null = built-in config.
   std::shared_ptr<const ColorConfig> color_config;
+  // The lighting layer, baked when the scene places a light (bake/lighting.h).
+  LightingOptions lighting;
   std::function<void(double fraction)> progress;  // from the calling thread, 0..1
 };
 
 struct TransferLayer {
   LayerSemantic semantic = LayerSemantic::kAlbedo;
-  uint32_t channels = 0;  // albedo 3 or 4 (alpha only if a texel is not opaque), normal 3, ...
-  bool hdr = false;       // some value is above 1 (emissive or linear EXR sources)
+  // albedo 3 or 4 (alpha only if a texel is not opaque), normal 3, ..., lighting 3 (+ AO)
+  uint32_t channels = 0;
+  bool hdr = false;  // some value is above 1 (emissive or linear EXR sources)
   // Covered texels with a colour or data channel above 1 (alpha and normals excluded), and
   // the largest such value: what an 8-bit layer clips.
   uint64_t texels_above_one = 0;
   float max_value = 0;
   // width * height * channels floats. Albedo/emissive: linear RGB(A), not premultiplied.
   // ORM: occlusion, roughness, metallic. Normal: unit xyz in the atlas tangent frame.
+  // Lighting: irradiance RGB (lux), then AO in [0, 1] when asked. Always hdr.
   // Uncovered texels are 0 (the build dilates them away).
   std::vector<float> texels;
   // transfer_to_stores: the texels in a store instead (memory or scratch file). An albedo store
@@ -95,6 +100,7 @@ struct TransferStats {
   uint64_t edge_only_texels = 0;  // covered conservatively only (closest-point value)
   uint64_t contested_texels = 0;  // touched by two charts (0 when the atlas has a gutter)
   uint64_t samples = 0;           // material evaluations
+  LightingStats lighting;         // the lighting layer's samples and rays (none: all 0)
   double seconds = 0;
 };
 
@@ -144,7 +150,8 @@ Status check_scene_textures(const scene::Scene& scene);
 
 // Which layers the materials of `scene` call for: albedo always; normal if some material has a
 // normal map; ORM if some material has a metallic-roughness or occlusion texture or factors
-// other than glTF's defaults; emissive if some material emits. (Alpha is decided by texels.)
+// other than glTF's defaults; emissive if some material emits; lighting if a displayed node
+// places a light. (Alpha is decided by texels.)
 std::vector<LayerSemantic> layers_used(const scene::Scene& scene);
 
 // Transfers the materials of an unwrapped scene (meshes carrying atlas UVs in [0,1], glTF

@@ -90,6 +90,15 @@ void add_scene(KeyStream& k, const scene::Scene& s) {
     k.add(n.name), k.add(n.local), k.add(n.mesh), k.add(n.children), k.add(n.texels_per_unit);
   }
   k.add(s.roots);
+  // Lights only when some node places one: the keys of light-less bakes stay as they were.
+  if (scene_has_lights(s)) {
+    k.add(uint64_t(s.lights.size()));
+    for (const scene::Light& l : s.lights) {
+      k.add(l.name), k.add(l.type), k.add(l.color), k.add(l.intensity), k.add(l.range);
+      k.add(l.inner_cone_angle), k.add(l.outer_cone_angle);
+    }
+    for (const scene::Node& n : s.nodes) k.add(n.light);
+  }
 }
 
 // Every option that decides the output's bytes; thread count and paths do not.
@@ -123,6 +132,10 @@ Expected<uint64_t> scene_bake_key(const scene::Scene& scene, const SceneBakeOpti
   k.add(std::string(VTBAKE_VERSION));
   add_options(k, options);
   add_scene(k, scene);
+  if (scene_has_lights(scene)) {
+    const LightingOptions& l = options.lighting;
+    k.add(l.shadows), k.add(l.ao_samples), k.add(l.ao_distance);
+  }
   // The density file the unwrap reads (the scene's NAME.density.json unless one is named).
   std::string density = options.unwrap.density_file == "-" ? "" : options.unwrap.density_file;
   if (options.unwrap.density_file.empty())

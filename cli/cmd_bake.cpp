@@ -117,6 +117,13 @@ void print_summary(const vt::SceneBakeSummary& s) {
               (unsigned long long)s.triangles, (unsigned long long)s.transfer.covered_texels,
               (unsigned long long)s.transfer.edge_only_texels,
               (unsigned long long)s.transfer.contested_texels);
+  if (const vt::LightingStats& l = s.transfer.lighting; l.samples > 0) {
+    std::printf(
+        "  lighting   %llu samples, %llu shadow rays, %llu AO rays, structure %.1f MiB "
+        "built in %.2f s\n",
+        (unsigned long long)l.samples, (unsigned long long)l.shadow_rays,
+        (unsigned long long)l.ao_rays, double(l.bvh_bytes) / (1 << 20), l.build_seconds);
+  }
   std::printf("  layers    ");
   for (const auto& l : s.build.layers) {
     std::printf(" %s(%u ch, %s", l.name.c_str(), unsigned(l.spec.channels),
@@ -300,6 +307,18 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
          "A texture that cannot be read: error (default: fail naming the material, slot and "
          "path) or warn (bake the slot from its factor alone and list the miss)")
       ->default_str("error");
+  app.add_option("--ao-samples", o.lighting.ao_samples,
+                 "Ambient occlusion rays per texel sample, cosine-weighted, into the lighting "
+                 "layer's 4th channel (0 = none; baked only when the scene has lights)")
+      ->check(CLI::Range(0, 65536))
+      ->default_val(0);
+  app.add_option("--ao-distance", o.lighting.ao_distance,
+                 "How far an AO ray looks, in world units (0 = the scene's bounding-box diagonal)")
+      ->check(CLI::NonNegativeNumber)
+      ->default_val(0);
+  app.add_flag(
+      "--no-shadows", [&o](int64_t) { o.lighting.shadows = false; },
+      "Lighting without shadow rays: every light reaches every texel facing it");
   vt::cli::add_scene_load_flags(app, o.load);
   vt::cli::add_unwrap_flags(app, o.unwrap);
   vt::cli::add_build_flags(app, o.build);

@@ -15,6 +15,8 @@ const char* to_string(LayerSemantic v) {
       return "emissive";
     case LayerSemantic::kCustom:
       return "custom";
+    case LayerSemantic::kLighting:
+      return "lighting";
   }
   return "unknown";
 }

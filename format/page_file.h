@@ -21,7 +21,8 @@ enum class LayerSemantic : uint8_t {
   kNormal = 1,
   kOrm = 2,
   kEmissive = 3,
-  kCustom = 4
+  kCustom = 4,
+  kLighting = 5,  // baked irradiance (HDR): added after custom, so earlier files read the same
 };
 
 // Storage type of one texel channel.

@@ -71,7 +71,8 @@ class AssimpScene {
     if (boned_meshes_ > 0)
       warn(std::to_string(boned_meshes_) + " skinned meshes baked in their bind pose");
     if (ai_.mNumLights > 0)
-      warn(std::to_string(ai_.mNumLights) + " lights ignored (lighting is not baked yet)");
+      warn(std::to_string(ai_.mNumLights) +
+           " lights ignored (only glTF KHR_lights_punctual lights are baked)");
     return std::move(scene_);
   }
 

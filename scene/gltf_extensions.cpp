@@ -30,8 +30,8 @@ constexpr ExtensionRule kExtensions[] = {
     {"KHR_materials_emissive_strength", Support::kRead, ""},
     {"KHR_mesh_quantization", Support::kRead, ""},
     {"EXT_meshopt_compression", Support::kRead, ""},
-    {"EXT_texture_webp", Support::kRead, ""},  // OpenImageIO reads WebP
-    {"KHR_lights_punctual", Support::kIgnored, "lighting is not baked yet"},
+    {"EXT_texture_webp", Support::kRead, ""},     // OpenImageIO reads WebP
+    {"KHR_lights_punctual", Support::kRead, ""},  // baked into the lighting layer
     {"EXT_lights_image_based", Support::kIgnored, "lighting is not baked yet"},
     {"KHR_materials_pbrSpecularGlossiness", Support::kIgnored,
      "diffuse is baked as base colour (metallic 0, roughness 1 - glossiness) where a material "
@@ -83,14 +83,6 @@ const ExtensionRule* find_rule(const std::string& name) {
   return nullptr;
 }
 
-std::string lights_warning(const JsonFields& root) {
-  const json& ext = root.object("extensions").object("KHR_lights_punctual").raw();
-  auto it = ext.find("lights");
-  size_t n = it != ext.end() && it->is_array() ? it->size() : 0;
-  return std::to_string(n) + (n == 1 ? " light" : " lights") +
-         " ignored (lighting is not baked yet)";
-}
-
 }  // namespace
 
 std::string gltf_version_text(const json& doc) {
@@ -137,7 +129,7 @@ Status check_version(const Gltf& g, Warnings* warnings) {
 Status check_required_extensions(const JsonFields& root) {
   for (const std::string& name : root.strings("extensionsRequired")) {
     const ExtensionRule* rule = find_rule(name);
-    bool ok = rule && (rule->support == Support::kRead || name == "KHR_lights_punctual");
+    bool ok = rule && rule->support == Support::kRead;
     if (!ok)
       return Error(ErrorCode::kUnsupported,
                    root.errors()->gltf().path + ": required extension " + name +
@@ -152,7 +144,6 @@ void warn_about_extensions(const JsonFields& root, const ExtensionUses& material
   std::vector<std::string> names = root.strings("extensionsUsed");
   for (const std::string& n : root.strings("extensionsRequired")) names.push_back(n);
   for (const auto& [name, count] : material_uses) names.push_back(name);
-  if (root.object("extensions").has("KHR_lights_punctual")) names.push_back("KHR_lights_punctual");
   std::sort(names.begin(), names.end());
   names.erase(std::unique(names.begin(), names.end()), names.end());
   const std::string& path = root.errors()->gltf().path;
@@ -161,9 +152,7 @@ void warn_about_extensions(const JsonFields& root, const ExtensionUses& material
     if (rule && rule->support != Support::kIgnored) continue;
     std::string line = path + ": " + name + ": ";
     auto uses = material_uses.find(name);
-    if (name == "KHR_lights_punctual")
-      line += lights_warning(root);
-    else if (!rule)
+    if (!rule)
       line += "not known to vtbake; ignored";
     else
       line += rule->instead;

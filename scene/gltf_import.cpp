@@ -116,6 +116,7 @@ Expected<Scene> load_document(Gltf& g, std::vector<uint8_t>* glb_bin) {
   scene.materials = load_materials(root, &uses, &warnings);
   VT_RETURN_IF_ERROR(errors.status());
   VT_RETURN_IF_ERROR(load_nodes(root, &scene));
+  VT_RETURN_IF_ERROR(load_lights(root, &scene));
   warn_about_extensions(root, uses, &warnings);
   VT_RETURN_IF_ERROR(errors.status());
   VT_RETURN_IF_ERROR(load_buffers(&g, glb_bin));

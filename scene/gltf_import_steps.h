@@ -44,4 +44,8 @@ double density_extra(const JsonFields& object);
 // Nodes and the displayed scene's roots; the graph must be a forest.
 Status load_nodes(const JsonFields& root, Scene* scene);
 
+// KHR_lights_punctual lights (checked with check_light) and the nodes that place them; after
+// load_nodes.
+Status load_lights(const JsonFields& root, Scene* scene);
+
 }  // namespace vt::scene::detail

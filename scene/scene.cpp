@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <initializer_list>
 #include <string>
 
@@ -69,15 +70,32 @@ std::array<double, 3> transform_direction(const Mat4& m, const Vec3& d) {
   return out;
 }
 
-std::vector<Instance> Scene::instances() const {
-  std::vector<Instance> result;
+std::array<double, 3> transform_vector(const Mat4& m, const Vec3& d) {
+  std::array<double, 3> out;
+  for (int i = 0; i < 3; ++i) out[i] = m[i] * d[0] + m[4 + i] * d[1] + m[8 + i] * d[2];
+  double len = std::sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2]);
+  if (len > 0 && std::isfinite(len))
+    for (double& v : out) v /= len;
+  else
+    out = {0, 0, 0};
+  return out;
+}
+
+namespace {
+
+// Calls visit(node index, world matrix) for every node below `roots`, depth first, once each
+// (a node reached twice or a cycle is visited once).
+template <class Visit>
+void walk_nodes(const Scene& scene, Visit&& visit) {
+  const std::vector<Node>& nodes = scene.nodes;
   std::vector<char> visited(nodes.size(), 0);
   struct Item {
     int node;
     Mat4 parent;
   };
   std::vector<Item> stack;
-  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, kIdentity});
+  for (auto it = scene.roots.rbegin(); it != scene.roots.rend(); ++it)
+    stack.push_back({*it, kIdentity});
   while (!stack.empty()) {
     Item item = stack.back();
     stack.pop_back();
@@ -86,12 +104,60 @@ std::vector<Instance> Scene::instances() const {
     visited[item.node] = 1;
     const Node& node = nodes[item.node];
     Mat4 world = multiply(item.parent, node.local);
-    if (node.mesh >= 0 && node.mesh < static_cast<int>(meshes.size()))
-      result.push_back({node.mesh, item.node, world});
+    visit(item.node, world);
     for (auto it = node.children.rbegin(); it != node.children.rend(); ++it)
       stack.push_back({*it, world});
   }
+}
+
+}  // namespace
+
+std::vector<Instance> Scene::instances() const {
+  std::vector<Instance> result;
+  walk_nodes(*this, [&](int n, const Mat4& world) {
+    const int mesh = nodes[n].mesh;
+    if (mesh >= 0 && mesh < static_cast<int>(meshes.size())) result.push_back({mesh, n, world});
+  });
   return result;
+}
+
+std::vector<PlacedLight> Scene::placed_lights() const {
+  std::vector<PlacedLight> result;
+  walk_nodes(*this, [&](int n, const Mat4& world) {
+    const int light = nodes[n].light;
+    if (light < 0 || light >= static_cast<int>(lights.size())) return;
+    PlacedLight p;
+    p.light = light, p.node = n;
+    p.position = {world[12], world[13], world[14]};
+    p.direction = transform_vector(world, {0, 0, -1});
+    result.push_back(p);
+  });
+  return result;
+}
+
+Status check_light(const Light& l) {
+  auto bad = [](const std::string& what) { return Error(ErrorCode::kInvalidArgument, what); };
+  auto num = [](double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", v);
+    return std::string(b);
+  };
+  for (float c : l.color)
+    if (!std::isfinite(c) || c < 0) return bad("color component " + num(c) + " is not >= 0");
+  if (!std::isfinite(l.intensity) || l.intensity < 0)
+    return bad("intensity " + num(l.intensity) + " is not a number >= 0");
+  if (l.type == LightType::kDirectional) return Status::Ok();
+  if (!(l.range > 0)) return bad("range " + num(l.range) + " is not > 0");
+  if (l.type != LightType::kSpot) return Status::Ok();
+  const double kHalfPi = 1.57079632679489661923;
+  if (!std::isfinite(l.inner_cone_angle) || l.inner_cone_angle < 0)
+    return bad("innerConeAngle " + num(l.inner_cone_angle) + " is not >= 0");
+  if (!std::isfinite(l.outer_cone_angle) || l.outer_cone_angle > kHalfPi + 1e-6)
+    return bad("outerConeAngle " + num(l.outer_cone_angle) + " is not <= pi / 2");
+  if (!(l.inner_cone_angle < l.outer_cone_angle))
+    return bad("innerConeAngle " + num(l.inner_cone_angle) + " is not below outerConeAngle " +
+               num(l.outer_cone_angle));
+  return Status::Ok();
 }
 
 size_t Scene::triangle_count() const {

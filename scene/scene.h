@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -111,10 +112,36 @@ struct Mesh {
   std::vector<Primitive> primitives;
 };
 
+// A KHR_lights_punctual light, in the extension's units. It shines down its node's -Z axis
+// (directional, spot) from its node's origin (point, spot).
+enum class LightType { kDirectional, kPoint, kSpot };
+struct Light {
+  std::string name;
+  LightType type = LightType::kPoint;
+  Vec3 color = {1, 1, 1};  // linear RGB, multiplies the intensity
+  // Directional: illuminance in lux (lm/m^2) on a surface facing the light. Point and spot:
+  // luminous intensity in candela (lm/sr).
+  float intensity = 1;
+  // Point and spot: the distance at which the light reaches zero through the extension's
+  // window clamp(1 - (d / range)^4, 0, 1) / d^2; infinity = unlimited (plain 1 / d^2).
+  float range = std::numeric_limits<float>::infinity();
+  float inner_cone_angle = 0;                        // spot: radians from the axis, full light
+  float outer_cone_angle = 0.78539816339744830962f;  // spot: radians, no light beyond (pi / 4)
+};
+
+// A light where its node puts it in the world.
+struct PlacedLight {
+  int light = -1;  // index into Scene::lights
+  int node = -1;
+  std::array<double, 3> position = {0, 0, 0};    // the node's world origin
+  std::array<double, 3> direction = {0, 0, -1};  // unit: where the light travels (node -Z)
+};
+
 struct Node {
   std::string name;
   Mat4 local = kIdentity;  // transform relative to the parent
   int mesh = -1;           // index into Scene::meshes, -1 = none
+  int light = -1;          // index into Scene::lights, -1 = none
   std::vector<int> children;
   // Atlas density of its subtree (glTF extras.vtbake_texels_per_unit); 0 = inherited.
   double texels_per_unit = 0;
@@ -133,15 +160,19 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<Image> images;
   std::vector<Node> nodes;
-  std::vector<int> roots;  // nodes of the displayed scene
+  std::vector<int> roots;     // nodes of the displayed scene
+  std::vector<Light> lights;  // KHR_lights_punctual (placed by nodes)
   // What the importer ignored or repaired, one line each, naming the file and the feature
-  // (e.g. "a.gltf: KHR_lights_punctual: 3 lights ignored (lighting is not baked)"). The CLI
+  // (e.g. "a.gltf: KHR_materials_sheen: sheen is not baked; the base layer is"). The CLI
   // prints them as warnings and the bake summary lists them.
   std::vector<std::string> warnings;
 
   // Every mesh instance in the node hierarchy below `roots`, depth first, with world matrices.
   // A node reached twice or a cycle is visited once (cycles are broken, never followed).
   std::vector<Instance> instances() const;
+  // Every light a node below `roots` places, in the same order, with world position and
+  // direction. Lights no displayed node names light nothing.
+  std::vector<PlacedLight> placed_lights() const;
   size_t triangle_count() const;  // over meshes (not instances)
 };
 
@@ -173,5 +204,13 @@ Status save_glb(const Scene& scene, const std::string& path);
 Mat4 multiply(const Mat4& a, const Mat4& b);
 std::array<double, 3> transform_point(const Mat4& m, const Vec3& p);
 std::array<double, 3> transform_direction(const Mat4& m, const Vec3& d);  // inverse-transpose
+// The linear part applied to a vector and normalised (a direction carried by the transform,
+// not a normal); {0, 0, 0} when the matrix collapses it.
+std::array<double, 3> transform_vector(const Mat4& m, const Vec3& d);
+
+// Checks a light's values against KHR_lights_punctual: finite, colour and intensity >= 0,
+// range > 0 (or infinity), spot 0 <= inner < outer <= pi / 2. The message names the field
+// ("intensity -2 is negative"); the importers add the file and the light.
+Status check_light(const Light& light);
 
 }  // namespace vt::scene

@@ -7,7 +7,7 @@ packages=(
   build-essential cmake ninja-build pkg-config clang-format
   libopenimageio-dev openimageio-tools libopenexr-dev libopencolorio-dev
   libcgal-dev libeigen3-dev libtbb-dev libdraco-dev libmeshoptimizer-dev libassimp-dev
-  libzstd-dev libxxhash-dev zlib1g-dev
+  libzstd-dev libxxhash-dev zlib1g-dev libembree-dev
   libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libvulkan-dev glslc mesa-vulkan-drivers

@@ -4,6 +4,7 @@
 // checks, and typed errors that name the file and the field.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -160,16 +161,93 @@ TEST(GltfMaterials, EmissiveStrength) {
                "expected a non-negative number");
 }
 
-TEST(GltfMaterials, LightsAreAWarningEvenWhenRequired) {
+// KHR_lights_punctual, required as Blender writes it: read without a warning, in the
+// extension's units, placed by nodes (a node's world transform moves and turns its light).
+json lights_doc() {
   json doc = triangle_doc();
   doc["extensionsUsed"] = {"KHR_lights_punctual"};
   doc["extensionsRequired"] = {"KHR_lights_punctual"};
   doc["extensions"] = {
       {"KHR_lights_punctual",
-       {{"lights", {{{"type", "point"}}, {{"type", "spot"}}, {{"type", "sun"}}}}}}};
-  auto s = load("lights.gltf", doc);
-  ASSERT_NO_FATAL_FAILURE(expect_warnings(
-      s, "lights.gltf", {"KHR_lights_punctual: 3 lights ignored (lighting is not baked yet)"}));
+       {{"lights",
+         {{{"name", "Sun"}, {"type", "directional"}, {"intensity", 3}, {"color", {1, 0.5, 0.25}}},
+          {{"name", "Bulb"}, {"type", "point"}, {"intensity", 100}, {"range", 20}},
+          {{"name", "Cone"},
+           {"type", "spot"},
+           {"spot", {{"innerConeAngle", 0.25}, {"outerConeAngle", 0.5}}}}}}}}};
+  // Node "a" (the parent) moves by (1, 2, 3); node "c", its child, turns 90 degrees about +X
+  // (quaternion x = sin 45) and holds the spot; "b" holds the sun, "d" (not shown) the bulb.
+  doc["nodes"][0]["translation"] = {1, 2, 3};
+  doc["nodes"][0]["children"] = {1, 2};
+  doc["nodes"][1]["extensions"]["KHR_lights_punctual"]["light"] = 0;
+  doc["nodes"].push_back({{"name", "c"},
+                          {"rotation", {0.70710678, 0, 0, 0.70710678}},
+                          {"extensions", {{"KHR_lights_punctual", {{"light", 2}}}}}});
+  doc["nodes"].push_back(
+      {{"name", "d"}, {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
+  return doc;
+}
+
+TEST(GltfMaterials, LightsAreReadWithoutWarningEvenWhenRequired) {
+  auto s = load("lights.gltf", lights_doc());
+  ASSERT_NO_FATAL_FAILURE(expect_warnings(s, "lights.gltf", {}));
+  ASSERT_EQ(s->lights.size(), 3u);
+  const scene::Light& sun = s->lights[0];
+  EXPECT_EQ(sun.type, scene::LightType::kDirectional);
+  EXPECT_EQ(sun.intensity, 3.0f);
+  EXPECT_EQ(sun.color, (scene::Vec3{1, 0.5f, 0.25f}));
+  const scene::Light& bulb = s->lights[1];
+  EXPECT_EQ(bulb.type, scene::LightType::kPoint);
+  EXPECT_EQ(bulb.intensity, 100.0f);
+  EXPECT_EQ(bulb.range, 20.0f);
+  const scene::Light& cone = s->lights[2];
+  EXPECT_EQ(cone.type, scene::LightType::kSpot);
+  EXPECT_EQ(cone.intensity, 1.0f);  // the extension's default
+  EXPECT_TRUE(std::isinf(cone.range));
+  EXPECT_EQ(cone.inner_cone_angle, 0.25f);
+  EXPECT_EQ(cone.outer_cone_angle, 0.5f);
+
+  // Only displayed nodes place lights: "d" is in no scene.
+  std::vector<scene::PlacedLight> placed = s->placed_lights();
+  ASSERT_EQ(placed.size(), 2u);
+  EXPECT_EQ(placed[0].light, 0);
+  EXPECT_EQ(placed[0].position, (std::array<double, 3>{1, 2, 3}));
+  EXPECT_EQ(placed[0].direction, (std::array<double, 3>{0, 0, -1}));
+  EXPECT_EQ(placed[1].light, 2);
+  EXPECT_EQ(placed[1].position, (std::array<double, 3>{1, 2, 3}));
+  // -Z turned 90 degrees about +X points along +Y.
+  EXPECT_NEAR(placed[1].direction[0], 0, 1e-7);
+  EXPECT_NEAR(placed[1].direction[1], 1, 1e-7);
+  EXPECT_NEAR(placed[1].direction[2], 0, 1e-7);
+}
+
+TEST(GltfMaterials, BadLightValuesAreErrorsNamingTheLight) {
+  const char* kLights = "/extensions/KHR_lights_punctual/lights";
+  struct Case {
+    std::string pointer;
+    json value;
+    const char* part;
+  } cases[] = {
+      {"/1/intensity", -2, "lights[1] 'Bulb': intensity -2 is not a number >= 0"},
+      {"/0/color", {1, -1, 0}, "lights[0] 'Sun': color component -1 is not >= 0"},
+      {"/1/range", 0, "lights[1] 'Bulb': range 0 is not > 0"},
+      {"/1/range", -5, "lights[1] 'Bulb': range -5 is not > 0"},
+      {"/2/spot/innerConeAngle", 0.75, "lights[2] 'Cone': innerConeAngle 0.75 is not below"},
+      {"/2/spot/outerConeAngle", 2, "lights[2] 'Cone': outerConeAngle 2 is not <= pi / 2"},
+      {"/2/spot/innerConeAngle", -0.1, "innerConeAngle -0.1 is not >= 0"},
+      {"/0/type", "sun", "lights[0] 'Sun'.type: 'sun' is not directional, point or spot"},
+      {"/0/intensity", "bright", "lights[0] 'Sun'.intensity: expected a number"},
+  };
+  for (const Case& c : cases) {
+    json doc = lights_doc();
+    doc[json::json_pointer(kLights + c.pointer)] = c.value;
+    SCOPED_TRACE(c.part);
+    expect_error(load("bad_light.gltf", doc), "bad_light.gltf", ErrorCode::kCorrupt, c.part);
+  }
+  json doc = lights_doc();
+  doc["nodes"][2]["extensions"]["KHR_lights_punctual"]["light"] = 7;
+  expect_error(load("bad_light.gltf", doc), "bad_light.gltf", ErrorCode::kCorrupt,
+               "light 7 does not exist (the file has 3 KHR_lights_punctual lights)");
 }
 
 TEST(GltfMaterials, UnsupportedRequiredExtensionIsRefusedByName) {

@@ -1,0 +1,90 @@
+// Baked lighting: direct irradiance from a scene's KHR_lights_punctual lights, with shadows cast
+// by ray against every triangle of the scene (Embree 3), and ambient occlusion on request. The
+// transfer (bake/transfer.h) calls it at each texel sample of the lighting layer, which exists
+// only when the scene places a light: no light, no ray-tracing structure, no time spent.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "common/status.h"
+#include "common/vec.h"
+#include "scene/scene.h"
+
+namespace vt {
+
+struct LightingOptions {
+  bool shadows = true;  // false: every light reaches every texel that faces it
+  // Ambient occlusion: cosine-weighted rays per texel sample over the shading normal's
+  // hemisphere (0 = none). The lighting layer then has a 4th channel: the fraction of them that
+  // reach `ao_distance` world units unblocked (1 = open sky).
+  int ao_samples = 0;
+  double ao_distance = 0;  // 0 = the scene's bounding-box diagonal
+};
+
+// The largest value the layer keeps: half float's largest finite value. Larger (or non-finite)
+// results are clamped and counted (LightingStats).
+constexpr float kMaxIrradiance = 65504.0f;
+
+struct LightingStats {
+  uint64_t samples = 0;      // texel samples lit
+  uint64_t shadow_rays = 0;  // rays cast to lights
+  uint64_t ao_rays = 0;      // ambient occlusion rays
+  uint64_t clamped = 0;      // samples above kMaxIrradiance, clamped to it
+  uint64_t non_finite = 0;   // samples whose sum was NaN or infinite (stored as 0 or the max)
+  uint64_t bvh_bytes = 0;    // memory Embree allocated for the scene's structure (peak)
+  double build_seconds = 0;  // building that structure
+};
+
+// One point of a surface to light, in world space.
+struct LightingSample {
+  Vec3d position;
+  Vec3d geometric_normal;  // unit, the triangle's (either winding: turned to the shading side)
+  Vec3d shading_normal;    // unit: interpolated vertex normal, normal map applied
+  double footprint = 0;    // world size of a texel here: rays start this far off the surface
+  uint64_t seed = 0;       // per texel and sub-sample: the same numbers at any thread count
+};
+
+class LightingBaker {
+ public:
+  // The scene's placed lights and, when shadows or AO need it, a ray-tracing structure over
+  // every instance's triangles in world space. `threads` bounds Embree's build (0 = all cores).
+  static Expected<std::unique_ptr<LightingBaker>> create(const scene::Scene& scene,
+                                                         const LightingOptions& options,
+                                                         int threads);
+  ~LightingBaker();
+
+  // Channels the lighting layer has: RGB irradiance, + AO when asked.
+  uint32_t channels() const { return options_.ao_samples > 0 ? 4 : 3; }
+  // Irradiance (lux: lm/m^2, the lights' own unit) at the sample from every light, in [0,
+  // kMaxIrradiance], then AO in [0, 1] when asked. Thread-safe.
+  void evaluate(const LightingSample& sample, float* out) const;
+  LightingStats stats() const;
+
+  struct Rays;  // the Embree device and scene (lighting.cpp)
+
+ private:
+  LightingBaker() = default;
+  bool occluded(const Vec3d& origin, const Vec3d& dir, double tfar) const;
+
+  LightingOptions options_;
+  struct Placed {
+    scene::LightType type;
+    Vec3d position, direction;  // direction: where the light travels
+    Vec3d radiant;              // colour x intensity
+    double range, cos_outer, angle_scale;
+  };
+  std::vector<Placed> lights_;
+  double ao_distance_ = 0;
+  std::unique_ptr<Rays> rays_;  // null when nothing needs rays
+  mutable std::atomic<uint64_t> samples_{0}, shadow_rays_{0}, ao_rays_{0}, clamped_{0},
+      non_finite_{0};
+  LightingStats build_stats_;
+};
+
+// Whether `scene` calls for a lighting layer: some displayed node places a light.
+bool scene_has_lights(const scene::Scene& scene);
+
+}  // namespace vt
