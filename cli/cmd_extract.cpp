@@ -9,7 +9,7 @@
 #include "cli/cli_util.h"
 #include "cli/command.h"
 #include "cli/json_output.h"
-#include "format/level_png.h"
+#include "cli/level_png.h"
 #include "format/page_file.h"
 #include "format/page_file_inspect.h"
 

@@ -19,12 +19,9 @@ struct RunResult {
   std::string out;
 };
 
-// `vtbake ARGS`; with merge_stderr the output holds stderr too, else stderr is discarded (so
-// that --json output parses).
-inline RunResult run_vtbake(const std::string& args, bool merge_stderr) {
+// A shell command line's stdout and exit status.
+inline RunResult run_command(const std::string& command) {
   RunResult r;
-  const std::string command =
-      std::string(VTBAKE_BINARY) + " " + args + (merge_stderr ? " 2>&1" : " 2>/dev/null");
   FILE* pipe = ::popen(command.c_str(), "r");
   if (!pipe) return r;
   char buf[4096];
@@ -32,6 +29,13 @@ inline RunResult run_vtbake(const std::string& args, bool merge_stderr) {
   const int status = ::pclose(pipe);
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+// `vtbake ARGS`; with merge_stderr the output holds stderr too, else stderr is discarded (so
+// that --json output parses).
+inline RunResult run_vtbake(const std::string& args, bool merge_stderr) {
+  return run_command(std::string(VTBAKE_BINARY) + " " + args +
+                     (merge_stderr ? " 2>&1" : " 2>/dev/null"));
 }
 
 // A file's bytes ("" when it cannot be read).

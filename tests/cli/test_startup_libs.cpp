@@ -1,7 +1,7 @@
-// The light commands (info, verify, version, clean, extract to PNG) start without the bake stack: the executable
-// links the runtime side only and loads the bake commands module for the other commands
-// (docs/ARCHITECTURE.md, "Start-up"). The dynamic loader's own log (LD_DEBUG=libs) says which
-// shared objects a process loaded.
+// The light commands (info, verify, version, clean, extract to PNG) start without the bake stack:
+// the executable links the runtime side only and loads the bake commands module for the other
+// commands (docs/ARCHITECTURE.md, "Start-up"). The dynamic loader's own log (LD_DEBUG=libs) says
+// which shared objects a process loaded.
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -19,16 +19,8 @@ namespace {
 
 // The loader's log of `vtbake ARGS` (on stderr; stdout dropped) and the exit status.
 vt::testing::RunResult loader_log(const std::string& args) {
-  vt::testing::RunResult r;
-  const std::string command =
-      "LD_DEBUG=libs " + std::string(VTBAKE_BINARY) + " " + args + " 2>&1 >/dev/null";
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return r;
-  char buf[4096];
-  for (size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;) r.out.append(buf, n);
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return vt::testing::run_command("LD_DEBUG=libs " + std::string(VTBAKE_BINARY) + " " + args +
+                                  " 2>&1 >/dev/null");
 }
 
 // What the bake stack loads: OpenImageIO, OpenColorIO, Vulkan, assimp, Draco, CGAL's GMP,

@@ -3,7 +3,7 @@
 # mingw-w64 and archives it, proving no POSIX-only call is left outside format/platform_file.cpp.
 # Debian ships no Windows zstd or xxhash libraries, so this compiles and archives objects (their
 # headers come from the host) but links no program; the unit tests do not run under wine.
-# The writer side of format/ (page_file_writer.cpp, atomic_output.cpp, level_png.cpp: temp files, fsync,
+# The writer side of format/ (page_file_writer.cpp, atomic_output.cpp: temp files, fsync,
 # renames) is the baker's and stays POSIX.
 # usage: cross_windows.sh OUT_DIR [JOBS]
 set -euo pipefail
@@ -24,7 +24,7 @@ cd "$root"
 version=$(sed -n 's/^project(vtbake VERSION \([0-9]*\)\.\([0-9]*\)\.\([0-9]*\).*/\1 \2 \3/p' CMakeLists.txt)
 read -r major minor patch <<<"$version"
 version_flags="-DVT_LIBRARY_VERSION_MAJOR=$major -DVT_LIBRARY_VERSION_MINOR=$minor -DVT_LIBRARY_VERSION_PATCH=$patch"
-posix_only=(format/page_file_writer.cpp format/atomic_output.cpp format/level_png.cpp)
+posix_only=(format/page_file_writer.cpp format/atomic_output.cpp)
 sources=()
 for f in codec/*.cpp codec/*.c format/*.cpp format/*.c runtime/*.cpp runtime/*.c; do
   [[ -e $f ]] || continue

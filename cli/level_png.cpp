@@ -1,4 +1,4 @@
-#include "format/level_png.h"
+#include "cli/level_png.h"
 
 #include <fcntl.h>
 #include <unistd.h>
