@@ -17,6 +17,7 @@
 #include "codec/metrics.h"
 #include "common/half.h"
 #include "common/parallel.h"
+#include "common/vec.h"
 #include "format/runtime_format.h"
 #include "render/report.h"
 #include "runtime/page_source.h"
@@ -37,6 +38,7 @@ bool is_colour(LayerSemantic s) {
 struct BakeSettings {
   int supersample = 1;
   MipFilter filter = MipFilter::kKaiser;
+  LightingOptions lighting;  // a lit bake's AO (the lights are the original scene's)
 };
 
 Expected<BakeSettings> bake_settings(const PageFileReader& reader) {
@@ -50,7 +52,37 @@ Expected<BakeSettings> bake_settings(const PageFileReader& reader) {
   const nlohmann::json build = meta.value("build", nlohmann::json::object());
   const std::string filter = build.is_object() ? build.value("filter", "kaiser") : "kaiser";
   VT_ASSIGN_OR_RETURN(s.filter, parse_mip_filter(filter.c_str()));
+  const nlohmann::json lit = meta.value("lighting", nlohmann::json::object());
+  if (lit.is_object()) {
+    // Shadows are what the scene's lights cast: the reference always casts them, so a bake
+    // made with --no-shadows (a speed knob) fails where a shadow falls. AO is asked for: the
+    // reference repeats the bake's samples and distance (seeded per texel, same rays).
+    s.lighting.ao_samples = lit.value("ao_samples", 0);
+    s.lighting.ao_distance = lit.value("ao_distance", 0.0);
+  }
   return s;
+}
+
+// The reference is lit by the original scene's lights where the original places them, on the
+// unwrapped geometry: a bake whose lights moved (or were baked from another scene) must fail,
+// whatever lights its own unwrapped file carries.
+void place_original_lights(const scene::Scene& original, scene::Scene& reference) {
+  reference.lights = original.lights;
+  for (scene::Node& n : reference.nodes) n.light = -1;
+  for (const scene::PlacedLight& p : original.placed_lights()) {
+    // A light node's frame: its -Z along the light's direction, at its position.
+    const Vec3d z =
+        normalized(Vec3d{-p.direction[0], -p.direction[1], -p.direction[2]}, Vec3d{0, 0, 1});
+    const Vec3d x =
+        normalized(cross(std::abs(z.y) < 0.9 ? Vec3d{0, 1, 0} : Vec3d{1, 0, 0}, z), Vec3d{1, 0, 0});
+    const Vec3d y = cross(z, x);
+    scene::Node n;
+    n.light = p.light;
+    n.local = {x.x, x.y, x.z, 0, y.x,           y.y,           y.z,           0,
+               z.x, z.y, z.z, 0, p.position[0], p.position[1], p.position[2], 1};
+    reference.roots.push_back(int(reference.nodes.size()));
+    reference.nodes.push_back(n);
+  }
 }
 
 // One file layer's reference: its working form (as the build keeps levels: linear, alpha
@@ -200,6 +232,18 @@ Status measure_page(const ReferenceLayer& r, const uint8_t* ref, const uint8_t* 
         ref_f[i] = half_to_float(h[0]), test_f[i] = half_to_float(h[1]);
       }
       a = ref_f.data(), b = test_f.data();
+    }
+    if (r.spec.semantic == LayerSemantic::kLighting) {
+      // Irradiance in lux has no peak: judged after the tone map x / (1 + x) (as
+      // codec/hdr_metrics.h's tone-mapped figure), where an error is as visible as it looks.
+      thread_local std::vector<float> ref_t, test_t;
+      const size_t values = n * r.spec.channels;
+      ref_t.assign(a, a + values), test_t.assign(b, b + values);
+      for (size_t i = 0; i < values; ++i) {
+        ref_t[i] = std::max(ref_t[i], 0.0f) / (1.0f + std::max(ref_t[i], 0.0f));
+        test_t[i] = std::max(test_t[i], 0.0f) / (1.0f + std::max(test_t[i], 0.0f));
+      }
+      a = ref_t.data(), b = test_t.data();
     }
     e.psnr = float_psnr(a, b, n * r.spec.channels, &e.max_abs);
     e.mean_shift = mean_shift(a, b, n, r.spec.channels);
@@ -537,10 +581,12 @@ Expected<AtlasCheckReport> check_atlas_pages(std::shared_ptr<const PageFileReade
   scene::Scene scene = unwrapped;
   scene.materials = original.materials;
   scene.images = original.images;
+  place_original_lights(original, scene);
   TransferOptions to;
   to.width = g.width;
   to.height = g.height;
   to.supersample = settings.supersample;
+  to.lighting = settings.lighting;
   to.threads = o.threads;
   to.scratch_dir = o.scratch_dir;
   auto transfer = transfer_materials(scene, to);

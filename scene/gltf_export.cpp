@@ -256,9 +256,32 @@ class DocumentBuilder {
       if (!n.name.empty()) j["name"] = n.name;
       if (n.local != kIdentity) j["matrix"] = n.local;
       if (n.mesh >= 0) j["mesh"] = n.mesh;
+      if (n.light >= 0) j["extensions"]["KHR_lights_punctual"]["light"] = n.light;
       if (!n.children.empty()) j["children"] = n.children;
       doc_["nodes"].push_back(j);
     }
+    add_lights(scene);
+  }
+
+  // KHR_lights_punctual, as gltf_lights.cpp reads it: the unwrapped scene keeps the lights a
+  // lit bake was baked with (the validator's reference and a re-bake need them).
+  void add_lights(const Scene& scene) {
+    if (scene.lights.empty()) return;
+    json lights = json::array();
+    for (const Light& l : scene.lights) {
+      static constexpr const char* kType[] = {"directional", "point", "spot"};
+      json j = {{"type", kType[int(l.type)]},
+                {"color", {l.color[0], l.color[1], l.color[2]}},
+                {"intensity", l.intensity}};
+      if (!l.name.empty()) j["name"] = l.name;
+      if (l.type != LightType::kDirectional && std::isfinite(l.range)) j["range"] = l.range;
+      if (l.type == LightType::kSpot)
+        j["spot"] = {{"innerConeAngle", l.inner_cone_angle},
+                     {"outerConeAngle", l.outer_cone_angle}};
+      lights.push_back(std::move(j));
+    }
+    doc_["extensions"]["KHR_lights_punctual"]["lights"] = std::move(lights);
+    use_extension("KHR_lights_punctual");
   }
 
   void use_extension(const char* name) {

@@ -2,6 +2,7 @@
 // scene carry the same JSON and the same buffer, both load back as the scene, and the write
 // options change only the values glTF would default.
 #include <gtest/gtest.h>
+#include <cmath>
 #include <cstring>
 
 #include <filesystem>
@@ -117,6 +118,56 @@ TEST(GltfExport, GltfLoadsBackAsTheScene) {
   EXPECT_TRUE(m.double_sided);
   EXPECT_FALSE(back->materials[0].double_sided);
   EXPECT_DOUBLE_EQ(back->nodes[0].local[12], -2.5);
+}
+
+// KHR_lights_punctual round trip: the unwrapped scene keeps the lights a lit bake used, with
+// their nodes (placement), types, units, range and cone angles.
+TEST(GltfExport, LightsLoadBackWithTheirNodes) {
+  Scene s = textured_ball();
+  scene::Light sun;
+  sun.name = "sun";
+  sun.type = scene::LightType::kDirectional;
+  sun.intensity = 3.5f;
+  sun.color = {1, 0.5f, 0.25f};
+  scene::Light bulb;  // infinite range: written without one
+  bulb.intensity = 40;
+  scene::Light spot;
+  spot.type = scene::LightType::kSpot;
+  spot.range = 12;
+  spot.inner_cone_angle = 0.25f;
+  spot.outer_cone_angle = 0.5f;
+  s.lights = {sun, bulb, spot};
+  for (int l = 0; l < 3; ++l) {
+    scene::Node n;
+    n.light = l;
+    n.local[12] = double(l);  // translation x
+    s.roots.push_back(int(s.nodes.size()));
+    s.nodes.push_back(n);
+  }
+  ASSERT_TRUE(scene::save_glb(s, temp("lights.glb")).ok());
+  auto back = scene::load_scene(temp("lights.glb"));
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_TRUE(back->warnings.empty()) << back->warnings.front();
+  ASSERT_EQ(back->lights.size(), 3u);
+  EXPECT_EQ(back->lights[0].name, "sun");
+  EXPECT_EQ(back->lights[0].type, scene::LightType::kDirectional);
+  EXPECT_FLOAT_EQ(back->lights[0].intensity, 3.5f);
+  EXPECT_EQ(back->lights[0].color, sun.color);
+  EXPECT_TRUE(std::isinf(back->lights[1].range));
+  EXPECT_FLOAT_EQ(back->lights[1].intensity, 40);
+  EXPECT_EQ(back->lights[2].type, scene::LightType::kSpot);
+  EXPECT_FLOAT_EQ(back->lights[2].range, 12);
+  EXPECT_FLOAT_EQ(back->lights[2].inner_cone_angle, 0.25f);
+  EXPECT_FLOAT_EQ(back->lights[2].outer_cone_angle, 0.5f);
+  const auto placed = back->placed_lights();
+  ASSERT_EQ(placed.size(), 3u);
+  for (int l = 0; l < 3; ++l) {
+    EXPECT_EQ(placed[l].light, l);
+    EXPECT_DOUBLE_EQ(placed[l].position[0], double(l));
+  }
+  // A scene without lights writes no extension at all.
+  ASSERT_TRUE(scene::save_gltf(textured_ball(), temp("unlit.gltf")).ok());
+  EXPECT_EQ(read_all(temp("unlit.gltf")).find("KHR_lights_punctual"), std::string::npos);
 }
 
 TEST(GltfExport, OptionsSpellOutOnlyWhatGltfDefaults) {
