@@ -20,24 +20,19 @@ void put_u32(std::vector<uint8_t>& out, uint32_t v) {
 // Buffers the PNG stream and hands it to the file in large writes; every write checked.
 class PngFile {
  public:
-  PngFile(int fd, const std::string& path) : fd_(fd), path_(path) {}
+  // The stream opens with PNG's signature.
+  PngFile(int fd, const std::string& path)
+      : fd_(fd), path_(path), out_{0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'} {}
   void chunk(const char type[4], const uint8_t* data, size_t size) {
     put_u32(out_, uint32_t(size));
     const size_t start = out_.size();
     out_.insert(out_.end(), type, type + 4);
     out_.insert(out_.end(), data, data + size);
     put_u32(out_, uint32_t(crc32(0, out_.data() + start, uInt(out_.size() - start))));
-    if (out_.size() >= (1u << 20)) flush();
+    if (out_.size() >= (1u << 20)) (void)flush();  // an error stays in status_
   }
-  void raw(const uint8_t* data, size_t size) { out_.insert(out_.end(), data, data + size); }
   Status flush() {
-    for (size_t done = 0; done < out_.size() && status_.ok();) {
-      const ssize_t n = ::write(fd_, out_.data() + done, out_.size() - done);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0)
-        status_ = Error(ErrorCode::kIo, path_ + ": write failed: " + std::strerror(errno));
-      done += n > 0 ? size_t(n) : 0;
-    }
+    if (status_.ok()) status_ = write_all(fd_, out_.data(), out_.size(), path_);
     out_.clear();
     return status_;
   }
@@ -67,8 +62,6 @@ Status write_level_png(const std::string& path, const LevelImage& image, const L
     const int fd = ::open(temp.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
     if (fd < 0) return Error(ErrorCode::kIo, path + ": cannot open for writing");
     PngFile png(fd, path);
-    static constexpr uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-    png.raw(kSignature, sizeof kSignature);
     std::vector<uint8_t> header;
     put_u32(header, image.width);
     put_u32(header, image.height);

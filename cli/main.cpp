@@ -45,6 +45,13 @@ std::string_view subcommand_word(int argc, char** argv) {
   return {};
 }
 
+// Whether the command line asks for --json: read before CLI11 has parsed it, for the errors
+// found before or while parsing.
+bool asks_for_json(int argc, char** argv) {
+  return std::any_of(argv + 1, argv + argc,
+                     [](const char* a) { return std::string_view(a) == "--json"; });
+}
+
 bool is_registered(std::string_view name) {
   for (const auto& command : registered_commands())
     if (command.name == name) return true;
@@ -95,9 +102,7 @@ int main(int argc, char** argv) {
     if (vt::Status loaded = load_commands_module(); !loaded.ok()) {
       std::fprintf(stderr, "vtbake: %s\n", loaded.message().c_str());
       // --json is not parsed yet; a pipeline that asked for it still gets its error object.
-      if (std::any_of(argv + 1, argv + argc,
-                      [](const char* a) { return std::string_view(a) == "--json"; }))
-        print_json_error("vtbake", kExitFailure, error_json(loaded));
+      if (asks_for_json(argc, argv)) print_json_error("vtbake", kExitFailure, error_json(loaded));
       return kExitFailure;
     }
   }
@@ -137,14 +142,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e) == 0 ? kExitOk : kExitBadInput;
     // --json was not parsed, but a pipeline that asked for it still gets its error object.
-    if (code != kExitOk && std::any_of(argv + 1, argv + argc, [](const char* a) {
-          return std::string_view(a) == "--json";
-        })) {
-      const auto named = std::find_if(argv + 1, argv + argc, [&](const char* a) {
-        return std::any_of(commands.begin(), commands.end(),
-                           [&](const auto& c) { return c.name == a; });
-      });
-      print_json_error(named == argv + argc ? "vtbake" : *named, code,
+    if (code != kExitOk && asks_for_json(argc, argv)) {
+      const std::string named(subcommand_word(argc, argv));
+      print_json_error(is_registered(named) ? named.c_str() : "vtbake", code,
                        {{"code", "usage"}, {"message", e.what()}});
     }
     return code;

@@ -291,20 +291,25 @@ Status write_output(const std::string& path,
   return outputs.commit();
 }
 
+Status write_all(int fd, const void* data, size_t size, const std::string& path) {
+  const auto* p = static_cast<const uint8_t*>(data);
+  while (size > 0) {
+    const ssize_t n = ::write(fd, p, size);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return Error(ErrorCode::kIo, path + ": write failed: " + errno_text());
+    p += n;
+    size -= size_t(n);
+  }
+  return Status::Ok();
+}
+
 Status write_output_bytes(const std::string& path, std::string_view bytes) {
   return write_output(path, [&](const std::string& temp) -> Status {
     const int fd = ::open(temp.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
     if (fd < 0) return Error(ErrorCode::kIo, path + ": cannot open for writing: " + errno_text());
-    size_t done = 0;
-    while (done < bytes.size()) {
-      const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) {
-        const std::string err = errno_text();
-        ::close(fd);
-        return Error(ErrorCode::kIo, path + ": write failed: " + err);
-      }
-      done += size_t(n);
+    if (Status s = write_all(fd, bytes.data(), bytes.size(), path); !s.ok()) {
+      ::close(fd);
+      return s;
     }
     if (::close(fd) != 0) return Error(ErrorCode::kIo, path + ": write failed: " + errno_text());
     return Status::Ok();

@@ -81,6 +81,10 @@ class OutputSet {
   bool committed_ = false;
 };
 
+// Writes all `size` bytes to `fd` (write() may move fewer, or be interrupted); an error names
+// `path`.
+Status write_all(int fd, const void* data, size_t size, const std::string& path);
+
 // The one way a single output file is written: `write` fills the temporary path it is given
 // (beside the target, OutputSet::stage); when it succeeds the file is synced and renamed over
 // `path`, else the temporary is removed and `path` keeps what it had. A full disk or a kill

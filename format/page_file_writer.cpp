@@ -26,19 +26,6 @@ std::string errno_text() {
   return std::strerror(errno);
 }
 
-Status write_all(int fd, const uint8_t* data, size_t size, const std::string& path) {
-  while (size > 0) {
-    ssize_t n = ::write(fd, data, size);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return Error(ErrorCode::kIo, path + ": write failed: " + errno_text());
-    }
-    data += n;
-    size -= size_t(n);
-  }
-  return Status::Ok();
-}
-
 Status pwrite_all(int fd, const uint8_t* data, size_t size, uint64_t offset,
                   const std::string& path) {
   while (size > 0) {
