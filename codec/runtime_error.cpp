@@ -124,14 +124,19 @@ Status measure_runtime_error(BcFormat format, bool normal, const uint8_t* source
 
 Status measure_runtime_hdr_error(BcFormat format, const uint8_t* source, const uint8_t* stored,
                                  const uint8_t* bc_blocks, int size, int channels,
-                                 RuntimeError& out) {
+                                 RuntimeError& out, const float* reference) {
   out = RuntimeError{};
   if (!bc_is_bc6h(format))
     return Error(ErrorCode::kInvalidArgument, "HDR runtime error: not a BC6H format");
   VT_ASSIGN_OR_RETURN(const std::vector<uint8_t>* landed,
                       land(format, stored, bc_blocks, size, channels));
-  add_hdr_error(source, landed->data(), size_t(size) * size, channels, std::min(channels, 3),
-                out.hdr);
+  const size_t texels = size_t(size) * size;
+  const int kept = std::min(channels, 3);
+  if (reference) {
+    add_hdr_error(reference, landed->data(), texels, channels, kept, out.hdr);
+  } else {
+    add_hdr_error(source, landed->data(), texels, channels, kept, out.hdr);
+  }
   return Status::Ok();
 }
 
