@@ -178,6 +178,47 @@ Row run_level(const HdrSet& set, int page, BcQuality q, int repeats, int max_pag
   return r;
 }
 
+// kHigh against the reference search (bc6h_encode_block_reference) on `count` blocks spread
+// evenly over the set's pages: both levels' error on the same blocks, and their speed.
+struct SearchRow {
+  int blocks = 0;
+  HdrError high, search;
+  double high_mtex_s = 0, search_mtex_s = 0;
+};
+
+SearchRow run_search(const HdrSet& set, int page, int count) {
+  SearchRow r;
+  const int per_page = (page / 4) * (page / 4);
+  const int64_t total = int64_t(set.pages.size()) * per_page;
+  count = int(std::min<int64_t>(count, total));
+  r.blocks = count;
+  double th = 0, ts = 0;
+  for (int k = 0; k < count; ++k) {
+    const int64_t at = total * k / count;  // evenly spread
+    const auto& rgb = set.pages[size_t(at / per_page)].rgb;
+    const int bi = int(at % per_page), bx = bi % (page / 4), by = bi / (page / 4);
+    uint16_t src[48], back[48];
+    for (int t = 0; t < 16; ++t)
+      for (int c = 0; c < 3; ++c)
+        src[3 * t + c] =
+            rgb[(size_t(by * 4 + t / 4) * size_t(page) + size_t(bx * 4 + t % 4)) * 3 + size_t(c)];
+    uint8_t block[16];
+    double t0 = thread_seconds();
+    bc6h_encode_block(src, false, BcQuality::kHigh, block);
+    th += thread_seconds() - t0;
+    bc6h_decode_block(block, false, back);
+    add_hdr_error(src, back, 16, 3, 3, r.high);
+    t0 = thread_seconds();
+    bc6h_encode_block_reference(src, false, block);
+    ts += thread_seconds() - t0;
+    bc6h_decode_block(block, false, back);
+    add_hdr_error(src, back, 16, 3, 3, r.search);
+  }
+  r.high_mtex_s = 16.0 * count / std::max(1e-9, th) / 1e6;
+  r.search_mtex_s = 16.0 * count / std::max(1e-9, ts) / 1e6;
+  return r;
+}
+
 }  // namespace
 
 BenchKind bc6h_bench_kind() {
@@ -194,7 +235,11 @@ BenchKind bc6h_bench_kind() {
                 "Folder of another encoder's BC6H blocks, NAME.bc6h per input NAME.exr (raw, "
                 "row-major): scored as one more level on the same pages",
                 ""},
-               {"reference-name", "Name of that level in the report", "reference"}};
+               {"reference-name", "Name of that level in the report", "reference"},
+               {"search-blocks",
+                "Blocks per image (spread over its pages) encoded at high and by the reference "
+                "search (all modes and partitions, wide endpoint steps); 0 = none",
+                "0"}};
   k.run = [](const BenchRequest& req) -> Expected<BenchReport> {
     VT_ASSIGN_OR_RETURN(int page, option_int(req, "page-size", 4, 4096));
     if (page % 4) return Error(ErrorCode::kInvalidArgument, "--page-size: a multiple of 4");
@@ -215,10 +260,11 @@ BenchKind bc6h_bench_kind() {
             "(srgb(x/(1+x)), peak 1), largest relative error\n";
     text << "  set                 level     pages  enc Mtex/s  dec Mtex/s  log2 mean  log2 max  "
             "TM PSNR dB  half+zstd b/t  bc6h+zstd b/t  modes (1-14)\n";
+    VT_ASSIGN_OR_RETURN(int search_blocks, option_int(req, "search-blocks", 0, 1 << 20));
     const std::string ref_dir = req.values.at("reference-blocks");
     const std::string ref_name = req.values.at("reference-name");
     const int levels = ref_dir.empty() ? 3 : 4;
-    HdrError total[4];
+    HdrError total[4], search_high, search_ref;
     for (const HdrSet& s : sets) {
       std::vector<uint8_t> ref;
       if (!ref_dir.empty()) {
@@ -263,6 +309,28 @@ BenchKind bc6h_bench_kind() {
                         {"half_zstd_bits_per_texel", r.raw_zstd_bpt},
                         {"bc6h_zstd_bits_per_texel", r.bc6h_zstd_bpt}});
       }
+      if (search_blocks > 0) {
+        if (req.progress) req.progress(s.name + " search");
+        const SearchRow sr = run_search(s, page, search_blocks);
+        search_high.add(sr.high);
+        search_ref.add(sr.search);
+        std::snprintf(line, sizeof line,
+                      "  %-19s %-9s %5d blocks: high %.2f dB TM / log2 mean %.5f (%.3f Mtex/s), "
+                      "search %.2f dB / %.5f (%.4f Mtex/s)\n",
+                      s.name.c_str(), "sample", sr.blocks, sr.high.tonemapped_psnr_db(),
+                      sr.high.log_abs_mean(), sr.high_mtex_s, sr.search.tonemapped_psnr_db(),
+                      sr.search.log_abs_mean(), sr.search_mtex_s);
+        text << line;
+        json.push_back({{"set", s.name},
+                        {"level", "search-sample"},
+                        {"blocks", sr.blocks},
+                        {"high_tonemapped_psnr_db", sr.high.tonemapped_psnr_db()},
+                        {"high_log2_error_mean", sr.high.log_abs_mean()},
+                        {"search_tonemapped_psnr_db", sr.search.tonemapped_psnr_db()},
+                        {"search_log2_error_mean", sr.search.log_abs_mean()},
+                        {"high_mtexel_s", sr.high_mtex_s},
+                        {"search_mtexel_s", sr.search_mtex_s}});
+      }
     }
     if (sets.size() > 1) {
       const std::string names[4] = {"realtime", "normal", "high", ref_name};
@@ -272,6 +340,14 @@ BenchKind bc6h_bench_kind() {
                       total[q].log_abs_max, total[q].tonemapped_psnr_db());
         text << line;
       }
+    }
+    if (search_blocks > 0 && sets.size() > 1) {
+      std::snprintf(
+          line, sizeof line,
+          "  %-19s %-9s pooled: high %.2f dB TM / log2 mean %.5f, search %.2f dB / %.5f\n",
+          "all (pooled)", "sample", search_high.tonemapped_psnr_db(), search_high.log_abs_mean(),
+          search_ref.tonemapped_psnr_db(), search_ref.log_abs_mean());
+      text << line;
     }
     return BenchReport{text.str(), json.dump(2)};
   };

@@ -637,7 +637,8 @@ float partition_residual(const Block& b, int partition) {
 }
 
 // Every +-1 step of every stored endpoint channel that lowers the error, until none does.
-void perturb(const Block& b, bool is_signed, Candidate& c, int rounds) {
+// (`widths` > 1: steps of +-1, +-2, +-4, ... up to 2^(widths - 1).)
+void perturb(const Block& b, bool is_signed, Candidate& c, int rounds, int widths = 1) {
   const ModeDesc& md = kModes[c.mode];
   const int n = md.regions * 2;
   const Range r = endpoint_range(md.endpoint_bits, is_signed);
@@ -645,7 +646,8 @@ void perturb(const Block& b, bool is_signed, Candidate& c, int rounds) {
     bool improved = false;
     for (int i = 0; i < n; ++i) {
       for (int ch = 0; ch < 3; ++ch) {
-        for (int step = -1; step <= 1; step += 2) {
+        for (int s = 0; s < 2 * widths; ++s) {
+          const int step = (s % 2 ? 1 : -1) * (1 << (s / 2));
           Candidate t = c;
           t.q[i][ch] += step;
           if (t.q[i][ch] < r.lo || t.q[i][ch] > r.hi) continue;
@@ -1078,15 +1080,9 @@ void bc6h_decode_block(const uint8_t block[16], bool is_signed, uint16_t rgb[48]
   }
 }
 
-void bc6h_encode_block(const uint16_t rgb[48], bool is_signed, BcQuality quality, uint8_t out[16]) {
-  if (quality == BcQuality::kRealtime) {
-    RealtimeLanes io;  // the block in every lane
-    for (int i = 0; i < 48; ++i)
-      for (int l = 0; l < kLanes; ++l) io.h[i][l] = rgb[i];
-    encode_realtime_lanes(io, is_signed);
-    pack_lanes(io, 1, out, 16);
-    return;
-  }
+namespace {
+
+Block make_block(const uint16_t rgb[48], bool is_signed) {
   Block b;
   for (int i = 0; i < 48; ++i) {
     // bc6h_half_to_int without branches (the loop vectorises).
@@ -1097,6 +1093,36 @@ void bc6h_encode_block(const uint16_t rgb[48], bool is_signed, BcQuality quality
   }
   for (int t = 0; t < 16; ++t)
     for (int ch = 0; ch < 3; ++ch) b.f[ch][t] = float(b.v[t][ch]);
+  return b;
+}
+
+}  // namespace
+
+void bc6h_encode_block_reference(const uint16_t rgb[48], bool is_signed, uint8_t out[16]) {
+  const Block b = make_block(rgb, is_signed);
+  constexpr int kIterations = 8, kRounds = 8, kWidths = 3;
+  Candidate best;
+  try_modes(b, is_signed, 0, kOneRegionModes, 4, kIterations, true, best);
+  if (best.err > 0) perturb(b, is_signed, best, kRounds, kWidths);
+  for (int p = 0; p < 32 && best.err > 0; ++p) {
+    Candidate c;
+    try_modes(b, is_signed, p, kTwoRegionModes, 10, kIterations, true, c);
+    if (c.err > 0) perturb(b, is_signed, c, kRounds, kWidths);
+    if (c.err < best.err) best = c;
+  }
+  pack(best, out);
+}
+
+void bc6h_encode_block(const uint16_t rgb[48], bool is_signed, BcQuality quality, uint8_t out[16]) {
+  if (quality == BcQuality::kRealtime) {
+    RealtimeLanes io;  // the block in every lane
+    for (int i = 0; i < 48; ++i)
+      for (int l = 0; l < kLanes; ++l) io.h[i][l] = rgb[i];
+    encode_realtime_lanes(io, is_signed);
+    pack_lanes(io, 1, out, 16);
+    return;
+  }
+  const Block b = make_block(rgb, is_signed);
   Candidate best;
   const bool high = quality == BcQuality::kHigh;
   const int iterations = high ? 4 : 3;

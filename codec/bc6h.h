@@ -30,6 +30,11 @@ namespace vt {
 
 // Encodes 16 texels of three half-float channels (48 values, row-major RGB) into one block.
 void bc6h_encode_block(const uint16_t rgb[48], bool is_signed, BcQuality quality, uint8_t out[16]);
+// A reference search for benchmarks (the yardstick for kHigh, issue 19), about 50-100x kHigh's
+// time: every mode and all 32 partitions, 8 least-squares iterations each, then a search of
+// +-1, +-2 and +-4 steps of every stored endpoint channel on the best candidate of every
+// partition, up to 8 rounds. Not a runtime path.
+void bc6h_encode_block_reference(const uint16_t rgb[48], bool is_signed, uint8_t out[16]);
 // Decodes one block into 16 RGB half-float texels. Any 16 bytes are a valid input; the output
 // is never NaN or infinite for unsigned blocks (signed mode 14 can encode -65536 as -infinity,
 // which no encoder here writes).
