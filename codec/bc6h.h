@@ -30,7 +30,7 @@ namespace vt {
 
 // Encodes 16 texels of three half-float channels (48 values, row-major RGB) into one block.
 void bc6h_encode_block(const uint16_t rgb[48], bool is_signed, BcQuality quality, uint8_t out[16]);
-// A reference search for benchmarks (the yardstick for kHigh, issue 19), about 50-100x kHigh's
+// A reference search for benchmarks (the yardstick for kHigh, issue 19), about 10x kHigh's
 // time: every mode and all 32 partitions, 8 least-squares iterations each, then a search of
 // +-1, +-2 and +-4 steps of every stored endpoint channel on the best candidate of every
 // partition, up to 8 rounds. Not a runtime path.
