@@ -754,10 +754,11 @@ constexpr int realtime_weight(int index) {
   return ((index * 64 + 7) * 2185) >> 15;  // (64 i + 7) / 15
 }
 constexpr bool realtime_tables_agree() {
+  auto distance = [](int a, int b) { return a > b ? a - b : b - a; };  // std::abs: not constexpr
   for (int f = 0; f <= 64; ++f) {
     int best = 0;
     for (int k = 0; k < 16; ++k)
-      if (std::abs(bptc::kWeights4[k] - f) < std::abs(bptc::kWeights4[best] - f)) best = k;
+      if (distance(bptc::kWeights4[k], f) < distance(bptc::kWeights4[best], f)) best = k;
     if (realtime_index(f) != best || realtime_weight(best) != bptc::kWeights4[best]) return false;
   }
   return true;
