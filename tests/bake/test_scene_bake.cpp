@@ -264,9 +264,12 @@ TEST(SceneBake, NormalMappedSphereKeepsItsNormals) {
   EXPECT_LT(p95, 2.0) << "mean " << mean << " max " << angles.back();
 }
 
-// A linear EXR of fine stripes, baked at 1/16 of its density: more samples per texel must
-// approach the footprint average (reference: 32 x 32 exact samples per texel) monotonically.
-TEST(SceneBake, SupersamplingImprovesAccuracyMonotonically) {
+// A linear EXR of fine stripes, baked at 1/16 of its density: every supersampling rate must be
+// at the footprint average (reference: 32 x 32 exact samples per texel), and more samples per
+// texel never further from it. (OpenImageIO's TextureSystem, before 2026-12-03, gave RMSE
+// 0.048, 0.00025, 0.00024 at 1, 4, 16; the transfer's own trilinear MIP lookups give 0.00024 at
+// every rate, the floor of the reference.)
+TEST(SceneBake, SupersamplingNeverLosesAccuracy) {
   test::ScratchDir dir;
   auto stripes = [](double u, double v, float* t) {
     double s = 0.5 + 0.45 * std::sin(2 * kPi * (37 * u + 11 * v));
@@ -304,8 +307,9 @@ TEST(SceneBake, SupersamplingImprovesAccuracyMonotonically) {
   }
   RecordProperty("rmse_1_4_16", std::to_string(rmse[0]) + " " + std::to_string(rmse[1]) + " " +
                                     std::to_string(rmse[2]));
-  EXPECT_LT(rmse[1], rmse[0]) << rmse[0] << " " << rmse[1] << " " << rmse[2];
-  EXPECT_LT(rmse[2], rmse[1]) << rmse[0] << " " << rmse[1] << " " << rmse[2];
+  EXPECT_LT(rmse[0], 0.002) << rmse[0] << " " << rmse[1] << " " << rmse[2];
+  EXPECT_LE(rmse[1], rmse[0] * 1.01) << rmse[0] << " " << rmse[1] << " " << rmse[2];
+  EXPECT_LE(rmse[2], rmse[1] * 1.01) << rmse[0] << " " << rmse[1] << " " << rmse[2];
 }
 
 TEST(SceneBake, SameTexelsWhateverTheThreadCount) {
