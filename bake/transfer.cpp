@@ -132,6 +132,8 @@ constexpr TextureSlot kTextureSlots[] = {
     {"occlusionTexture", &scene::Material::occlusion_texture},
     {"emissiveTexture", &scene::Material::emissive_texture},
 };
+// Indices into kTextureSlots.
+enum TexSlot { kBaseColorTex, kMetalRoughTex, kNormalTex, kOcclusionTex, kEmissiveTex, kTexSlots };
 
 // One primitive as the transfer sees it.
 struct PrimInfo {
@@ -153,6 +155,16 @@ struct TriEval {
   // Lighting: the triangle in world space (its own winding) and a texel's world size there.
   Vec3d world_normal;
   double footprint = 0;
+  // Per texture slot of the material (TexSlot): the texture (null: none or missing), its
+  // transformed UVs at the vertices (the transform is affine, so interpolating them equals
+  // transforming each sample), sampler and footprint, constant over the triangle.
+  struct Lookup {
+    const TransferTexture* texture = nullptr;
+    double s[3], t[3];
+    TextureLookup q;
+    TextureFootprint footprint;
+  };
+  Lookup tex[kTexSlots];
 };
 
 // The layers transfer fills. Accumulators, samples and want_ are indexed by a layer's slot,
@@ -315,14 +327,13 @@ class Transfer {
                           const OIIO::ImageSpec& spec) const;
   Status setup_prims();
   Status setup_raster();
-  bool sample_texture(const scene::TextureRef& ref, const TriEval& te, const double l[3],
-                      float out[4]) const;
+  bool sample_texture(TexSlot slot, const TriEval& te, const double l[3], float out[4]) const;
   void evaluate(const TriEval& te, const double l[3], uint64_t seed, Sample& s) const;
   void make_eval(uint32_t t, TriEval& te) const;
-  void transfer_rows(uint32_t r0, uint32_t r1, std::vector<float> (&acc)[kSlots],
+  void transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlots],
                      std::vector<uint8_t>& coverage, RowCounts& counts,
                      const std::function<void(double)>& progress) const;
-  void finish_rows(std::vector<float> (&acc)[kSlots], const uint8_t* coverage, size_t n,
+  void finish_rows(float* const (&acc)[kSlots], const uint8_t* coverage, size_t n,
                    LayerFacts (&facts)[kSlots]) const;
   std::vector<TransferLayer> make_layers(std::shared_ptr<LevelStore> (&stores)[kSlots],
                                          const LayerFacts (&facts)[kSlots]) const;
@@ -623,24 +634,33 @@ void Transfer::make_eval(uint32_t t, TriEval& te) const {
     te.footprint =
         std::max(length(world_vector(w, te.dpdx, false)), length(world_vector(w, te.dpdy, false)));
   }
+  for (int k = 0; k < kTexSlots; ++k) {
+    const scene::TextureRef& ref = (*pi.mat).*kTextureSlots[k].ref;
+    TriEval::Lookup& lk = te.tex[k];
+    lk.texture = ref.valid() ? images_[ref.image].texture.get() : nullptr;
+    if (!lk.texture) continue;  // none, or missing (MissingTextures::kWarn): factor alone
+    const auto& uv = p.uvs[ref.texcoord];
+    for (int j = 0; j < 3; ++j) {
+      const auto st = scene::texture_uv(ref, uv[te.v[j]][0], uv[te.v[j]][1]);
+      lk.s[j] = st[0], lk.t[j] = st[1];
+    }
+    lk.q.wrap_s = ref.wrap_s, lk.q.wrap_t = ref.wrap_t;
+    lk.q.nearest = ref.mag_filter == scene::FilterMode::kNearest;
+    lk.q.d = scene::texture_uv_derivatives(ref, te.duv[ref.texcoord]);
+    lk.footprint = lk.texture->footprint(lk.q.d);
+  }
 }
 
-bool Transfer::sample_texture(const scene::TextureRef& ref, const TriEval& te, const double l[3],
+bool Transfer::sample_texture(TexSlot slot, const TriEval& te, const double l[3],
                               float out[4]) const {
-  const ImageSlot& slot = images_[ref.image];
-  if (!slot.texture) return false;  // a missing texture (MissingTextures::kWarn): factor alone
-  const auto& uv = te.p->prim->uvs[ref.texcoord];
-  TextureLookup q;
-  const auto [s, t] =
-      scene::texture_uv(ref, uv[te.v[0]][0] * l[0] + uv[te.v[1]][0] * l[1] + uv[te.v[2]][0] * l[2],
-                        uv[te.v[0]][1] * l[0] + uv[te.v[1]][1] * l[1] + uv[te.v[2]][1] * l[2]);
-  q.s = s, q.t = t;
-  q.d = scene::texture_uv_derivatives(ref, te.duv[ref.texcoord]);
-  q.wrap_s = ref.wrap_s, q.wrap_t = ref.wrap_t;
-  q.nearest = ref.mag_filter == scene::FilterMode::kNearest;
+  const TriEval::Lookup& lk = te.tex[slot];
+  if (!lk.texture) return false;
+  TextureLookup q = lk.q;
+  q.s = lk.s[0] * l[0] + lk.s[1] * l[1] + lk.s[2] * l[2];
+  q.t = lk.t[0] * l[0] + lk.t[1] * l[1] + lk.t[2] * l[2];
   float r[4] = {0, 0, 0, 1};
-  slot.texture->sample(q, r);
-  switch (slot.channels) {
+  lk.texture->sample(q, lk.footprint, r);
+  switch (lk.texture->channels()) {
     case 1:
       out[0] = out[1] = out[2] = r[0], out[3] = 1;
       break;
@@ -660,15 +680,15 @@ void Transfer::evaluate(const TriEval& te, const double l[3], uint64_t seed, Sam
   const scene::Material& m = *te.p->mat;
   const scene::Primitive& p = *te.p->prim;
   float tex[4];
-  auto colour = [&](const scene::TextureRef& ref, float* rgb) {
-    if (!ref.valid() || !sample_texture(ref, te, l, tex)) return false;
+  auto colour = [&](TexSlot slot, const scene::TextureRef& ref, float* rgb) {
+    if (!sample_texture(slot, te, l, tex)) return false;
     for (int c = 0; c < 4; ++c) rgb[c] = tex[c];
     if (const auto& to_working = images_[ref.image].to_working) to_working->apply_rgb(rgb);
     return true;
   };
   // Albedo: factor x texture x vertex colour (glTF).
   Vec4 a = {1, 1, 1, 1}, vertex = {1, 1, 1, 1};
-  colour(m.base_color_texture, a.data());
+  colour(kBaseColorTex, m.base_color_texture, a.data());
   if (!p.colors.empty()) {
     for (int c = 0; c < 4; ++c) {
       vertex[c] = float(p.colors[te.v[0]][c] * l[0] + p.colors[te.v[1]][c] * l[1] +
@@ -679,16 +699,15 @@ void Transfer::evaluate(const TriEval& te, const double l[3], uint64_t seed, Sam
   for (int c = 0; c < 4; ++c) s.albedo[c] = albedo[c];
   if (want_[kEmissiveSlot]) {
     float e[4] = {1, 1, 1, 1};
-    colour(m.emissive_texture, e);
+    colour(kEmissiveTex, m.emissive_texture, e);
     for (int c = 0; c < 3; ++c) s.emissive[c] = e[c] * m.emissive_factor[c] * m.emissive_strength;
   }
   if (want_[kOrmSlot]) {
     float occ = 1, rough = m.roughness_factor, metal = m.metallic_factor;
-    if (m.occlusion_texture.valid() && sample_texture(m.occlusion_texture, te, l, tex)) {
+    if (sample_texture(kOcclusionTex, te, l, tex)) {
       occ = 1.0f + m.occlusion_strength * (tex[0] - 1.0f);
     }
-    if (m.metallic_roughness_texture.valid() &&
-        sample_texture(m.metallic_roughness_texture, te, l, tex)) {
+    if (sample_texture(kMetalRoughTex, te, l, tex)) {
       rough *= tex[1], metal *= tex[2];
     }
     s.orm[0] = occ, s.orm[1] = rough, s.orm[2] = metal;
@@ -696,8 +715,7 @@ void Transfer::evaluate(const TriEval& te, const double l[3], uint64_t seed, Sam
   if (want_[kNormalSlot] || want_[kLightingSlot]) {
     Vec3d n = normalized(lerp3(te.p->normals, te.v, l), te.face_normal);
     Vec3d world = n;
-    if (want_[kNormalSlot] && m.normal_texture.valid() &&
-        sample_texture(m.normal_texture, te, l, tex)) {
+    if (want_[kNormalSlot] && sample_texture(kNormalTex, te, l, tex)) {
       const auto& tg = te.p->tangents;
       Vec3d t = {tg[te.v[0]][0] * l[0] + tg[te.v[1]][0] * l[1] + tg[te.v[2]][0] * l[2],
                  tg[te.v[0]][1] * l[0] + tg[te.v[1]][1] * l[1] + tg[te.v[2]][1] * l[2],
@@ -735,7 +753,7 @@ void Transfer::evaluate(const TriEval& te, const double l[3], uint64_t seed, Sam
 }
 
 // One band's accumulators as final layer texels: values above 1 counted, normals renormalised.
-void Transfer::finish_rows(std::vector<float> (&acc)[kSlots], const uint8_t* coverage, size_t n,
+void Transfer::finish_rows(float* const (&acc)[kSlots], const uint8_t* coverage, size_t n,
                            LayerFacts (&facts)[kSlots]) const {
   for (int l = 0; l < kSlots; ++l) {
     if (!want_[l]) continue;
@@ -784,11 +802,12 @@ std::vector<TransferLayer> Transfer::make_layers(std::shared_ptr<LevelStore> (&s
       if (!f.alpha) layer.channels = 3;
       if (!f.alpha && stores[l]->in_memory()) {
         const uint32_t W = stores[l]->width(), H = stores[l]->height();
-        std::vector<float> rgba = stores[l]->release(), rgb(size_t(W) * H * 3);
+        // In place (each RGB lands at or before its RGBA), so no second copy is alive.
+        std::vector<float> texels = stores[l]->release();
         for (size_t i = 0; i < size_t(W) * H; ++i)
-          for (int c = 0; c < 3; ++c) rgb[3 * i + c] = rgba[4 * i + c];
-        rgba = {};
-        stores[l] = LevelStore::adopt(W, H, 3, std::move(rgb));
+          for (int c = 0; c < 3; ++c) texels[3 * i + c] = texels[4 * i + c];
+        texels.resize(size_t(W) * H * 3);
+        stores[l] = LevelStore::adopt(W, H, 3, std::move(texels));
       }
     }
     layer.store = std::move(stores[l]);
@@ -799,7 +818,7 @@ std::vector<TransferLayer> Transfer::make_layers(std::shared_ptr<LevelStore> (&s
 
 // Rows [r0, r1) of the atlas (r0 a multiple of kBandRows) into `acc` (those rows only) and the
 // coverage; the bands run on all threads.
-void Transfer::transfer_rows(uint32_t r0, uint32_t r1, std::vector<float> (&acc)[kSlots],
+void Transfer::transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlots],
                              std::vector<uint8_t>& coverage, RowCounts& counts,
                              const std::function<void(double)>& progress) const {
   const uint32_t W = opt_.width, H = opt_.height;
@@ -875,6 +894,7 @@ void Transfer::transfer_rows(uint32_t r0, uint32_t r1, std::vector<float> (&acc)
 uint32_t Transfer::rows_per_pass() const {
   const uint32_t H = opt_.height;
   uint64_t rows = opt_.band_rows;
+  if (rows == 0 && opt_.stores_in_memory) rows = H;  // accumulated in the stores themselves
   if (rows == 0) {
     uint64_t per_row = 0;
     for (int l = 0; l < kSlots; ++l)
@@ -911,26 +931,35 @@ Expected<TransferResult> Transfer::run() {
   auto coverage = std::make_shared<std::vector<uint8_t>>(size_t(W) * H, 0);
   bins_ = bin_by_rows(tris_, H, kBandRows);
   const uint32_t pass = rows_per_pass();
-  std::vector<float> acc[kSlots];
+  // Accumulators: an in-memory store's own rows (zero when created), else a pass's buffer
+  // written to the scratch store after.
+  std::vector<float> buffer[kSlots];
+  float* acc[kSlots] = {};
   LayerFacts facts[kSlots];
   RowCounts counts;
   for (uint32_t r0 = 0; r0 < H; r0 += pass) {
     const uint32_t r1 = std::min(H, r0 + pass);
     const size_t n = size_t(r1 - r0) * W;
-    for (int l = 0; l < kSlots; ++l)
-      if (want_[l]) acc[l].assign(n * channels_[l], 0.0f);
+    for (int l = 0; l < kSlots; ++l) {
+      if (!want_[l]) continue;
+      if (stores[l]->in_memory()) {
+        acc[l] = stores[l]->data() + size_t(r0) * W * channels_[l];
+      } else {
+        buffer[l].assign(n * channels_[l], 0.0f);
+        acc[l] = buffer[l].data();
+      }
+    }
     std::function<void(double)> progress;
     if (opt_.progress)
       progress = [&](double f) { opt_.progress((double(r0) + f * double(r1 - r0)) / double(H)); };
     transfer_rows(r0, r1, acc, *coverage, counts, progress);
     finish_rows(acc, coverage->data() + size_t(r0) * W, n, facts);
     for (int l = 0; l < kSlots; ++l) {
-      if (!want_[l]) continue;
-      VT_RETURN_IF_ERROR(
-          stores[l]->write_rows(r0, r1 - r0, acc[l].data()).with_context("transfer"));
+      if (!want_[l] || stores[l]->in_memory()) continue;
+      VT_RETURN_IF_ERROR(stores[l]->write_rows(r0, r1 - r0, acc[l]).with_context("transfer"));
     }
   }
-  for (auto& a : acc) a = {};
+  for (auto& b : buffer) b = {};
 
   result.layers = make_layers(stores, facts);
   result.coverage = coverage;

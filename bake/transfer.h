@@ -45,7 +45,8 @@ struct TransferOptions {
   // Larger atlases are a resource error (default: the page format's 2^24 texels a side).
   uint64_t max_texels = uint64_t(1) << 48;
   // The atlas is transferred `band_rows` rows at a time (rounded to a multiple of 16; 0 = as
-  // many as `band_memory` bytes of accumulators hold), each pass written to the layers' stores.
+  // many as `band_memory` bytes of accumulators hold; in-memory stores: all rows, accumulated in
+  // the stores themselves), each pass written to the layers' stores.
   // The texels do not depend on it.
   uint32_t band_rows = 0;
   uint64_t band_memory = uint64_t(256) << 20;

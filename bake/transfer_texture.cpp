@@ -146,89 +146,132 @@ void TransferTexture::make_box_levels(const ColorConverter* to_linear,
   }
 }
 
-// One bilinear (or nearest) tap of `level` at (s, t), added to out[0..channels).
-void TransferTexture::tap(const Level& level, double s, double t, const TextureLookup& q,
-                          float* out) const {
-  const int ch = channels_;
-  const int64_t w = level.width, h = level.height;
-  const float* base = data_ + level.offset;
+namespace {
+
+// Texels i and i + 1 of a level n texels wide as the wrap mode addresses them; one division at
+// most (none inside the level).
+inline void wrap_pair(int64_t i, int64_t n, scene::WrapMode mode, int64_t& a, int64_t& b) {
+  if (i >= 0 && i + 1 < n) {
+    a = i, b = i + 1;
+    return;
+  }
+  switch (mode) {
+    case scene::WrapMode::kClampToEdge:
+      a = std::clamp<int64_t>(i, 0, n - 1), b = std::clamp<int64_t>(i + 1, 0, n - 1);
+      return;
+    case scene::WrapMode::kMirroredRepeat:
+      a = wrap_index(i, n, mode), b = wrap_index(i + 1, n, mode);
+      return;
+    case scene::WrapMode::kRepeat:
+      break;
+  }
+  a = wrap_index(i, n, mode);
+  b = a + 1 == n ? 0 : a + 1;
+}
+
+// One bilinear (or nearest) tap of a level at (s, t), added to out[0..CH).
+template <int CH>
+inline void tap(const float* base, int64_t w, int64_t h, double s, double t, const TextureLookup& q,
+                float* out) {
   if (q.nearest) {
     const int64_t x = wrap_index(int64_t(std::floor(s * double(w))), w, q.wrap_s);
     const int64_t y = wrap_index(int64_t(std::floor(t * double(h))), h, q.wrap_t);
-    const float* p = base + size_t(y * w + x) * ch;
-    for (int k = 0; k < ch; ++k) out[k] += p[k];
+    const float* p = base + size_t(y * w + x) * CH;
+    for (int k = 0; k < CH; ++k) out[k] += p[k];
     return;
   }
   const double x = s * double(w) - 0.5, y = t * double(h) - 0.5;
   const double fx0 = std::floor(x), fy0 = std::floor(y);
   const float fx = float(x - fx0), fy = float(y - fy0);
-  const int64_t xa = wrap_index(int64_t(fx0), w, q.wrap_s);
-  const int64_t xb = wrap_index(int64_t(fx0) + 1, w, q.wrap_s);
-  const int64_t ya = wrap_index(int64_t(fy0), h, q.wrap_t);
-  const int64_t yb = wrap_index(int64_t(fy0) + 1, h, q.wrap_t);
-  const float* p00 = base + size_t(ya * w + xa) * ch;
-  const float* p10 = base + size_t(ya * w + xb) * ch;
-  const float* p01 = base + size_t(yb * w + xa) * ch;
-  const float* p11 = base + size_t(yb * w + xb) * ch;
+  int64_t xa, xb, ya, yb;
+  wrap_pair(int64_t(fx0), w, q.wrap_s, xa, xb);
+  wrap_pair(int64_t(fy0), h, q.wrap_t, ya, yb);
+  const float* r0 = base + size_t(ya * w) * CH;
+  const float* r1 = base + size_t(yb * w) * CH;
+  const float *p00 = r0 + xa * CH, *p10 = r0 + xb * CH, *p01 = r1 + xa * CH, *p11 = r1 + xb * CH;
   // Lerps of differences: equal texels give exactly their value (a constant 1 stays 1).
-  for (int k = 0; k < ch; ++k) {
+  for (int k = 0; k < CH; ++k) {
     const float top = p00[k] + fx * (p10[k] - p00[k]);
     const float bottom = p01[k] + fx * (p11[k] - p01[k]);
     out[k] += top + fy * (bottom - top);
   }
 }
 
+}  // namespace
+
 // The footprint's two axes in level-0 texels; the longer is the major axis. Taps: as many as
 // the ratio of the axes (at most kMaxTaps), spread evenly along the major axis over one
 // footprint; MIP level: log2 of the major axis over the taps (each tap covers its share),
 // trilinear between the two levels around it.
-void TransferTexture::sample(const TextureLookup& q, float* out) const {
-  const int ch = channels_;
-  for (int k = 0; k < ch; ++k) out[k] = 0;
-  const double s = finite_or_zero(q.s), t = finite_or_zero(q.t);
+TextureFootprint TransferTexture::footprint(const std::array<double, 4>& d) const {
+  TextureFootprint f;
   const Level& l0 = levels_[0];
-  double ax = q.d[0] * l0.width, ay = q.d[1] * l0.height;
-  double bx = q.d[2] * l0.width, by = q.d[3] * l0.height;
+  const double ax = d[0] * l0.width, ay = d[1] * l0.height;
+  const double bx = d[2] * l0.width, by = d[3] * l0.height;
   double la = ax * ax + ay * ay, lb = bx * bx + by * by;
-  if (!std::isfinite(la) || !std::isfinite(lb)) la = lb = 0;
-  // Major axis in texture space (s, t per footprint).
-  double ms = q.d[0], mt = q.d[1];
-  if (lb > la) std::swap(la, lb), ms = q.d[2], mt = q.d[3];
+  if (!std::isfinite(la) || !std::isfinite(lb)) return f;
+  f.step_s = d[0], f.step_t = d[1];
+  if (lb > la) std::swap(la, lb), f.step_s = d[2], f.step_t = d[3];
+  if (la <= 1.0) return f;
   const double major = std::sqrt(la), minor = std::sqrt(lb);
-  int taps = 1;
-  double lod = 0;
-  if (major > 1.0) {
-    taps = int(std::min<double>(kMaxTaps, std::ceil(major / std::max(minor, 1.0))));
-    lod = std::log2(major / taps);
-  }
+  f.taps = int(std::min<double>(kMaxTaps, std::ceil(major / std::max(minor, 1.0))));
+  const double lod = std::log2(major / f.taps);
   const size_t last = levels_.size() - 1;
-  size_t lev = 0;
-  float blend = 0;  // weight of level lev + 1
   if (lod > 0) {
     const double fl = std::floor(lod);
     if (fl >= double(last)) {
-      lev = last;
+      f.level = uint32_t(last);
     } else {
-      lev = size_t(fl);
-      blend = float(lod - fl);
+      f.level = uint32_t(fl);
+      f.blend = float(lod - fl);
     }
   }
-  if (taps == 1) {
-    if (blend == 0) return tap(levels_[lev], s, t, q, out);
-    float a[4] = {0, 0, 0, 0}, b[4] = {0, 0, 0, 0};
-    tap(levels_[lev], s, t, q, a);
-    tap(levels_[lev + 1], s, t, q, b);
-    for (int k = 0; k < ch; ++k) out[k] = a[k] + blend * (b[k] - a[k]);
+  return f;
+}
+
+void TransferTexture::sample(const TextureLookup& q, const TextureFootprint& f, float* out) const {
+  switch (channels_) {
+    case 1:
+      return sample_channels<1>(q, f, out);
+    case 2:
+      return sample_channels<2>(q, f, out);
+    case 3:
+      return sample_channels<3>(q, f, out);
+    default:
+      return sample_channels<4>(q, f, out);
+  }
+}
+
+template <int CH>
+void TransferTexture::sample_channels(const TextureLookup& q, const TextureFootprint& f,
+                                      float* out) const {
+  const double s = finite_or_zero(q.s), t = finite_or_zero(q.t);
+  const Level& la0 = levels_[f.level];
+  const float* base0 = data_ + la0.offset;
+  float a[CH] = {}, b[CH] = {};
+  if (f.taps == 1) {
+    tap<CH>(base0, la0.width, la0.height, s, t, q, a);
+    if (f.blend != 0) {
+      const Level& la1 = levels_[f.level + 1];
+      tap<CH>(data_ + la1.offset, la1.width, la1.height, s, t, q, b);
+      for (int k = 0; k < CH; ++k) a[k] += f.blend * (b[k] - a[k]);
+    }
+    for (int k = 0; k < CH; ++k) out[k] = a[k];
     return;
   }
-  float a[4] = {0, 0, 0, 0}, b[4] = {0, 0, 0, 0};
-  for (int i = 0; i < taps; ++i) {
-    const double f = (i + 0.5) / taps - 0.5;
-    const double ts = s + f * ms, tt = t + f * mt;
-    tap(levels_[lev], ts, tt, q, a);
-    if (blend != 0) tap(levels_[lev + 1], ts, tt, q, b);
+  for (int i = 0; i < f.taps; ++i) {
+    const double o = (i + 0.5) / f.taps - 0.5;
+    tap<CH>(base0, la0.width, la0.height, s + o * f.step_s, t + o * f.step_t, q, a);
   }
-  for (int k = 0; k < ch; ++k) out[k] = (a[k] + blend * (b[k] - a[k])) / float(taps);
+  if (f.blend != 0) {
+    const Level& la1 = levels_[f.level + 1];
+    for (int i = 0; i < f.taps; ++i) {
+      const double o = (i + 0.5) / f.taps - 0.5;
+      tap<CH>(data_ + la1.offset, la1.width, la1.height, s + o * f.step_s, t + o * f.step_t, q, b);
+    }
+    for (int k = 0; k < CH; ++k) a[k] += f.blend * (b[k] - a[k]);
+  }
+  for (int k = 0; k < CH; ++k) out[k] = a[k] / float(f.taps);
 }
 
 }  // namespace vt

@@ -28,6 +28,15 @@ struct TextureLookup {
   bool nearest = false;  // magFilter NEAREST: every tap takes its whole texel
 };
 
+// What a footprint asks of one texture (constant over a triangle, whose UVs are affine in the
+// atlas): taps along the major axis, the MIP level and the weight of the next one.
+struct TextureFootprint {
+  int taps = 1;
+  uint32_t level = 0;
+  float blend = 0;                // weight of level + 1
+  double step_s = 0, step_t = 0;  // the major axis, (s, t) over one footprint
+};
+
 class TransferTexture {
  public:
   // Reads `path` whole: its own MIP levels when the file has them (a tiled .tx/.exr), else
@@ -54,15 +63,20 @@ class TransferTexture {
 
   // The filtered value at `q`: channels() floats in out[0..channels()-1] (the rest untouched).
   // Deterministic and thread-safe. Non-finite coordinates sample (0, 0); non-finite footprints
-  // a point.
-  void sample(const TextureLookup& q, float* out) const;
+  // a point. The same as sample(q, footprint(q.d), out).
+  void sample(const TextureLookup& q, float* out) const { sample(q, footprint(q.d), out); }
+  // The footprint {ds/dx, dt/dx, ds/dy, dt/dy} as taps and levels, and a lookup with it (q.d
+  // unused): for many lookups with one footprint.
+  TextureFootprint footprint(const std::array<double, 4>& d) const;
+  void sample(const TextureLookup& q, const TextureFootprint& f, float* out) const;
 
  private:
   struct Level {
     uint32_t width = 0, height = 0;
     size_t offset = 0;  // first float of the level in texels_
   };
-  void tap(const Level& level, double s, double t, const TextureLookup& q, float* out) const;
+  template <int CH>
+  void sample_channels(const TextureLookup& q, const TextureFootprint& f, float* out) const;
   void make_box_levels(const ColorConverter* to_linear, const ColorConverter* from_linear);
 
   int channels_ = 0;
