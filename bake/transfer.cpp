@@ -115,6 +115,9 @@ uint64_t raster_triangle(const RasterTriangle& tri, int32_t t, int32_t chart, Ba
 
 struct ImageSlot {
   std::unique_ptr<TransferTexture> texture;  // null: the image could not be read
+  // A colour image that a data slot reads too (an occlusion map that is the base colour's
+  // image): its levels averaged as stored, not in linear light. Null: `texture` serves all.
+  std::unique_ptr<TransferTexture> data_texture;
   int channels = 0;
   // Colour use (base colour, emissive): from the image's colour space to the working space and
   // back (for the MIP levels); null = none (already linear). Data uses (normal, ORM) never
@@ -365,6 +368,15 @@ bool used_as_colour(const scene::Scene& scene, size_t image) {
   });
 }
 
+bool used_as_data(const scene::Scene& scene, size_t image) {
+  return std::any_of(scene.materials.begin(), scene.materials.end(), [&](const auto& m) {
+    for (const scene::TextureRef* r :
+         {&m.metallic_roughness_texture, &m.normal_texture, &m.occlusion_texture})
+      if (r->valid() && size_t(r->image) == image) return true;
+    return false;
+  });
+}
+
 // The colour space: the config's file rules for `path` (a file, not an embedded image), else
 // the image's metadata, else sRGB (8/16-bit) or the working space (float).
 Status Transfer::set_colour_space(ImageSlot& slot, const std::string& path,
@@ -472,10 +484,18 @@ Status Transfer::setup_images() {
     }
     slot.channels = texture->channels();
     // Textures past the budget are read from a mapped scratch file (the same samples).
-    if (texture_bytes_ + texture->bytes() > opt_.texture_cache)
-      VT_RETURN_IF_ERROR(texture->move_to_scratch(scratch.string()).with_context(slot.name));
-    texture_bytes_ += texture->bytes();
-    slot.texture = std::make_unique<TransferTexture>(std::move(texture).value());
+    auto keep = [&](TransferTexture& t) -> Expected<std::unique_ptr<TransferTexture>> {
+      if (texture_bytes_ + t.bytes() > opt_.texture_cache)
+        VT_RETURN_IF_ERROR(t.move_to_scratch(scratch.string()).with_context(slot.name));
+      texture_bytes_ += t.bytes();
+      return std::make_unique<TransferTexture>(std::move(t));
+    };
+    VT_ASSIGN_OR_RETURN(slot.texture, keep(*texture));
+    if (slot.to_working && used_as_data(scene_, i)) {
+      auto data = TransferTexture::load(source);
+      if (!data.ok()) return data.status().with_context(slot.name);
+      VT_ASSIGN_OR_RETURN(slot.data_texture, keep(*data));
+    }
   }
   return check_missing_textures();
 }
@@ -637,7 +657,11 @@ void Transfer::make_eval(uint32_t t, TriEval& te) const {
   for (int k = 0; k < kTexSlots; ++k) {
     const scene::TextureRef& ref = (*pi.mat).*kTextureSlots[k].ref;
     TriEval::Lookup& lk = te.tex[k];
-    lk.texture = ref.valid() ? images_[ref.image].texture.get() : nullptr;
+    const ImageSlot* image = ref.valid() ? &images_[ref.image] : nullptr;
+    const bool colour = k == kBaseColorTex || k == kEmissiveTex;
+    lk.texture = !image                           ? nullptr
+                 : !colour && image->data_texture ? image->data_texture.get()
+                                                  : image->texture.get();
     if (!lk.texture) continue;  // none, or missing (MissingTextures::kWarn): factor alone
     const auto& uv = p.uvs[ref.texcoord];
     for (int j = 0; j < 3; ++j) {

@@ -58,11 +58,12 @@ struct TransferOptions {
   // transfer_to_stores: the layers' stores are in memory, or scratch files under scratch_dir.
   bool stores_in_memory = true;
   // Filter for MIP levels made (maketx-style, in the scratch folder) for untiled sources;
-  // "" = box-filtered levels (TransferTexture's). With a filter, the levels are made from the
-  // file's encoded values and converted to the working space after. Measured against the
-  // texel-footprint (box) average on stripes above the atlas Nyquist limit: "lanczos3" lowers the
-  // RMSE at 1 sample per texel (0.048 -> 0.034) but raises it at 4 and 16 (0.0003 -> 0.018 /
-  // 0.006), so the default keeps the box levels.
+  // "" = box-filtered levels (TransferTexture's, colour averaged in linear light). A maketx
+  // filter averages the file's encoded values. Measured against the texel-footprint (box)
+  // average on stripes above the atlas Nyquist limit with OpenImageIO's TextureSystem (before
+  // 2026-12-03): "lanczos3" lowered the RMSE at 1 sample per texel (0.048 -> 0.034) but raised it
+  // at 4 and 16 (0.0003 -> 0.018 / 0.006); the box levels now give 0.00024 at every rate
+  // (SceneBake.SupersamplingNeverLosesAccuracy), so the default keeps them.
   std::string mip_filter;
   MissingTextures missing_textures = MissingTextures::kError;
   // The atlas chart of every triangle, in transfer order (meshes, primitives that have
