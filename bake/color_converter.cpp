@@ -35,6 +35,9 @@ class OcioConverter final : public ColorConverter {
  public:
   OcioConverter(OCIO::ConstProcessorRcPtr processor, bool srgb_decode) : srgb_decode_(srgb_decode) {
     if (processor) cpu_ = processor->getOptimizedCPUProcessor(OCIO::OPTIMIZATION_DEFAULT);
+    if (srgb_decode_) {
+      for (int i = 0; i <= kCurveSteps; ++i) curve_[i] = srgb_to_linear(float(i) / kCurveSteps);
+    }
     if (is_identity()) return;
     per_channel_ = !cpu_->hasChannelCrosstalk();
     if (per_channel_) make_tables();
@@ -83,7 +86,17 @@ class OcioConverter final : public ColorConverter {
 
   void apply_rgb(float rgb[3]) const override {
     if (srgb_decode_) {
-      for (int c = 0; c < 3; ++c) rgb[c] = srgb_to_linear(std::max(rgb[c], 0.0f));
+      for (int c = 0; c < 3; ++c) {
+        const float v = std::max(rgb[c], 0.0f);
+        if (v < 1.0f) {  // the curve's table, linearly interpolated
+          const float x = v * float(kCurveSteps);
+          const int i = int(x);
+          const float f = x - float(i);
+          rgb[c] = curve_[i] + f * (curve_[i + 1] - curve_[i]);
+        } else {
+          rgb[c] = srgb_to_linear(v);
+        }
+      }
     } else if (!is_identity()) {
       cpu_->applyRGB(rgb);
     }
@@ -91,6 +104,11 @@ class OcioConverter final : public ColorConverter {
 
  private:
   static constexpr int kBucketShift = 15;
+  // apply_rgb's sRGB decode: srgb_to_linear at kCurveSteps + 1 points of [0, 1], interpolated
+  // linearly (interpolation error below 1e-8: linear below the knee, curvature below 1.2
+  // above it; float rounding up to 3e-7 near 1).
+  static constexpr int kCurveSteps = 4096;
+  float curve_[kCurveSteps + 1] = {};
 
   void make_tables() {
     for (int k = 0; k < 256; ++k) lut_[k] = convert_one(float(k) / 255.0f);

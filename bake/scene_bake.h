@@ -27,7 +27,7 @@ struct SceneBakeOptions {
   // The build of the transferred layers, as `vtbake build` takes it: output (the .vtpf path),
   // codec, payload and border, filter, alpha coverage, non-finite policy, scratch_dir (transfer
   // and build; "" = beside the output), memory_limit (transfer buffers: an eighth, at most 256 MiB,
-  // for a pass's accumulators, a quarter for OpenImageIO's texture cache, texture_cache_bytes; +
+  // for a pass's accumulators, a quarter for the source textures in memory, texture_cache_bytes; +
   // build) and threads (every stage). bake_scene sets what the scene decides: layers, address mode
   // (clamp: charts do not tile), metadata and progress.
   BuildOptions build;

@@ -5,6 +5,7 @@
 #include "bake/level_store.h"
 #include "bake/lighting.h"
 #include "bake/png_check.h"
+#include "bake/transfer_texture.h"
 #include "bake/unwrap/atlas_raster.h"
 #include "common/parallel.h"
 #include "common/vec.h"
@@ -13,7 +14,6 @@
 
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
-#include <OpenImageIO/texture.h>
 
 #include <unistd.h>
 #include <algorithm>
@@ -114,11 +114,15 @@ uint64_t raster_triangle(const RasterTriangle& tri, int32_t t, int32_t chart, Ba
 // ---- Materials -------------------------------------------------------------------------------
 
 struct ImageSlot {
-  OIIO::TextureSystem::TextureHandle* handle = nullptr;  // null: the image could not be read
+  std::unique_ptr<TransferTexture> texture;  // null: the image could not be read
+  // A colour image that a data slot reads too (an occlusion map that is the base colour's
+  // image): its levels averaged as stored, not in linear light. Null: `texture` serves all.
+  std::unique_ptr<TransferTexture> data_texture;
   int channels = 0;
-  // Colour use (base colour, emissive): from the image's colour space to the working space;
-  // null = none (already linear). Data uses (normal, ORM) never convert.
-  std::shared_ptr<const ColorConverter> to_working;
+  // Colour use (base colour, emissive): from the image's colour space to the working space and
+  // back (for the MIP levels); null = none (already linear). Data uses (normal, ORM) never
+  // convert. A filtered sample is converted, as the validator's reference samples.
+  std::shared_ptr<const ColorConverter> to_working, from_working;
   std::string name;
   std::string tried;  // the file opened (for an embedded image, its scratch copy)
   std::string error;  // why it could not be read
@@ -131,6 +135,8 @@ constexpr TextureSlot kTextureSlots[] = {
     {"occlusionTexture", &scene::Material::occlusion_texture},
     {"emissiveTexture", &scene::Material::emissive_texture},
 };
+// Indices into kTextureSlots.
+enum TexSlot { kBaseColorTex, kMetalRoughTex, kNormalTex, kOcclusionTex, kEmissiveTex, kTexSlots };
 
 // One primitive as the transfer sees it.
 struct PrimInfo {
@@ -152,6 +158,16 @@ struct TriEval {
   // Lighting: the triangle in world space (its own winding) and a texel's world size there.
   Vec3d world_normal;
   double footprint = 0;
+  // Per texture slot of the material (TexSlot): the texture (null: none or missing), its
+  // transformed UVs at the vertices (the transform is affine, so interpolating them equals
+  // transforming each sample), sampler and footprint, constant over the triangle.
+  struct Lookup {
+    const TransferTexture* texture = nullptr;
+    double s[3], t[3];
+    TextureLookup q;
+    TextureFootprint footprint;
+  };
+  Lookup tex[kTexSlots];
 };
 
 // The layers transfer fills. Accumulators, samples and want_ are indexed by a layer's slot,
@@ -299,7 +315,6 @@ class Transfer {
  public:
   Transfer(const scene::Scene& scene, const TransferOptions& opt) : scene_(scene), opt_(opt) {}
   ~Transfer() {
-    if (ts_) OIIO::TextureSystem::destroy(ts_);
     for (const auto& f : temp_files_) {
       std::error_code ec;
       std::filesystem::remove(f, ec);
@@ -315,15 +330,13 @@ class Transfer {
                           const OIIO::ImageSpec& spec) const;
   Status setup_prims();
   Status setup_raster();
-  bool sample_texture(OIIO::TextureSystem::Perthread* pt, const scene::TextureRef& ref,
-                      const TriEval& te, const double l[3], float out[4]) const;
-  void evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, const double l[3],
-                uint64_t seed, Sample& s) const;
+  bool sample_texture(TexSlot slot, const TriEval& te, const double l[3], float out[4]) const;
+  void evaluate(const TriEval& te, const double l[3], uint64_t seed, Sample& s) const;
   void make_eval(uint32_t t, TriEval& te) const;
-  void transfer_rows(uint32_t r0, uint32_t r1, std::vector<float> (&acc)[kSlots],
+  void transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlots],
                      std::vector<uint8_t>& coverage, RowCounts& counts,
                      const std::function<void(double)>& progress) const;
-  void finish_rows(std::vector<float> (&acc)[kSlots], const uint8_t* coverage, size_t n,
+  void finish_rows(float* const (&acc)[kSlots], const uint8_t* coverage, size_t n,
                    LayerFacts (&facts)[kSlots]) const;
   std::vector<TransferLayer> make_layers(std::shared_ptr<LevelStore> (&stores)[kSlots],
                                          const LayerFacts (&facts)[kSlots]) const;
@@ -331,7 +344,6 @@ class Transfer {
 
   const scene::Scene& scene_;
   const TransferOptions& opt_;
-  OIIO::TextureSystem* ts_ = nullptr;
   std::vector<ImageSlot> images_;
   std::vector<MissingTexture> missing_;
   std::vector<std::string> temp_files_;
@@ -345,9 +357,7 @@ class Transfer {
   uint32_t channels_[kSlots] = {};  // accumulated channels by slot (kSlotInfo; lighting: + AO)
   std::unique_ptr<LightingBaker> lighting_;  // only when the scene has lights
   double sub_scale_ = 1.0;
-  mutable std::atomic<bool> lookup_failed_{false};
-  mutable std::mutex error_mutex_;
-  mutable std::string lookup_error_;
+  uint64_t texture_bytes_ = 0;  // the loaded textures' texels
 };
 
 // Base colour and emissive textures are colour; the other slots are data.
@@ -355,6 +365,15 @@ bool used_as_colour(const scene::Scene& scene, size_t image) {
   return std::any_of(scene.materials.begin(), scene.materials.end(), [&](const auto& m) {
     return (m.base_color_texture.valid() && size_t(m.base_color_texture.image) == image) ||
            (m.emissive_texture.valid() && size_t(m.emissive_texture.image) == image);
+  });
+}
+
+bool used_as_data(const scene::Scene& scene, size_t image) {
+  return std::any_of(scene.materials.begin(), scene.materials.end(), [&](const auto& m) {
+    for (const scene::TextureRef* r :
+         {&m.metallic_roughness_texture, &m.normal_texture, &m.occlusion_texture})
+      if (r->valid() && size_t(r->image) == image) return true;
+    return false;
   });
 }
 
@@ -370,7 +389,11 @@ Status Transfer::set_colour_space(ImageSlot& slot, const std::string& path,
       colours.texture_space(path, spec.get_string_attribute("oiio:ColorSpace"), is_float);
   auto converter = colours.converter(space, colours.working_space());
   if (!converter.ok()) return converter.status().with_context(slot.name);
-  if (!(*converter)->is_identity()) slot.to_working = std::move(converter).value();
+  if ((*converter)->is_identity()) return Status::Ok();
+  auto back = colours.converter(colours.working_space(), space);
+  if (!back.ok()) return back.status().with_context(slot.name);
+  slot.to_working = std::move(converter).value();
+  slot.from_working = std::move(back).value();
   return Status::Ok();
 }
 
@@ -390,12 +413,6 @@ Status Transfer::setup_images() {
       used[r.image] = true;
     }
   }
-  ts_ = OIIO::TextureSystem::create(false);
-  ts_->attribute("automip", 1);
-  // The budget's share, raised below to the largest untiled source held whole.
-  uint64_t cache = opt_.texture_cache;
-  auto set_cache = [&] { ts_->attribute("max_memory_MB", float(double(cache) / double(1 << 20))); };
-  set_cache();
   images_.resize(scene_.images.size());
   namespace fs = std::filesystem;
   fs::path scratch =
@@ -408,7 +425,7 @@ Status Transfer::setup_images() {
     slot.name =
         img.embedded() ? "embedded image " + std::to_string(i) + " '" + img.name + "'" : img.path;
     if (img.embedded()) {
-      // OpenImageIO's texture cache reads by file name: a private copy is the robust way.
+      // OpenImageIO reads by file name: a private copy is the robust way.
       const std::string ext = img.embedded_extension();
       // Unique per process and per call, so concurrent transfers never share a copy.
       static std::atomic<uint64_t> calls{0};
@@ -421,25 +438,26 @@ Status Transfer::setup_images() {
       if (!f) return Error(ErrorCode::kIo, path + ": cannot write a copy of " + slot.name);
       temp_files_.push_back(path);
     }
-    OIIO::ustring name(path);
     slot.tried = path;
-    const OIIO::ImageSpec* spec = ts_->imagespec(name, 0);
-    if (!spec) {
-      // Reported per material slot by check_missing_textures.
-      slot.error = ts_->geterror();
-      slot.error = slot.error.substr(0, slot.error.find('\n'));  // further lines repeat it
-      if (slot.error.empty()) slot.error = "OpenImageIO cannot read it";
-      continue;
-    }
-    slot.channels = std::min(spec->nchannels, 4);
-    if (used_as_colour(scene_, i)) {
-      VT_RETURN_IF_ERROR(set_colour_space(slot, img.embedded() ? "" : img.path, *spec));
-    }
-    // Optionally, untiled sources get MIP levels made with another filter (as maketx does);
-    // should that fail, OpenImageIO's automatic levels still give a result.
     bool untiled = false;
-    if (auto in = OIIO::ImageInput::open(path)) untiled = in->spec().tile_width == 0;
-    (void)OIIO::geterror();
+    {
+      auto in = OIIO::ImageInput::open(path);
+      if (!in) {
+        // Reported per material slot by check_missing_textures.
+        slot.error = OIIO::geterror();
+        slot.error = slot.error.substr(0, slot.error.find('\n'));  // further lines repeat it
+        if (slot.error.empty()) slot.error = "OpenImageIO cannot read it";
+        continue;
+      }
+      const OIIO::ImageSpec& spec = in->spec();
+      untiled = spec.tile_width == 0;
+      if (used_as_colour(scene_, i)) {
+        VT_RETURN_IF_ERROR(set_colour_space(slot, img.embedded() ? "" : img.path, spec));
+      }
+    }
+    // Optionally, untiled sources get MIP levels made with another filter (as maketx does),
+    // read back as the texture's levels; should that fail, box-filtered levels are made.
+    std::string source = path;
     if (!opt_.mip_filter.empty() && untiled) {
       static std::atomic<uint64_t> made{0};
       std::string tx = (scratch / ("vtbake-transfer-" + std::to_string(getpid()) + "-mip" +
@@ -450,22 +468,35 @@ Status Transfer::setup_images() {
       config.tile_width = config.tile_height = 64;
       if (OIIO::ImageBufAlgo::make_texture(OIIO::ImageBufAlgo::MakeTxTexture, path, tx, config)) {
         temp_files_.push_back(tx);
-        name = OIIO::ustring(tx);
+        source = tx;
       } else {
         (void)OIIO::geterror();
         std::error_code ec;
         std::filesystem::remove(tx, ec);
       }
     }
-    // OpenImageIO reads an untiled image whole, as one float "tile", and makes its MIP levels
-    // from it; a cache smaller than that evicts and re-reads the file over and over (measured:
-    // 2.6x the time and 60 MiB more at a 32 MiB cache for a 4096^2 RGB PNG).
-    if (untiled && name == OIIO::ustring(path))
-      cache = std::max(cache, uint64_t(spec->width) * uint64_t(spec->height) *
-                                  uint64_t(spec->nchannels) * sizeof(float) * 4 / 3);
-    slot.handle = ts_->get_texture_handle(name);
+    auto texture = TransferTexture::load(source, slot.to_working.get(), slot.from_working.get());
+    if (!texture.ok()) {
+      if (texture.status().code() != ErrorCode::kNotFound)
+        return texture.status().with_context(slot.name);
+      slot.error = texture.status().message();
+      continue;
+    }
+    slot.channels = texture->channels();
+    // Textures past the budget are read from a mapped scratch file (the same samples).
+    auto keep = [&](TransferTexture& t) -> Expected<std::unique_ptr<TransferTexture>> {
+      if (texture_bytes_ + t.bytes() > opt_.texture_cache)
+        VT_RETURN_IF_ERROR(t.move_to_scratch(scratch.string()).with_context(slot.name));
+      texture_bytes_ += t.bytes();
+      return std::make_unique<TransferTexture>(std::move(t));
+    };
+    VT_ASSIGN_OR_RETURN(slot.texture, keep(*texture));
+    if (slot.to_working && used_as_data(scene_, i)) {
+      auto data = TransferTexture::load(source);
+      if (!data.ok()) return data.status().with_context(slot.name);
+      VT_ASSIGN_OR_RETURN(slot.data_texture, keep(*data));
+    }
   }
-  if (cache != opt_.texture_cache) set_cache();
   return check_missing_textures();
 }
 
@@ -473,7 +504,7 @@ Status Transfer::check_missing_textures() {
   for (const scene::Material* m : materials_in_use(scene_)) {
     for (const TextureSlot& ts : kTextureSlots) {
       const scene::TextureRef& r = m->*ts.ref;
-      if (!r.valid() || images_[r.image].handle) continue;
+      if (!r.valid() || images_[r.image].texture) continue;
       const scene::Image& img = scene_.images[r.image];
       MissingTexture miss;
       miss.material = m->name;
@@ -623,44 +654,37 @@ void Transfer::make_eval(uint32_t t, TriEval& te) const {
     te.footprint =
         std::max(length(world_vector(w, te.dpdx, false)), length(world_vector(w, te.dpdy, false)));
   }
+  for (int k = 0; k < kTexSlots; ++k) {
+    const scene::TextureRef& ref = (*pi.mat).*kTextureSlots[k].ref;
+    TriEval::Lookup& lk = te.tex[k];
+    const ImageSlot* image = ref.valid() ? &images_[ref.image] : nullptr;
+    const bool colour = k == kBaseColorTex || k == kEmissiveTex;
+    lk.texture = !image                           ? nullptr
+                 : !colour && image->data_texture ? image->data_texture.get()
+                                                  : image->texture.get();
+    if (!lk.texture) continue;  // none, or missing (MissingTextures::kWarn): factor alone
+    const auto& uv = p.uvs[ref.texcoord];
+    for (int j = 0; j < 3; ++j) {
+      const auto st = scene::texture_uv(ref, uv[te.v[j]][0], uv[te.v[j]][1]);
+      lk.s[j] = st[0], lk.t[j] = st[1];
+    }
+    lk.q.wrap_s = ref.wrap_s, lk.q.wrap_t = ref.wrap_t;
+    lk.q.nearest = ref.mag_filter == scene::FilterMode::kNearest;
+    lk.q.d = scene::texture_uv_derivatives(ref, te.duv[ref.texcoord]);
+    lk.footprint = lk.texture->footprint(lk.q.d);
+  }
 }
 
-bool Transfer::sample_texture(OIIO::TextureSystem::Perthread* pt, const scene::TextureRef& ref,
-                              const TriEval& te, const double l[3], float out[4]) const {
-  const ImageSlot& slot = images_[ref.image];
-  if (!slot.handle) return false;  // a missing texture (MissingTextures::kWarn): factor alone
-  const auto& uv = te.p->prim->uvs[ref.texcoord];
-  const auto [s, t] =
-      scene::texture_uv(ref, uv[te.v[0]][0] * l[0] + uv[te.v[1]][0] * l[1] + uv[te.v[2]][0] * l[2],
-                        uv[te.v[0]][1] * l[0] + uv[te.v[1]][1] * l[1] + uv[te.v[2]][1] * l[2]);
-  const std::array<double, 4> d = scene::texture_uv_derivatives(ref, te.duv[ref.texcoord]);
-  auto wrap = [](scene::WrapMode m) {
-    switch (m) {
-      case scene::WrapMode::kClampToEdge:
-        return OIIO::TextureOpt::WrapClamp;
-      case scene::WrapMode::kMirroredRepeat:
-        return OIIO::TextureOpt::WrapMirror;
-      default:
-        return OIIO::TextureOpt::WrapPeriodic;
-    }
-  };
-  OIIO::TextureOpt opt;
-  opt.swrap = wrap(ref.wrap_s);
-  opt.twrap = wrap(ref.wrap_t);
-  opt.interpmode = ref.mag_filter == scene::FilterMode::kNearest ? OIIO::TextureOpt::InterpClosest
-                                                                 : OIIO::TextureOpt::InterpBilinear;
-  opt.mipmode = OIIO::TextureOpt::MipModeAniso;
-  opt.anisotropic = 16;
+bool Transfer::sample_texture(TexSlot slot, const TriEval& te, const double l[3],
+                              float out[4]) const {
+  const TriEval::Lookup& lk = te.tex[slot];
+  if (!lk.texture) return false;
+  TextureLookup q = lk.q;
+  q.s = lk.s[0] * l[0] + lk.s[1] * l[1] + lk.s[2] * l[2];
+  q.t = lk.t[0] * l[0] + lk.t[1] * l[1] + lk.t[2] * l[2];
   float r[4] = {0, 0, 0, 1};
-  if (!ts_->texture(slot.handle, pt, opt, float(s), float(t), float(d[0]), float(d[1]), float(d[2]),
-                    float(d[3]), slot.channels, r)) {
-    if (!lookup_failed_.exchange(true)) {
-      std::lock_guard<std::mutex> lock(error_mutex_);
-      lookup_error_ = slot.name + ": texture lookup failed (" + ts_->geterror() + ")";
-    }
-    return false;
-  }
-  switch (slot.channels) {
+  lk.texture->sample(q, lk.footprint, r);
+  switch (lk.texture->channels()) {
     case 1:
       out[0] = out[1] = out[2] = r[0], out[3] = 1;
       break;
@@ -676,20 +700,19 @@ bool Transfer::sample_texture(OIIO::TextureSystem::Perthread* pt, const scene::T
   return true;
 }
 
-void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, const double l[3],
-                        uint64_t seed, Sample& s) const {
+void Transfer::evaluate(const TriEval& te, const double l[3], uint64_t seed, Sample& s) const {
   const scene::Material& m = *te.p->mat;
   const scene::Primitive& p = *te.p->prim;
   float tex[4];
-  auto colour = [&](const scene::TextureRef& ref, float* rgb) {
-    if (!ref.valid() || !sample_texture(pt, ref, te, l, tex)) return false;
+  auto colour = [&](TexSlot slot, const scene::TextureRef& ref, float* rgb) {
+    if (!sample_texture(slot, te, l, tex)) return false;
     for (int c = 0; c < 4; ++c) rgb[c] = tex[c];
     if (const auto& to_working = images_[ref.image].to_working) to_working->apply_rgb(rgb);
     return true;
   };
   // Albedo: factor x texture x vertex colour (glTF).
   Vec4 a = {1, 1, 1, 1}, vertex = {1, 1, 1, 1};
-  colour(m.base_color_texture, a.data());
+  colour(kBaseColorTex, m.base_color_texture, a.data());
   if (!p.colors.empty()) {
     for (int c = 0; c < 4; ++c) {
       vertex[c] = float(p.colors[te.v[0]][c] * l[0] + p.colors[te.v[1]][c] * l[1] +
@@ -700,16 +723,15 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
   for (int c = 0; c < 4; ++c) s.albedo[c] = albedo[c];
   if (want_[kEmissiveSlot]) {
     float e[4] = {1, 1, 1, 1};
-    colour(m.emissive_texture, e);
+    colour(kEmissiveTex, m.emissive_texture, e);
     for (int c = 0; c < 3; ++c) s.emissive[c] = e[c] * m.emissive_factor[c] * m.emissive_strength;
   }
   if (want_[kOrmSlot]) {
     float occ = 1, rough = m.roughness_factor, metal = m.metallic_factor;
-    if (m.occlusion_texture.valid() && sample_texture(pt, m.occlusion_texture, te, l, tex)) {
+    if (sample_texture(kOcclusionTex, te, l, tex)) {
       occ = 1.0f + m.occlusion_strength * (tex[0] - 1.0f);
     }
-    if (m.metallic_roughness_texture.valid() &&
-        sample_texture(pt, m.metallic_roughness_texture, te, l, tex)) {
+    if (sample_texture(kMetalRoughTex, te, l, tex)) {
       rough *= tex[1], metal *= tex[2];
     }
     s.orm[0] = occ, s.orm[1] = rough, s.orm[2] = metal;
@@ -717,8 +739,7 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
   if (want_[kNormalSlot] || want_[kLightingSlot]) {
     Vec3d n = normalized(lerp3(te.p->normals, te.v, l), te.face_normal);
     Vec3d world = n;
-    if (want_[kNormalSlot] && m.normal_texture.valid() &&
-        sample_texture(pt, m.normal_texture, te, l, tex)) {
+    if (want_[kNormalSlot] && sample_texture(kNormalTex, te, l, tex)) {
       const auto& tg = te.p->tangents;
       Vec3d t = {tg[te.v[0]][0] * l[0] + tg[te.v[1]][0] * l[1] + tg[te.v[2]][0] * l[2],
                  tg[te.v[0]][1] * l[0] + tg[te.v[1]][1] * l[1] + tg[te.v[2]][1] * l[2],
@@ -756,7 +777,7 @@ void Transfer::evaluate(OIIO::TextureSystem::Perthread* pt, const TriEval& te, c
 }
 
 // One band's accumulators as final layer texels: values above 1 counted, normals renormalised.
-void Transfer::finish_rows(std::vector<float> (&acc)[kSlots], const uint8_t* coverage, size_t n,
+void Transfer::finish_rows(float* const (&acc)[kSlots], const uint8_t* coverage, size_t n,
                            LayerFacts (&facts)[kSlots]) const {
   for (int l = 0; l < kSlots; ++l) {
     if (!want_[l]) continue;
@@ -805,11 +826,12 @@ std::vector<TransferLayer> Transfer::make_layers(std::shared_ptr<LevelStore> (&s
       if (!f.alpha) layer.channels = 3;
       if (!f.alpha && stores[l]->in_memory()) {
         const uint32_t W = stores[l]->width(), H = stores[l]->height();
-        std::vector<float> rgba = stores[l]->release(), rgb(size_t(W) * H * 3);
+        // In place (each RGB lands at or before its RGBA), so no second copy is alive.
+        std::vector<float> texels = stores[l]->release();
         for (size_t i = 0; i < size_t(W) * H; ++i)
-          for (int c = 0; c < 3; ++c) rgb[3 * i + c] = rgba[4 * i + c];
-        rgba = {};
-        stores[l] = LevelStore::adopt(W, H, 3, std::move(rgb));
+          for (int c = 0; c < 3; ++c) texels[3 * i + c] = texels[4 * i + c];
+        texels.resize(size_t(W) * H * 3);
+        stores[l] = LevelStore::adopt(W, H, 3, std::move(texels));
       }
     }
     layer.store = std::move(stores[l]);
@@ -820,7 +842,7 @@ std::vector<TransferLayer> Transfer::make_layers(std::shared_ptr<LevelStore> (&s
 
 // Rows [r0, r1) of the atlas (r0 a multiple of kBandRows) into `acc` (those rows only) and the
 // coverage; the bands run on all threads.
-void Transfer::transfer_rows(uint32_t r0, uint32_t r1, std::vector<float> (&acc)[kSlots],
+void Transfer::transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlots],
                              std::vector<uint8_t>& coverage, RowCounts& counts,
                              const std::function<void(double)>& progress) const {
   const uint32_t W = opt_.width, H = opt_.height;
@@ -840,7 +862,6 @@ void Transfer::transfer_rows(uint32_t r0, uint32_t r1, std::vector<float> (&acc)
 
   for_each_band(bands, opt_.threads, progress, [&](uint32_t bi) {
     const uint32_t b = b0 + bi;
-    OIIO::TextureSystem::Perthread* pt = ts_->get_perthread_info();
     BandRaster band;
     uint32_t y0 = b * kBandRows, y1 = std::min(H, y0 + kBandRows);
     band.reset(W, y0, y1);
@@ -853,7 +874,7 @@ void Transfer::transfer_rows(uint32_t r0, uint32_t r1, std::vector<float> (&acc)
       make_eval(t, te);
       raster_triangle(tris_[t], int32_t(t), chart_[t], band, pattern, H,
                       [&](size_t i, const double* l, uint32_t sub) {
-                        evaluate(pt, te, l, (uint64_t(y0) * W + i) * 32 + sub, s);
+                        evaluate(te, l, (uint64_t(y0) * W + i) * 32 + sub, s);
                         store(base + i, s, weight, true);
                         ++n_samples;
                       });
@@ -883,7 +904,7 @@ void Transfer::transfer_rows(uint32_t r0, uint32_t r1, std::vector<float> (&acc)
       make_eval(t, te);
       double l[3];
       tris_[t].closest_barycentrics((i % W) + 0.5, (y0 + i / W) + 0.5, l);
-      evaluate(pt, te, l, (uint64_t(y0) * W + i) * 32 + 16, s);
+      evaluate(te, l, (uint64_t(y0) * W + i) * 32 + 16, s);
       store(texel, s, 1.0f, false);
       ++n_samples;
     }
@@ -897,6 +918,7 @@ void Transfer::transfer_rows(uint32_t r0, uint32_t r1, std::vector<float> (&acc)
 uint32_t Transfer::rows_per_pass() const {
   const uint32_t H = opt_.height;
   uint64_t rows = opt_.band_rows;
+  if (rows == 0 && opt_.stores_in_memory) rows = H;  // accumulated in the stores themselves
   if (rows == 0) {
     uint64_t per_row = 0;
     for (int l = 0; l < kSlots; ++l)
@@ -933,27 +955,35 @@ Expected<TransferResult> Transfer::run() {
   auto coverage = std::make_shared<std::vector<uint8_t>>(size_t(W) * H, 0);
   bins_ = bin_by_rows(tris_, H, kBandRows);
   const uint32_t pass = rows_per_pass();
-  std::vector<float> acc[kSlots];
+  // Accumulators: an in-memory store's own rows (zero when created), else a pass's buffer
+  // written to the scratch store after.
+  std::vector<float> buffer[kSlots];
+  float* acc[kSlots] = {};
   LayerFacts facts[kSlots];
   RowCounts counts;
   for (uint32_t r0 = 0; r0 < H; r0 += pass) {
     const uint32_t r1 = std::min(H, r0 + pass);
     const size_t n = size_t(r1 - r0) * W;
-    for (int l = 0; l < kSlots; ++l)
-      if (want_[l]) acc[l].assign(n * channels_[l], 0.0f);
+    for (int l = 0; l < kSlots; ++l) {
+      if (!want_[l]) continue;
+      if (stores[l]->in_memory()) {
+        acc[l] = stores[l]->data() + size_t(r0) * W * channels_[l];
+      } else {
+        buffer[l].assign(n * channels_[l], 0.0f);
+        acc[l] = buffer[l].data();
+      }
+    }
     std::function<void(double)> progress;
     if (opt_.progress)
       progress = [&](double f) { opt_.progress((double(r0) + f * double(r1 - r0)) / double(H)); };
     transfer_rows(r0, r1, acc, *coverage, counts, progress);
-    if (lookup_failed_) return Error(ErrorCode::kIo, lookup_error_);
     finish_rows(acc, coverage->data() + size_t(r0) * W, n, facts);
     for (int l = 0; l < kSlots; ++l) {
-      if (!want_[l]) continue;
-      VT_RETURN_IF_ERROR(
-          stores[l]->write_rows(r0, r1 - r0, acc[l].data()).with_context("transfer"));
+      if (!want_[l] || stores[l]->in_memory()) continue;
+      VT_RETURN_IF_ERROR(stores[l]->write_rows(r0, r1 - r0, acc[l]).with_context("transfer"));
     }
   }
-  for (auto& a : acc) a = {};
+  for (auto& b : buffer) b = {};
 
   result.layers = make_layers(stores, facts);
   result.coverage = coverage;
@@ -965,6 +995,7 @@ Expected<TransferResult> Transfer::run() {
   result.stats.contested_texels = counts.contested;
   result.stats.samples = counts.samples;
   if (lighting_) result.stats.lighting = lighting_->stats();
+  result.stats.texture_bytes = texture_bytes_;
   result.stats.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

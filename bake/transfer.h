@@ -3,10 +3,11 @@
 // exact (texel-centre samples, top-left fill rule, shared edges evaluated bit-identically so no
 // sample lands in two triangles) and conservative (a texel any part of a triangle touches is
 // covered; with no sample inside it takes the closest point of the closest triangle). Textures
-// are read through OpenImageIO's TextureSystem, filtered at the footprint of the atlas texel
-// (or sub-sample). Normal maps are decoded in the source tangent frame and re-encoded in the
-// atlas UVs' tangent frame. The output is linear (colour) or data texels in memory plus a
-// coverage mask, ready for build_page_file.
+// are read once through OpenImageIO into float MIP levels (colour converted to the working
+// space per source texel, bake/transfer_texture.h) and filtered at the footprint of the atlas
+// texel (or sub-sample): anisotropic, trilinear, bilinear taps. Normal maps are decoded in the
+// source tangent frame and re-encoded in the atlas UVs' tangent frame. The output is linear
+// (colour) or data texels in memory plus a coverage mask, ready for build_page_file.
 #pragma once
 
 #include <cstdint>
@@ -44,22 +45,25 @@ struct TransferOptions {
   // Larger atlases are a resource error (default: the page format's 2^24 texels a side).
   uint64_t max_texels = uint64_t(1) << 48;
   // The atlas is transferred `band_rows` rows at a time (rounded to a multiple of 16; 0 = as
-  // many as `band_memory` bytes of accumulators hold), each pass written to the layers' stores.
+  // many as `band_memory` bytes of accumulators hold; in-memory stores: all rows, accumulated in
+  // the stores themselves), each pass written to the layers' stores.
   // The texels do not depend on it.
   uint32_t band_rows = 0;
   uint64_t band_memory = uint64_t(256) << 20;
-  // OpenImageIO's texture cache for the scene's textures (its max_memory_MB): tiles and MIP
-  // levels beyond it are dropped and re-read. The scene bake passes texture_cache_bytes(limit).
-  // Raised to the largest untiled source (w x h x channels floats and its MIP levels), which
-  // OpenImageIO holds whole: below that it re-reads the file for every eviction.
+  // Memory for the scene's textures (bake/transfer_texture.h: every MIP level as floats,
+  // w x h x channels x 4 bytes x 4/3 each). Textures loaded past it are read from mapped
+  // scratch files under scratch_dir instead; the texels do not depend on it. The scene bake
+  // passes texture_cache_bytes(limit).
   uint64_t texture_cache = uint64_t(2) << 30;
   // transfer_to_stores: the layers' stores are in memory, or scratch files under scratch_dir.
   bool stores_in_memory = true;
   // Filter for MIP levels made (maketx-style, in the scratch folder) for untiled sources;
-  // "" = OpenImageIO's automatic box-filtered levels. Measured against the texel-footprint
-  // (box) average on stripes above the atlas Nyquist limit: "lanczos3" lowers the RMSE at 1
-  // sample per texel (0.048 -> 0.034) but raises it at 4 and 16 (0.0003 -> 0.018 / 0.006),
-  // so the default keeps the box levels.
+  // "" = box-filtered levels (TransferTexture's, colour averaged in linear light). A maketx
+  // filter averages the file's encoded values. Measured against the texel-footprint (box)
+  // average on stripes above the atlas Nyquist limit with OpenImageIO's TextureSystem (before
+  // 2026-12-03): "lanczos3" lowered the RMSE at 1 sample per texel (0.048 -> 0.034) but raised it
+  // at 4 and 16 (0.0003 -> 0.018 / 0.006); the box levels now give 0.00024 at every rate
+  // (SceneBake.SupersamplingNeverLosesAccuracy), so the default keeps them.
   std::string mip_filter;
   MissingTextures missing_textures = MissingTextures::kError;
   // The atlas chart of every triangle, in transfer order (meshes, primitives that have
@@ -101,6 +105,7 @@ struct TransferStats {
   uint64_t contested_texels = 0;  // touched by two charts (0 when the atlas has a gutter)
   uint64_t samples = 0;           // material evaluations
   LightingStats lighting;         // the lighting layer's samples and rays (none: all 0)
+  uint64_t texture_bytes = 0;     // the source textures' MIP levels (memory or mapped scratch)
   double seconds = 0;
 };
 
@@ -137,9 +142,8 @@ std::span<const TextureSlot> texture_slots();
 // atlas set the unwrapper appends would otherwise pass for a missing one.
 Status check_texcoord_sets(const scene::Scene& scene);
 
-// The texture cache a transfer gets within a memory limit: a quarter of it, at least 32 MiB
-// (a few tiles per texture and MIP level; below that the cache re-reads tiles without end) and
-// at most 2 GiB (the scene bake's default 8 GiB limit gives 2 GiB, as before the budget).
+// The texture memory a transfer gets within a memory limit: a quarter of it, at least 32 MiB
+// and at most 2 GiB (the scene bake's default 8 GiB limit gives 2 GiB, as before the budget).
 uint64_t texture_cache_bytes(uint64_t memory_limit);
 
 // Every PNG a material in use reads (file or embedded) has whole chunks with correct CRCs

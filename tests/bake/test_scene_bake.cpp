@@ -264,9 +264,12 @@ TEST(SceneBake, NormalMappedSphereKeepsItsNormals) {
   EXPECT_LT(p95, 2.0) << "mean " << mean << " max " << angles.back();
 }
 
-// A linear EXR of fine stripes, baked at 1/16 of its density: more samples per texel must
-// approach the footprint average (reference: 32 x 32 exact samples per texel) monotonically.
-TEST(SceneBake, SupersamplingImprovesAccuracyMonotonically) {
+// A linear EXR of fine stripes, baked at 1/16 of its density: every supersampling rate must be
+// at the footprint average (reference: 32 x 32 exact samples per texel), and more samples per
+// texel never further from it. (OpenImageIO's TextureSystem, before 2026-12-03, gave RMSE
+// 0.048, 0.00025, 0.00024 at 1, 4, 16; the transfer's own trilinear MIP lookups give 0.00024 at
+// every rate, the floor of the reference.)
+TEST(SceneBake, SupersamplingNeverLosesAccuracy) {
   test::ScratchDir dir;
   auto stripes = [](double u, double v, float* t) {
     double s = 0.5 + 0.45 * std::sin(2 * kPi * (37 * u + 11 * v));
@@ -304,8 +307,35 @@ TEST(SceneBake, SupersamplingImprovesAccuracyMonotonically) {
   }
   RecordProperty("rmse_1_4_16", std::to_string(rmse[0]) + " " + std::to_string(rmse[1]) + " " +
                                     std::to_string(rmse[2]));
-  EXPECT_LT(rmse[1], rmse[0]) << rmse[0] << " " << rmse[1] << " " << rmse[2];
-  EXPECT_LT(rmse[2], rmse[1]) << rmse[0] << " " << rmse[1] << " " << rmse[2];
+  EXPECT_LT(rmse[0], 0.002) << rmse[0] << " " << rmse[1] << " " << rmse[2];
+  EXPECT_LE(rmse[1], rmse[0] * 1.01) << rmse[0] << " " << rmse[1] << " " << rmse[2];
+  EXPECT_LE(rmse[2], rmse[1] * 1.01) << rmse[0] << " " << rmse[1] << " " << rmse[2];
+}
+
+// One sRGB image of black and white columns read as base colour and as occlusion (as
+// VirtualCity's materials do), baked at 1/16 of its density: the colour MIP levels average
+// linear light and the occlusion reads the codes' own average, 0.5 both (occlusion through the
+// colour levels would read their re-encoded linear mean, 0.735).
+TEST(SceneBake, AnImageReadAsColourAndAsDataKeepsEachUsesLevels) {
+  test::ScratchDir dir;
+  auto columns = [](double u, double, float* t) { t[0] = t[1] = t[2] = float(int(u * 256) % 2); };
+  ASSERT_TRUE(write_texture(dir.file("cols.png"), 256, 256, 3, columns).ok());
+  scene::Material m;
+  scene::Scene s = test::textured_scene(make_grid(1.0f, 1, 1), dir.file("cols.png"), m);
+  s.materials[0].occlusion_texture.image = s.materials[0].base_color_texture.image;
+  auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 16});
+  ASSERT_TRUE(un.ok());
+  auto t = transfer_materials(un->scene, test::atlas_transfer_options(un->stats));
+  ASSERT_TRUE(t.ok()) << t.status().message();
+  ASSERT_EQ(t->layers.size(), 2u);
+  uint64_t n = 0;
+  for (size_t i = 0; i < size_t(t->width) * t->height; ++i) {
+    if (!(*t->coverage)[i]) continue;
+    EXPECT_NEAR(t->layers[0].texels[3 * i], 0.5f, 0.02f) << i;  // linear albedo
+    EXPECT_NEAR(t->layers[1].texels[3 * i], 0.5f, 0.02f) << i;  // occlusion
+    ++n;
+  }
+  EXPECT_GT(n, 100u);
 }
 
 TEST(SceneBake, SameTexelsWhateverTheThreadCount) {
