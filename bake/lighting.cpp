@@ -11,14 +11,35 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <string>
 
+#include "scene/image_load.h"
+#include "scene/material_rules.h"
+
 namespace vt {
+
+// A shadow caster whose material cuts holes (MASK, and BLEND: see lighting.h): what the
+// occlusion filter needs to find the base colour's alpha at a hit.
+struct AlphaPlane {
+  uint32_t width = 0, height = 0;
+  std::vector<float> alpha;  // row-major; empty: the image could not be read
+};
+struct AlphaCaster {
+  const AlphaPlane* plane = nullptr;  // the base colour texture's alpha; null: none
+  scene::TextureRef ref;
+  std::vector<scene::Vec2> uvs;     // the texture's UV set, per vertex (empty without a texture)
+  std::vector<float> vertex_alpha;  // COLOR_0's alpha per vertex (empty: 1)
+  std::vector<uint32_t> indices;
+  float factor = 1.0f, cutoff = 0.5f;
+};
 
 struct LightingBaker::Rays {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   std::atomic<int64_t> bytes{0}, peak{0};
+  std::map<int, AlphaPlane> alpha_images;  // by scene image index
+  std::vector<std::unique_ptr<AlphaCaster>> casters;
   ~Rays() {
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
@@ -52,9 +73,107 @@ bool monitor(void* user, ssize_t bytes, bool /*post*/) {
   return true;
 }
 
+// A texel of an alpha plane, wrapped as the texture's sampler says.
+float alpha_texel(const AlphaCaster& c, int x, int y) {
+  auto wrap = [](int i, int n, scene::WrapMode m) {
+    switch (m) {
+      case scene::WrapMode::kClampToEdge:
+        return std::clamp(i, 0, n - 1);
+      case scene::WrapMode::kMirroredRepeat: {
+        const int p = ((i % (2 * n)) + 2 * n) % (2 * n);
+        return p < n ? p : 2 * n - 1 - p;
+      }
+      default:
+        return ((i % n) + n) % n;
+    }
+  };
+  const AlphaPlane& p = *c.plane;
+  return p.alpha[size_t(wrap(y, int(p.height), c.ref.wrap_t)) * p.width +
+                 wrap(x, int(p.width), c.ref.wrap_s)];
+}
+
+// The base colour's alpha at barycentric (u, v) of `triangle`: texture (bilinear, or nearest
+// for a nearest magFilter, level 0) x factor x vertex alpha (scene/material_rules.h).
+float caster_alpha(const AlphaCaster& c, uint32_t triangle, float u, float v) {
+  const uint32_t* t = &c.indices[3 * size_t(triangle)];
+  const double b[3] = {1.0 - u - v, u, v};
+  double a = c.factor;
+  if (!c.vertex_alpha.empty())
+    a *= b[0] * c.vertex_alpha[t[0]] + b[1] * c.vertex_alpha[t[1]] + b[2] * c.vertex_alpha[t[2]];
+  if (c.plane) {
+    double s = 0, r = 0;
+    for (int k = 0; k < 3; ++k) s += b[k] * c.uvs[t[k]][0], r += b[k] * c.uvs[t[k]][1];
+    const auto st = scene::texture_uv(c.ref, s, r);
+    const double x = st[0] * c.plane->width - 0.5, y = st[1] * c.plane->height - 0.5;
+    if (c.ref.mag_filter == scene::FilterMode::kNearest) {
+      a *= alpha_texel(c, int(std::floor(x + 0.5)), int(std::floor(y + 0.5)));
+    } else {
+      const int x0 = int(std::floor(x)), y0 = int(std::floor(y));
+      const double fx = x - x0, fy = y - y0;
+      a *= (1 - fy) * ((1 - fx) * alpha_texel(c, x0, y0) + fx * alpha_texel(c, x0 + 1, y0)) +
+           fy * ((1 - fx) * alpha_texel(c, x0, y0 + 1) + fx * alpha_texel(c, x0 + 1, y0 + 1));
+    }
+  }
+  return float(a);
+}
+
+// Embree's occlusion filter of a cutting caster: a hit where alpha is below the cutoff is no
+// hit (the ray goes on through the hole).
+void alpha_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* c = static_cast<const AlphaCaster*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
+    if (caster_alpha(*c, prim, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i)) <
+        c->cutoff)
+      args->valid[i] = 0;
+  }
+}
+
 std::string device_error(RTCDevice device, const char* what) {
   return std::string("lighting: Embree ") + what + " failed (error " +
          std::to_string(int(rtcGetDeviceError(device))) + ")";
+}
+
+// Makes `g` (primitive `p`) cut holes in shadows where its material asks: MASK at its cutoff,
+// BLEND at 0.5. An image that cannot be read leaves the factor alone (as the transfer does with
+// a missing texture, which it reports).
+Status add_alpha_caster(const scene::Scene& scene, const scene::Primitive& p,
+                        LightingBaker::Rays& rays, RTCGeometry g) {
+  if (p.material < 0 || size_t(p.material) >= scene.materials.size()) return Status::Ok();
+  const scene::Material& m = scene.materials[p.material];
+  if (m.alpha_mode == scene::AlphaMode::kOpaque) return Status::Ok();
+  auto c = std::make_unique<AlphaCaster>();
+  c->cutoff = m.alpha_mode == scene::AlphaMode::kMask ? m.alpha_cutoff : 0.5f;
+  c->factor = m.base_color_factor[3];
+  c->indices = p.indices;
+  for (const auto& col : p.colors) c->vertex_alpha.push_back(col[3]);
+  if (c->vertex_alpha.size() != p.positions.size()) c->vertex_alpha.clear();
+  const scene::TextureRef& ref = m.base_color_texture;
+  const std::vector<scene::Vec2>* uvs = ref.valid() ? scene::texture_uv_set(p, ref) : nullptr;
+  if (uvs && uvs->size() == p.positions.size() && size_t(ref.image) < scene.images.size()) {
+    auto it = rays.alpha_images.find(ref.image);
+    if (it == rays.alpha_images.end()) {
+      AlphaPlane plane;
+      if (Expected<scene::FloatImage> img = scene::load_float_image(scene.images[ref.image])) {
+        plane.width = img->width, plane.height = img->height;
+        plane.alpha.resize(size_t(img->width) * img->height);
+        for (size_t i = 0; i < plane.alpha.size(); ++i) plane.alpha[i] = img->rgba[4 * i + 3];
+      }
+      it = rays.alpha_images.emplace(ref.image, std::move(plane)).first;
+    }
+    if (!it->second.alpha.empty()) {
+      c->plane = &it->second;
+      c->uvs = *uvs;
+      c->ref = ref;
+    }
+  }
+  // Nothing can fall below the cutoff: an ordinary caster.
+  if (!c->plane && c->vertex_alpha.empty() && c->factor >= c->cutoff) return Status::Ok();
+  rtcSetGeometryUserData(g, c.get());
+  rtcSetGeometryOccludedFilterFunction(g, alpha_filter);
+  rays.casters.push_back(std::move(c));
+  return Status::Ok();
 }
 
 }  // namespace
@@ -125,6 +244,7 @@ Expected<std::unique_ptr<LightingBaker>> LightingBaker::create(const scene::Scen
         const bool ok = p.indices[k] < n && p.indices[k + 1] < n && p.indices[k + 2] < n;
         for (int c = 0; c < 3; ++c) idx[k + c] = ok ? p.indices[k + c] : 0;
       }
+      VT_RETURN_IF_ERROR(add_alpha_caster(scene, p, rays, g));
       rtcCommitGeometry(g);
       rtcAttachGeometry(rays.scene, g);
       rtcReleaseGeometry(g);
@@ -200,6 +320,11 @@ void LightingBaker::evaluate(const LightingSample& s, float* out) const {
     const Vec3d e = l.radiant * (cosine * falloff);
     if (!(e.x > 0 || e.y > 0 || e.z > 0)) continue;
     if (rays_ && options_.shadows) {
+      // A light behind the surface itself (a normal map turning the shading normal towards it)
+      // is blocked by the surface: on a closed mesh the ray would hit it, except within the
+      // offset of an edge, where light leaked in bands (found by the screen-space check). The
+      // same rule as the AO rays'.
+      if (!(dot(ng, ray_dir) > 0)) continue;
       ++shadow_rays;
       if (occluded(origin, ray_dir, tfar)) continue;
     }
@@ -242,6 +367,71 @@ void LightingBaker::evaluate(const LightingSample& s, float* out) const {
   if (ao_rays) ao_rays_.fetch_add(ao_rays, std::memory_order_relaxed);
   if (clamped) clamped_.fetch_add(1, std::memory_order_relaxed);
   if (non_finite) non_finite_.fetch_add(1, std::memory_order_relaxed);
+}
+
+SurfaceCaster::~SurfaceCaster() = default;
+
+Expected<std::unique_ptr<SurfaceCaster>> SurfaceCaster::create(std::span<const Mesh> meshes,
+                                                               int threads) {
+  std::unique_ptr<SurfaceCaster> c(new SurfaceCaster());
+  c->rays_ = std::make_unique<LightingBaker::Rays>();
+  LightingBaker::Rays& rays = *c->rays_;
+  const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : std::string();
+  rays.device = rtcNewDevice(config.c_str());
+  if (!rays.device) return Error(ErrorCode::kInternal, "lighting: Embree device creation failed");
+  rays.scene = rtcNewScene(rays.device);
+  rtcSetSceneFlags(rays.scene, RTC_SCENE_FLAG_ROBUST);
+  for (uint32_t m = 0; m < meshes.size(); ++m) {
+    // One geometry per mesh, so that the geometry id is the mesh index (empty ones too).
+    const Mesh& mesh = meshes[m];
+    const size_t vertices = mesh.positions.size() / 3, triangles = mesh.indices.size() / 3;
+    RTCGeometry g = rtcNewGeometry(rays.device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                          RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                          std::max<size_t>(vertices, 1)));
+    auto* idx = static_cast<uint32_t*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t),
+                                std::max<size_t>(triangles, 1)));
+    if (!v || !idx) {
+      rtcReleaseGeometry(g);
+      return Error(ErrorCode::kResourceLimit, device_error(rays.device, "geometry buffer"));
+    }
+    std::fill(v, v + 3, 0.0f);
+    std::copy(mesh.positions.begin(), mesh.positions.begin() + 3 * vertices, v);
+    std::fill(idx, idx + 3, 0u);
+    for (size_t k = 0; k < 3 * triangles; k += 3) {
+      const bool ok = mesh.indices[k] < vertices && mesh.indices[k + 1] < vertices &&
+                      mesh.indices[k + 2] < vertices;
+      for (int i = 0; i < 3; ++i) idx[k + i] = ok ? mesh.indices[k + i] : 0;
+    }
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(rays.scene, g, m);
+    rtcReleaseGeometry(g);
+  }
+  rtcCommitScene(rays.scene);
+  if (rtcGetDeviceError(rays.device) != RTC_ERROR_NONE)
+    return Error(ErrorCode::kInternal, device_error(rays.device, "scene build"));
+  return c;
+}
+
+std::optional<SurfaceCaster::Hit> SurfaceCaster::first_hit(const Vec3d& origin, const Vec3d& dir,
+                                                           double tfar) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh;
+  rh.ray.org_x = float(origin.x), rh.ray.org_y = float(origin.y), rh.ray.org_z = float(origin.z);
+  rh.ray.dir_x = float(dir.x), rh.ray.dir_y = float(dir.y), rh.ray.dir_z = float(dir.z);
+  rh.ray.tnear = 0.0f;
+  rh.ray.tfar = float(tfar);
+  rh.ray.time = 0.0f;
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(rays_->scene, &context, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+  return Hit{rh.hit.geomID, rh.hit.primID, double(rh.hit.u), double(rh.hit.v), double(rh.ray.tfar)};
 }
 
 LightingStats LightingBaker::stats() const {

@@ -7,6 +7,8 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <span>
 #include <vector>
 
 #include "common/status.h"
@@ -51,6 +53,10 @@ class LightingBaker {
  public:
   // The scene's placed lights and, when shadows or AO need it, a ray-tracing structure over
   // every instance's triangles in world space. `threads` bounds Embree's build (0 = all cores).
+  // Alpha cuts holes in what casts: a MASK material blocks a ray only where its base colour's
+  // alpha (texture at the hit's UV, level 0, x factor x vertex alpha) reaches alphaCutoff; a
+  // BLEND material likewise at 0.5 (a hard cut: no partial transmission, so a half-transparent
+  // pane casts either a full shadow or none). A texture that cannot be read leaves the factor.
   static Expected<std::unique_ptr<LightingBaker>> create(const scene::Scene& scene,
                                                          const LightingOptions& options,
                                                          int threads);
@@ -82,6 +88,31 @@ class LightingBaker {
   mutable std::atomic<uint64_t> samples_{0}, shadow_rays_{0}, ao_rays_{0}, clamped_{0},
       non_finite_{0};
   LightingStats build_stats_;
+};
+
+// The first surface along a ray through world-space triangle meshes (Embree 3, robust). The
+// screen-space check of the lighting layer (render/lighting_check.h) finds each pixel's surface of
+// the original scene with it, as a G-buffer pass would.
+class SurfaceCaster {
+ public:
+  struct Mesh {
+    std::span<const float> positions;   // x, y, z per vertex, world space
+    std::span<const uint32_t> indices;  // triangle list; an index out of range: no triangle
+  };
+  struct Hit {
+    uint32_t mesh = 0, triangle = 0;
+    double u = 0, v = 0;  // barycentric weights of the triangle's 2nd and 3rd vertex
+    double t = 0;         // distance along the (unit) direction
+  };
+  // `threads` bounds Embree's build (0 = all cores).
+  static Expected<std::unique_ptr<SurfaceCaster>> create(std::span<const Mesh> meshes, int threads);
+  ~SurfaceCaster();
+  // The nearest hit in (0, tfar] along unit `dir`, either side of a triangle. Thread-safe.
+  std::optional<Hit> first_hit(const Vec3d& origin, const Vec3d& dir, double tfar) const;
+
+ private:
+  SurfaceCaster() = default;
+  std::unique_ptr<LightingBaker::Rays> rays_;
 };
 
 // Whether `scene` calls for a lighting layer: some displayed node places a light.

@@ -4,6 +4,7 @@
 // cone only; AO is 1 on an open plane and lower in a corner; the bytes do not depend on threads
 // or bands; a scene with no light has no lighting layer and bakes the same bytes whatever the
 // lighting options; zero, huge and infinite intensities and range 0 give finite texels.
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -209,6 +210,61 @@ TEST(Lighting, AnOccluderCastsAShadow) {
   for_floor_texels(*lighting_layer(open),
                    [&](std::array<double, 2>, const float* t) { ASSERT_NEAR(t[0], 100.0f, 1e-3); });
   EXPECT_EQ(open.stats.lighting.shadow_rays, 0u);
+}
+
+// A lid over the floor whose material is alpha-masked with a square hole in the middle (alpha 0
+// where the lid's UVs are in [0.78, 0.89]^2, world |x|, |y| < ~0.143): light falls through the
+// hole, the rest of the lid shadows. As MASK, as BLEND (cut at 0.5), and the same lid opaque.
+TEST(Lighting, AlphaMaskedCasterLetsLightThroughItsHoles) {
+  test::ScratchDir dir;
+  const std::string png = dir.file("holed.png");
+  {
+    const int w = 100;
+    std::vector<uint8_t> rgba(size_t(w) * w * 4, 255);
+    for (int j = 0; j < w; ++j)
+      for (int i = 0; i < w; ++i) {
+        const double u = (i + 0.5) / w, v = (j + 0.5) / w;
+        if (u > 0.78 && u < 0.89 && v > 0.78 && v < 0.89) rgba[(size_t(j) * w + i) * 4 + 3] = 0;
+      }
+    auto out = OIIO::ImageOutput::create(png);
+    ASSERT_TRUE(out);
+    OIIO::ImageSpec spec(w, w, 4, OIIO::TypeDesc::UINT8);
+    ASSERT_TRUE(out->open(png, spec) && out->write_image(OIIO::TypeDesc::UINT8, rgba.data()) &&
+                out->close());
+  }
+  for (scene::AlphaMode mode :
+       {scene::AlphaMode::kMask, scene::AlphaMode::kBlend, scene::AlphaMode::kOpaque}) {
+    scene::Scene s = floor_scene();
+    scene::Material lid;
+    lid.alpha_mode = mode;
+    lid.alpha_cutoff = 0.5f;
+    lid.base_color_texture.image = test::add_image(s, png);
+    s.materials.push_back(lid);
+    s.meshes[0].primitives.push_back(square(-0.3, 0.3, -0.3, 0.3, 0.5, 0.72, 0.95, 0.72, 0.95, 1));
+    s.meshes[0].primitives.back().material = 1;
+    add_light(s, light_of(scene::LightType::kDirectional, 100), scene::kIdentity);
+    for (int ao : {0, 16}) {
+      LightingOptions o;
+      o.ao_samples = ao;
+      TransferResult r = transfer(s, o);
+      const TransferLayer* l = lighting_layer(r);
+      ASSERT_NE(l, nullptr);
+      int through = 0, shadowed = 0;
+      for_floor_texels(*l, [&](std::array<double, 2> p, const float* t) {
+        const double m = std::max(std::abs(p[0]), std::abs(p[1]));
+        if (m < 0.1) {
+          ASSERT_NEAR(t[0], mode == scene::AlphaMode::kOpaque ? 0.0f : 100.0f, 1e-3)
+              << int(mode) << " " << p[0] << " " << p[1];
+          ++through;
+        } else if (m > 0.19 && m < 0.27) {
+          ASSERT_EQ(t[0], 0.0f) << int(mode) << " " << p[0] << " " << p[1];
+          ++shadowed;
+        }
+      });
+      EXPECT_GE(through, 12);  // 4 x 4 texels
+      EXPECT_GT(shadowed, 50);
+    }
+  }
 }
 
 TEST(Lighting, SpotLightsItsConeOnly) {
