@@ -267,6 +267,40 @@ TEST(Lighting, AlphaMaskedCasterLetsLightThroughItsHoles) {
   }
 }
 
+// A wall of no thickness standing on the floor along x = 0 (its own chart, meeting the floor's at
+// a seam), a bulb low on its -x side: every floor texel whose centre lies on the +x side is dark,
+// right up to the seam (no light under or through the wall), and the -x side is lit.
+TEST(Lighting, AThinWallLeaksNoLightAtItsSeam) {
+  scene::Scene s = floor_scene();
+  scene::Primitive wall = square(-1, 1, 0, 1, 0, 0.72, 0.95, 0.05, 0.65, 2);
+  for (auto& p : wall.positions) p = {0.0f, p[0], p[1]};  // the plane x = 0, z from 0 up to 1
+  for (auto& n : wall.normals) n = {-1, 0, 0};
+  s.meshes[0].primitives.push_back(wall);
+  s.meshes[0].primitives.back().material = 0;
+  add_light(s, light_of(scene::LightType::kPoint, 10), at(-0.5, 0, 0.3));
+  for (int ao : {0, 16}) {
+    LightingOptions o;
+    o.ao_samples = ao;
+    TransferResult r = transfer(s, o);
+    const TransferLayer* l = lighting_layer(r);
+    ASSERT_NE(l, nullptr);
+    int dark = 0, lit = 0, seam = 0;
+    for_floor_texels(*l, [&](std::array<double, 2> p, const float* t) {
+      if (p[0] > 0.0) {
+        ASSERT_EQ(t[0], 0.0f) << p[0] << " " << p[1];
+        ++dark;
+        seam += p[0] < 0.06;  // within a texel of the wall
+      } else if (p[0] < -0.06) {
+        ASSERT_GT(t[0], 0.0f) << p[0] << " " << p[1];
+        ++lit;
+      }
+    });
+    EXPECT_GT(dark, 300);
+    EXPECT_GT(lit, 300);
+    EXPECT_GT(seam, 10);
+  }
+}
+
 TEST(Lighting, SpotLightsItsConeOnly) {
   scene::Scene s = floor_scene();
   scene::Light spot = light_of(scene::LightType::kSpot, 50);
