@@ -8,6 +8,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -16,6 +17,7 @@
 
 #include "scene/image_load.h"
 #include "scene/material_rules.h"
+#include "scene/tangent_frame.h"
 
 namespace vt {
 
@@ -34,11 +36,28 @@ struct AlphaCaster {
   float factor = 1.0f, cutoff = 0.5f;
 };
 
+// A surface a bounce ray can meet: what its base colour and shading need (world space).
+struct RgbPlane {
+  uint32_t width = 0, height = 0;
+  std::vector<float> rgb;  // linear, row-major; empty: the image could not be read
+};
+struct BounceSurface {
+  std::vector<Vec3d> positions, normals;
+  std::vector<uint32_t> indices;
+  double factor[3] = {1, 1, 1};
+  std::vector<std::array<float, 3>> vertex_rgb;  // COLOR_0 (empty: white)
+  const RgbPlane* plane = nullptr;               // the base colour texture; null: none
+  scene::TextureRef ref;
+  std::vector<scene::Vec2> uvs;
+};
+
 struct LightingBaker::Rays {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   std::atomic<int64_t> bytes{0}, peak{0};
   std::map<int, AlphaPlane> alpha_images;  // by scene image index
+  std::map<int, RgbPlane> rgb_images;      // by scene image index (bounces)
+  std::vector<BounceSurface> surfaces;     // by geometry id (bounces)
   std::vector<std::unique_ptr<AlphaCaster>> casters;
   ~Rays() {
     if (scene) rtcReleaseScene(scene);
@@ -71,6 +90,16 @@ bool monitor(void* user, ssize_t bytes, bool /*post*/) {
   while (now > peak && !rays->peak.compare_exchange_weak(peak, now)) {
   }
   return true;
+}
+
+// Direction i of the rank-1 lattice (R2 sequence) rotated by (r0, r1), cosine-weighted about n
+// (t, b, n an orthonormal frame).
+Vec3d lattice_direction(const Vec3d& t, const Vec3d& b, const Vec3d& n, double r0, double r1,
+                        int i) {
+  double u1 = r0 + 0.7548776662466927 * i, u2 = r1 + 0.5698402909980532 * i;
+  u1 -= std::floor(u1), u2 -= std::floor(u2);
+  const double r = std::sqrt(u1), phi = 2.0 * kPi * u2;
+  return t * (r * std::cos(phi)) + b * (r * std::sin(phi)) + n * std::sqrt(std::max(0.0, 1.0 - u1));
 }
 
 // A texel of an alpha plane, wrapped as the texture's sampler says.
@@ -115,6 +144,102 @@ float caster_alpha(const AlphaCaster& c, uint32_t triangle, float u, float v) {
     }
   }
   return float(a);
+}
+
+int wrap_index(int i, int n, scene::WrapMode m) {
+  switch (m) {
+    case scene::WrapMode::kClampToEdge:
+      return std::clamp(i, 0, n - 1);
+    case scene::WrapMode::kMirroredRepeat: {
+      const int p = ((i % (2 * n)) + 2 * n) % (2 * n);
+      return p < n ? p : 2 * n - 1 - p;
+    }
+    default:
+      return ((i % n) + n) % n;
+  }
+}
+
+// The base colour (linear RGB) at barycentric `w` of `triangle`: factor x texture (bilinear,
+// level 0) x vertex colour.
+void surface_albedo(const BounceSurface& sf, uint32_t triangle, const double w[3], double out[3]) {
+  const uint32_t* t = &sf.indices[3 * size_t(triangle)];
+  for (int c = 0; c < 3; ++c) out[c] = sf.factor[c];
+  if (!sf.vertex_rgb.empty()) {
+    for (int c = 0; c < 3; ++c)
+      out[c] *= w[0] * sf.vertex_rgb[t[0]][c] + w[1] * sf.vertex_rgb[t[1]][c] +
+                w[2] * sf.vertex_rgb[t[2]][c];
+  }
+  if (sf.plane) {
+    double u = 0, v = 0;
+    for (int k = 0; k < 3; ++k) u += w[k] * sf.uvs[t[k]][0], v += w[k] * sf.uvs[t[k]][1];
+    const auto st = scene::texture_uv(sf.ref, u, v);
+    const RgbPlane& p = *sf.plane;
+    const double x = st[0] * p.width - 0.5, y = st[1] * p.height - 0.5;
+    const int x0 = int(std::floor(x)), y0 = int(std::floor(y));
+    const double fx = x - x0, fy = y - y0;
+    double tex[3] = {0, 0, 0};
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) {
+        const double wt = (i ? fx : 1 - fx) * (j ? fy : 1 - fy);
+        const size_t o = (size_t(wrap_index(y0 + j, int(p.height), sf.ref.wrap_t)) * p.width +
+                          wrap_index(x0 + i, int(p.width), sf.ref.wrap_s)) *
+                         3;
+        for (int c = 0; c < 3; ++c) tex[c] += wt * p.rgb[o + c];
+      }
+    for (int c = 0; c < 3; ++c) out[c] *= tex[c];
+  }
+}
+
+// What a bounce ray needs of primitive `p` placed by `world` (attached as the next geometry).
+void add_bounce_surface(const scene::Scene& scene, const scene::Primitive& p,
+                        const scene::Mat4& world, LightingBaker::Rays& rays) {
+  BounceSurface sf;
+  const std::vector<scene::Vec3> normals =
+      p.normals.size() == p.positions.size() ? p.normals : scene::compute_normals(p);
+  for (size_t k = 0; k < p.positions.size(); ++k) {
+    const auto w = scene::transform_point(world, p.positions[k]);
+    const auto n = scene::transform_direction(world, normals[k]);
+    sf.positions.push_back({w[0], w[1], w[2]});
+    sf.normals.push_back(normalized(Vec3d{n[0], n[1], n[2]}, Vec3d{0, 0, 1}));
+  }
+  const uint32_t count = uint32_t(p.positions.size());
+  for (size_t k = 0; k + 2 < p.indices.size(); k += 3) {
+    const bool ok = p.indices[k] < count && p.indices[k + 1] < count && p.indices[k + 2] < count;
+    for (int c = 0; c < 3; ++c) sf.indices.push_back(ok ? p.indices[k + c] : 0);
+  }
+  if (p.colors.size() == p.positions.size())
+    for (const auto& c : p.colors) sf.vertex_rgb.push_back({c[0], c[1], c[2]});
+  if (p.material >= 0 && size_t(p.material) < scene.materials.size()) {
+    const scene::Material& m = scene.materials[p.material];
+    for (int c = 0; c < 3; ++c) sf.factor[c] = m.base_color_factor[c];
+    const scene::TextureRef& ref = m.base_color_texture;
+    const std::vector<scene::Vec2>* uvs = ref.valid() ? scene::texture_uv_set(p, ref) : nullptr;
+    if (uvs && uvs->size() == p.positions.size() && size_t(ref.image) < scene.images.size()) {
+      auto it = rays.rgb_images.find(ref.image);
+      if (it == rays.rgb_images.end()) {
+        RgbPlane plane;
+        if (Expected<scene::FloatImage> img = scene::load_float_image(scene.images[ref.image])) {
+          plane.width = img->width, plane.height = img->height;
+          plane.rgb.resize(size_t(img->width) * img->height * 3);
+          // 8- and 16-bit colour images carry the sRGB curve; float ones are linear.
+          for (size_t i = 0; i < size_t(img->width) * img->height; ++i)
+            for (int c = 0; c < 3; ++c) {
+              const float v = img->rgba[4 * i + c];
+              plane.rgb[3 * i + c] = img->is_float   ? std::max(v, 0.0f)
+                                     : v <= 0.04045f ? v / 12.92f
+                                                     : std::pow((v + 0.055f) / 1.055f, 2.4f);
+            }
+        }
+        it = rays.rgb_images.emplace(ref.image, std::move(plane)).first;
+      }
+      if (!it->second.rgb.empty()) {
+        sf.plane = &it->second;
+        sf.uvs = *uvs;
+        sf.ref = ref;
+      }
+    }
+  }
+  rays.surfaces.push_back(std::move(sf));
 }
 
 // Embree's occlusion filter of a cutting caster: a hit where alpha is below the cutoff is no
@@ -189,6 +314,10 @@ Expected<std::unique_ptr<LightingBaker>> LightingBaker::create(const scene::Scen
                                                                int threads) {
   if (options.ao_samples < 0 || options.ao_samples > 65536)
     return Error(ErrorCode::kInvalidArgument, "lighting: AO samples must be 0..65536");
+  if (options.bounces < 0 || options.bounces > 1)
+    return Error(ErrorCode::kInvalidArgument, "lighting: bounces must be 0 or 1");
+  if (options.bounces > 0 && (options.bounce_samples < 1 || options.bounce_samples > 65536))
+    return Error(ErrorCode::kInvalidArgument, "lighting: bounce samples must be 1..65536");
   if (!(options.ao_distance >= 0) || !std::isfinite(options.ao_distance))
     return Error(ErrorCode::kInvalidArgument, "lighting: AO distance must be a finite number >= 0");
   std::unique_ptr<LightingBaker> b(new LightingBaker());
@@ -206,7 +335,7 @@ Expected<std::unique_ptr<LightingBaker>> LightingBaker::create(const scene::Scen
     q.angle_scale = 1.0 / std::max(0.001, cos_inner - q.cos_outer);  // the extension's guard
     b->lights_.push_back(q);
   }
-  if (!options.shadows && options.ao_samples == 0) return b;
+  if (!options.shadows && options.ao_samples == 0 && options.bounces == 0) return b;
 
   auto start = std::chrono::steady_clock::now();
   b->rays_ = std::make_unique<Rays>();
@@ -245,6 +374,7 @@ Expected<std::unique_ptr<LightingBaker>> LightingBaker::create(const scene::Scen
         for (int c = 0; c < 3; ++c) idx[k + c] = ok ? p.indices[k + c] : 0;
       }
       VT_RETURN_IF_ERROR(add_alpha_caster(scene, p, rays, g));
+      if (options.bounces > 0) add_bounce_surface(scene, p, inst.world, rays);
       rtcCommitGeometry(g);
       rtcAttachGeometry(rays.scene, g);
       rtcReleaseGeometry(g);
@@ -277,26 +407,16 @@ bool LightingBaker::occluded(const Vec3d& origin, const Vec3d& dir, double tfar)
   return ray.tfar < 0;  // Embree sets -inf on a hit
 }
 
-void LightingBaker::evaluate(const LightingSample& s, float* out) const {
-  const Vec3d ns = s.shading_normal;
-  Vec3d ng = s.geometric_normal;
-  if (dot(ng, ns) < 0) ng = ng * -1.0;
-  // Half a texel off the surface, and never inside float's rounding of the position (the
-  // structure holds floats): huge and tiny scene scales alike.
-  const double scale =
-      std::max({std::abs(s.position.x), std::abs(s.position.y), std::abs(s.position.z), 1e-30});
-  const double offset =
-      std::max(0.5 * (std::isfinite(s.footprint) ? s.footprint : 0.0), scale * 4e-7);
-  const Vec3d origin = s.position + ng * offset;
-  uint64_t shadow_rays = 0, ao_rays = 0;
-  double sum[3] = {0, 0, 0};
+void LightingBaker::direct(const Vec3d& position, const Vec3d& ng, const Vec3d& ns, double offset,
+                           double sum[3], uint64_t& shadow_rays) const {
+  const Vec3d origin = position + ng * offset;
   for (const Placed& l : lights_) {
     Vec3d to_light, ray_dir;  // from the surface point (shading), from the ray origin
     double tfar = std::numeric_limits<double>::infinity(), falloff = 1.0;
     if (l.type == scene::LightType::kDirectional) {
       to_light = ray_dir = l.direction * -1.0;
     } else {
-      const Vec3d d = l.position - s.position;
+      const Vec3d d = l.position - position;
       const double dist = length(d);
       if (!(dist > 0) || !std::isfinite(dist)) continue;  // a light on the surface: no direction
       to_light = d / dist;
@@ -330,6 +450,79 @@ void LightingBaker::evaluate(const LightingSample& s, float* out) const {
     }
     sum[0] += e.x, sum[1] += e.y, sum[2] += e.z;
   }
+}
+
+void LightingBaker::bounce(const Vec3d& origin, const Vec3d& ng, const Vec3d& ns, uint64_t seed,
+                           double sum[3], uint64_t& shadow_rays, uint64_t& bounce_rays) const {
+  // The AO rays' lattice under another seed: stratified, per texel sample, thread-independent.
+  const uint64_t h = mix64(seed ^ 0x5851f42d4c957f2dull);
+  const double r0 = unit_double(h), r1 = unit_double(mix64(h));
+  const Vec3d t =
+      normalized(cross(std::abs(ns.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0}, ns), Vec3d{1, 0, 0});
+  const Vec3d b = cross(ns, t);
+  const int n = options_.bounce_samples;
+  double add[3] = {0, 0, 0};
+  for (int i = 0; i < n; ++i) {
+    const Vec3d dir = lattice_direction(t, b, ns, r0, r1, i);
+    if (!(dot(dir, ng) > 0)) continue;  // below the surface itself
+    ++bounce_rays;
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    RTCRayHit rh;
+    rh.ray.org_x = float(origin.x), rh.ray.org_y = float(origin.y), rh.ray.org_z = float(origin.z);
+    rh.ray.dir_x = float(dir.x), rh.ray.dir_y = float(dir.y), rh.ray.dir_z = float(dir.z);
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = std::numeric_limits<float>::infinity();
+    rh.ray.time = 0.0f;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(rays_->scene, &context, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID || rh.hit.geomID >= rays_->surfaces.size())
+      continue;
+    const BounceSurface& sf = rays_->surfaces[rh.hit.geomID];
+    const uint32_t* tri = &sf.indices[3 * size_t(rh.hit.primID)];
+    const double w[3] = {1.0 - rh.hit.u - rh.hit.v, rh.hit.u, rh.hit.v};
+    Vec3d p{0, 0, 0}, nrm{0, 0, 0};
+    for (int k = 0; k < 3; ++k)
+      p = p + sf.positions[tri[k]] * w[k], nrm = nrm + sf.normals[tri[k]] * w[k];
+    const Vec3d gn = normalized(cross(sf.positions[tri[1]] - sf.positions[tri[0]],
+                                      sf.positions[tri[2]] - sf.positions[tri[0]]),
+                                dir * -1.0);
+    // The side the ray arrived on is the side that reflects (either winding).
+    Vec3d hn = normalized(nrm, gn), hg = gn;
+    if (dot(hg, dir) > 0) hg = hg * -1.0;
+    if (dot(hn, hg) < 0) hn = hn * -1.0;
+    double albedo[3];
+    surface_albedo(sf, rh.hit.primID, w, albedo);
+    if (!(albedo[0] > 0 || albedo[1] > 0 || albedo[2] > 0)) continue;
+    const double scale = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z), 1e-30});
+    // Off the hit surface by the distance's rounding, and at least as far as the sample's own.
+    const double off = std::max(scale * 4e-7, length(origin - p) * 1e-5);
+    double e[3] = {0, 0, 0};
+    direct(p, hg, hn, off, e, shadow_rays);
+    for (int c = 0; c < 3; ++c) add[c] += albedo[c] * e[c];
+  }
+  for (int c = 0; c < 3; ++c) sum[c] += add[c] / std::max(n, 1);
+}
+
+void LightingBaker::evaluate(const LightingSample& s, float* out) const {
+  const Vec3d ns = s.shading_normal;
+  Vec3d ng = s.geometric_normal;
+  if (dot(ng, ns) < 0) ng = ng * -1.0;
+  // Half a texel off the surface, and never inside float's rounding of the position (the
+  // structure holds floats): huge and tiny scene scales alike.
+  const double scale =
+      std::max({std::abs(s.position.x), std::abs(s.position.y), std::abs(s.position.z), 1e-30});
+  const double offset =
+      std::max(0.5 * (std::isfinite(s.footprint) ? s.footprint : 0.0), scale * 4e-7);
+  const Vec3d origin = s.position + ng * offset;
+  uint64_t shadow_rays = 0, ao_rays = 0, bounce_rays = 0;
+  double sum[3] = {0, 0, 0};
+  direct(s.position, ng, ns, offset, sum, shadow_rays);
+  if (options_.bounces > 0 && rays_) bounce(origin, ng, ns, s.seed, sum, shadow_rays, bounce_rays);
   bool clamped = false, non_finite = false;
   for (int c = 0; c < 3; ++c) {
     double v = sum[c];
@@ -351,11 +544,7 @@ void LightingBaker::evaluate(const LightingSample& s, float* out) const {
     const int n = options_.ao_samples;
     int open = 0;
     for (int i = 0; i < n; ++i) {
-      double u1 = r0 + 0.7548776662466927 * i, u2 = r1 + 0.5698402909980532 * i;
-      u1 -= std::floor(u1), u2 -= std::floor(u2);
-      const double r = std::sqrt(u1), phi = 2.0 * kPi * u2;
-      const Vec3d dir = t * (r * std::cos(phi)) + b * (r * std::sin(phi)) +
-                        ns * std::sqrt(std::max(0.0, 1.0 - u1));
+      const Vec3d dir = lattice_direction(t, b, ns, r0, r1, i);
       if (!(dot(dir, ng) > 0)) continue;  // below the surface itself (normal-mapped normals)
       ++ao_rays;
       open += !occluded(origin, dir, ao_distance_);
@@ -365,6 +554,7 @@ void LightingBaker::evaluate(const LightingSample& s, float* out) const {
   samples_.fetch_add(1, std::memory_order_relaxed);
   if (shadow_rays) shadow_rays_.fetch_add(shadow_rays, std::memory_order_relaxed);
   if (ao_rays) ao_rays_.fetch_add(ao_rays, std::memory_order_relaxed);
+  if (bounce_rays) bounce_rays_.fetch_add(bounce_rays, std::memory_order_relaxed);
   if (clamped) clamped_.fetch_add(1, std::memory_order_relaxed);
   if (non_finite) non_finite_.fetch_add(1, std::memory_order_relaxed);
 }
@@ -437,6 +627,7 @@ std::optional<SurfaceCaster::Hit> SurfaceCaster::first_hit(const Vec3d& origin, 
 LightingStats LightingBaker::stats() const {
   LightingStats s = build_stats_;
   s.samples = samples_.load(), s.shadow_rays = shadow_rays_.load(), s.ao_rays = ao_rays_.load();
+  s.bounce_rays = bounce_rays_.load();
   s.clamped = clamped_.load(), s.non_finite = non_finite_.load();
   return s;
 }

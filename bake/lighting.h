@@ -24,6 +24,12 @@ struct LightingOptions {
   // reach `ao_distance` world units unblocked (1 = open sky).
   int ao_samples = 0;
   double ao_distance = 0;  // 0 = the scene's bounding-box diagonal
+  // One diffuse bounce (0 = direct light only, 1): `bounce_samples` cosine-weighted rays per
+  // texel sample over the shading normal; each surface one meets adds its base colour (linear:
+  // factor x texture, sRGB decoded, x vertex colour) times its own direct irradiance, so the
+  // sample gains the mean of albedo x E over the rays (a Lambertian bounce: E = pi x mean L).
+  int bounces = 0;
+  int bounce_samples = 16;
 };
 
 // The largest value the layer keeps: half float's largest finite value. Larger (or non-finite)
@@ -34,6 +40,8 @@ struct LightingStats {
   uint64_t samples = 0;      // texel samples lit
   uint64_t shadow_rays = 0;  // rays cast to lights
   uint64_t ao_rays = 0;      // ambient occlusion rays
+  uint64_t bounce_rays = 0;  // rays looking for a surface to bounce from (their shadow rays
+                             // are counted in shadow_rays)
   uint64_t clamped = 0;      // samples above kMaxIrradiance, clamped to it
   uint64_t non_finite = 0;   // samples whose sum was NaN or infinite (stored as 0 or the max)
   uint64_t bvh_bytes = 0;    // memory Embree allocated for the scene's structure (peak)
@@ -74,6 +82,12 @@ class LightingBaker {
  private:
   LightingBaker() = default;
   bool occluded(const Vec3d& origin, const Vec3d& dir, double tfar) const;
+  // Direct irradiance at a point (shadowed when options_.shadows), added to `sum`.
+  void direct(const Vec3d& position, const Vec3d& ng, const Vec3d& ns, double offset, double sum[3],
+              uint64_t& shadow_rays) const;
+  // The bounce's irradiance at a sample (see LightingOptions::bounces), added to `sum`.
+  void bounce(const Vec3d& origin, const Vec3d& ng, const Vec3d& ns, uint64_t seed, double sum[3],
+              uint64_t& shadow_rays, uint64_t& bounce_rays) const;
 
   LightingOptions options_;
   struct Placed {
@@ -85,8 +99,8 @@ class LightingBaker {
   std::vector<Placed> lights_;
   double ao_distance_ = 0;
   std::unique_ptr<Rays> rays_;  // null when nothing needs rays
-  mutable std::atomic<uint64_t> samples_{0}, shadow_rays_{0}, ao_rays_{0}, clamped_{0},
-      non_finite_{0};
+  mutable std::atomic<uint64_t> samples_{0}, shadow_rays_{0}, ao_rays_{0}, bounce_rays_{0},
+      clamped_{0}, non_finite_{0};
   LightingStats build_stats_;
 };
 

@@ -69,6 +69,8 @@ LightingOptions baked_lighting_options(const PageFileReader& reader) {
     // reference repeats the bake's samples and distance (seeded per texel, same rays).
     o.ao_samples = lit.value("ao_samples", 0);
     o.ao_distance = lit.value("ao_distance", 0.0);
+    o.bounces = lit.value("bounces", 0);
+    o.bounce_samples = lit.value("bounce_samples", 16);
   }
   return o;
 }

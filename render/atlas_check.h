@@ -117,8 +117,9 @@ Expected<AtlasCheckReport> check_atlas_pages(std::shared_ptr<const PageFileReade
 Status uploaded_texels(const PageSource& source, const LayerSpec& spec, const PageId& id,
                        uint32_t layer, std::vector<uint8_t>& upload, uint8_t* out);
 
-// The lighting settings a scene bake recorded in its metadata (AO samples and distance; shadows
-// on, whatever the bake used: the references always cast them). Defaults for a file without.
+// The lighting settings a scene bake recorded in its metadata (AO samples and distance, bounces;
+// shadows on, whatever the bake used: the references always cast them). Defaults for a file
+// without.
 LightingOptions baked_lighting_options(const PageFileReader& reader);
 
 // The report as report.json's "atlas" object (docs/JSON.md).

@@ -169,6 +169,20 @@ TEST_F(ValidateLighting, ViewsOfAShadowlessBakeFailTheLightingCheck) {
   EXPECT_TRUE(lighting_failed(r)) << r.out;
 }
 
+// --bounces 1: the metadata records it, the atlas check repeats it (same rays: every page as
+// baked) and the views' reference gathers the bounce too.
+TEST_F(ValidateLighting, ABouncedBakeValidates) {
+  const RunResult atlas = bake_and_check("lit.gltf", "bounce", "--bounces 1 --bounce-samples 8");
+  EXPECT_EQ(atlas.exit_code, 0) << atlas.out;
+  const nlohmann::json l = lighting_report(atlas);
+  ASSERT_TRUE(l.is_object()) << atlas.out;
+  EXPECT_EQ(l["pages_failed"], 0);
+  const RunResult r = views_check("bounce");
+  if (no_vulkan(r)) GTEST_SKIP() << "no Vulkan device: " << r.out;
+  EXPECT_FALSE(lighting_failed(r)) << r.out;
+  EXPECT_EQ(lighting_views(r).size(), 2u) << r.out;
+}
+
 TEST_F(ValidateLighting, AViewsCheckWithoutALightingLayerHasNoLightingObject) {
   const std::string out = dir_ + "/unlit.vtpf";
   const RunResult b = run_vtbake(

@@ -301,6 +301,64 @@ TEST(Lighting, AThinWallLeaksNoLightAtItsSeam) {
   }
 }
 
+// One diffuse bounce: a white wall along y = 0.5 lit by a slanted sun throws light onto the floor
+// in front of it, near the wall as its form factor says, more near than far, never more than the
+// wall's own irradiance over two (a half-space); the floor in the wall's shadow stays dark (the
+// wall's back is unlit, the floor does not light itself); the same bytes on 1 and 2 threads.
+TEST(Lighting, OneBounceLightsTheFloorInFrontOfALitWall) {
+  scene::Scene s = floor_scene();
+  scene::Primitive wall = square(-1, 1, 0, 1, 0, 0.72, 0.95, 0.05, 0.65, 2);
+  for (auto& p : wall.positions) p = {p[0], 0.5f, p[1]};
+  for (auto& n : wall.normals) n = {0, -1, 0};
+  s.meshes[0].primitives.push_back(wall);
+  s.meshes[0].primitives.back().material = 0;
+  const double a = 0.6;  // the sun comes from -y, up: to the light (0, -sin a, cos a)
+  add_light(s, light_of(scene::LightType::kDirectional, 100), turned_about_x(a));
+  const double wall_e = 100 * std::sin(a);
+  LightingOptions direct_only, bounced;
+  bounced.bounces = 1;
+  bounced.bounce_samples = 64;
+  TransferResult r0 = transfer(s, direct_only), r1 = transfer(s, bounced, 2);
+  const TransferLayer *l0 = lighting_layer(r0), *l1 = lighting_layer(r1);
+  ASSERT_NE(l0, nullptr);
+  ASSERT_NE(l1, nullptr);
+  EXPECT_GT(r1.stats.lighting.bounce_rays, 0u);
+  EXPECT_EQ(r0.stats.lighting.bounce_rays, 0u);
+  // Close to the wall it looks infinite: a floor point at distance d from a wall of height 1
+  // sees it with the form factor (1 - d / sqrt(d^2 + 1)) / 2.
+  double near_gain = 0, far_gain = 0, near_expected = 0;
+  int near = 0, far = 0, shadowed = 0;
+  for (uint32_t y = 0; y < kAtlas; ++y)
+    for (uint32_t x = 0; x < kAtlas; ++x) {
+      if (!inside_floor(x, y)) continue;
+      const auto p = floor_xy(x, y);
+      const size_t i = (size_t(y) * kAtlas + x) * 3;
+      const double gain = l1->texels[i] - l0->texels[i];
+      if (p[1] > 0.56) {
+        ASSERT_EQ(l0->texels[i], 0.0f) << p[0] << " " << p[1];
+        ASSERT_EQ(l1->texels[i], 0.0f) << p[0] << " " << p[1];
+        ++shadowed;
+      } else if (p[1] < 0.45) {
+        ASSERT_GE(gain, 0.0) << p[0] << " " << p[1];
+        ASSERT_LT(gain, 0.5 * wall_e) << p[0] << " " << p[1];
+      }
+      if (std::abs(p[0]) < 0.5 && p[1] > 0.3 && p[1] < 0.45) {
+        const double d = 0.5 - p[1];
+        near_gain += gain, ++near;
+        near_expected += wall_e * 0.5 * (1 - d / std::sqrt(d * d + 1));
+      }
+      if (std::abs(p[0]) < 0.5 && p[1] < -0.7) far_gain += gain, ++far;
+    }
+  ASSERT_GT(near, 10);
+  ASSERT_GT(far, 10);
+  // Measured 23.5 lux against 24.9 for an infinite wall (this one is 2 wide).
+  EXPECT_NEAR(near_gain / near, near_expected / near, 0.1 * near_expected / near);
+  EXPECT_GT(near_gain / near, 2.0 * far_gain / far);
+  EXPECT_GT(shadowed, 50);
+  TransferResult one = transfer(s, bounced, 1);
+  EXPECT_EQ(lighting_layer(one)->texels, l1->texels);
+}
+
 TEST(Lighting, SpotLightsItsConeOnly) {
   scene::Scene s = floor_scene();
   scene::Light spot = light_of(scene::LightType::kSpot, 50);
