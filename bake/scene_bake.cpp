@@ -466,6 +466,8 @@ nlohmann::json to_json(const SceneBakeSummary& s) {
                                    {"non_finite", t.lighting.non_finite},
                                    {"structure_bytes", t.lighting.bvh_bytes},
                                    {"structure_seconds", t.lighting.build_seconds}};
+    if (t.lighting.bounce_rays > 0)
+      out["transfer"]["lighting"]["bounce_rays"] = t.lighting.bounce_rays;
   }
   return out;
 }
