@@ -263,7 +263,11 @@ class LayerRun {
       thread_local std::vector<uint8_t> bytes;
       page.resize(page_texels * layer_.work_channels);
       bytes.resize(layer_.encoder->page_bytes());
-      reference.resize(layer_.spec.texel_type == TexelType::kU8 ? bytes.size() : 0);
+      // 8-bit layers: the unclipped values, when clipped; half layers: the floats before rounding.
+      const TexelType type = layer_.spec.texel_type;
+      reference.resize(type == TexelType::kU8    ? bytes.size()
+                       : type == TexelType::kF16 ? bytes.size() / 2
+                                                 : 0);
       cut_page(g_, id, plan_.options.address, band, page.data());
       keys[x] = page_key(id, page);
       auto copied = reuse(id, keys[x], encoded[x]);
@@ -274,8 +278,9 @@ class LayerRun {
       }
       const bool clipped = layer_.store_page(page.data(), page_texels, alpha_.scale, bytes.data(),
                                              reference.empty() ? nullptr : reference.data());
-      errors[x] = layer_.encoder->encode(
-          bytes.data(), encoded[x], clipped && !reference.empty() ? reference.data() : nullptr);
+      const bool measure = type == TexelType::kF16 || (clipped && !reference.empty());
+      errors[x] =
+          layer_.encoder->encode(bytes.data(), encoded[x], measure ? reference.data() : nullptr);
     });
     LevelSummary& lsum = sum_.levels[level_];
     std::vector<uint64_t>& layer_keys = sum_.page_keys[li_];
@@ -294,6 +299,7 @@ class LayerRun {
         error_.sse += e.squared_error;  // a clipped constant page's error (else nothing)
         error_.samples += e.samples;
         error_.max_error = std::max(error_.max_error, e.max_error);
+        error_.hdr.add(e.hdr);  // a half page's rounding
         VT_RETURN_IF_ERROR(sink_.add_constant_page(
             id, li_, std::span<const uint8_t>(e.constant, layer_.spec.texel_bytes())));
         continue;

@@ -148,8 +148,8 @@ struct LayerSummary {
   // the stored pages per DCT page mode (format/dct_page_modes.h).
   RuntimeError runtime;
   uint64_t dct_modes[kDctModeKinds] = {};
-  // Half-float layers stored lossy (BC6H blocks): the stored pages' HDR error (psnr_db is then
-  // infinite: 8-bit figures do not apply). Lossless half layers have no samples.
+  // Half-float layers: the stored pages' HDR error (raw halves or BC6H blocks) against the float
+  // values they were rounded from (psnr_db is then infinite: 8-bit figures do not apply).
   HdrError hdr;
   NonFiniteReport non_finite;
   // Out-of-range values the storage clipped. In an 8-bit layer psnr_db, max_error and the

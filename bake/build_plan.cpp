@@ -499,7 +499,8 @@ bool LayerPlan::store_page(float* texels, size_t count, float alpha_scale, uint8
       const uint16_t h = float_to_half(texels[i]);
       std::memcpy(out + 2 * i, &h, 2);
     }
-    return clipped;  // (no reference: float layers report no 8-bit error figures)
+    if (reference) std::memcpy(reference, texels, count * wc * sizeof(float));
+    return clipped;
   }
   // 8-bit storage: working values outside [0, 1] clip (colour after its transfer curve, which
   // maps [0, 1] onto itself); normals are unit vectors and never do.

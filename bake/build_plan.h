@@ -47,7 +47,9 @@ struct LayerPlan {
   // the storage clipped some value (8 bits: outside [0, 1]; half: beyond +-kHalfMax); for 8-bit
   // layers `reference`, when not null, then receives
   // what the stored bytes would be unclipped (count * spec.channels values in 8-bit code units,
-  // unrounded): the values the page's error is measured against.
+  // unrounded): the values the page's error is measured against. Half layers always fill it
+  // (when not null) with the float values before rounding to half (count * spec.channels): half
+  // storage is not lossless, and its error is measured against them.
   bool store_page(float* texels, size_t count, float alpha_scale, uint8_t* out,
                   float* reference = nullptr) const;
 };

@@ -66,7 +66,7 @@ nlohmann::json layer_json(const LayerSummary& l) {
                       {"non_finite", l.non_finite.non_finite},
                       {"negative", l.non_finite.negative}};
   add_runtime_json(l, j);
-  if (l.hdr.samples > 0) j["hdr"] = hdr_json(l.hdr);  // lossy half storage (BC6H blocks)
+  if (l.hdr.samples > 0) j["hdr"] = hdr_json(l.hdr);  // half storage vs the floats
   if (l.non_finite.any()) {
     j["first_bad_texel"] = {{"x", l.non_finite.first_x},
                             {"y", l.non_finite.first_y},

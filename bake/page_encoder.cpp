@@ -180,8 +180,14 @@ Status PageEncoder::encode(const uint8_t* texels, EncodedPage& out, const float*
     out.state = PageState::kConstant;
     std::memset(out.constant, 0, sizeof(out.constant));
     std::memcpy(out.constant, texels, layer_.texel_bytes());
-    // Exact, and not counted, unless clipped: then what clipping lost counts.
-    if (reference) measure(reference, texels, page_bytes(), out);
+    // Exact, and not counted, unless clipped: then what clipping lost counts (half pages: what
+    // rounding to half lost).
+    if (reference && spec_.texel_type == TexelType::kF16) {
+      add_hdr_error(reference, texels, texel_count(), int(spec_.channels),
+                    std::min(int(spec_.channels), 3), out.hdr);
+    } else if (reference) {
+      measure(reference, texels, page_bytes(), out);
+    }
     return Status::Ok();
   }
   out.state = PageState::kStored;
@@ -194,6 +200,10 @@ Status PageEncoder::encode(const uint8_t* texels, EncodedPage& out, const float*
       } else {
         out.samples = page_bytes();
       }
+    } else if (spec_.texel_type == TexelType::kF16 && reference) {
+      // Raw halves: exact for the halves, not for the floats they were rounded from.
+      add_hdr_error(reference, texels, texel_count(), int(spec_.channels),
+                    std::min(int(spec_.channels), 3), out.hdr);
     }
     return measure_runtime(texels, texels, reference, out);
   }
@@ -203,10 +213,14 @@ Status PageEncoder::encode(const uint8_t* texels, EncodedPage& out, const float*
   back.resize(page_bytes());
   VT_RETURN_IF_ERROR(layer_.encode(texels, settings_, out.bytes, back.data(), &out.dct_mode));
   if (spec_.texel_type == TexelType::kF16) {
-    // BC6H blocks of half texels: the HDR metrics, not 8-bit units.
-    out.hdr = HdrError{};
-    add_hdr_error(texels, back.data(), size_t(layer_.page_size()) * layer_.page_size(),
-                  int(spec_.channels), std::min(int(spec_.channels), 3), out.hdr);
+    // BC6H blocks of half texels: the HDR metrics, not 8-bit units, against the floats when
+    // given.
+    const int kept = std::min(int(spec_.channels), 3);
+    if (reference) {
+      add_hdr_error(reference, back.data(), texel_count(), int(spec_.channels), kept, out.hdr);
+    } else {
+      add_hdr_error(texels, back.data(), texel_count(), int(spec_.channels), kept, out.hdr);
+    }
     return measure_runtime(texels, back.data(), reference, out);
   }
   if (reference) {
@@ -231,7 +245,7 @@ Status PageEncoder::measure_runtime(const uint8_t* texels, const uint8_t* stored
   }
   if (hdr)
     return measure_runtime_hdr_error(*bc, texels, stored, own, int(layer_.page_size()),
-                                     int(spec_.channels), out.runtime);
+                                     int(spec_.channels), out.runtime, reference);
   return measure_runtime_error(*bc, spec_.semantic == LayerSemantic::kNormal, texels, stored, own,
                                int(layer_.page_size()), int(layer_.texel_bytes()), out.runtime,
                                reference);

@@ -71,7 +71,9 @@ struct EncodedPage {
   uint64_t samples = 0;    // channel values compared (every stored 8-bit page's)
   uint8_t dct_mode = 0;    // DCT layers: the page mode chosen (format/dct_page_modes.h)
   RuntimeError runtime;    // after the runtime BC format (layers that have one)
-  HdrError hdr;  // lossy half-float pages (BC6H blocks): the stored page against its texels
+  // Half-float pages given their float values (`reference`): the stored page (halves, or BC6H
+  // blocks) against them; empty otherwise.
+  HdrError hdr;
 };
 
 class PageEncoder {
@@ -82,9 +84,11 @@ class PageEncoder {
                                       uint32_t page_size);
 
   // Encodes page_size^2 texels of layer.texel_bytes() each. Thread-safe. `reference`, when not
-  // null (8-bit layers), holds what the texels were before clipping (page_bytes() values in
-  // 8-bit code units, LayerPlan::store_page): the errors, stored and runtime, are measured
-  // against it, so a lossless page of clipped texels reports what clipping lost.
+  // null, holds for 8-bit layers what the texels were before clipping (page_bytes() values in
+  // 8-bit code units, LayerPlan::store_page), for half layers the floats they were rounded from
+  // (page_size^2 * channels): the errors, stored and runtime, are measured against it, so a
+  // lossless page of clipped texels reports what clipping lost and a half page what rounding to
+  // half lost.
   Status encode(const uint8_t* texels, EncodedPage& out, const float* reference = nullptr) const;
   // Decodes a stored page back to texels (tests and verification). Thread-safe.
   Status decode(std::span<const uint8_t> bytes, uint8_t* texels) const;
@@ -103,6 +107,7 @@ class PageEncoder {
 
   PageCodec codec() const { return layer_.codec(); }
   size_t page_bytes() const { return layer_.page_bytes(); }
+  size_t texel_count() const { return size_t(layer_.page_size()) * layer_.page_size(); }
 
  private:
   PageEncoder(LayerCodec layer, const LayerSpec& spec, const PageEncoderOptions& options)

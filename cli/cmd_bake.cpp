@@ -129,6 +129,7 @@ void print_summary(const vt::SceneBakeSummary& s) {
     std::printf(" %s(%u ch, %s", l.name.c_str(), unsigned(l.spec.channels),
                 vt::to_string(l.spec.codec));
     if (std::isfinite(l.psnr_db)) std::printf(", %.1f dB", l.psnr_db);
+    if (l.hdr.samples > 0) std::printf(", stored %s", vt::cli::hdr_error_text(l.hdr).c_str());
     std::printf("%s)", vt::cli::runtime_error_text(l).c_str());
   }
   std::printf("\n");

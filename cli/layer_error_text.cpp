@@ -11,8 +11,9 @@ std::string hdr_error_text(const HdrError& e) {
   char buf[160];
   const double psnr = e.tonemapped_psnr_db();
   if (!std::isfinite(psnr)) return "exact";
-  std::snprintf(buf, sizeof buf, "log2 error mean %.4f max %.3f, tone-mapped PSNR %.2f dB",
-                e.log_abs_mean(), e.log_abs_max, psnr);
+  std::snprintf(buf, sizeof buf,
+                "log2 error mean %.3g max %.3g, relative max %.3g, tone-mapped PSNR %.2f dB",
+                e.log_abs_mean(), e.log_abs_max, e.relative_max, psnr);
   return buf;
 }
 

@@ -436,7 +436,7 @@ const WeightLut kLut;
 // Chooses every texel's index and sets c.err: the projection onto the palette's line, and with
 // `search` its neighbours too, scored exactly (the palette is near-uniform along the line, but
 // finish() rounds). An anchor index must fit one bit less: it is kept to the lower half.
-void choose_indices(const Block& b, bool is_signed, bool search, Candidate& c, bool score = true) {
+void choose_indices(const Block& b, bool is_signed, bool search, Candidate& c) {
   Palette p;
   make_palette(c, is_signed, p);
   const ModeDesc& md = kModes[c.mode];
@@ -458,10 +458,6 @@ void choose_indices(const Block& b, bool is_signed, bool search, Candidate& c, b
     for (int ch = 0; ch < 3; ++ch) proj += (b.f[ch][t] - float(p.v[r][0][ch])) * dir[r][ch];
     const int top = is_anchor(md.regions, c.partition, t) ? half - 1 : last;
     int best = std::min(int(lut[std::clamp(int(proj * inv[r] + 0.5f), 0, 64)]), top);
-    if (!score) {
-      c.idx[t] = uint8_t(best);
-      continue;
-    }
     int64_t best_e = texel_error(b.v[t], p.v[r][best]);
     if (search) {
       const int centre = best;
@@ -641,7 +637,8 @@ float partition_residual(const Block& b, int partition) {
 }
 
 // Every +-1 step of every stored endpoint channel that lowers the error, until none does.
-void perturb(const Block& b, bool is_signed, Candidate& c, int rounds) {
+// (`widths` > 1: steps of +-1, +-2, +-4, ... up to 2^(widths - 1).)
+void perturb(const Block& b, bool is_signed, Candidate& c, int rounds, int widths = 1) {
   const ModeDesc& md = kModes[c.mode];
   const int n = md.regions * 2;
   const Range r = endpoint_range(md.endpoint_bits, is_signed);
@@ -649,7 +646,8 @@ void perturb(const Block& b, bool is_signed, Candidate& c, int rounds) {
     bool improved = false;
     for (int i = 0; i < n; ++i) {
       for (int ch = 0; ch < 3; ++ch) {
-        for (int step = -1; step <= 1; step += 2) {
+        for (int s = 0; s < 2 * widths; ++s) {
+          const int step = (s % 2 ? 1 : -1) * (1 << (s / 2));
           Candidate t = c;
           t.q[i][ch] += step;
           if (t.q[i][ch] < r.lo || t.q[i][ch] > r.hi) continue;
@@ -669,47 +667,6 @@ void perturb(const Block& b, bool is_signed, Candidate& c, int rounds) {
     }
     if (!improved || c.err == 0) break;
   }
-}
-
-// The real-time level: one region along the principal axis, one least-squares step on the
-// continuous line, then the most precise one-region mode whose deltas hold the endpoints
-// (14, 13, 12, else the untransformed 11), indices by projection.
-void encode_realtime(const Block& b, bool is_signed, Candidate& c) {
-  Endpoints ep;
-  float* lo = ep.e[0];
-  float* hi = ep.e[1];
-  fit_line(b, 0xffff, lo, hi);
-  // Least squares for the weights the texels' projections would take.
-  float d[3], dd = 0;
-  for (int ch = 0; ch < 3; ++ch) d[ch] = hi[ch] - lo[ch], dd += d[ch] * d[ch];
-  if (dd > 0) {
-    c.mode = 10;
-    c.partition = 0;
-    const float inv = 64.0f / dd;
-    for (int t = 0; t < 16; ++t) {
-      float proj = 0;
-      for (int ch = 0; ch < 3; ++ch) proj += (b.f[ch][t] - lo[ch]) * d[ch];
-      c.idx[t] = kLut.idx4[std::clamp(int(proj * inv + 0.5f), 0, 64)];
-    }
-    refine_region(b, c, 0, lo, hi);
-  }
-  orient(b, 0, 0, lo, hi, is_signed);
-  // The delta each mode would store, from the continuous endpoints (one step of margin for
-  // rounding; quantize_endpoints clamps what still does not fit).
-  float span = 0;
-  for (int ch = 0; ch < 3; ++ch) span = std::max(span, std::fabs(hi[ch] - lo[ch]));
-  span *= is_signed ? 32.0f / 31.0f / 32768.0f : 64.0f / 31.0f / 65536.0f;
-  int mode = 10;
-  for (const int m : {13, 12, 11}) {
-    const ModeDesc& md = kModes[m];
-    const float steps = span * float(1 << (md.endpoint_bits - (is_signed ? 1 : 0)));
-    if (steps + 1.0f <= float((1 << (md.delta_bits[0] - 1)) - 1)) {
-      mode = m;
-      break;
-    }
-  }
-  quantize_endpoints(mode, is_signed, ep, c);
-  choose_indices(b, is_signed, false, c, /*score=*/false);  // nothing to compare it with
 }
 
 // 128 bits written from the lowest.
@@ -761,6 +718,327 @@ void pack(const Candidate& c, uint8_t out[16]) {
   }
 }
 
+// ---- Real-time level: 16 blocks at a time ----
+//
+// One region along the principal axis, one least-squares step on the continuous line, then the
+// most precise one-region mode whose deltas hold the endpoints (14, 13, 12, else the
+// untransformed 11), indices by projection. The kernel runs the same arithmetic on 16 blocks
+// side by side (structure of arrays, innermost loops over the blocks), which compilers turn into
+// SIMD, as bc1.cpp's real-time kernel does: built for AVX-512, AVX2 and the baseline, picked at
+// run time, the same IEEE operations in the same order per block (no FMA, no reassociation,
+// branches as selects), so the bytes do not depend on the machine, nor on which lanes a block
+// shares. Only the two ends of the palette are needed (the indices come from the projection,
+// unscored): weight 0 and 64 interpolate to the endpoints themselves.
+constexpr int kLanes = 16;
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(_WIN32) && \
+    !defined(__SANITIZE_ADDRESS__)
+#define VT_BC6H_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define VT_BC6H_CLONES
+#endif
+
+struct RealtimeLanes {
+  uint16_t h[48][kLanes];   // in: the blocks' half floats, texel-major RGB (3 * texel + channel)
+  int32_t mode[kLanes];     // out: mode index (10-13)
+  int32_t q[2][3][kLanes];  // out: the two stored endpoints (as decoded, before unquantize)
+  int32_t idx[16][kLanes];  // out: indices
+};
+
+// The nearest 4-bit index to a position 0..64 along the line (kLut.idx4, ties to the lower
+// index) and an index's weight (bptc::kWeights4), as arithmetic the kernel's loops vectorise.
+constexpr int realtime_index(int position) {
+  return (position * 15 + 26) >> 6;
+}
+constexpr int realtime_weight(int index) {
+  return ((index * 64 + 7) * 2185) >> 15;  // (64 i + 7) / 15
+}
+constexpr bool realtime_tables_agree() {
+  auto distance = [](int a, int b) { return a > b ? a - b : b - a; };  // std::abs: not constexpr
+  for (int f = 0; f <= 64; ++f) {
+    int best = 0;
+    for (int k = 0; k < 16; ++k)
+      if (distance(bptc::kWeights4[k], f) < distance(bptc::kWeights4[best], f)) best = k;
+    if (realtime_index(f) != best || realtime_weight(best) != bptc::kWeights4[best]) return false;
+  }
+  return true;
+}
+static_assert(realtime_tables_agree());
+
+// unquantize() and finish() for a lane's endpoint width (branches as selects; unsigned
+// arithmetic where an unused branch would overflow).
+template <bool kSigned>
+inline int lane_unquantize(int q, int bits) {
+  if constexpr (!kSigned) {
+    const int mid = int((((uint32_t(q) << 16) + 0x8000u) >> uint32_t(bits)));
+    const int v = q == 0 ? 0 : q == (1 << bits) - 1 ? 0xffff : mid;
+    return bits >= 15 ? q : v;
+  } else {
+    const int a = q < 0 ? -q : q;
+    const int mid = int((((uint32_t(a) << 15) + 0x4000u) >> uint32_t(bits - 1)));
+    const int m = a >= (1 << (bits - 1)) - 1 ? 0x7fff : mid;
+    const int v = q == 0 ? 0 : q < 0 ? -m : m;
+    return bits >= 16 ? q : v;
+  }
+}
+
+template <bool kSigned>
+inline int lane_finish(int v) {
+  if constexpr (!kSigned) {
+    return (v * 31) >> 6;
+  } else {
+    const int a = ((v < 0 ? -v : v) * 31) >> 5;
+    return v < 0 ? -a : a;
+  }
+}
+
+// quantize() for a lane's endpoint width. lrint's round-to-nearest-even as an add and subtract
+// of 1.5 * 2^23 (exact for |q| < 2^22; here |q| <= 65536).
+template <bool kSigned>
+inline int lane_quantize(float x, int bits) {
+  const int lo = kSigned ? (bits >= 16 ? -32767 : -(1 << (bits - 1))) : 0;
+  const int hi = kSigned ? (1 << (bits - 1)) - 1 : (1 << bits) - 1;
+  const float u = kSigned ? x * (32.0f / 31.0f) : x * (64.0f / 31.0f);
+  const int full = kSigned ? 16 : 15;
+  const float scaled =
+      u * float(1 << (bits - (kSigned ? 1 : 0))) * (kSigned ? 1.0f / 32768.0f : 1.0f / 65536.0f) -
+      0.5f;
+  const float q = bits >= full ? u : scaled;
+  const float magic = 12582912.0f;
+  const float big = q + magic;
+  const float rounded = big - magic;
+  int q0 = int(rounded);
+  q0 = q0 < lo ? lo : hi < q0 ? hi : q0;
+  int best = q0;
+  float best_d = std::fabs(float(lane_finish<kSigned>(lane_unquantize<kSigned>(q0, bits))) - x);
+  const int down = q0 - 1, up = q0 + 1;
+  const float dd = std::fabs(float(lane_finish<kSigned>(lane_unquantize<kSigned>(down, bits))) - x);
+  const bool take_down = down >= lo && dd < best_d;
+  best = take_down ? down : best;
+  best_d = take_down ? dd : best_d;
+  const float du = std::fabs(float(lane_finish<kSigned>(lane_unquantize<kSigned>(up, bits))) - x);
+  const bool take_up = up <= hi && du < best_d;
+  return take_up ? up : best;
+}
+
+template <bool kSigned>
+[[gnu::always_inline]] inline void realtime_lanes(RealtimeLanes& io) {
+  constexpr int L = kLanes;
+  float f[3][16][L];
+  for (int t = 0; t < 16; ++t) {
+    for (int ch = 0; ch < 3; ++ch) {
+      for (int l = 0; l < L; ++l) {
+        // bc6h_half_to_int without branches.
+        const int h = io.h[3 * t + ch][l], mag = h & 0x7fff, neg = h >> 15;
+        int v = mag > 0x7c00 ? 0 : mag < 0x7bff ? mag : 0x7bff;
+        v = neg ? (kSigned ? -v : 0) : v;
+        f[ch][t][l] = float(v);
+      }
+    }
+  }
+  // fit_line() over all 16 texels.
+  float mean[3][L], d[3][16][L];
+  for (int ch = 0; ch < 3; ++ch) {
+    float sum[L];
+    for (int l = 0; l < L; ++l) sum[l] = 0;
+    for (int t = 0; t < 16; ++t)
+      for (int l = 0; l < L; ++l) sum[l] += f[ch][t][l];
+    for (int l = 0; l < L; ++l) mean[ch][l] = sum[l] / 16.0f;
+    for (int t = 0; t < 16; ++t)
+      for (int l = 0; l < L; ++l) d[ch][t][l] = f[ch][t][l] - mean[ch][l];
+  }
+  float cov[6][L];
+  for (int k = 0; k < 6; ++k)
+    for (int l = 0; l < L; ++l) cov[k][l] = 0;
+  for (int t = 0; t < 16; ++t) {
+    for (int l = 0; l < L; ++l) {
+      const float x = d[0][t][l], y = d[1][t][l], z = d[2][t][l];
+      cov[0][l] += x * x, cov[1][l] += x * y, cov[2][l] += x * z;
+      cov[3][l] += y * y, cov[4][l] += y * z, cov[5][l] += z * z;
+    }
+  }
+  float axis[3][L], len2[L];
+  for (int l = 0; l < L; ++l) {
+    const float c0 = cov[0][l], c1 = cov[1][l], c2 = cov[2][l], c3 = cov[3][l], c4 = cov[4][l],
+                c5 = cov[5][l];
+    // Power iteration from the row of the largest diagonal entry; a zero step keeps the axis.
+    const bool first = c0 >= c3 && c0 >= c5, second = c3 >= c5;
+    float a0 = first ? c0 : second ? c1 : c2;
+    float a1 = first ? c1 : second ? c3 : c4;
+    float a2 = first ? c2 : second ? c4 : c5;
+#pragma GCC unroll 4
+    for (int it = 0; it < 4; ++it) {
+      const float x = c0 * a0 + c1 * a1 + c2 * a2;
+      const float y = c1 * a0 + c3 * a1 + c4 * a2;
+      const float z = c2 * a0 + c4 * a1 + c5 * a2;
+      float big = std::fabs(x);
+      big = big < std::fabs(y) ? std::fabs(y) : big;
+      big = big < std::fabs(z) ? std::fabs(z) : big;
+      const bool step = big > 0;
+      a0 = step ? x / big : a0, a1 = step ? y / big : a1, a2 = step ? z / big : a2;
+    }
+    axis[0][l] = a0, axis[1][l] = a1, axis[2][l] = a2;
+    len2[l] = a0 * a0 + a1 * a1 + a2 * a2;
+  }
+  float tmin[L], tmax[L];
+  for (int l = 0; l < L; ++l) tmin[l] = tmax[l] = 0;
+  for (int t = 0; t < 16; ++t) {
+    for (int l = 0; l < L; ++l) {
+      const float p = d[0][t][l] * axis[0][l] + d[1][t][l] * axis[1][l] + d[2][t][l] * axis[2][l];
+      tmin[l] = p < tmin[l] ? p : tmin[l];
+      tmax[l] = tmax[l] < p ? p : tmax[l];
+    }
+  }
+  float lo[3][L], hi[3][L];
+  for (int ch = 0; ch < 3; ++ch) {
+    for (int l = 0; l < L; ++l) {
+      const bool line = len2[l] > 0;
+      lo[ch][l] = line ? mean[ch][l] + axis[ch][l] * tmin[l] / len2[l] : mean[ch][l];
+      hi[ch][l] = line ? mean[ch][l] + axis[ch][l] * tmax[l] / len2[l] : mean[ch][l];
+    }
+  }
+  // Indices for the texels' projections, then least squares for their weights (refine_region).
+  float wb[16][L];
+  {
+    float dv[3][L], inv[L];
+    for (int l = 0; l < L; ++l) {
+      float dd = 0;
+      for (int ch = 0; ch < 3; ++ch) {
+        dv[ch][l] = hi[ch][l] - lo[ch][l];
+        dd += dv[ch][l] * dv[ch][l];
+      }
+      inv[l] = dd > 0 ? 64.0f / dd : 0.0f;  // 0: no step (see below)
+    }
+    for (int t = 0; t < 16; ++t) {
+      for (int l = 0; l < L; ++l) {
+        float proj = 0;
+        for (int ch = 0; ch < 3; ++ch) proj += (f[ch][t][l] - lo[ch][l]) * dv[ch][l];
+        int k = int(proj * inv[l] + 0.5f);
+        k = k < 0 ? 0 : k > 64 ? 64 : k;
+        wb[t][l] = float(realtime_weight(realtime_index(k))) * (1.0f / 64.0f);
+      }
+    }
+    float aa[L], ab[L], bb[L], ax[3][L], bx[3][L];
+    for (int l = 0; l < L; ++l) {
+      aa[l] = ab[l] = bb[l] = 0;
+      for (int ch = 0; ch < 3; ++ch) ax[ch][l] = bx[ch][l] = 0;
+    }
+    for (int t = 0; t < 16; ++t) {
+      for (int l = 0; l < L; ++l) {
+        const float b = wb[t][l], a = 1.0f - b;
+        aa[l] += a * a, ab[l] += a * b, bb[l] += b * b;
+        for (int ch = 0; ch < 3; ++ch) ax[ch][l] += a * f[ch][t][l], bx[ch][l] += b * f[ch][t][l];
+      }
+    }
+    for (int l = 0; l < L; ++l) {
+      const float det = aa[l] * bb[l] - ab[l] * ab[l];
+      // No step for a point (all texels equal) or a singular system.
+      const bool step = inv[l] > 0 && !(std::fabs(det) < 1e-6f);
+      for (int ch = 0; ch < 3; ++ch) {
+        const float nlo = (bb[l] * ax[ch][l] - ab[l] * bx[ch][l]) / det;
+        const float nhi = (aa[l] * bx[ch][l] - ab[l] * ax[ch][l]) / det;
+        lo[ch][l] = step ? nlo : lo[ch][l];
+        hi[ch][l] = step ? nhi : hi[ch][l];
+      }
+    }
+  }
+  // orient(): clamp to what a block holds, texel 0 in the first half of the line; then the mode
+  // and quantize_endpoints().
+  {
+    const float top = kLimit, bottom = kSigned ? -top : 0.0f;
+    float proj[L], dd[L], span[L];
+    for (int l = 0; l < L; ++l) proj[l] = dd[l] = span[l] = 0;
+    for (int ch = 0; ch < 3; ++ch) {
+      for (int l = 0; l < L; ++l) {
+        const float a = lo[ch][l], b = hi[ch][l];
+        lo[ch][l] = a < bottom ? bottom : top < a ? top : a;
+        hi[ch][l] = b < bottom ? bottom : top < b ? top : b;
+        const float dv = hi[ch][l] - lo[ch][l];
+        proj[l] += (f[ch][0][l] - lo[ch][l]) * dv;
+        dd[l] += dv * dv;
+      }
+    }
+    for (int ch = 0; ch < 3; ++ch) {
+      for (int l = 0; l < L; ++l) {
+        const bool swap = proj[l] * 2.0f > dd[l];
+        const float a = lo[ch][l], b = hi[ch][l];
+        lo[ch][l] = swap ? b : a;
+        hi[ch][l] = swap ? a : b;
+        const float s = std::fabs(hi[ch][l] - lo[ch][l]);
+        span[l] = span[l] < s ? s : span[l];
+      }
+    }
+    int eb[L], half_range[L];
+    for (int l = 0; l < L; ++l) {
+      const float sp = span[l] * (kSigned ? 32.0f / 31.0f / 32768.0f : 64.0f / 31.0f / 65536.0f);
+      // Modes 14, 13, 12 (index 13, 12, 11) when their deltas hold the span with a step of
+      // margin; the signed endpoints spend a bit on the sign.
+      const float s = kSigned ? 0.5f : 1.0f;
+      const bool m13 = sp * (65536.0f * s) + 1.0f <= 7.0f;
+      const bool m12 = sp * (4096.0f * s) + 1.0f <= 127.0f;
+      const bool m11 = sp * (2048.0f * s) + 1.0f <= 255.0f;
+      io.mode[l] = m13 ? 13 : m12 ? 12 : m11 ? 11 : 10;
+      eb[l] = m13 ? 16 : m12 ? 12 : m11 ? 11 : 10;
+      half_range[l] = m13 ? 8 : m12 ? 128 : m11 ? 256 : 1 << 30;  // 2^(delta bits - 1)
+    }
+    for (int ch = 0; ch < 3; ++ch) {
+      for (int l = 0; l < L; ++l) {
+        const int q0 = lane_quantize<kSigned>(lo[ch][l], eb[l]);
+        const int q1 = lane_quantize<kSigned>(hi[ch][l], eb[l]);
+        const int delta = q1 - q0, r = half_range[l];  // mode 11 (untransformed): no clamp
+        const int clamped = delta < -r ? -r : delta > r - 1 ? r - 1 : delta;
+        io.q[0][ch][l] = q0;
+        io.q[1][ch][l] = q0 + clamped;
+      }
+    }
+  }
+  // choose_indices() without the scoring: the projection onto the decoded endpoints' line.
+  float p0[3][L], dir[3][L], inv[L];
+  for (int l = 0; l < L; ++l) inv[l] = 0;
+  for (int ch = 0; ch < 3; ++ch) {
+    for (int l = 0; l < L; ++l) {
+      const int mode = io.mode[l];
+      const int eb = mode == 13 ? 16 : mode == 12 ? 12 : mode == 11 ? 11 : 10;
+      const int a = lane_finish<kSigned>(lane_unquantize<kSigned>(io.q[0][ch][l], eb));
+      const int b = lane_finish<kSigned>(lane_unquantize<kSigned>(io.q[1][ch][l], eb));
+      p0[ch][l] = float(a);
+      dir[ch][l] = float(b - a);
+      inv[l] += dir[ch][l] * dir[ch][l];  // dd, first
+    }
+  }
+  for (int l = 0; l < L; ++l) inv[l] = inv[l] > 0 ? 64.0f / inv[l] : 0.0f;
+  for (int t = 0; t < 16; ++t) {
+    const int top = t == 0 ? 7 : 15;  // the anchor's index has one bit less
+    for (int l = 0; l < L; ++l) {
+      float proj = 0;
+      for (int ch = 0; ch < 3; ++ch) proj += (f[ch][t][l] - p0[ch][l]) * dir[ch][l];
+      int k = int(proj * inv[l] + 0.5f);
+      k = k < 0 ? 0 : k > 64 ? 64 : k;
+      const int i = realtime_index(k);
+      io.idx[t][l] = i < top ? i : top;
+    }
+  }
+}
+
+VT_BC6H_CLONES
+void encode_realtime_lanes(RealtimeLanes& io, bool is_signed) {
+  if (is_signed)
+    realtime_lanes<true>(io);
+  else
+    realtime_lanes<false>(io);
+}
+
+// Packs the first n lanes' blocks, `out_stride` bytes apart.
+void pack_lanes(const RealtimeLanes& io, int n, uint8_t* out, size_t out_stride) {
+  for (int l = 0; l < n; ++l) {
+    Candidate c;
+    c.mode = io.mode[l];
+    for (int ch = 0; ch < 3; ++ch) c.q[0][ch] = io.q[0][ch][l], c.q[1][ch] = io.q[1][ch][l];
+    for (int t = 0; t < 16; ++t) c.idx[t] = uint8_t(io.idx[t][l]);
+    pack(c, out + size_t(l) * out_stride);
+  }
+}
+
 constexpr int kOneRegionModes[4] = {10, 11, 12, 13};  // modes 11-14
 constexpr int kTwoRegionModes[10] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
 
@@ -803,7 +1081,9 @@ void bc6h_decode_block(const uint8_t block[16], bool is_signed, uint16_t rgb[48]
   }
 }
 
-void bc6h_encode_block(const uint16_t rgb[48], bool is_signed, BcQuality quality, uint8_t out[16]) {
+namespace {
+
+Block make_block(const uint16_t rgb[48], bool is_signed) {
   Block b;
   for (int i = 0; i < 48; ++i) {
     // bc6h_half_to_int without branches (the loop vectorises).
@@ -814,12 +1094,37 @@ void bc6h_encode_block(const uint16_t rgb[48], bool is_signed, BcQuality quality
   }
   for (int t = 0; t < 16; ++t)
     for (int ch = 0; ch < 3; ++ch) b.f[ch][t] = float(b.v[t][ch]);
+  return b;
+}
+
+}  // namespace
+
+void bc6h_encode_block_reference(const uint16_t rgb[48], bool is_signed, uint8_t out[16]) {
+  const Block b = make_block(rgb, is_signed);
+  constexpr int kIterations = 8, kRounds = 8, kWidths = 3;
   Candidate best;
+  try_modes(b, is_signed, 0, kOneRegionModes, 4, kIterations, true, best);
+  if (best.err > 0) perturb(b, is_signed, best, kRounds, kWidths);
+  for (int p = 0; p < 32 && best.err > 0; ++p) {
+    Candidate c;
+    try_modes(b, is_signed, p, kTwoRegionModes, 10, kIterations, true, c);
+    if (c.err > 0) perturb(b, is_signed, c, kRounds, kWidths);
+    if (c.err < best.err) best = c;
+  }
+  pack(best, out);
+}
+
+void bc6h_encode_block(const uint16_t rgb[48], bool is_signed, BcQuality quality, uint8_t out[16]) {
   if (quality == BcQuality::kRealtime) {
-    encode_realtime(b, is_signed, best);
-    pack(best, out);
+    RealtimeLanes io;  // the block in every lane
+    for (int i = 0; i < 48; ++i)
+      for (int l = 0; l < kLanes; ++l) io.h[i][l] = rgb[i];
+    encode_realtime_lanes(io, is_signed);
+    pack_lanes(io, 1, out, 16);
     return;
   }
+  const Block b = make_block(rgb, is_signed);
+  Candidate best;
   const bool high = quality == BcQuality::kHigh;
   const int iterations = high ? 4 : 3;
   try_modes(b, is_signed, 0, kOneRegionModes, 4, iterations, true, best);
@@ -859,6 +1164,32 @@ Status bc6h_encode_image(bool is_signed, BcQuality quality, const void* texels, 
   VT_RETURN_IF_ERROR(check_bc6h_image(texels, out, width, height, channels));
   const int blocks_x = width / 4;
   const size_t nc = size_t(channels);
+  if (quality == BcQuality::kRealtime) {
+    // kLanes blocks of a block row at a time; idle lanes repeat the row's last block.
+    RealtimeLanes io;
+    std::vector<uint16_t> rows(size_t(width) * 4 * nc);
+    for (int by = 0; by < height / 4; ++by) {
+      std::memcpy(rows.data(),
+                  static_cast<const uint8_t*>(texels) + size_t(by) * 4 * size_t(width) * nc * 2,
+                  rows.size() * 2);
+      for (int bx0 = 0; bx0 < blocks_x; bx0 += kLanes) {
+        const int n = std::min(kLanes, blocks_x - bx0);
+        for (int l = 0; l < kLanes; ++l) {
+          const size_t x0 = size_t(bx0 + std::min(l, n - 1)) * 4;
+          for (int y = 0; y < 4; ++y) {
+            const uint16_t* src = rows.data() + (size_t(y) * size_t(width) + x0) * nc;
+            for (int x = 0; x < 4; ++x)
+              for (int ch = 0; ch < 3; ++ch)
+                io.h[3 * (4 * y + x) + ch][l] =
+                    ch < channels ? src[size_t(x) * nc + size_t(ch)] : 0;
+          }
+        }
+        encode_realtime_lanes(io, is_signed);
+        pack_lanes(io, n, out + (size_t(by) * size_t(blocks_x) + size_t(bx0)) * 16, 16);
+      }
+    }
+    return Status::Ok();
+  }
   uint16_t rgb[48], row[16];
   for (int by = 0; by < height / 4; ++by) {
     for (int bx = 0; bx < blocks_x; ++bx) {

@@ -11,7 +11,9 @@
 // is where the format interpolates: roughly log2 space, so every exposure gets the same relative
 // precision. They minimise the squared error of those integers.
 //   kRealtime: one region; endpoints along the principal axis, one least-squares step, indices
-//     by projection; the best of modes 11-14. For load-time transcoding.
+//     by projection; the most precise of modes 11-14 that holds the endpoints. For load-time
+//     transcoding: 16 blocks at a time in SIMD (bc6h_encode_image; one block alone costs a
+//     whole batch).
 //   kNormal: also two regions: the 4 partitions whose regions fit a line best, modes 1-10;
 //     indices by exhaustive search; least-squares iterations on the quantized endpoints.
 //   kHigh: the 12 best partitions, more iterations, then a search of +-1 steps of every
@@ -28,6 +30,11 @@ namespace vt {
 
 // Encodes 16 texels of three half-float channels (48 values, row-major RGB) into one block.
 void bc6h_encode_block(const uint16_t rgb[48], bool is_signed, BcQuality quality, uint8_t out[16]);
+// A reference search for benchmarks (the yardstick for kHigh, issue 19), about 10x kHigh's
+// time: every mode and all 32 partitions, 8 least-squares iterations each, then a search of
+// +-1, +-2 and +-4 steps of every stored endpoint channel on the best candidate of every
+// partition, up to 8 rounds. Not a runtime path.
+void bc6h_encode_block_reference(const uint16_t rgb[48], bool is_signed, uint8_t out[16]);
 // Decodes one block into 16 RGB half-float texels. Any 16 bytes are a valid input; the output
 // is never NaN or infinite for unsigned blocks (signed mode 14 can encode -65536 as -infinity,
 // which no encoder here writes).

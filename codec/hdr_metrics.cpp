@@ -2,6 +2,7 @@
 #include "codec/hdr_metrics.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstring>
 
@@ -43,6 +44,31 @@ double HdrError::tonemapped_psnr_db() const {
   return 10.0 * std::log10(double(samples) / tonemapped_sse);
 }
 
+namespace {
+
+float sane_float(float f) {
+  if (std::isnan(f)) return 0.0f;
+  return std::clamp(f, -FLT_MAX, FLT_MAX);
+}
+
+void add_sample(float a, float b, HdrError& out) {
+  const double dl = std::fabs(hdr_log_value(a) - hdr_log_value(b));
+  out.log_abs_sum += dl;
+  out.log_abs_max = std::max(out.log_abs_max, dl);
+  const double dt = hdr_tonemap(a) - hdr_tonemap(b);
+  out.tonemapped_sse += dt * dt;
+  const double rel = std::fabs(double(a) - double(b)) / std::max(std::fabs(double(a)), 0x1p-14);
+  out.relative_max = std::max(out.relative_max, rel);
+}
+
+uint16_t half_at(const uint8_t* p, size_t t, int channels, int c) {
+  uint16_t h;
+  std::memcpy(&h, p + (t * size_t(channels) + size_t(c)) * 2, 2);
+  return h;
+}
+
+}  // namespace
+
 void add_hdr_error(const void* reference, const void* test, size_t texels, int channels, int kept,
                    HdrError& out) {
   const auto* ra = static_cast<const uint8_t*>(reference);
@@ -50,20 +76,23 @@ void add_hdr_error(const void* reference, const void* test, size_t texels, int c
   kept = std::clamp(kept, 0, channels);
   for (size_t t = 0; t < texels; ++t) {
     for (int c = 0; c < kept; ++c) {
-      const size_t at = (t * size_t(channels) + size_t(c)) * 2;
-      uint16_t ha, hb;
-      std::memcpy(&ha, ra + at, 2);
-      std::memcpy(&hb, rb + at, 2);
+      const uint16_t ha = half_at(ra, t, channels, c), hb = half_at(rb, t, channels, c);
       ++out.samples;
-      if (ha == hb) continue;
-      const float a = sane(ha), b = sane(hb);
-      const double dl = std::fabs(hdr_log_value(a) - hdr_log_value(b));
-      out.log_abs_sum += dl;
-      out.log_abs_max = std::max(out.log_abs_max, dl);
-      const double dt = hdr_tonemap(a) - hdr_tonemap(b);
-      out.tonemapped_sse += dt * dt;
-      const double rel = std::fabs(double(a) - double(b)) / std::max(std::fabs(double(a)), 0x1p-14);
-      out.relative_max = std::max(out.relative_max, rel);
+      if (ha != hb) add_sample(sane(ha), sane(hb), out);
+    }
+  }
+}
+
+void add_hdr_error(const float* reference, const void* test, size_t texels, int channels, int kept,
+                   HdrError& out) {
+  const auto* rb = static_cast<const uint8_t*>(test);
+  kept = std::clamp(kept, 0, channels);
+  for (size_t t = 0; t < texels; ++t) {
+    for (int c = 0; c < kept; ++c) {
+      const float a = sane_float(reference[t * size_t(channels) + size_t(c)]);
+      const float b = sane(half_at(rb, t, channels, c));
+      ++out.samples;
+      if (a != b) add_sample(a, b, out);
     }
   }
 }

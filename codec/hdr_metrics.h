@@ -27,6 +27,11 @@ struct HdrError {
 // over the first `kept` channels, adding into `out`.
 void add_hdr_error(const void* reference, const void* test, size_t texels, int channels, int kept,
                    HdrError& out);
+// The same against float values (what a half layer was made from: its storage rounds them to
+// half, a relative error up to 2^-11, and clips beyond +-65504): NaN counts as 0 and
+// infinities as +-FLT_MAX.
+void add_hdr_error(const float* reference, const void* test, size_t texels, int channels, int kept,
+                   HdrError& out);
 
 // The metric's maps, for tests and tools.
 double hdr_log_value(float x);

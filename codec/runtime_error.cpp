@@ -27,6 +27,23 @@ double angle_deg(const uint8_t* a, const uint8_t* b) {
   return std::acos(std::clamp(c, -1.0, 1.0)) * (180.0 / std::numbers::pi);
 }
 
+// What the GPU samples: `bc_blocks` (or `stored` encoded as the runtime transcodes it) decoded
+// to size x size texels of `channels` channels, in a buffer of this thread's that the next call
+// reuses.
+Expected<const std::vector<uint8_t>*> land(BcFormat format, const uint8_t* stored,
+                                           const uint8_t* bc_blocks, int size, int channels) {
+  thread_local std::vector<uint8_t> blocks, landed;
+  if (!bc_blocks) {
+    blocks.resize(bc_image_bytes(format, size, size));
+    VT_RETURN_IF_ERROR(
+        bc_encode_image(format, BcQuality::kRealtime, stored, size, size, channels, blocks.data()));
+    bc_blocks = blocks.data();
+  }
+  landed.resize(size_t(size) * size * size_t(channels) * size_t(bc_channel_bytes(format)));
+  VT_RETURN_IF_ERROR(bc_decode_image(format, bc_blocks, size, size, channels, landed.data()));
+  return &landed;
+}
+
 }  // namespace
 
 void RuntimeError::add(const RuntimeError& o) {
@@ -63,15 +80,9 @@ Status measure_runtime_error(BcFormat format, bool normal, const uint8_t* source
                              const uint8_t* stored, const uint8_t* bc_blocks, int size,
                              int channels, RuntimeError& out, const float* reference) {
   out = RuntimeError{};
-  thread_local std::vector<uint8_t> blocks, landed;
-  if (!bc_blocks) {
-    blocks.resize(bc_image_bytes(format, size, size));
-    VT_RETURN_IF_ERROR(
-        bc_encode_image(format, BcQuality::kRealtime, stored, size, size, channels, blocks.data()));
-    bc_blocks = blocks.data();
-  }
-  landed.resize(size_t(size) * size * size_t(channels));
-  VT_RETURN_IF_ERROR(bc_decode_image(format, bc_blocks, size, size, channels, landed.data()));
+  VT_ASSIGN_OR_RETURN(const std::vector<uint8_t>* landed_texels,
+                      land(format, stored, bc_blocks, size, channels));
+  const std::vector<uint8_t>& landed = *landed_texels;
   const int kept = std::min(channels, bc_format_channels(format));
   const size_t texels = size_t(size) * size;
   if (reference) {
@@ -113,21 +124,19 @@ Status measure_runtime_error(BcFormat format, bool normal, const uint8_t* source
 
 Status measure_runtime_hdr_error(BcFormat format, const uint8_t* source, const uint8_t* stored,
                                  const uint8_t* bc_blocks, int size, int channels,
-                                 RuntimeError& out) {
+                                 RuntimeError& out, const float* reference) {
   out = RuntimeError{};
   if (!bc_is_bc6h(format))
     return Error(ErrorCode::kInvalidArgument, "HDR runtime error: not a BC6H format");
-  thread_local std::vector<uint8_t> blocks, landed;
-  if (!bc_blocks) {
-    blocks.resize(bc_image_bytes(format, size, size));
-    VT_RETURN_IF_ERROR(
-        bc_encode_image(format, BcQuality::kRealtime, stored, size, size, channels, blocks.data()));
-    bc_blocks = blocks.data();
+  VT_ASSIGN_OR_RETURN(const std::vector<uint8_t>* landed,
+                      land(format, stored, bc_blocks, size, channels));
+  const size_t texels = size_t(size) * size;
+  const int kept = std::min(channels, 3);
+  if (reference) {
+    add_hdr_error(reference, landed->data(), texels, channels, kept, out.hdr);
+  } else {
+    add_hdr_error(source, landed->data(), texels, channels, kept, out.hdr);
   }
-  landed.resize(size_t(size) * size * size_t(channels) * 2);
-  VT_RETURN_IF_ERROR(bc_decode_image(format, bc_blocks, size, size, channels, landed.data()));
-  add_hdr_error(source, landed.data(), size_t(size) * size, channels, std::min(channels, 3),
-                out.hdr);
   return Status::Ok();
 }
 

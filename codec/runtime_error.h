@@ -46,8 +46,10 @@ Status measure_runtime_error(BcFormat format, bool normal, const uint8_t* source
 
 // The same for half-float pages and BC6H (`format` kBc6hUf16 or kBc6hSf16): `source` and
 // `stored` are size x size texels of `channels` halves; fills out.hdr over the RGB channels.
+// `reference`, when not null, holds the float values the halves were rounded from (size * size *
+// channels): the error is measured against them instead of `source`.
 Status measure_runtime_hdr_error(BcFormat format, const uint8_t* source, const uint8_t* stored,
                                  const uint8_t* bc_blocks, int size, int channels,
-                                 RuntimeError& out);
+                                 RuntimeError& out, const float* reference = nullptr);
 
 }  // namespace vt

@@ -335,6 +335,14 @@ Expected<LitFrames> render_lit_view(Renderer& renderer, const Camera& camera,
     out.emissive_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t2).count();
   }
+  if (lit.layer[uint32_t(LitInput::kNormal)]) {
+    const auto t3 = std::chrono::steady_clock::now();
+    const LitFrameOptions n = normals_frame_for(camera);
+    VT_ASSIGN_OR_RETURN(out.normals_virtual, renderer.render_lit_virtual(camera, n));
+    VT_ASSIGN_OR_RETURN(out.normals_reference, renderer.render_lit_reference(camera, n));
+    out.normals_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t3).count();
+  }
   return out;
 }
 
@@ -344,10 +352,17 @@ LitFrameOptions emissive_frame_for(const Camera& camera) {
   return o;
 }
 
+LitFrameOptions normals_frame_for(const Camera& camera) {
+  LitFrameOptions o = lit_frame_for(camera, 1u << uint32_t(LitInput::kNormal));
+  o.shading_normals = true;
+  return o;
+}
+
 nlohmann::json to_json(const LitViewReport& lit) {
   const ViewMetrics& m = lit.metrics;
   nlohmann::json j = {{"psnr_rgb", m.psnr_rgb},
                       {"worst_tile_psnr", m.worst_tile_psnr},
+                      {"worst_tile", {m.worst_tile_x, m.worst_tile_y}},
                       {"ssim", m.ssim},
                       {"max_abs_error", m.max_abs},
                       {"pixels_compared", m.pixels},
@@ -356,6 +371,10 @@ nlohmann::json to_json(const LitViewReport& lit) {
   if (lit.emissive) {
     j["emissive"] = to_json(*lit.emissive);
     j["emissive"]["ms"] = lit.emissive_ms;
+  }
+  if (lit.normals) {
+    j["normals"] = to_json(*lit.normals);
+    j["normals"]["ms"] = lit.normals_ms;
   }
   return j;
 }

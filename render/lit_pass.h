@@ -68,6 +68,8 @@ Status upload_lit_pages(Renderer& renderer, const LitLayers& lit,
 // The lights of an emissive-only frame: every light off and only the emissive input, so both
 // passes shade to the emissive contribution alone (black elsewhere).
 LitFrameOptions emissive_frame_for(const Camera& camera);
+// A normals frame: both passes write their shading normal (render/normal_check.h).
+LitFrameOptions normals_frame_for(const Camera& camera);
 
 struct LitFrames {
   ReferenceFrame reference;
@@ -77,6 +79,10 @@ struct LitFrames {
   std::optional<ReferenceFrame> emissive_reference;
   std::optional<VirtualFrame> emissive_virtual;
   double emissive_ms = 0;
+  // With a normal layer: the normals pair (normals_frame_for), both passes' time.
+  std::optional<ReferenceFrame> normals_reference;
+  std::optional<VirtualFrame> normals_virtual;
+  double normals_ms = 0;
 };
 // Both lit passes of one view (the streamer converged, the caches uploaded), and the
 // emissive-only pair when `lit` has an emissive layer.

@@ -999,7 +999,7 @@ void fill_lit_frame(const Buffer& frame, const LitFrameOptions& o) {
   LitFrameBlock b{};
   for (int c = 0; c < 3; ++c)
     b.eye[c] = o.eye[c], b.key[c] = o.key_dir[c], b.fill[c] = o.fill_dir[c];
-  b.eye[3] = o.ambient;
+  b.eye[3] = o.shading_normals ? -1.0f : o.ambient;  // lit.glsl lit_normals_frame
   b.key[3] = o.key;
   b.fill[3] = o.fill;
   std::memcpy(frame.mapped(), &b, sizeof(b));

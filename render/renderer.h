@@ -1,5 +1,5 @@
 // The validation renderer's three passes over one set of meshes, headless, read back to the CPU:
-//  - reference: each mesh's own mip-mapped texture, trilinear sampler, 4x anisotropic taps;
+//  - reference: each mesh's own mip-mapped texture, trilinear sampler, anisotropic taps (up to 16);
 //  - feedback: one uint32 page request per pixel at reduced resolution (runtime/ format:
 //    bits 0-11 page x, 12-23 page y, 24-28 level; 0xFFFFFFFF where nothing was drawn), alpha-
 //    tested against what the cache holds;
@@ -164,6 +164,7 @@ struct LitFrameOptions {
   float fill_dir[3] = {0, 0, 1};  // towards the fill light
   float key = 1.4f, fill = 0.45f, ambient = 0.1f;
   uint32_t inputs = 0;
+  bool shading_normals = false;  // write the shading normal (n * 0.5 + 0.5), not a colour
 };
 
 class Renderer {

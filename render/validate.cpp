@@ -166,7 +166,12 @@ Expected<ViewMetrics> compare_view(const ReferenceFrame& reference_frame, const 
   m.worst_tile_psnr = kPsnrIdentical;
   for (size_t k = 0; k < sse.size(); ++k) {
     if (count[k] < 32) continue;
-    m.worst_tile_psnr = std::min(m.worst_tile_psnr, psnr_from_mse(sse[k] / (3.0 * count[k])));
+    const double p = psnr_from_mse(sse[k] / (3.0 * count[k]));
+    if (p < m.worst_tile_psnr) {
+      m.worst_tile_psnr = p;
+      m.worst_tile_x = uint32_t(k % tiles_x) * kTile;
+      m.worst_tile_y = uint32_t(k / tiles_x) * kTile;
+    }
   }
   m.coarser_share = covered ? double(coarser) / double(covered) : 0.0;
   if (m.pixels > 0) {
@@ -207,11 +212,12 @@ Thresholds scene_thresholds() {
 }
 
 Thresholds lit_scene_thresholds() {
-  // Provisional. Correct sample-scene bakes, six planned views at 640x360: lit 26-33 dB whole
-  // view, worst tile down to 19.6 dB (specular on the normal-mapped floor, seen close); a
-  // green-flipped normal layer sinks the whole view below 30 dB.
+  // Provisional. Correct sample-scene bakes, six planned views at 1280x720: lit 29.96-33.4 dB
+  // whole view, worst tile down to 17.0 dB (specular on the normal-mapped floor, seen close).
+  // A flipped normal layer is not this bound's to catch (a flipped test bake reads 29.8-32.6
+  // dB, a correct one 30.2-30.4): the normals frame is (normal_check.h).
   Thresholds t;
-  t.min_psnr = 30.0;
+  t.min_psnr = 28.0;
   t.min_tile_psnr = 17.0;
   t.max_coarser_share = 1.0;  // residency and coverage are the view's own checks
   t.max_coverage_mismatch = 1.0;
@@ -233,8 +239,8 @@ std::vector<std::string> check_view(const ViewMetrics& m, const Thresholds& t) {
     why.push_back(line);
   }
   if (m.worst_tile_psnr < t.min_tile_psnr) {
-    std::snprintf(line, sizeof(line), "worst tile PSNR %.2f dB below %.2f dB", m.worst_tile_psnr,
-                  t.min_tile_psnr);
+    std::snprintf(line, sizeof(line), "worst tile (pixel %u, %u) PSNR %.2f dB below %.2f dB",
+                  m.worst_tile_x, m.worst_tile_y, m.worst_tile_psnr, t.min_tile_psnr);
     why.push_back(line);
   }
   if (m.coverage_mismatch_share > t.max_coverage_mismatch) {
@@ -268,6 +274,7 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
   converge.lit = options.lit;
   report.lit_thresholds = options.lit_thresholds;
   report.emissive_bounds = options.emissive_bounds;
+  report.normal_bounds = options.normal_bounds;
   for (uint32_t v = 0; v < cameras.size(); ++v) {
     // A cold cache per view: frames-to-converge then measures the view alone.
     VT_ASSIGN_OR_RETURN(std::unique_ptr<Streamer> streamer,
@@ -312,6 +319,13 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
         for (const std::string& why : check_emissive(*view.lit->emissive, options.emissive_bounds))
           view.failures.push_back("lit " + why);
       }
+      if (lit->normals_reference && lit->normals_virtual) {
+        VT_ASSIGN_OR_RETURN(view.lit->normals,
+                            compare_normals(*lit->normals_reference, *lit->normals_virtual));
+        view.lit->normals_ms = lit->normals_ms;
+        for (const std::string& why : check_normals(*view.lit->normals, options.normal_bounds))
+          view.failures.push_back("lit " + why);
+      }
     }
     if (!options.out_dir.empty()) {
       const std::string base = options.out_dir + "/view_" + std::to_string(v) + "_";
@@ -325,8 +339,13 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
         view.images.push_back(base + name);
       }
       if (lit) {
-        for (const auto& [name, image] : {std::pair{"lit_reference.png", &lit->reference.color},
-                                          std::pair{"lit_virtual.png", &lit->virt.color}}) {
+        std::vector<std::pair<const char*, const Rgba8Image*>> lit_images = {
+            {"lit_reference.png", &lit->reference.color}, {"lit_virtual.png", &lit->virt.color}};
+        if (lit->normals_reference && lit->normals_virtual) {
+          lit_images.push_back({"normals_reference.png", &lit->normals_reference->color});
+          lit_images.push_back({"normals_virtual.png", &lit->normals_virtual->color});
+        }
+        for (const auto& [name, image] : lit_images) {
           VT_RETURN_IF_ERROR(write_png(base + name, *image));
           view.images.push_back(base + name);
         }
@@ -590,6 +609,7 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
   vopt.lit = lit.layers;
   vopt.lit_thresholds = o.lit_thresholds;
   vopt.emissive_bounds = o.emissive_bounds;
+  vopt.normal_bounds = o.normal_bounds;
 
   const double setup_seconds = seconds_since(setup_start);
   const auto views_start = std::chrono::steady_clock::now();

@@ -16,6 +16,7 @@
 #include "render/camera.h"
 #include "render/emissive_check.h"
 #include "render/lit_pass.h"
+#include "render/normal_check.h"
 #include "render/renderer.h"
 #include "render/streaming_check.h"
 #include "render/view_density.h"
@@ -64,7 +65,8 @@ struct ViewMetrics {
   // PSNR (channels 0-2) of the worst 16 x 16 tile with at least 32 compared pixels: a local
   // fault (a bad border, one wrong page) barely moves the whole-view PSNR but sinks its tile.
   double worst_tile_psnr = 0;
-  double ssim = 0;           // whole image, channels 0-2
+  uint32_t worst_tile_x = 0, worst_tile_y = 0;  // its top-left pixel
+  double ssim = 0;                              // whole image, channels 0-2
   double coarser_share = 0;  // share of covered pixels whose fine taps read a coarser level
   uint64_t unresident_pixels = 0;
   // Share of the pixels either render drew that only one of them drew and no alpha cutoff
@@ -113,6 +115,8 @@ struct LitViewReport {
   double reference_ms = 0, virtual_ms = 0;
   std::optional<EmissiveMetrics> emissive;  // with an emissive layer (emissive_check.h)
   double emissive_ms = 0;                   // both emissive-only passes
+  std::optional<NormalMetrics> normals;     // with a normal layer (normal_check.h)
+  double normals_ms = 0;                    // both normals passes
 };
 // A view's "lit" object in report.json (docs/JSON.md).
 nlohmann::json to_json(const LitViewReport& lit);
@@ -154,7 +158,8 @@ struct ValidationReport {
   Thresholds thresholds;
   Thresholds lit_thresholds;
   EmissiveBounds emissive_bounds;
-  Thresholds lighting_thresholds;        // the lighting view check's (with a lighting layer)
+  NormalBounds normal_bounds;
+  Thresholds lighting_thresholds;  // the lighting view check's (with a lighting layer)
   std::vector<std::string> lit_layers;   // the layers the lit pass read (names); empty: no lit pass
   std::vector<std::string> lit_skipped;  // layers it could not render, and why
   std::vector<ViewReport> views;
@@ -185,6 +190,7 @@ struct ValidateOptions {
   LitLayers lit;                         // lit pass inputs; none set: no lit pass
   Thresholds lit_thresholds = lit_scene_thresholds();
   EmissiveBounds emissive_bounds = default_emissive_bounds();
+  NormalBounds normal_bounds = default_normal_bounds();
   std::string
       out_dir;  // where PNGs go (view_<i>_{reference,virtual,diff,residency}.png); "" = none
   std::vector<float> alpha_cutoffs;  // the scene's MASK cutoffs (compare_view)
@@ -222,6 +228,7 @@ struct BakeValidationOptions {
   Thresholds thresholds = scene_thresholds();
   Thresholds lit_thresholds = lit_scene_thresholds();
   EmissiveBounds emissive_bounds = default_emissive_bounds();
+  NormalBounds normal_bounds = default_normal_bounds();
   // The lighting view check's bounds; unset: lighting_thresholds() (lighting_check.h).
   std::optional<Thresholds> lighting_thresholds;
   uint32_t slots = 32;           // physical cache slots per side

@@ -19,37 +19,50 @@ layout(push_constant) uniform Push {
 pc;
 
 #ifndef VT_VERTEX_STAGE
-const int kTaps = 4;
+// At most this many taps per pixel: 16x anisotropic, as GPUs' highest setting. A fixed, smaller
+// count blurred footprints beyond its ratio isotropically in each texture's own space, and the
+// source's UV space and the atlas's differ in shape: grazing faces then differed by up to 8 dB
+// per tile between two renders of correct texels (docs/BENCHMARKS.md, validation section).
+const int kMaxTaps = 16;
 
 // Alpha within this much of a material's cutoff may flip the alpha test between two renders of
 // the same texels (BC decoding and filtering rounding): the passes flag such fragments so the
 // exact check can tell a flipped alpha test from a wrong texel.
 const float kAlphaEdge = 4.5 / 255.0;
 
-// 4x anisotropic footprint: kTaps taps along the major axis of the pixel's footprint; the LOD
-// comes from the larger of the minor axis and the major axis over the tap count (each tap then
-// covers its share of the footprint). `step` is the uv distance between taps.
+// Anisotropic footprint: `taps` taps (the anisotropy ratio, rounded up, 1..kMaxTaps) along the
+// major axis of the pixel's footprint; the LOD comes from the larger of the minor axis and the
+// major axis over the tap count (each tap then covers its share of the footprint). `step` is
+// the uv distance between taps.
 struct Footprint {
   vec2 step;
   float lod;
+  int taps;
 };
 
-Footprint footprint(vec2 uv, float deriv_scale) {
-  vec2 dx = dFdx(uv) * pc.tex.xy * deriv_scale;
-  vec2 dy = dFdy(uv) * pc.tex.xy * deriv_scale;
+// dx, dy: the pixel's derivatives in texels of level 0; texel: level 0's texel size in uv.
+Footprint footprint_texels(vec2 dx, vec2 dy, vec2 texel, float max_lod) {
   float lx = length(dx);
   float ly = length(dy);
   vec2 major = lx >= ly ? dx : dy;
   float lmaj = max(lx, ly);
   float lmin = min(lx, ly);
   Footprint f;
-  f.lod = clamp(log2(max(max(lmaj / float(kTaps), lmin), 1e-6)), 0.0, float(pc.misc.z));
-  f.step = major / (pc.tex.xy * float(kTaps));
+  f.taps = int(clamp(ceil(lmaj / max(lmin, 1e-6)), 1.0, float(kMaxTaps)));
+  f.lod = clamp(log2(max(max(lmaj / float(f.taps), lmin), 1e-6)), 0.0, max_lod);
+  f.step = major * texel / float(f.taps);
   return f;
 }
 
+Footprint footprint(vec2 uv, float deriv_scale) {
+  return footprint_texels(dFdx(uv) * pc.tex.xy * deriv_scale, dFdy(uv) * pc.tex.xy * deriv_scale,
+                          1.0 / pc.tex.xy, float(pc.misc.z));
+}
+
+vec2 tap_offset(Footprint f, int i) { return f.step * (float(i) - 0.5 * float(f.taps - 1)); }
+
 vec2 tap_uv(vec2 uv, Footprint f, int i) {
-  vec2 u = uv + f.step * (float(i) - 0.5 * float(kTaps - 1));
+  vec2 u = uv + tap_offset(f, i);
   if (pc.misc.y == 2) return u;
   return pc.misc.y == 1 ? fract(u) : clamp(u, 0.0, 1.0);
 }

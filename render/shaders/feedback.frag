@@ -4,7 +4,7 @@
 #include "virtual_texture.glsl"
 
 // Feedback pass: one page request per pixel, bits 0-11 page x, 12-23 page y, 24-28 level.
-// Each pixel reports one of its taps, rotated by pixel and frame, so that over kTaps frames
+// Each pixel reports one of its taps, rotated by pixel and frame, so that over f.taps frames
 // every tap's page is requested. Alpha-tested as the virtual pass, with what is resident, so
 // that surfaces seen through holes request their pages; a hole counts only once the level the
 // pixel wants is resident (a coarser alpha may close or open it wrongly).
@@ -22,7 +22,7 @@ void main() {
     vec4 c = vt_filtered(u_cache, u_page_table, v_uv, f, sampled);
     if (sampled <= level && c.a < pc.tex.w) discard;
   }
-  int tap = (pc.misc.x + int(gl_FragCoord.x) + 2 * int(gl_FragCoord.y)) & (kTaps - 1);
+  int tap = (pc.misc.x + int(gl_FragCoord.x) + 2 * int(gl_FragCoord.y)) % f.taps;
   ivec2 page = vt_page(tap_uv(v_uv, f, tap), level);
   out_request = uint(page.x) | (uint(page.y) << 12) | (uint(level) << 24);
 }

@@ -10,13 +10,22 @@ const int kLitOrm = 2;
 const int kLitEmissive = 4;
 
 // The lights of one view (world space): the key and fill lights' directions towards the light
-// (w: intensity), fixed relative to the camera so that every view is lit; eye.w: ambient.
+// (w: intensity), fixed relative to the camera so that every view is lit; eye.w: ambient, or
+// negative for a normals frame (lit_normals_frame).
 layout(set = 0, binding = LIT_FRAME_BINDING) uniform LitFrame {
   vec4 eye;
   vec4 key;
   vec4 fill;
 }
 lit;
+
+// A normals frame writes the normal map's detail instead of a colour: the shading normal minus
+// the interpolated vertex normal `n` (both facing the eye), * 0.5 + 0.5 (render/normal_check.h).
+bool lit_normals_frame() { return lit.eye.w < 0.0; }
+vec4 lit_normal_detail(vec3 shading, vec3 n, vec3 world) {
+  vec3 g = dot(n, lit.eye.xyz - world) < 0.0 ? -n : n;
+  return vec4((shading - g) * 0.5 + 0.5, 1.0);
+}
 
 vec3 srgb_to_linear3(vec3 c) {
   return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));

@@ -27,27 +27,21 @@ layout(location = 6) in vec4 v_tex_uv23;  // metallic-roughness, emissive
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out uint out_covered;
 
-// The same 4x anisotropic taps as common.glsl's footprint, in the texture's own texel size.
+// common.glsl's anisotropic taps in the texture's own texel size and level count.
 vec4 sample_taps(sampler2D t, vec2 uv) {
   vec2 size = vec2(textureSize(t, 0));
-  vec2 dx = dFdx(uv) * size, dy = dFdy(uv) * size;
-  float lx = length(dx), ly = length(dy);
-  vec2 major = lx >= ly ? dx : dy;
-  float lod = clamp(log2(max(max(max(lx, ly) / float(kTaps), min(lx, ly)), 1e-6)), 0.0,
-                    float(textureQueryLevels(t) - 1));
-  vec2 step = major / (size * float(kTaps));
+  Footprint f = footprint_texels(dFdx(uv) * size, dFdy(uv) * size, 1.0 / size,
+                                 float(textureQueryLevels(t) - 1));
   vec4 c = vec4(0.0);
-  for (int i = 0; i < kTaps; ++i) {
-    c += textureLod(t, uv + step * (float(i) - 0.5 * float(kTaps - 1)), lod);
-  }
-  return c / float(kTaps);
+  for (int i = 0; i < f.taps; ++i) c += textureLod(t, uv + tap_offset(f, i), f.lod);
+  return c / float(f.taps);
 }
 
 void main() {
   Footprint f = footprint(v_uv, 1.0);
   vec4 albedo = vec4(0.0);
-  for (int i = 0; i < kTaps; ++i) albedo += textureLod(u_albedo, tap_uv(v_uv, f, i), f.lod);
-  albedo /= float(kTaps);
+  for (int i = 0; i < f.taps; ++i) albedo += textureLod(u_albedo, tap_uv(v_uv, f, i), f.lod);
+  albedo /= float(f.taps);
   albedo.a *= v_color.a;
   if (pc.tex.w >= 0.0 && albedo.a < pc.tex.w) discard;
   // Only the inputs this frame shades with (uniform branches).
@@ -71,6 +65,11 @@ void main() {
   }
   // Back faces (open or two-sided surfaces) are lit as seen.
   if (dot(n, lit.eye.xyz - v_world) < 0.0) shading = -shading;
+  if (lit_normals_frame()) {
+    out_color = lit_normal_detail(shading, n, v_world);
+    out_covered = 1u;
+    return;
+  }
   vec3 orm = (pc.misc.w & kLitOrm) != 0 ? vec3(occlusion, tmr.gb) : kLitDefaultOrm;
   vec3 emissive = vec3(0.0);
   if ((pc.misc.w & kLitEmissive) != 0) {

@@ -57,7 +57,7 @@ void main() {
   float blend = f.lod - float(l0);
   int sampled = 0, ignored = 0;
   Inputs c = Inputs(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
-  for (int i = 0; i < kTaps; ++i) {
+  for (int i = 0; i < f.taps; ++i) {
     vec2 uv = tap_uv(v_uv, f, i);
     Inputs a = sample_level(uv, l0, sampled);
     Inputs b = l1 != l0 ? sample_level(uv, l1, ignored) : a;
@@ -66,7 +66,7 @@ void main() {
     c.orm += mix(a.orm, b.orm, blend);
     c.emissive += mix(a.emissive, b.emissive, blend);
   }
-  vec4 albedo = c.albedo / float(kTaps);
+  vec4 albedo = c.albedo / float(f.taps);
   if (pc.tex.w >= 0.0 && albedo.a < pc.tex.w) discard;
 
   vec3 n = normalize(v_normal);
@@ -79,13 +79,18 @@ void main() {
     t = dot(t, t) > 1e-20 ? normalize(t)
                           : normalize(cross(abs(n.x) < 0.9 ? vec3(1, 0, 0) : vec3(0, 1, 0), n));
     vec3 b = cross(n, t) * (dot(cross(n, t), dpdv) > 0.0 ? -1.0 : 1.0);
-    vec3 tn = decode_normal_xy(c.normal.xy / float(kTaps));
+    vec3 tn = decode_normal_xy(c.normal.xy / float(f.taps));
     shading = normalize(t * tn.x + b * tn.y + n * tn.z);
   }
   if (dot(n, lit.eye.xyz - v_world) < 0.0) shading = -shading;
-  vec3 orm = (pc.misc.w & kLitOrm) != 0 ? c.orm.rgb / float(kTaps) : kLitDefaultOrm;
+  if (lit_normals_frame()) {
+    out_color = lit_normal_detail(shading, n, v_world);
+    out_status = 0x80000000u | uint(l0) | (uint(sampled) << 8);
+    return;
+  }
+  vec3 orm = (pc.misc.w & kLitOrm) != 0 ? c.orm.rgb / float(f.taps) : kLitDefaultOrm;
   vec3 emissive =
-      (pc.misc.w & kLitEmissive) != 0 ? srgb_to_linear3(c.emissive.rgb / float(kTaps)) : vec3(0.0);
+      (pc.misc.w & kLitEmissive) != 0 ? srgb_to_linear3(c.emissive.rgb / float(f.taps)) : vec3(0.0);
   vec3 lin = shade(v_world, shading, srgb_to_linear3(albedo.rgb), orm, emissive);
   out_color = vec4(linear_to_srgb3(lin), 1.0);
   out_status = 0x80000000u | uint(l0) | (uint(sampled) << 8);

@@ -23,8 +23,8 @@ vec3 linear_to_srgb(vec3 c) {
 void main() {
   Footprint f = footprint(v_uv, 1.0);
   vec4 c = vec4(0.0);
-  for (int i = 0; i < kTaps; ++i) c += textureLod(u_texture, tap_uv(v_uv, f, i), f.lod);
-  c /= float(kTaps);
+  for (int i = 0; i < f.taps; ++i) c += textureLod(u_texture, tap_uv(v_uv, f, i), f.lod);
+  c /= float(f.taps);
   // Skipped for white so that scenes without vertex colours render exactly as before.
   if (v_color.rgb != vec3(1.0)) {
     c.rgb = linear_to_srgb(clamp(srgb_to_linear(c.rgb) * v_color.rgb, 0.0, 1.0));

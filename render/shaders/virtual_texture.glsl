@@ -62,12 +62,12 @@ vec4 vt_filtered(sampler2D cache, usampler2D table, vec2 uv, Footprint f, out in
   sampled = 0;
   int coarse = l1;
   vec4 c = vec4(0.0);
-  for (int i = 0; i < kTaps; ++i) {
+  for (int i = 0; i < f.taps; ++i) {
     vec2 t = tap_uv(uv, f, i);
     vec4 a = vt_sample_level(cache, table, t, l0, sampled);
     vec4 b = l1 != l0 ? vt_sample_level(cache, table, t, l1, coarse) : a;
     c += mix(a, b, blend);
   }
   if (coarse > l1 && blend > 0.0) vt_coarse_fallback = true;
-  return c / float(kTaps);
+  return c / float(f.taps);
 }

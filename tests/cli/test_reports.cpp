@@ -96,6 +96,13 @@ TEST_F(Reports, ClippedHdrIsWarnedAboutAndHalfKeepsIt) {
   EXPECT_GT(j["layers"][0]["runtime"]["hdr"]["tonemapped_psnr_db"].get<double>(), 30.0);
   EXPECT_LT(j["layers"][0]["runtime"]["hdr"]["log2_error_mean"].get<double>(), 0.1);
   EXPECT_EQ(j["layers"][0]["clipped"]["texels"], 0);
+  // Raw halves: the rounding to half, measured against the float source (not "lossless").
+  ASSERT_TRUE(j["layers"][0].contains("hdr")) << j.dump();
+  EXPECT_LE(j["layers"][0]["hdr"]["relative_error_max"].get<double>(), 0x1p-11);
+  r = run_vtbake("build " + exr + " --payload 24 --float-texels half -o " + dir_ + "/f.vtpf", true);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_EQ(r.out.find("lossless"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("raw+zstd -> bc6h_uf16, stored "), std::string::npos) << r.out;
   EXPECT_EQ(
       run_vtbake("build " + exr + " --float-texels bc6h -o " + dir_ + "/g.vtpf", false).exit_code,
       2);

@@ -468,6 +468,112 @@ TEST(Bc6hEncode, Deterministic) {
   }
 }
 
+// A 132x132 HDR page (33 blocks a row: partial batches of the real-time kernel) with every kind
+// of block: exponential gradients over 2^-14..2^15, noise over six stops, hard edges between
+// black and 3e4, flat blocks, and scattered NaN, infinities and negatives (signed: negatives
+// everywhere).
+std::vector<uint16_t> pinned_hdr_page(int size, int channels, bool is_signed, uint32_t seed) {
+  std::vector<uint16_t> img(size_t(size) * size * size_t(channels));
+  Rng rng(seed);
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      const int region = ((y / 12) * 7 + (x / 12) * 3) % 5;
+      for (int c = 0; c < channels; ++c) {
+        float v = 0;
+        if (region == 0) v = std::exp2(-14.0f + 29.0f * float(x + y * (c + 1)) / float(3 * size));
+        if (region == 1) v = std::exp2(float(rng.below(600)) / 100.0f - 2.0f) * (1.0f + 0.3f * c);
+        if (region == 2) v = ((x ^ y) & 2) ? 0.0f : 30000.0f / float(1 + c);
+        if (region == 3) v = 0.25f + float(c);
+        if (region == 4) v = float(x % 4) * 0.5f + float(c) * float(y % 4) * 64.0f;
+        if (is_signed && ((x + 2 * y + c) % 3 == 0)) v = -v;
+        uint16_t h = float_to_half(v);
+        const int r = rng.below(200);
+        if (r == 0) h = 0x7e00;                 // NaN
+        if (r == 1) h = 0x7c00;                 // +infinity
+        if (r == 2) h = 0xfc00;                 // -infinity
+        if (r == 3) h = float_to_half(-0.75f);  // negative (0 when unsigned)
+        img[(size_t(y) * size + size_t(x)) * size_t(channels) + size_t(c)] = h;
+      }
+    }
+  }
+  return img;
+}
+
+uint64_t fnv1a(const void* data, size_t bytes) {
+  uint64_t h = 1469598103934665603ull;
+  for (size_t i = 0; i < bytes; ++i)
+    h = (h ^ static_cast<const uint8_t*>(data)[i]) * 1099511628211ull;
+  return h;
+}
+
+// The real-time encoder's blocks and their decoded texels, pinned (digests from the scalar
+// encoder before the 16-block kernel): the runtime transcode of HDR layers must give these exact
+// bytes on every machine (AVX-512, AVX2 and baseline builds of the kernel), and the decoder must
+// read them back to the same texels.
+TEST(Bc6hEncode, RealtimeOutputIsPinned) {
+  struct Case {
+    BcFormat format;
+    int channels;
+    uint64_t blocks, texels;
+  };
+  const Case cases[] = {
+      {BcFormat::kBc6hUf16, 3, 0x2634cc8f0e730f11ull, 0xdcc24f854150380cull},
+      {BcFormat::kBc6hUf16, 4, 0xe8d5f407114b709cull, 0x7b1d7f7e2f7366a3ull},
+      {BcFormat::kBc6hUf16, 1, 0x5389090e84e919fdull, 0xcda750cbaf4bc779ull},
+      {BcFormat::kBc6hSf16, 3, 0x37182fd5db623ba0ull, 0x644b368fd30f1a5full},
+  };
+  const int size = 132;
+  for (const Case& c : cases) {
+    const bool is_signed = c.format == BcFormat::kBc6hSf16;
+    const std::vector<uint16_t> page = pinned_hdr_page(size, c.channels, is_signed, 2026);
+    std::vector<uint8_t> blocks(bc_image_bytes(c.format, size, size));
+    ASSERT_TRUE(bc_encode_image(c.format, BcQuality::kRealtime,
+                                reinterpret_cast<const uint8_t*>(page.data()), size, size,
+                                c.channels, blocks.data())
+                    .ok());
+    std::vector<uint16_t> back(page.size());
+    ASSERT_TRUE(bc_decode_image(c.format, blocks.data(), size, size, c.channels,
+                                reinterpret_cast<uint8_t*>(back.data()))
+                    .ok());
+    const uint64_t hb = fnv1a(blocks.data(), blocks.size());
+    const uint64_t ht = fnv1a(back.data(), back.size() * 2);
+    EXPECT_EQ(hb, c.blocks) << "format " << int(c.format) << ", " << c.channels
+                            << " channels: blocks 0x" << std::hex << hb;
+    EXPECT_EQ(ht, c.texels) << "format " << int(c.format) << ", " << c.channels
+                            << " channels: texels 0x" << std::hex << ht;
+  }
+}
+
+// One block through bc6h_encode_block (the kernel with one lane used) gives the same bytes as
+// the same block inside an image (every lane used).
+TEST(Bc6hEncode, RealtimeBlockMatchesImage) {
+  for (const bool is_signed : {false, true}) {
+    const int size = 132;
+    const std::vector<uint16_t> page = pinned_hdr_page(size, 3, is_signed, 7);
+    const BcFormat f = is_signed ? BcFormat::kBc6hSf16 : BcFormat::kBc6hUf16;
+    std::vector<uint8_t> blocks(bc_image_bytes(f, size, size));
+    ASSERT_TRUE(bc_encode_image(f, BcQuality::kRealtime,
+                                reinterpret_cast<const uint8_t*>(page.data()), size, size, 3,
+                                blocks.data())
+                    .ok());
+    for (int by = 0; by < size / 4; by += 5) {
+      for (int bx = 0; bx < size / 4; ++bx) {
+        uint16_t rgb[48];
+        for (int t = 0; t < 16; ++t)
+          for (int ch = 0; ch < 3; ++ch)
+            rgb[3 * t + ch] =
+                page[((size_t(by) * 4 + size_t(t / 4)) * size + size_t(bx) * 4 + size_t(t % 4)) *
+                         3 +
+                     size_t(ch)];
+        uint8_t one[16];
+        bc6h_encode_block(rgb, is_signed, BcQuality::kRealtime, one);
+        EXPECT_EQ(0, std::memcmp(one, &blocks[(size_t(by) * (size / 4) + size_t(bx)) * 16], 16))
+            << "block " << bx << "," << by << (is_signed ? " signed" : "");
+      }
+    }
+  }
+}
+
 TEST(HdrMetrics, LogAndToneMappedErrors) {
   // L(1) = 1, L(3) = 2, L(-3) = -2; T(1) = srgb(0.5).
   EXPECT_DOUBLE_EQ(hdr_log_value(1.0f), 1.0);

@@ -217,11 +217,13 @@ class LitCheck : public ::testing::Test {
   static bool lit_failed(const ValidationReport& r) {
     for (const ViewReport& v : r.views)
       if (v.lit)
-        std::printf("lit view %u: %.2f dB, worst tile %.2f dB\n", v.view, v.lit->metrics.psnr_rgb,
-                    v.lit->metrics.worst_tile_psnr);
+        std::printf("lit view %u: %.2f dB, worst tile %.2f dB; normals mean %.2f deg, r %.3f\n",
+                    v.view, v.lit->metrics.psnr_rgb, v.lit->metrics.worst_tile_psnr,
+                    v.lit->normals ? v.lit->normals->mean_deg : -1.0,
+                    v.lit->normals ? v.lit->normals->detail_correlation : -1.0);
     for (const ViewReport& v : r.views)
       for (const std::string& f : v.failures)
-        if (f.rfind("lit: ", 0) == 0) return true;
+        if (f.rfind("lit", 0) == 0) return true;  // "lit: ", "lit emissive: ", "lit normals: "
     return false;
   }
 
@@ -238,6 +240,10 @@ TEST_F(LitCheck, CorrectBakePassesWithLitImages) {
     EXPECT_TRUE(v.failures.empty()) << v.failures[0];
     EXPECT_GT(v.lit->metrics.pixels, 1000u);
     EXPECT_GE(v.lit->metrics.psnr_rgb, r->lit_thresholds.min_psnr);
+    ASSERT_TRUE(v.lit->normals.has_value());  // the bake has a normal layer
+    EXPECT_TRUE(v.lit->normals->detail_judged());
+    EXPECT_GE(v.lit->normals->detail_correlation, r->normal_bounds.min_detail_correlation);
+    EXPECT_LE(v.lit->normals->mean_deg, r->normal_bounds.max_mean_deg);
     int lit_images = 0;
     for (const std::string& image : v.images) {
       lit_images +=
@@ -269,6 +275,15 @@ TEST_F(LitCheck, NormalLayerWithGreenFlippedFails) {
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_TRUE(lit_failed(*r));
   EXPECT_FALSE(r->passed());
+  // The normals frame is what sees it: every view's detail no longer correlates.
+  for (const ViewReport& v : r->views) {
+    ASSERT_TRUE(v.lit && v.lit->normals);
+    EXPECT_TRUE(v.lit->normals->detail_judged());
+    EXPECT_LT(v.lit->normals->detail_correlation, r->normal_bounds.min_detail_correlation);
+    bool named = false;
+    for (const std::string& f : v.failures) named |= f.rfind("lit normals: ", 0) == 0;
+    EXPECT_TRUE(named) << "view " << v.view;
+  }
 }
 
 TEST_F(LitCheck, EmissiveAtHalfStrengthFails) {
