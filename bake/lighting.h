@@ -7,6 +7,8 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <span>
 #include <vector>
 
 #include "common/status.h"
@@ -22,6 +24,12 @@ struct LightingOptions {
   // reach `ao_distance` world units unblocked (1 = open sky).
   int ao_samples = 0;
   double ao_distance = 0;  // 0 = the scene's bounding-box diagonal
+  // One diffuse bounce (0 = direct light only, 1): `bounce_samples` cosine-weighted rays per
+  // texel sample over the shading normal; each surface one meets adds its base colour (linear:
+  // factor x texture, sRGB decoded, x vertex colour) times its own direct irradiance, so the
+  // sample gains the mean of albedo x E over the rays (a Lambertian bounce: E = pi x mean L).
+  int bounces = 0;
+  int bounce_samples = 16;
 };
 
 // The largest value the layer keeps: half float's largest finite value. Larger (or non-finite)
@@ -32,6 +40,8 @@ struct LightingStats {
   uint64_t samples = 0;      // texel samples lit
   uint64_t shadow_rays = 0;  // rays cast to lights
   uint64_t ao_rays = 0;      // ambient occlusion rays
+  uint64_t bounce_rays = 0;  // rays looking for a surface to bounce from (their shadow rays
+                             // are counted in shadow_rays)
   uint64_t clamped = 0;      // samples above kMaxIrradiance, clamped to it
   uint64_t non_finite = 0;   // samples whose sum was NaN or infinite (stored as 0 or the max)
   uint64_t bvh_bytes = 0;    // memory Embree allocated for the scene's structure (peak)
@@ -51,6 +61,10 @@ class LightingBaker {
  public:
   // The scene's placed lights and, when shadows or AO need it, a ray-tracing structure over
   // every instance's triangles in world space. `threads` bounds Embree's build (0 = all cores).
+  // Alpha cuts holes in what casts: a MASK material blocks a ray only where its base colour's
+  // alpha (texture at the hit's UV, level 0, x factor x vertex alpha) reaches alphaCutoff; a
+  // BLEND material likewise at 0.5 (a hard cut: no partial transmission, so a half-transparent
+  // pane casts either a full shadow or none). A texture that cannot be read leaves the factor.
   static Expected<std::unique_ptr<LightingBaker>> create(const scene::Scene& scene,
                                                          const LightingOptions& options,
                                                          int threads);
@@ -68,6 +82,12 @@ class LightingBaker {
  private:
   LightingBaker() = default;
   bool occluded(const Vec3d& origin, const Vec3d& dir, double tfar) const;
+  // Direct irradiance at a point (shadowed when options_.shadows), added to `sum`.
+  void direct(const Vec3d& position, const Vec3d& ng, const Vec3d& ns, double offset, double sum[3],
+              uint64_t& shadow_rays) const;
+  // The bounce's irradiance at a sample (see LightingOptions::bounces), added to `sum`.
+  void bounce(const Vec3d& origin, const Vec3d& ng, const Vec3d& ns, uint64_t seed, double sum[3],
+              uint64_t& shadow_rays, uint64_t& bounce_rays) const;
 
   LightingOptions options_;
   struct Placed {
@@ -79,9 +99,34 @@ class LightingBaker {
   std::vector<Placed> lights_;
   double ao_distance_ = 0;
   std::unique_ptr<Rays> rays_;  // null when nothing needs rays
-  mutable std::atomic<uint64_t> samples_{0}, shadow_rays_{0}, ao_rays_{0}, clamped_{0},
-      non_finite_{0};
+  mutable std::atomic<uint64_t> samples_{0}, shadow_rays_{0}, ao_rays_{0}, bounce_rays_{0},
+      clamped_{0}, non_finite_{0};
   LightingStats build_stats_;
+};
+
+// The first surface along a ray through world-space triangle meshes (Embree 3, robust). The
+// screen-space check of the lighting layer (render/lighting_check.h) finds each pixel's surface of
+// the original scene with it, as a G-buffer pass would.
+class SurfaceCaster {
+ public:
+  struct Mesh {
+    std::span<const float> positions;   // x, y, z per vertex, world space
+    std::span<const uint32_t> indices;  // triangle list; an index out of range: no triangle
+  };
+  struct Hit {
+    uint32_t mesh = 0, triangle = 0;
+    double u = 0, v = 0;  // barycentric weights of the triangle's 2nd and 3rd vertex
+    double t = 0;         // distance along the (unit) direction
+  };
+  // `threads` bounds Embree's build (0 = all cores).
+  static Expected<std::unique_ptr<SurfaceCaster>> create(std::span<const Mesh> meshes, int threads);
+  ~SurfaceCaster();
+  // The nearest hit in (0, tfar] along unit `dir`, either side of a triangle. Thread-safe.
+  std::optional<Hit> first_hit(const Vec3d& origin, const Vec3d& dir, double tfar) const;
+
+ private:
+  SurfaceCaster() = default;
+  std::unique_ptr<LightingBaker::Rays> rays_;
 };
 
 // Whether `scene` calls for a lighting layer: some displayed node places a light.

@@ -318,6 +318,10 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
                         {"shadows", options.lighting.shadows},
                         {"ao_samples", options.lighting.ao_samples},
                         {"ao_distance", options.lighting.ao_distance}};
+    if (options.lighting.bounces > 0) {  // a bake without bounces keeps its metadata as it was
+      meta["lighting"]["bounces"] = options.lighting.bounces;
+      meta["lighting"]["bounce_samples"] = options.lighting.bounce_samples;
+    }
   }
   bo.metadata_json = meta.dump();
   prepared.unwrapped = std::move(unwrapped).value();
@@ -462,6 +466,8 @@ nlohmann::json to_json(const SceneBakeSummary& s) {
                                    {"non_finite", t.lighting.non_finite},
                                    {"structure_bytes", t.lighting.bvh_bytes},
                                    {"structure_seconds", t.lighting.build_seconds}};
+    if (t.lighting.bounce_rays > 0)
+      out["transfer"]["lighting"]["bounce_rays"] = t.lighting.bounce_rays;
   }
   return out;
 }

@@ -317,6 +317,15 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
                  "How far an AO ray looks, in world units (0 = the scene's bounding-box diagonal)")
       ->check(CLI::NonNegativeNumber)
       ->default_val(0);
+  app.add_option("--bounces", o.lighting.bounces,
+                 "Diffuse bounces of light into the lighting layer: 0 (direct only) or 1 (each "
+                 "texel also gathers light reflected once by the surfaces around it)")
+      ->check(CLI::Range(0, 1))
+      ->default_val(0);
+  app.add_option("--bounce-samples", o.lighting.bounce_samples,
+                 "Cosine-weighted rays per texel sample for --bounces 1")
+      ->check(CLI::Range(1, 65536))
+      ->default_val(16);
   app.add_flag(
       "--no-shadows", [&o](int64_t) { o.lighting.shadows = false; },
       "Lighting without shadow rays: every light reaches every texel facing it");

@@ -20,6 +20,9 @@ vt::cli::CommandRunner make_sample_scene(CLI::App& app) {
       ->check(CLI::Range(4, 8192));
   app.add_option("--texture-size", opt->texture_size, "Side of every texture in texels")
       ->check(CLI::Range(16, 8192));
+  app.add_flag("--lights", opt->lights,
+               "Add a sun, a point and a spot light (KHR_lights_punctual, required): the bake "
+               "gets a lighting layer");
   return [dir, opt](const vt::cli::GlobalOptions& global) -> int {
     vt::Status s = vt::write_sample_scene(*dir, *opt);
     if (!s.ok()) return vt::cli::report_error("sample-scene", s);

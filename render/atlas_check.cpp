@@ -52,16 +52,30 @@ Expected<BakeSettings> bake_settings(const PageFileReader& reader) {
   const nlohmann::json build = meta.value("build", nlohmann::json::object());
   const std::string filter = build.is_object() ? build.value("filter", "kaiser") : "kaiser";
   VT_ASSIGN_OR_RETURN(s.filter, parse_mip_filter(filter.c_str()));
-  const nlohmann::json lit = meta.value("lighting", nlohmann::json::object());
+  s.lighting = baked_lighting_options(reader);
+  return s;
+}
+
+}  // namespace
+
+LightingOptions baked_lighting_options(const PageFileReader& reader) {
+  LightingOptions o;
+  const nlohmann::json meta = nlohmann::json::parse(reader.metadata_json(), nullptr, false);
+  const nlohmann::json lit =
+      meta.is_object() ? meta.value("lighting", nlohmann::json::object()) : nlohmann::json();
   if (lit.is_object()) {
     // Shadows are what the scene's lights cast: the reference always casts them, so a bake
     // made with --no-shadows (a speed knob) fails where a shadow falls. AO is asked for: the
     // reference repeats the bake's samples and distance (seeded per texel, same rays).
-    s.lighting.ao_samples = lit.value("ao_samples", 0);
-    s.lighting.ao_distance = lit.value("ao_distance", 0.0);
+    o.ao_samples = lit.value("ao_samples", 0);
+    o.ao_distance = lit.value("ao_distance", 0.0);
+    o.bounces = lit.value("bounces", 0);
+    o.bounce_samples = lit.value("bounce_samples", 16);
   }
-  return s;
+  return o;
 }
+
+namespace {
 
 // The reference is lit by the original scene's lights where the original places them, on the
 // unwrapped geometry: a bake whose lights moved (or were baked from another scene) must fail,

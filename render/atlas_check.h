@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "bake/lighting.h"
 #include "common/status.h"
 #include "format/page_file.h"
 #include "scene/scene.h"
@@ -115,6 +116,11 @@ Expected<AtlasCheckReport> check_atlas_pages(std::shared_ptr<const PageFileReade
 // are. `upload` is scratch; `out` takes page_size^2 texels of spec.texel_bytes().
 Status uploaded_texels(const PageSource& source, const LayerSpec& spec, const PageId& id,
                        uint32_t layer, std::vector<uint8_t>& upload, uint8_t* out);
+
+// The lighting settings a scene bake recorded in its metadata (AO samples and distance, bounces;
+// shadows on, whatever the bake used: the references always cast them). Defaults for a file
+// without.
+LightingOptions baked_lighting_options(const PageFileReader& reader);
 
 // The report as report.json's "atlas" object (docs/JSON.md).
 nlohmann::json to_json(const AtlasCheckReport& report);

@@ -7,8 +7,8 @@
 
 #include "common/srgb.h"
 #include "common/vec.h"
-#include "render/image_load.h"
 #include "render/validate.h"
+#include "scene/image_load.h"
 #include "scene/material_rules.h"
 #include "scene/tangent_frame.h"
 
@@ -51,10 +51,10 @@ class ImageCache {
  public:
   explicit ImageCache(const scene::Scene& s) : scene_(s), images_(s.images.size()) {}
   // Null for a texture reference without an image.
-  Expected<const FloatImage*> get(const scene::TextureRef& t) {
+  Expected<const scene::FloatImage*> get(const scene::TextureRef& t) {
     if (!t.valid() || size_t(t.image) >= images_.size()) return nullptr;
     if (!images_[t.image]) {
-      VT_ASSIGN_OR_RETURN(FloatImage img, load_float_image(scene_.images[t.image]));
+      VT_ASSIGN_OR_RETURN(scene::FloatImage img, scene::load_float_image(scene_.images[t.image]));
       images_[t.image] = std::move(img);
     }
     return &*images_[t.image];
@@ -62,13 +62,13 @@ class ImageCache {
 
  private:
   const scene::Scene& scene_;
-  std::vector<std::optional<FloatImage>> images_;
+  std::vector<std::optional<scene::FloatImage>> images_;
 };
 
 // ORM as the bake's transfer computes it, each factor applied per texel (filtering commutes with
 // it): roughness and metallic the factors times G and B of the metallic-roughness texture (R 1),
 // and apart, on its own UV set and sampler, occlusion 1 + strength (R - 1).
-ReferenceTexture metal_rough_texture(const scene::Material& m, const FloatImage* mr,
+ReferenceTexture metal_rough_texture(const scene::Material& m, const scene::FloatImage* mr,
                                      uint32_t max_side) {
   const uint32_t w = mr ? mr->width : 1, h = mr ? mr->height : 1;
   std::vector<uint8_t> texels(size_t(w) * h * 4);
@@ -84,7 +84,7 @@ ReferenceTexture metal_rough_texture(const scene::Material& m, const FloatImage*
                       max_side);
 }
 
-ReferenceTexture occlusion_texture(const scene::Material& m, const FloatImage* occ,
+ReferenceTexture occlusion_texture(const scene::Material& m, const scene::FloatImage* occ,
                                    uint32_t max_side) {
   if (!occ) return constant_texture(255, 255, 255);
   std::vector<uint8_t> texels(size_t(occ->width) * occ->height * 4, 255);
@@ -98,8 +98,8 @@ ReferenceTexture occlusion_texture(const scene::Material& m, const FloatImage* o
 }
 
 // A data (raw) or colour (sRGB-encoded) 8-bit texture of an image.
-ReferenceTexture image_texture(const FloatImage& img, bool colour, const scene::TextureRef& ref,
-                               uint32_t max_side) {
+ReferenceTexture image_texture(const scene::FloatImage& img, bool colour,
+                               const scene::TextureRef& ref, uint32_t max_side) {
   std::vector<uint8_t> texels(img.rgba.size());
   for (size_t i = 0; i < img.rgba.size(); ++i) {
     const float v = img.rgba[i];
@@ -113,7 +113,7 @@ ReferenceTexture image_texture(const FloatImage& img, bool colour, const scene::
 Expected<LitMaterial> lit_material(const scene::Material& m, ImageCache& images,
                                    uint32_t max_side) {
   LitMaterial out;
-  VT_ASSIGN_OR_RETURN(const FloatImage* normal, images.get(m.normal_texture));
+  VT_ASSIGN_OR_RETURN(const scene::FloatImage* normal, images.get(m.normal_texture));
   if (normal) {
     out.normal = image_texture(*normal, false, m.normal_texture, max_side);
     out.has_normal_map = true;
@@ -122,11 +122,11 @@ Expected<LitMaterial> lit_material(const scene::Material& m, ImageCache& images,
   } else {
     out.normal = constant_texture(128, 128, 255);
   }
-  VT_ASSIGN_OR_RETURN(const FloatImage* occ, images.get(m.occlusion_texture));
-  VT_ASSIGN_OR_RETURN(const FloatImage* mr, images.get(m.metallic_roughness_texture));
+  VT_ASSIGN_OR_RETURN(const scene::FloatImage* occ, images.get(m.occlusion_texture));
+  VT_ASSIGN_OR_RETURN(const scene::FloatImage* mr, images.get(m.metallic_roughness_texture));
   out.orm = metal_rough_texture(m, mr, max_side);
   out.occlusion = occlusion_texture(m, occ, max_side);
-  VT_ASSIGN_OR_RETURN(const FloatImage* emissive, images.get(m.emissive_texture));
+  VT_ASSIGN_OR_RETURN(const scene::FloatImage* emissive, images.get(m.emissive_texture));
   out.emissive = emissive ? image_texture(*emissive, true, m.emissive_texture, max_side)
                           : constant_texture(255, 255, 255);
   for (int c = 0; c < 3; ++c) out.emissive_scale[c] = m.emissive_factor[c] * m.emissive_strength;

@@ -857,6 +857,7 @@ void fill_vt_push(Push& p, const VirtualTextureSetup& vt) {
   p.vt[3] = int32_t(g.page_size());
   p.misc[1] = vt.address_mode == AddressMode::kWrap ? 1 : 0;
   p.misc[2] = int32_t(g.level_count()) - 1;
+  p.misc[3] = vt.tone_map ? 1 : 0;  // the lit passes put their inputs here instead
 }
 
 }  // namespace

@@ -84,6 +84,9 @@ struct VirtualTextureSetup {
   RuntimeFormat cache_format = RuntimeFormat::kRgba8;
   uint32_t slots_x = 16;
   uint32_t slots_y = 16;
+  // The lighting layer (HDR irradiance, AO in alpha): the feedback and virtual passes show rgb
+  // as x / (1 + x) (the atlas check's tone map) and alpha-test nothing.
+  bool tone_map = false;
 };
 
 // One page's texels (cache format) to put into a physical slot.

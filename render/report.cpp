@@ -188,6 +188,7 @@ std::string report_json(const ValidationReport& r) {
                      {"framing", v.framing},
                      {"density", to_json(v.density)}});
     if (v.lit) views.back()["lit"] = to_json(*v.lit);
+    if (v.lighting) views.back()["lighting"] = to_json(*v.lighting);
   }
   json doc = {{"page_file", r.page_file},
               {"layer", r.layer},
@@ -200,7 +201,11 @@ std::string report_json(const ValidationReport& r) {
                 {"min_tile_psnr", r.thresholds.min_tile_psnr},
                 {"max_coarser_share", r.thresholds.max_coarser_share},
                 {"max_coverage_mismatch", r.thresholds.max_coverage_mismatch},
-                {"min_density", r.thresholds.min_density}}},
+                {"min_density", r.thresholds.min_density},
+                {"lighting",
+                 {{"min_psnr", r.lighting_thresholds.min_psnr},
+                  {"min_tile_psnr", r.lighting_thresholds.min_tile_psnr},
+                  {"max_coverage_mismatch", r.lighting_thresholds.max_coverage_mismatch}}}}},
               {"lit",
                {{"layers", r.lit_layers},
                 {"skipped", r.lit_skipped},

@@ -5,7 +5,7 @@
 #include <limits>
 
 #include "common/srgb.h"
-#include "render/image_load.h"
+#include "scene/image_load.h"
 #include "scene/material_rules.h"
 
 namespace vt::render {
@@ -101,7 +101,7 @@ Expected<SceneDraws> draws(const scene::Scene& s, UvOf uv_of, bool reference) {
 // RGBA8 sRGB texels of an image, float images encoded from linear.
 Expected<std::vector<uint8_t>> load_rgba8(const scene::Image& image, uint32_t* width,
                                           uint32_t* height) {
-  VT_ASSIGN_OR_RETURN(const FloatImage img, load_float_image(image));
+  VT_ASSIGN_OR_RETURN(const scene::FloatImage img, scene::load_float_image(image));
   *width = img.width;
   *height = img.height;
   std::vector<uint8_t> out(img.rgba.size());

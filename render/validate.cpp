@@ -4,12 +4,14 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 
 #include "codec/metrics.h"
 #include "format/page_file.h"
 #include "format/runtime_format.h"
 #include "render/contact_sheet.h"
 #include "render/coverage_tolerance.h"
+#include "render/lighting_check.h"
 #include "render/report.h"
 #include "render/scene_draws.h"
 #include "runtime/page_source.h"
@@ -481,6 +483,54 @@ Expected<LitInputs> lit_inputs_for(const PageSource& source, BakeInputs& in,
   return lit;
 }
 
+// With a lighting layer, its screen-space check in every view (lighting_check.h), after the
+// views' own checks; the lit inputs' shading frames and materials are reused when the lit check
+// made them.
+Status check_lighting_views(Renderer& renderer, const std::shared_ptr<const PageSource>& source,
+                            BakeInputs& in, LitInputs& lit, const BakeValidationOptions& o,
+                            std::span<const Camera> cameras, ValidationReport& report) {
+  const std::vector<LayerSpec>& specs = in.reader->layers();
+  std::optional<uint32_t> layer;
+  for (uint32_t l = 0; l < specs.size() && !layer; ++l)
+    if (specs[l].semantic == LayerSemantic::kLighting) layer = l;
+  if (!layer) return Status::Ok();
+  const nlohmann::json meta = nlohmann::json::parse(in.reader->metadata_json(), nullptr, false);
+  const double texels_per_unit = meta.is_object() ? meta.value("texels_per_unit", 0.0) : 0.0;
+  const double texel_size = texels_per_unit > 0 ? 1.0 / texels_per_unit : 0.0;
+  if (!lit.layers.any()) {
+    VT_RETURN_IF_ERROR(add_shading_frames(in.original, in.reference, true));
+    VT_ASSIGN_OR_RETURN(lit.materials, lit_materials(in.original));
+  }
+  VT_ASSIGN_OR_RETURN(
+      std::unique_ptr<LightingReference> reference,
+      LightingReference::create(in.original, in.reference, lit.materials,
+                                baked_lighting_options(*in.reader), texel_size, o.atlas.threads));
+  LightingViewOptions lo;
+  lo.layer = *layer;
+  lo.address_mode = specs[*layer].address_mode;
+  lo.streamer.slots_x = lo.streamer.slots_y = o.slots;
+  lo.max_frames = o.max_frames;
+  lo.thresholds = report.lighting_thresholds;
+  for (uint32_t v = 0; v < cameras.size() && v < report.views.size(); ++v) {
+    VT_ASSIGN_OR_RETURN(LightingViewResult r,
+                        check_lighting_view(renderer, source, *reference, cameras[v], lo));
+    ViewReport& view = report.views[v];
+    for (const std::string& why : r.failures) view.failures.push_back("lighting: " + why);
+    view.lighting = r.report;
+    if (report.out_dir.empty()) continue;
+    const std::string base = report.out_dir + "/view_" + std::to_string(v) + "_lighting_";
+    const std::pair<const char*, Rgba8Image> images[] = {
+        {"reference.png", r.reference},
+        {"virtual.png", r.virt},
+        {"diff.png", difference_map(r.reference, r.virt)}};
+    for (const auto& [name, image] : images) {
+      VT_RETURN_IF_ERROR(write_png(base + name, image));
+      view.images.push_back(base + name);
+    }
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
@@ -526,6 +576,9 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
   VT_ASSIGN_OR_RETURN(std::unique_ptr<VulkanContext> ctx, VulkanContext::create(vo));
   PageFileSourceOptions so;
   so.bc7_as_rgba8 = ctx->is_lavapipe();  // lavapipe samples BC7 15-25x slower than BC1
+  // Likewise BC6H (the lighting layer): its views took 6-12x the albedo views' time on lavapipe.
+  // The atlas check judges the BC6H upload; the views then see the halves as stored.
+  so.bc6h_as_rgba16f = ctx->is_lavapipe();
   VT_ASSIGN_OR_RETURN(std::unique_ptr<PageSource> source, make_page_file_source(in.reader, so));
   VT_ASSIGN_OR_RETURN(LitInputs lit, lit_inputs_for(*source, in, o));
 
@@ -560,10 +613,11 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
 
   const double setup_seconds = seconds_since(setup_start);
   const auto views_start = std::chrono::steady_clock::now();
-  VT_ASSIGN_OR_RETURN(
-      ValidationReport report,
-      validate_views(*renderer, std::shared_ptr<const PageSource>(std::move(source)), cameras,
-                     vopt));
+  const std::shared_ptr<const PageSource> shared_source(std::move(source));
+  VT_ASSIGN_OR_RETURN(ValidationReport report,
+                      validate_views(*renderer, shared_source, cameras, vopt));
+  report.lighting_thresholds = o.lighting_thresholds.value_or(lighting_thresholds());
+  VT_RETURN_IF_ERROR(check_lighting_views(*renderer, shared_source, in, lit, o, cameras, report));
   for (size_t v = 0; v < report.views.size(); ++v) {
     ViewReport& view = report.views[v];
     view.density = measure_view_density(surfaces, cameras[v], o.width, o.height);

@@ -121,6 +121,17 @@ struct LitViewReport {
 // A view's "lit" object in report.json (docs/JSON.md).
 nlohmann::json to_json(const LitViewReport& lit);
 
+// The screen-space check of the lighting layer in one view (lighting_check.h): the tone-mapped
+// irradiance through the virtual-texture path against the per-pixel reference from the original
+// scene; alpha = AO (psnr_alpha reported, not judged: both sides are sampled).
+struct LightingViewReport {
+  ViewMetrics metrics;
+  ConvergeResult converge;
+  double reference_ms = 0, virtual_ms = 0;  // the CPU reference frame; the final virtual pass
+};
+// A view's "lighting" object in report.json (docs/JSON.md).
+nlohmann::json to_json(const LightingViewReport& lighting);
+
 struct ViewReport {
   uint32_t view = 0;
   ViewMetrics metrics;
@@ -134,6 +145,8 @@ struct ViewReport {
   // The lit comparison, when the bake has a normal, ORM or emissive layer it can render; its
   // failures are in `failures`, prefixed "lit: ".
   std::optional<LitViewReport> lit;
+  // With a lighting layer: its screen-space check; failures in `failures`, prefixed "lighting: ".
+  std::optional<LightingViewReport> lighting;
 };
 
 struct ValidationReport {
@@ -146,6 +159,7 @@ struct ValidationReport {
   Thresholds lit_thresholds;
   EmissiveBounds emissive_bounds;
   NormalBounds normal_bounds;
+  Thresholds lighting_thresholds;  // the lighting view check's (with a lighting layer)
   std::vector<std::string> lit_layers;   // the layers the lit pass read (names); empty: no lit pass
   std::vector<std::string> lit_skipped;  // layers it could not render, and why
   std::vector<ViewReport> views;
@@ -215,6 +229,8 @@ struct BakeValidationOptions {
   Thresholds lit_thresholds = lit_scene_thresholds();
   EmissiveBounds emissive_bounds = default_emissive_bounds();
   NormalBounds normal_bounds = default_normal_bounds();
+  // The lighting view check's bounds; unset: lighting_thresholds() (lighting_check.h).
+  std::optional<Thresholds> lighting_thresholds;
   uint32_t slots = 32;           // physical cache slots per side
   uint32_t max_frames = 48;      // per view, before giving up converging
   bool prefer_hardware = false;  // a hardware Vulkan device rather than lavapipe

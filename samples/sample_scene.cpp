@@ -370,6 +370,42 @@ void add_sample_meshes(scene::Scene& sc, const SampleSceneOptions& o) {
   node("leaf card", card_mesh, translate_scale(3.0, 0.0, 2.0, 1.0, -0.6));
 }
 
+// The lit variant's lights: a warm sun from above left, a bulb over the sphere and a spot
+// looking straight down at the boxes, each at a node of its own (its -Z along the light).
+void add_sample_lights(scene::Scene& sc) {
+  auto place = [&](const std::string& name, scene::Light light, Vec3 position, Vec3 direction) {
+    light.name = name;
+    sc.lights.push_back(light);
+    const Vec3 z = normalize3({-direction[0], -direction[1], -direction[2]});
+    const Vec3 x = normalize3(std::abs(z[1]) < 0.9f ? Vec3{z[2], 0, -z[0]} : Vec3{0, -z[2], z[1]});
+    const Vec3 y = {z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2],
+                    z[0] * x[1] - z[1] * x[0]};
+    scene::Node n;
+    n.name = name;
+    n.light = int(sc.lights.size() - 1);
+    n.local = {x[0], x[1], x[2], 0, y[0],        y[1],        y[2],        0,
+               z[0], z[1], z[2], 0, position[0], position[1], position[2], 1};
+    sc.nodes.push_back(n);
+    sc.roots.push_back(int(sc.nodes.size() - 1));
+  };
+  scene::Light sun;
+  sun.type = scene::LightType::kDirectional;
+  sun.color = {1.0f, 0.9f, 0.8f};
+  sun.intensity = 3.0f;  // lux
+  place("sun", sun, {0, 8, 0}, {0.4f, -1.0f, 0.3f});
+  scene::Light bulb;
+  bulb.type = scene::LightType::kPoint;
+  bulb.intensity = 40.0f;  // candela
+  bulb.range = 20.0f;
+  place("bulb", bulb, {1.0f, 3.0f, 1.0f}, {0, -1, 0});
+  scene::Light spot;
+  spot.type = scene::LightType::kSpot;
+  spot.intensity = 80.0f;
+  spot.inner_cone_angle = 0.2f;
+  spot.outer_cone_angle = 0.6f;
+  place("spot", spot, {-2.0f, 4.0f, -2.0f}, {0, -1, 0});
+}
+
 }  // namespace
 
 Status write_sample_scene(const std::string& dir, const SampleSceneOptions& o) {
@@ -381,8 +417,11 @@ Status write_sample_scene(const std::string& dir, const SampleSceneOptions& o) {
   scene::Scene sc;
   add_sample_materials(sc, dir);
   add_sample_meshes(sc, o);
+  if (o.lights) add_sample_lights(sc);
   sc.source_path = (fs::path(dir) / "scene.gltf").string();
-  VT_RETURN_IF_ERROR(scene::save_gltf(sc, sc.source_path, kSampleSceneGltf));
+  scene::GltfWriteOptions wo = kSampleSceneGltf;
+  wo.lights_required = o.lights;
+  VT_RETURN_IF_ERROR(scene::save_gltf(sc, sc.source_path, wo));
   // The scene's own atlas size (bake/unwrap/texel_density.h): its textures would ask for about
   // 52 x 53 pages (the bricks' 427 texels per unit); 16 keeps the main job within its few
   // minutes and its output as it always was.

@@ -17,6 +17,9 @@ struct SampleSceneOptions {
   uint32_t ground_cells = 16;     // ground grid cells per side (2 triangles each)
   uint32_t sphere_segments = 48;  // UV sphere: segments around, segments / 2 rings
   uint32_t texture_size = 512;    // side of every generated texture
+  // The lit variant: a sun, a point light and a spot light (KHR_lights_punctual, listed in
+  // extensionsRequired as a lit level's export lists it), so a bake gets a lighting layer.
+  bool lights = false;
 };
 
 // Writes DIR/scene.gltf, DIR/scene.bin and the textures (PNG, one EXR). Creates DIR.

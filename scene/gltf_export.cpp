@@ -282,6 +282,7 @@ class DocumentBuilder {
     }
     doc_["extensions"]["KHR_lights_punctual"]["lights"] = std::move(lights);
     use_extension("KHR_lights_punctual");
+    if (options_.lights_required) doc_["extensionsRequired"].push_back("KHR_lights_punctual");
   }
 
   void use_extension(const char* name) {

@@ -23,6 +23,9 @@ struct GltfWriteOptions {
   // engine sampling the baked normal layer decodes it right. Tangents the primitive carried
   // for its source normal map are kept as the application attribute _SOURCE_TANGENT.
   bool atlas_tangents = false;
+  // KHR_lights_punctual in extensionsRequired too, not only extensionsUsed (as level exports
+  // whose look depends on their lights list it).
+  bool lights_required = false;
 };
 
 // Writes the document as glTF 2.0 text at PATH and its buffer at PATH's stem + ".bin" in the

@@ -11,7 +11,9 @@ layout(push_constant) uniform Push {
   // x: level count, y: page payload, z: page border, w: page size (payload + 2 * border).
   ivec4 vt;
   // x: frame index (feedback tap rotation), y: address mode (0 clamp, 1 wrap, 2 the sampler's:
-  // taps are left as they are, for material samplers with per-axis modes), z: max LOD.
+  // taps are left as they are, for material samplers with per-axis modes), z: max LOD; w, in the
+  // feedback and virtual passes: 1 = an HDR lighting layer (rgb tone-mapped x / (1 + x), alpha
+  // is AO: no alpha test), 0 otherwise (the lit passes use w for their inputs, lit.glsl).
   ivec4 misc;
 }
 pc;

@@ -17,7 +17,7 @@ layout(location = 0) out uint out_request;
 void main() {
   Footprint f = footprint(v_uv, pc.tex.z);
   int level = int(floor(f.lod));
-  if (pc.tex.w >= 0.0) {
+  if (pc.tex.w >= 0.0 && pc.misc.w != 1) {
     int sampled;
     vec4 c = vt_filtered(u_cache, u_page_table, v_uv, f, sampled);
     if (sampled <= level && c.a < pc.tex.w) discard;

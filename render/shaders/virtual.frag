@@ -20,8 +20,10 @@ void main() {
   Footprint f = footprint(v_uv, 1.0);
   int sampled;
   vec4 c = vt_filtered(u_cache, u_page_table, v_uv, f, sampled);
-  if (pc.tex.w >= 0.0 && c.a < pc.tex.w) discard;
-  bool edge = pc.tex.w >= 0.0 && c.a < pc.tex.w + kAlphaEdge;
+  const bool tested = pc.tex.w >= 0.0 && pc.misc.w != 1;
+  if (tested && c.a < pc.tex.w) discard;
+  bool edge = tested && c.a < pc.tex.w + kAlphaEdge;
+  if (pc.misc.w == 1) c.rgb = max(c.rgb, vec3(0.0)) / (1.0 + max(c.rgb, vec3(0.0)));
   out_color = c;
   out_status = 0x80000000u | (edge ? 0x40000000u : 0u) |
                (vt_border_read ? 0x20000000u : 0u) | (vt_coarse_fallback ? 0x10000000u : 0u) | uint(int(floor(f.lod))) |

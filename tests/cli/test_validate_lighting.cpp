@@ -1,12 +1,15 @@
-// End-to-end: the atlas check of a baked lighting layer (issue 21). The reference is lit by the
+// End-to-end: the atlas and screen-space checks of a baked lighting layer (issue 21), on the lit
+// sample scene (`vtbake sample-scene --lights`). The reference is lit by the
 // original scene's lights where the original places them, with shadows always and the bake's
 // AO settings; lux are compared after the tone map x / (1 + x). A correct lit bake passes; a
 // bake whose light moved, or that skipped shadows, fails on its lighting layer.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "tests/cli/cli_test_util.h"
 
@@ -19,33 +22,27 @@ class ValidateLighting : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = fresh_test_dir("validate_lighting");
-    setup_error_ = write_sample_scene(dir_ + "/scene");
+    // The lit sample scene: a sun, a bulb and a spot, KHR_lights_punctual required, as Blender
+    // writes a lit level.
+    setup_error_ = write_sample_scene(
+        dir_ + "/scene", "--ground-cells 2 --sphere-segments 8 --texture-size 32 --lights");
     if (!setup_error_.empty()) return;
-    // The sample scene with a sun, a bulb and a spot, as Blender writes them.
-    nlohmann::json doc = nlohmann::json::parse(read_file(dir_ + "/scene/scene.gltf"));
-    doc["extensionsUsed"].push_back("KHR_lights_punctual");
-    doc["extensionsRequired"] = {"KHR_lights_punctual"};
-    doc["extensions"]["KHR_lights_punctual"]["lights"] = {
-        {{"type", "directional"}, {"intensity", 3.0}, {"color", {1.0, 0.9, 0.8}}},
-        {{"type", "point"}, {"intensity", 40.0}, {"range", 20.0}},
-        {{"type", "spot"},
-         {"intensity", 80.0},
-         {"spot", {{"innerConeAngle", 0.2}, {"outerConeAngle", 0.6}}}}};
-    const int first = int(doc["nodes"].size());
-    doc["nodes"].push_back({{"name", "sun"},
-                            {"rotation", {-0.5, 0.1, 0.1, 0.85}},
-                            {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
-    doc["nodes"].push_back({{"name", "bulb"},
-                            {"translation", {1.0, 3.0, 1.0}},
-                            {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
-    doc["nodes"].push_back({{"name", "spot"},
-                            {"translation", {-2.0, 4.0, 0.0}},
-                            {"rotation", {-0.7071, 0.0, 0.0, 0.7071}},
-                            {"extensions", {{"KHR_lights_punctual", {{"light", 2}}}}}});
-    for (int n = first; n < first + 3; ++n) doc["scenes"][0]["nodes"].push_back(n);
-    std::ofstream(dir_ + "/scene/lit.gltf") << doc.dump();
-    doc["nodes"][first + 1]["translation"] = {3.0, 2.0, -2.0};
+    std::filesystem::rename(dir_ + "/scene/scene.gltf", dir_ + "/scene/lit.gltf");
+    nlohmann::json doc = nlohmann::json::parse(read_file(dir_ + "/scene/lit.gltf"));
+    if (doc.value("extensionsRequired", nlohmann::json::array()) !=
+        nlohmann::json::array({"KHR_lights_punctual"})) {
+      setup_error_ = "sample-scene --lights does not require KHR_lights_punctual";
+      return;
+    }
+    for (auto& node : doc["nodes"])
+      if (node.value("name", "") == "bulb") {
+        // The light nodes are written as matrices: move the translation column.
+        node["matrix"][12] = 3.0, node["matrix"][13] = 2.0, node["matrix"][14] = -2.0;
+      }
     std::ofstream(dir_ + "/scene/moved.gltf") << doc.dump();
+    // The same scene without its lights (for the light-less check).
+    const std::string unlit = write_sample_scene(dir_ + "/unlit");
+    if (!unlit.empty()) setup_error_ = unlit;
   }
   static void TearDownTestSuite() { remove_test_dir(dir_); }
   void SetUp() override { ASSERT_TRUE(setup_error_.empty()) << setup_error_; }
@@ -62,6 +59,35 @@ class ValidateLighting : public ::testing::Test {
                           " --atlas-only --out " + dir_ + "/" + name + ".validate",
                       false);
   }
+  // Validates NAME.vtpf (made by bake_and_check) against lit.gltf through two rendered views: the
+  // screen-space check of the lighting layer runs beside the views' own checks.
+  static RunResult views_check(const std::string& name) {
+    return run_vtbake("--json validate " + dir_ + "/scene/lit.gltf " + dir_ + "/" + name +
+                          ".vtpf --views 2 --size 320x180 --out " + dir_ + "/" + name + ".views",
+                      false);
+  }
+  static bool no_vulkan(const RunResult& r) {
+    return r.exit_code == 2 &&
+           (r.out.find("Vulkan") != std::string::npos || r.out.find("vulkan") != std::string::npos);
+  }
+  // Every view's "lighting" object; empty when the output is not a report.
+  static std::vector<nlohmann::json> lighting_views(const RunResult& r) {
+    const auto j = nlohmann::json::parse(r.out, nullptr, false);
+    std::vector<nlohmann::json> out;
+    if (!j.is_object() || !j.contains("views")) return out;
+    for (const auto& v : j["views"]) out.push_back(v.value("lighting", nlohmann::json()));
+    return out;
+  }
+  // Whether some view failed the lighting check (its failures name it).
+  static bool lighting_failed(const RunResult& r) {
+    const auto j = nlohmann::json::parse(r.out, nullptr, false);
+    if (!j.is_object()) return false;
+    for (const auto& v : j["views"])
+      for (const auto& why : v["failures"])
+        if (why.get<std::string>().rfind("lighting: ", 0) == 0) return true;
+    return false;
+  }
+
   static nlohmann::json lighting_report(const RunResult& r) {
     const auto j = nlohmann::json::parse(r.out, nullptr, false);
     if (!j.is_object()) return {};
@@ -109,6 +135,64 @@ TEST_F(ValidateLighting, ShadowsOffFails) {
   const nlohmann::json l = lighting_report(r);
   ASSERT_TRUE(l.is_object()) << r.out;
   EXPECT_GT(l["pages_failed"].get<int>(), 0);
+}
+
+// The screen-space check (views rendered through the virtual-texture path against a per-pixel
+// reference from the original scene). Runs after the atlas tests above, reusing their bakes.
+TEST_F(ValidateLighting, ViewsOfACorrectLitBakePassTheLightingCheck) {
+  bake_and_check("lit.gltf", "lit_views");
+  const RunResult r = views_check("lit_views");
+  if (no_vulkan(r)) GTEST_SKIP() << "no Vulkan device: " << r.out;
+  EXPECT_FALSE(lighting_failed(r)) << r.out;
+  const std::vector<nlohmann::json> views = lighting_views(r);
+  ASSERT_EQ(views.size(), 2u) << r.out;
+  for (const nlohmann::json& l : views) {
+    ASSERT_TRUE(l.is_object()) << r.out;
+    EXPECT_GT(l["pixels_compared"].get<int>(), 1000);
+    EXPECT_GE(l["psnr_rgb"].get<double>(), 30.0);
+  }
+}
+
+TEST_F(ValidateLighting, ViewsOfAMovedLightFailTheLightingCheck) {
+  bake_and_check("moved.gltf", "moved_views");
+  const RunResult r = views_check("moved_views");
+  if (no_vulkan(r)) GTEST_SKIP() << "no Vulkan device: " << r.out;
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_TRUE(lighting_failed(r)) << r.out;
+}
+
+TEST_F(ValidateLighting, ViewsOfAShadowlessBakeFailTheLightingCheck) {
+  bake_and_check("lit.gltf", "noshadow_views", "--no-shadows");
+  const RunResult r = views_check("noshadow_views");
+  if (no_vulkan(r)) GTEST_SKIP() << "no Vulkan device: " << r.out;
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_TRUE(lighting_failed(r)) << r.out;
+}
+
+// --bounces 1: the metadata records it, the atlas check repeats it (same rays: every page as
+// baked) and the views' reference gathers the bounce too.
+TEST_F(ValidateLighting, ABouncedBakeValidates) {
+  const RunResult atlas = bake_and_check("lit.gltf", "bounce", "--bounces 1 --bounce-samples 8");
+  EXPECT_EQ(atlas.exit_code, 0) << atlas.out;
+  const nlohmann::json l = lighting_report(atlas);
+  ASSERT_TRUE(l.is_object()) << atlas.out;
+  EXPECT_EQ(l["pages_failed"], 0);
+  const RunResult r = views_check("bounce");
+  if (no_vulkan(r)) GTEST_SKIP() << "no Vulkan device: " << r.out;
+  EXPECT_FALSE(lighting_failed(r)) << r.out;
+  EXPECT_EQ(lighting_views(r).size(), 2u) << r.out;
+}
+
+TEST_F(ValidateLighting, AViewsCheckWithoutALightingLayerHasNoLightingObject) {
+  const std::string out = dir_ + "/unlit.vtpf";
+  const RunResult b = run_vtbake(
+      "-q bake " + dir_ + "/unlit/scene.gltf -o " + out + " --size 4 --supersample 1", true);
+  ASSERT_EQ(b.exit_code, 0) << b.out;
+  const RunResult r = run_vtbake("--json validate " + dir_ + "/unlit/scene.gltf " + out +
+                                     " --views 1 --size 160x90 --out " + dir_ + "/unlit.views",
+                                 false);
+  if (no_vulkan(r)) GTEST_SKIP() << "no Vulkan device: " << r.out;
+  for (const nlohmann::json& l : lighting_views(r)) EXPECT_TRUE(l.is_null()) << r.out;
 }
 
 }  // namespace

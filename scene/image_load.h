@@ -1,6 +1,7 @@
-// The validator's one reader of a scene's images (OpenImageIO, files or embedded bytes), with the
+// The one whole-image reader of a scene's images (OpenImageIO, files or embedded bytes), with the
 // transfer's channel rules (bake/transfer.cpp sample_texture): grey -> (g, g, g, 1), grey + alpha
-// -> (g, g, g, a), RGB -> alpha 1. The reference pass and the lit reference build on it.
+// -> (g, g, g, a), RGB -> alpha 1. The validator's reference and lit reference passes and the
+// lighting baker's alpha-masked shadows (bake/lighting.cpp) build on it.
 #pragma once
 
 #include <cstdint>
@@ -9,7 +10,7 @@
 #include "common/status.h"
 #include "scene/scene.h"
 
-namespace vt::render {
+namespace vt::scene {
 
 struct FloatImage {
   uint32_t width = 0, height = 0;
@@ -23,4 +24,4 @@ struct FloatImage {
 // has a size of 0 or over 65536 per side.
 Expected<FloatImage> load_float_image(const scene::Image& image);
 
-}  // namespace vt::render
+}  // namespace vt::scene

@@ -1,11 +1,11 @@
-#include "render/image_load.h"
+#include "scene/image_load.h"
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <memory>
 
-namespace vt::render {
+namespace vt::scene {
 
 Expected<FloatImage> load_float_image(const scene::Image& image) {
   OIIO::Filesystem::IOMemReader mem(image.bytes.data(), image.bytes.size());
@@ -14,18 +14,16 @@ Expected<FloatImage> load_float_image(const scene::Image& image) {
   std::unique_ptr<OIIO::ImageInput> in =
       image.embedded() ? OIIO::ImageInput::open(name, nullptr, &mem) : OIIO::ImageInput::open(name);
   if (!in) {
-    return Error(ErrorCode::kNotFound,
-                 "render: cannot open image '" + name + "': " + OIIO::geterror());
+    return Error(ErrorCode::kNotFound, "cannot open image '" + name + "': " + OIIO::geterror());
   }
   const OIIO::ImageSpec& spec = in->spec();
   const int ch = spec.nchannels;
   if (spec.width <= 0 || spec.height <= 0 || ch <= 0 || spec.width > 65536 || spec.height > 65536) {
-    return Error(ErrorCode::kCorrupt, "render: image '" + name + "' has a bad size");
+    return Error(ErrorCode::kCorrupt, "image '" + name + "' has a bad size");
   }
   std::vector<float> px(size_t(spec.width) * spec.height * ch);
   if (!in->read_image(0, 0, 0, ch, OIIO::TypeDesc::FLOAT, px.data())) {
-    return Error(ErrorCode::kCorrupt,
-                 "render: cannot read image '" + name + "': " + in->geterror());
+    return Error(ErrorCode::kCorrupt, "cannot read image '" + name + "': " + in->geterror());
   }
   FloatImage out;
   out.width = uint32_t(spec.width);
@@ -44,4 +42,4 @@ Expected<FloatImage> load_float_image(const scene::Image& image) {
   return out;
 }
 
-}  // namespace vt::render
+}  // namespace vt::scene
