@@ -104,21 +104,9 @@ Vec3d lattice_direction(const Vec3d& t, const Vec3d& b, const Vec3d& n, double r
 
 // A texel of an alpha plane, wrapped as the texture's sampler says.
 float alpha_texel(const AlphaCaster& c, int x, int y) {
-  auto wrap = [](int i, int n, scene::WrapMode m) {
-    switch (m) {
-      case scene::WrapMode::kClampToEdge:
-        return std::clamp(i, 0, n - 1);
-      case scene::WrapMode::kMirroredRepeat: {
-        const int p = ((i % (2 * n)) + 2 * n) % (2 * n);
-        return p < n ? p : 2 * n - 1 - p;
-      }
-      default:
-        return ((i % n) + n) % n;
-    }
-  };
   const AlphaPlane& p = *c.plane;
-  return p.alpha[size_t(wrap(y, int(p.height), c.ref.wrap_t)) * p.width +
-                 wrap(x, int(p.width), c.ref.wrap_s)];
+  return p.alpha[size_t(scene::wrap_texel(c.ref.wrap_t, y, p.height)) * p.width +
+                 size_t(scene::wrap_texel(c.ref.wrap_s, x, p.width))];
 }
 
 // The base colour's alpha at barycentric (u, v) of `triangle`: texture (bilinear, or nearest
@@ -146,19 +134,6 @@ float caster_alpha(const AlphaCaster& c, uint32_t triangle, float u, float v) {
   return float(a);
 }
 
-int wrap_index(int i, int n, scene::WrapMode m) {
-  switch (m) {
-    case scene::WrapMode::kClampToEdge:
-      return std::clamp(i, 0, n - 1);
-    case scene::WrapMode::kMirroredRepeat: {
-      const int p = ((i % (2 * n)) + 2 * n) % (2 * n);
-      return p < n ? p : 2 * n - 1 - p;
-    }
-    default:
-      return ((i % n) + n) % n;
-  }
-}
-
 // The base colour (linear RGB) at barycentric `w` of `triangle`: factor x texture (bilinear,
 // level 0) x vertex colour.
 void surface_albedo(const BounceSurface& sf, uint32_t triangle, const double w[3], double out[3]) {
@@ -181,9 +156,10 @@ void surface_albedo(const BounceSurface& sf, uint32_t triangle, const double w[3
     for (int j = 0; j < 2; ++j)
       for (int i = 0; i < 2; ++i) {
         const double wt = (i ? fx : 1 - fx) * (j ? fy : 1 - fy);
-        const size_t o = (size_t(wrap_index(y0 + j, int(p.height), sf.ref.wrap_t)) * p.width +
-                          wrap_index(x0 + i, int(p.width), sf.ref.wrap_s)) *
-                         3;
+        const size_t o =
+            (size_t(scene::wrap_texel(sf.ref.wrap_t, y0 + j, int(p.height))) * p.width +
+             scene::wrap_texel(sf.ref.wrap_s, x0 + i, int(p.width))) *
+            3;
         for (int c = 0; c < 3; ++c) tex[c] += wt * p.rgb[o + c];
       }
     for (int c = 0; c < 3; ++c) out[c] *= tex[c];

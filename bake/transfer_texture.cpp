@@ -1,6 +1,7 @@
 // Source textures for the transfer (see transfer_texture.h).
 #include "bake/transfer_texture.h"
 #include "bake/color.h"
+#include "scene/material_rules.h"
 
 #include <OpenImageIO/imageio.h>
 
@@ -20,23 +21,6 @@ constexpr int kMaxTaps = 16;  // anisotropy: taps along the footprint's major ax
 std::string first_line(std::string s) {
   s = s.substr(0, s.find('\n'));  // further lines repeat it
   return s.empty() ? "OpenImageIO cannot read it" : s;
-}
-
-// Texel index i of a level n texels wide, addressed as glTF's wrap mode says.
-inline int64_t wrap_index(int64_t i, int64_t n, scene::WrapMode mode) {
-  switch (mode) {
-    case scene::WrapMode::kClampToEdge:
-      return std::clamp<int64_t>(i, 0, n - 1);
-    case scene::WrapMode::kMirroredRepeat: {
-      int64_t m = i % (2 * n);
-      if (m < 0) m += 2 * n;
-      return m < n ? m : 2 * n - 1 - m;
-    }
-    case scene::WrapMode::kRepeat:
-      break;
-  }
-  int64_t m = i % n;
-  return m < 0 ? m + n : m;
 }
 
 // Coordinates past this are sampled at 0 (the wrap of such a float has no fraction left).
@@ -160,12 +144,12 @@ inline void wrap_pair(int64_t i, int64_t n, scene::WrapMode mode, int64_t& a, in
       a = std::clamp<int64_t>(i, 0, n - 1), b = std::clamp<int64_t>(i + 1, 0, n - 1);
       return;
     case scene::WrapMode::kMirroredRepeat:
-      a = wrap_index(i, n, mode), b = wrap_index(i + 1, n, mode);
+      a = scene::wrap_texel(mode, i, n), b = scene::wrap_texel(mode, i + 1, n);
       return;
     case scene::WrapMode::kRepeat:
       break;
   }
-  a = wrap_index(i, n, mode);
+  a = scene::wrap_texel(mode, i, n);
   b = a + 1 == n ? 0 : a + 1;
 }
 
@@ -174,8 +158,8 @@ template <int CH>
 inline void tap(const float* base, int64_t w, int64_t h, double s, double t, const TextureLookup& q,
                 float* out) {
   if (q.nearest) {
-    const int64_t x = wrap_index(int64_t(std::floor(s * double(w))), w, q.wrap_s);
-    const int64_t y = wrap_index(int64_t(std::floor(t * double(h))), h, q.wrap_t);
+    const int64_t x = scene::wrap_texel(q.wrap_s, int64_t(std::floor(s * double(w))), w);
+    const int64_t y = scene::wrap_texel(q.wrap_t, int64_t(std::floor(t * double(h))), h);
     const float* p = base + size_t(y * w + x) * CH;
     for (int k = 0; k < CH; ++k) out[k] += p[k];
     return;

@@ -1,5 +1,6 @@
 #include "scene/material_rules.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace vt::scene {
@@ -36,6 +37,22 @@ double wrap_coordinate(WrapMode mode, double x) {
       break;
   }
   return x - std::floor(x);
+}
+
+int64_t wrap_texel(WrapMode mode, int64_t i, int64_t n) {
+  switch (mode) {
+    case WrapMode::kClampToEdge:
+      return std::clamp<int64_t>(i, 0, n - 1);
+    case WrapMode::kMirroredRepeat: {
+      int64_t m = i % (2 * n);
+      if (m < 0) m += 2 * n;
+      return m < n ? m : 2 * n - 1 - m;
+    }
+    case WrapMode::kRepeat:
+      break;
+  }
+  const int64_t m = i % n;
+  return m < 0 ? m + n : m;
 }
 
 Vec4 base_color(const Material& m, const Vec4& texture, const Vec4& vertex_color) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "scene/scene.h"
@@ -25,6 +26,9 @@ std::array<double, 4> texture_uv_derivatives(const TextureRef& ref, std::array<d
 // A texture coordinate brought into [0, 1] as the sampler's wrap mode addresses it: REPEAT keeps
 // the fraction, MIRRORED_REPEAT reflects every other period, CLAMP_TO_EDGE clamps.
 double wrap_coordinate(WrapMode mode, double x);
+// Texel index i of a level n texels wide (n > 0), addressed as the wrap mode says: the integer
+// form of wrap_coordinate for texel lookups.
+int64_t wrap_texel(WrapMode mode, int64_t i, int64_t n);
 
 // Base colour in linear light, as glTF 2.0 defines it: factor x texture x vertex colour (COLOR_0,
 // {1, 1, 1, 1} when absent). Alpha is 1 for OPAQUE materials whatever the inputs hold.
