@@ -5,6 +5,7 @@
 
 #include "bench/bc6h_bench.h"
 #include "bench/codec_bench.h"
+#include "bench/file_decode_bench.h"
 #include "bench/hard_content_bench.h"
 
 namespace vt::bench {
@@ -14,6 +15,7 @@ const std::vector<BenchKind>& bench_kinds() {
       codec_bench_kind(),
       hard_content_bench_kind(),
       bc6h_bench_kind(),
+      file_decode_bench_kind(),
   };
   return kinds;
 }
