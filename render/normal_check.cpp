@@ -7,6 +7,8 @@
 
 namespace vt::render {
 
+constexpr double kDegreesPerRadian = 57.295779513082320876;
+
 NormalBounds default_normal_bounds() {
   // Correct bakes (2026-12-03, adaptive taps): the sample scene's default bake at 1280x720,
   // mean angle 2.1-4.9 deg, correlation 0.90-0.98 (reference detail 17-24 deg RMS: the tile
@@ -42,8 +44,8 @@ Expected<NormalMetrics> compare_normals(const ReferenceFrame& reference,
     }
     // Both shading normals are unit and share the vertex normal: the detail vectors' difference
     // is the normals' chord, 2 sin(angle / 2).
-    const double deg = 2.0 * std::asin(std::min(1.0, std::sqrt(diff) / 2.0)) * (180.0 / M_PI);
-    const double ref_deg = 2.0 * std::asin(std::min(1.0, std::sqrt(la) / 2.0)) * (180.0 / M_PI);
+    const double deg = 2.0 * std::asin(std::min(1.0, std::sqrt(diff) / 2.0)) * kDegreesPerRadian;
+    const double ref_deg = 2.0 * std::asin(std::min(1.0, std::sqrt(la) / 2.0)) * kDegreesPerRadian;
     sum_deg += deg;
     sq_angle_r += ref_deg * ref_deg;
     dot_rv += ab, sq_r += la, sq_v += lb;
