@@ -15,6 +15,7 @@
 #include <map>
 #include <string>
 
+#include "common/srgb.h"
 #include "scene/image_load.h"
 #include "scene/material_rules.h"
 #include "scene/tangent_frame.h"
@@ -201,9 +202,7 @@ void add_bounce_surface(const scene::Scene& scene, const scene::Primitive& p,
           for (size_t i = 0; i < size_t(img->width) * img->height; ++i)
             for (int c = 0; c < 3; ++c) {
               const float v = img->rgba[4 * i + c];
-              plane.rgb[3 * i + c] = img->is_float   ? std::max(v, 0.0f)
-                                     : v <= 0.04045f ? v / 12.92f
-                                                     : std::pow((v + 0.055f) / 1.055f, 2.4f);
+              plane.rgb[3 * i + c] = img->is_float ? std::max(v, 0.0f) : srgb_to_linear(v);
             }
         }
         it = rays.rgb_images.emplace(ref.image, std::move(plane)).first;
