@@ -159,7 +159,7 @@ struct ValidationReport {
   Thresholds lit_thresholds;
   EmissiveBounds emissive_bounds;
   NormalBounds normal_bounds;
-  Thresholds lighting_thresholds;  // the lighting view check's (with a lighting layer)
+  Thresholds lighting_thresholds;        // the lighting view check's (with a lighting layer)
   std::vector<std::string> lit_layers;   // the layers the lit pass read (names); empty: no lit pass
   std::vector<std::string> lit_skipped;  // layers it could not render, and why
   std::vector<ViewReport> views;
