@@ -517,6 +517,10 @@ void rank_partitions(const Texels& t, int subsets, int count, int nch, int* orde
 
 void bc7_encode_block(const uint8_t rgba[64], BcQuality quality, uint8_t out[16],
                       bool ignore_alpha) {
+  if (quality == BcQuality::kRealtime) {
+    bc7_encode_blocks_realtime(rgba, 1, out, ignore_alpha);
+    return;
+  }
   Texels t;
   bool has_alpha = false;
   for (int i = 0; i < 16; ++i) {
@@ -528,7 +532,7 @@ void bc7_encode_block(const uint8_t rgba[64], BcQuality quality, uint8_t out[16]
     for (int i = 0; i < 16; ++i) t.c[3][i] = 255.0f;
   }
   const bool high = quality == BcQuality::kHigh;
-  const int refine = quality == BcQuality::kRealtime ? 2 : high ? 4 : 2;
+  const int refine = high ? 4 : 2;
   const float alpha_err = opaque_alpha_error(t);
   const bool ig = ignore_alpha;
 
@@ -537,7 +541,7 @@ void bc7_encode_block(const uint8_t rgba[64], BcQuality quality, uint8_t out[16]
     if (e.err < best.err) best = e;
   };
   if (has_alpha) consider(encode_rotated(t, 5, 0, 0, refine));
-  if (quality != BcQuality::kRealtime && best.err > 0) {
+  if (best.err > 0) {
     const int keep2 = high ? 16 : 3;
     int order[64];
     if (has_alpha) {

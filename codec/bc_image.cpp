@@ -119,6 +119,11 @@ Status bc_encode_image(BcFormat format, BcQuality quality, const uint8_t* texels
       bc1_encode_blocks_realtime(row.data(), size_t(blocks_x), out_row, 8);
       continue;
     }
+    if (realtime && format == BcFormat::kBc7) {
+      bc7_encode_blocks_realtime(row.data(), size_t(blocks_x), out_row,
+                                 /*ignore_alpha=*/channels < 4);
+      continue;
+    }
     if (realtime && format == BcFormat::kBc3) {
       bc1_encode_blocks_realtime(row.data(), size_t(blocks_x), out_row + 8, 16);
       for (int bx = 0; bx < blocks_x; ++bx) {
