@@ -4,12 +4,12 @@
 // AVX-512, AVX2 and the baseline and picked at run time, with the same IEEE operations in the
 // same order on every build (codec/CMakeLists.txt: no FMA contraction), hence the same bytes.
 //
-// Per block: endpoints along the principal axis (power iteration on the covariance), the p-bit
-// pairs tried, indices chosen exhaustively against the palette the decoder builds (an integer
-// score per entry, exact in float, so the error minimised is the error a GPU shows), then two
-// least-squares refinements on the chosen indices with the p-bits the block chose, each kept
-// only where it lowers the error (trying every p-bit pair again there bought 0.07 dB on Kodak
-// for 1.75x the time: docs/BENCHMARKS.md).
+// Per block: endpoints along the principal axis (power iteration on the covariance), p-bits
+// each chosen by which rounds its endpoint closer (where the caller fixes them, those), indices
+// chosen exhaustively against the palette the decoder builds (an integer score per entry, exact
+// in float, so the error minimised is the error a GPU shows), then two least-squares
+// refinements on the chosen indices, each kept only where it lowers the error. Scoring every
+// p-bit pair instead costs 2.4x the time for +0.1 dB on Kodak (docs/BENCHMARKS.md).
 // Blocks whose alpha varies are fitted in RGBA; opaque blocks in RGB, with alpha decoding to
 // exactly 255 (both p-bits set) unless the caller ignores alpha (RGB layers), where the p-bits
 // are free for colour and alpha decodes to 254 or 255.
@@ -199,10 +199,33 @@ VT_BC7_CLONES void fit_mode6_lanes(const uint32_t (&texels)[16][kLanes], unsigne
     }
   };
   float pbits[2][kLanes];
-  for (int k = 0; k < 4; ++k) {
-    if (!(pbit_pairs & (1u << k))) continue;
-    for (int l = 0; l < kLanes; ++l) pbits[0][l] = float(k & 1), pbits[1][l] = float(k >> 1);
+  // Free p-bits: each endpoint takes the one that rounds it closer.
+  auto choose_pbits = [&] {
+    for (int k = 0; k < 2; ++k) {
+      for (int l = 0; l < kLanes; ++l) {
+        float d[2] = {0, 0};
+        for (int p = 0; p < 2; ++p) {
+          for (int c = 0; c < NCH; ++c) {
+            const float r = (e[k][c][l] - float(p)) * 0.5f + 0.5f;
+            const float q0 = float(int(r < 0.0f ? 0.0f : r));
+            const float q = q0 > 127.0f ? 127.0f : q0;
+            const float diff = q * 2.0f + float(p) - e[k][c][l];
+            d[p] += diff * diff;
+          }
+        }
+        pbits[k][l] = d[1] < d[0] ? 1.0f : 0.0f;
+      }
+    }
+  };
+  if (pbit_pairs == 0xfu) {
+    choose_pbits();
     try_pbits(pbits);
+  } else {
+    for (int k = 0; k < 4; ++k) {
+      if (!(pbit_pairs & (1u << k))) continue;
+      for (int l = 0; l < kLanes; ++l) pbits[0][l] = float(k & 1), pbits[1][l] = float(k >> 1);
+      try_pbits(pbits);
+    }
   }
 
   // Least squares for the endpoints on the chosen indices; a refinement stands only where it
@@ -234,9 +257,12 @@ VT_BC7_CLONES void fit_mode6_lanes(const uint32_t (&texels)[16][kLanes], unsigne
         e[1][c][l] = ok ? e1 : e[1][c][l];
       }
     }
-    // The refined endpoints keep the p-bits the block chose.
-    for (int l = 0; l < kLanes; ++l)
-      pbits[0][l] = float(out.p[0][l]), pbits[1][l] = float(out.p[1][l]);
+    if (pbit_pairs == 0xfu) {
+      choose_pbits();
+    } else {
+      for (int l = 0; l < kLanes; ++l)
+        pbits[0][l] = float(out.p[0][l]), pbits[1][l] = float(out.p[1][l]);
+    }
     try_pbits(pbits);
   }
   if (NCH == 3) {
