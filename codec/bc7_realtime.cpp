@@ -5,14 +5,15 @@
 // same order on every build (codec/CMakeLists.txt: no FMA contraction), hence the same bytes.
 //
 // Per block: endpoints along the principal axis (power iteration on the covariance), p-bits
-// each chosen by which rounds its endpoint closer (where the caller fixes them, those), indices
+// each chosen by which rounds its endpoint closer (unless the caller fixes them), indices
 // chosen exhaustively against the palette the decoder builds (an integer score per entry, exact
 // in float, so the error minimised is the error a GPU shows), then two least-squares
-// refinements on the chosen indices, each kept only where it lowers the error. Scoring every
-// p-bit pair instead costs 2.4x the time for +0.1 dB on Kodak (docs/BENCHMARKS.md).
-// Blocks whose alpha varies are fitted in RGBA; opaque blocks in RGB, with alpha decoding to
-// exactly 255 (both p-bits set) unless the caller ignores alpha (RGB layers), where the p-bits
-// are free for colour and alpha decodes to 254 or 255.
+// refinements on the chosen indices and p-bits, each kept only where it lowers the error.
+// Scoring every p-bit pair instead costs 2.4x the time for +0.1 dB on Kodak, choosing the
+// p-bits again after each refinement 1.2x for +0.04 dB (docs/BENCHMARKS.md). Blocks whose alpha
+// varies are fitted in RGBA; opaque blocks in RGB, with alpha decoding to exactly 255 (both
+// p-bits set) unless the caller ignores alpha (RGB layers), where the p-bits are free for colour
+// and alpha decodes to 254 or 255.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -199,8 +200,8 @@ VT_BC7_CLONES void fit_mode6_lanes(const uint32_t (&texels)[16][kLanes], unsigne
     }
   };
   float pbits[2][kLanes];
-  // Free p-bits: each endpoint takes the one that rounds it closer.
-  auto choose_pbits = [&] {
+  if (pbit_pairs == 0xfu) {
+    // Free p-bits: each endpoint takes the one that rounds it closer.
     for (int k = 0; k < 2; ++k) {
       for (int l = 0; l < kLanes; ++l) {
         float d[2] = {0, 0};
@@ -216,9 +217,6 @@ VT_BC7_CLONES void fit_mode6_lanes(const uint32_t (&texels)[16][kLanes], unsigne
         pbits[k][l] = d[1] < d[0] ? 1.0f : 0.0f;
       }
     }
-  };
-  if (pbit_pairs == 0xfu) {
-    choose_pbits();
     try_pbits(pbits);
   } else {
     for (int k = 0; k < 4; ++k) {
@@ -257,12 +255,9 @@ VT_BC7_CLONES void fit_mode6_lanes(const uint32_t (&texels)[16][kLanes], unsigne
         e[1][c][l] = ok ? e1 : e[1][c][l];
       }
     }
-    if (pbit_pairs == 0xfu) {
-      choose_pbits();
-    } else {
-      for (int l = 0; l < kLanes; ++l)
-        pbits[0][l] = float(out.p[0][l]), pbits[1][l] = float(out.p[1][l]);
-    }
+    // The refined endpoints keep the p-bits the block chose.
+    for (int l = 0; l < kLanes; ++l)
+      pbits[0][l] = float(out.p[0][l]), pbits[1][l] = float(out.p[1][l]);
     try_pbits(pbits);
   }
   if (NCH == 3) {

@@ -128,7 +128,7 @@ TEST(Bc7, ConstantBlocksWithinOne) {
 TEST(Bc7, OpaqueErrorBounds) {
   const int w = 64, h = 64;
   auto img = test::smooth_image(w, h, 3, 21);
-  const double bounds[3] = {41.0, 43.2, 43.6};  // measured 41.19, 43.43, 43.86
+  const double bounds[3] = {41.0, 43.2, 43.6};  // measured 41.17, 43.43, 43.86
   double previous = 0;
   for (int level = 0; level < 3; ++level) {
     std::vector<uint8_t> blocks(bc_image_bytes(BcFormat::kBc7, w, h)), out(img.size());
