@@ -143,7 +143,7 @@ TEST(BuildTasks, CoverageLevelsWaitForTheWholeLevelBefore) {
   for (uint32_t y = 5; y < 30; ++y)
     for (uint32_t x = 3; x < 50; ++x) (*coverage)[size_t(y) * w + x] = 1;
   BuildOptions o = raw_options(memory_image(w, h, procedural_texels(w, h)));
-  o.layers[0].coverage = coverage;
+  o.layers[0].coverage = CoverageMask::from_bytes(w, h, coverage->data());
   auto plan = plan_build(o);
   ASSERT_TRUE(plan.ok());
   const std::vector<BuildTask> tasks = make_build_tasks(*plan);
@@ -202,9 +202,9 @@ TEST(LevelSource, ConsumedSourceIsConvertedInPlaceWithTheSameResult) {
   auto coverage = std::make_shared<std::vector<uint8_t>>(size_t(w) * h, 1);
   for (uint32_t x = 0; x < w; ++x) (*coverage)[x] = 0;
   BuildOptions copy = raw_options(memory_image(w, h, procedural_texels(w, h)));
-  copy.layers[0].coverage = coverage;
+  copy.layers[0].coverage = CoverageMask::from_bytes(w, h, coverage->data());
   BuildOptions consume = raw_options(memory_image(w, h, procedural_texels(w, h)));
-  consume.layers[0].coverage = coverage;
+  consume.layers[0].coverage = copy.layers[0].coverage;
   consume.layers[0].consume_source = true;
   auto source = std::static_pointer_cast<MemoryImageSource>(consume.layers[0].source);
   auto a = test::build_in_memory(copy);
