@@ -236,6 +236,30 @@ TEST(LevelStore, MemoryAndScratchHoldTheSameRows) {
   }
 }
 
+// An opaque albedo store loses its alpha in place, in memory and in its scratch file (which
+// shrinks to the 3-channel size), with rows that cross the copy's bands.
+TEST(LevelStore, KeepChannelsDropsTheLastChannelsInPlace) {
+  const uint32_t w = 300, h = 9000, ch = 4;  // ~4.3 MiB a scratch band: two bands and a bit
+  std::vector<float> rows(size_t(w) * h * ch);
+  for (size_t i = 0; i < rows.size(); ++i) rows[i] = float(i % 1000003);
+  std::vector<float> want(size_t(w) * h * 3);
+  for (size_t t = 0; t < size_t(w) * h; ++t)
+    for (uint32_t c = 0; c < 3; ++c) want[3 * t + c] = rows[ch * t + c];
+  for (bool in_memory : {true, false}) {
+    auto store =
+        LevelStore::create(w, h, ch, in_memory, std::filesystem::temp_directory_path().string());
+    ASSERT_TRUE(store.ok());
+    ASSERT_TRUE((*store)->write_rows(0, h, rows.data()).ok());
+    ASSERT_TRUE((*store)->keep_channels(3).ok());
+    EXPECT_EQ((*store)->channels(), 3u);
+    EXPECT_EQ((*store)->bytes(), uint64_t(w) * h * 3 * sizeof(float));
+    std::vector<float> back(want.size());
+    ASSERT_TRUE((*store)->read(0, h, back.data()).ok());
+    EXPECT_TRUE(back == want) << "in memory " << in_memory;
+    EXPECT_FALSE((*store)->read(h, h + 1, back.data()).ok());
+  }
+}
+
 TEST(LevelStore, DilationFillsUncoveredTexelsFromCoveredOnes) {
   const uint32_t w = 16, h = 8;
   std::vector<float> texels(size_t(w) * h, 0.0f);
