@@ -148,6 +148,8 @@ Status LevelStore::read(uint32_t y0, uint32_t y1, float* out) {
 }
 
 Status StoredImageSource::read_rows(uint32_t y0, uint32_t y1, float* out) {
+  if (released_hash_)
+    return Error(ErrorCode::kInternal, "layer rows read after the build took them over");
   const uint32_t sc = store_->channels(), c = info_.channels;
   if (sc == c) return store_->read(y0, y1, out);
   rows_.resize(size_t(y1 - y0) * store_->row_floats());

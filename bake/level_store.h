@@ -86,7 +86,9 @@ class StoredImageSource final : public ImageSource {
   // its own file (no second copy on disk); null otherwise. The source is spent once the caller
   // says so with the hash of the rows it read (content_hash gives it from then on).
   std::shared_ptr<LevelStore> scratch_store() const {
-    return store_->in_memory() || store_->channels() != info_.channels ? nullptr : store_;
+    const bool own =
+        !released_hash_ && !store_->in_memory() && store_->channels() == info_.channels;
+    return own ? store_ : nullptr;
   }
   void spent(uint64_t content_hash) { released_hash_ = content_hash; }
   // The hash of the rows (kept once the texels are handed over).

@@ -215,6 +215,45 @@ TEST(LevelSource, ConsumedSourceIsConvertedInPlaceWithTheSameResult) {
   for (const auto& [key, page] : a->sink.pages) EXPECT_EQ(page.bytes, b->sink.pages.at(key).bytes);
 }
 
+// A scene bake's scratch-file layer is converted in its own file (no second copy): the plan
+// hash, the pages and the source's content hash are those of a build from a copy.
+TEST(LevelSource, ScratchSourceIsConvertedInItsOwnFileWithTheSameResult) {
+  const uint32_t w = 48, h = 40;
+  const std::vector<float> texels = procedural_texels(w, h);
+  std::vector<uint8_t> coverage(size_t(w) * h, 1);
+  for (uint32_t x = 0; x < w; ++x) coverage[x] = 0;
+  const std::string dir = std::filesystem::temp_directory_path().string();
+  auto store = LevelStore::create(w, h, 3, false, dir);
+  ASSERT_TRUE(store.ok());
+  ASSERT_TRUE((*store)->write_rows(0, h, texels.data()).ok());
+  std::shared_ptr<LevelStore> shared = std::move(*store);
+  auto stored = std::make_shared<StoredImageSource>(memory_image(w, h, {})->info(), shared);
+  const uint64_t source_hash = *stored->content_hash();
+  ASSERT_NE(stored->scratch_store(), nullptr);
+
+  BuildOptions copy = raw_options(memory_image(w, h, texels));
+  copy.layers[0].coverage = CoverageMask::from_bytes(w, h, coverage.data());
+  BuildOptions own = raw_options(stored);
+  own.layers[0].coverage = copy.layers[0].coverage;
+  own.layers[0].consume_source = true;
+  own.memory_limit = copy.memory_limit = 16 << 10;  // level 0 in a scratch file
+  auto a = plan_build(copy), b = plan_build(own);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_FALSE(b->layers[0].level0->in_memory());
+  EXPECT_EQ(a->hash, b->hash);
+  EXPECT_EQ(*stored->content_hash(), source_hash);  // as read, before the conversion
+  EXPECT_EQ(stored->scratch_store(), nullptr);      // taken once
+  std::vector<float> rows(texels.size());
+  EXPECT_FALSE(stored->read_rows(0, h, rows.data()).ok());
+  ASSERT_TRUE(shared->read(0, h, rows.data()).ok());
+  EXPECT_NE(rows, texels);  // the store now holds the working form (linear, dilated)
+  test::MemorySink sa, sb;
+  ASSERT_TRUE(build_pages(*a, sa).ok());
+  ASSERT_TRUE(build_pages(*b, sb).ok());
+  EXPECT_EQ(sa.pages.size(), sb.pages.size());
+  for (const auto& [key, page] : sa.pages) EXPECT_EQ(page.bytes, sb.pages.at(key).bytes);
+}
+
 TEST(LevelStore, MemoryAndScratchHoldTheSameRows) {
   const uint32_t w = 37, h = 23, ch = 3;
   std::vector<float> rows(size_t(w) * h * ch);
