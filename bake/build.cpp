@@ -137,8 +137,9 @@ class LayerRun {
     const uint64_t key = band_key(band, row);
     if (alpha_.active && l == 0) count_level0_alpha(band, row);
     t0 = Clock::now();
-    pages = present_pages(row);
-    if (encode) VT_RETURN_IF_ERROR(encode_row(band, row));
+    VT_ASSIGN_OR_RETURN(const std::vector<uint8_t> present, present_pages(row));
+    pages = uint32_t(std::count(present.begin(), present.end(), uint8_t(1)));
+    if (encode) VT_RETURN_IF_ERROR(encode_row(band, row, present));
     t_encode += seconds_since(t0);
     if (next_) {
       t0 = Clock::now();
@@ -148,21 +149,23 @@ class LayerRun {
     return key;
   }
 
-  uint32_t present_pages(uint32_t row) const {
-    const uint8_t* coverage = current_->coverage();
-    uint32_t n = 0;
-    for (uint32_t x = 0; x < g_.pages_x(level_); ++x)
-      n += !coverage || page_has_coverage(g_, PageId{level_, x, row}, coverage);
-    return n;
+  // One byte per page of page row `row`: 1 = some payload texel covered (all, without a mask).
+  Expected<std::vector<uint8_t>> present_pages(uint32_t row) const {
+    if (const CoverageMask* coverage = current_->coverage())
+      return pages_with_coverage(g_, level_, row, *coverage);
+    return std::vector<uint8_t>(g_.pages_x(level_), 1);
   }
 
   // A level task: the level just written is complete; dilate it and settle its alpha scale.
   Status finish_level() {
     if (!next_) return Status::Ok();
-    if (const uint8_t* cov = current_->coverage()) {
+    if (const CoverageMask* cov = current_->coverage()) {
+      const bool in_memory =
+          CoverageMask::fits_memory(next_->width(), next_->height(), plan_.options.memory_limit);
+      VT_ASSIGN_OR_RETURN(std::shared_ptr<CoverageMask> half,
+                          cov->downsample(in_memory, plan_.scratch_dir));
       VT_RETURN_IF_ERROR(next_->set_coverage_and_dilate(
-          downsample_coverage(cov, current_->width(), current_->height()),
-          dilation_budget(plan_.options), plan_.scratch_dir));
+          std::move(half), dilation_budget(plan_.options), plan_.scratch_dir));
     }
     if (alpha_.active) {
       alpha_.finish_level(uint64_t(next_->width()) * next_->height(),
@@ -247,17 +250,15 @@ class LayerRun {
     return true;
   }
 
-  Status encode_row(const RowBand& band, uint32_t row) {
+  Status encode_row(const RowBand& band, uint32_t row, const std::vector<uint8_t>& present) {
     const uint32_t px = g_.pages_x(level_), S = g_.page_size();
     const size_t page_texels = size_t(S) * S;
-    const uint8_t* coverage = current_->coverage();
     std::vector<EncodedPage> encoded(px);
-    std::vector<uint8_t> present(px), reused(px);
+    std::vector<uint8_t> reused(px);
     std::vector<uint64_t> keys(px);
     std::vector<Status> errors(px);
     parallel_for(px, plan_.threads, [&](size_t x) {
       const PageId id{level_, uint32_t(x), row};
-      present[x] = !coverage || page_has_coverage(g_, id, coverage);
       if (!present[x]) return;
       thread_local std::vector<float> page, reference;
       thread_local std::vector<uint8_t> bytes;

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "bake/coverage_mask.h"
 #include "bake/image_source.h"
 #include "bake/page_encoder.h"
 #include "bake/pyramid.h"
@@ -45,10 +46,9 @@ struct LayerInput {
   // Colour layers: "" = ColorConfig::texture_space of the source's metadata
   // (ImageInfo::color_space): sRGB for 8/16-bit data and the working space for float data.
   std::string color_space;
-  // Optional level-0 coverage (width * height bytes, non-zero = covered); empty = all covered.
-  // With a mask, every level is dilated by pull-push and pages with no covered payload texel
-  // are absent; the levels must then fit in the memory limit.
-  std::shared_ptr<const std::vector<uint8_t>> coverage;
+  // Optional level-0 coverage (the image's size); null = all covered. With a mask, every level
+  // is dilated by pull-push and pages with no covered payload texel are absent.
+  std::shared_ptr<const CoverageMask> coverage;
   bool alpha_dropped = false;  // set by drop_opaque_alpha: the source's alpha was all 1
   // The build may take an in-memory source's texels (ImageSource::release_texels) as its
   // level 0 and convert them in place instead of copying them; the source is empty afterwards.

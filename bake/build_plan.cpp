@@ -122,7 +122,8 @@ Status check_inputs(const BuildOptions& options) {
                         std::to_string(info.height) + ", layer 0 is " +
                         std::to_string(first->width) + "x" + std::to_string(first->height));
     }
-    if (in.coverage && in.coverage->size() != size_t(info.width) * info.height) {
+    if (in.coverage &&
+        (in.coverage->width() != info.width || in.coverage->height() != info.height)) {
       return Status(ErrorCode::kInvalidArgument,
                     "layer " + std::to_string(i) + ": coverage mask size differs from image size");
     }
@@ -133,16 +134,22 @@ Status check_inputs(const BuildOptions& options) {
 // Which level-0 pages DCT tables are trained on: with at most `limit` present pages, all of
 // them; otherwise pages spread evenly over at least 16 page rows spread evenly down the level
 // (and over each row), so that a random-access source reads only those bands.
-std::vector<PageId> training_pages(const PageGeometry& g, const uint8_t* coverage, size_t limit) {
+Expected<std::vector<PageId>> training_pages(const PageGeometry& g, const CoverageMask* coverage,
+                                             size_t limit) {
   const uint32_t px = g.pages_x(0), py = g.pages_y(0);
   std::vector<std::vector<PageId>> rows(py);
   size_t present = 0;
-  for (uint32_t y = 0; y < py; ++y)
+  for (uint32_t y = 0; y < py; ++y) {
+    std::vector<uint8_t> covered(px, 1);
+    if (coverage) {
+      VT_ASSIGN_OR_RETURN(covered, pages_with_coverage(g, 0, y, *coverage));
+    }
     for (uint32_t x = 0; x < px; ++x)
-      if (!coverage || page_has_coverage(g, PageId{0, x, y}, coverage)) {
+      if (covered[x]) {
         rows[y].push_back(PageId{0, x, y});
         ++present;
       }
+  }
   std::vector<PageId> chosen;
   if (present <= limit) {
     for (const auto& row : rows) chosen.insert(chosen.end(), row.begin(), row.end());
@@ -165,8 +172,8 @@ Expected<std::vector<std::vector<uint8_t>>> training_sample(const BuildPlan& pla
                                                             const LayerPlan& layer, size_t limit) {
   const PageGeometry& g = plan.desc.geometry;
   const uint32_t P = g.payload, S = g.page_size();
-  const uint8_t* coverage = layer.level0->coverage();
-  const std::vector<PageId> chosen = training_pages(g, coverage, limit);
+  const CoverageMask* coverage = layer.level0->coverage();
+  VT_ASSIGN_OR_RETURN(const std::vector<PageId> chosen, training_pages(g, coverage, limit));
 
   // A streamed level 0 is read again for the build: this read must not count bad values.
   std::shared_ptr<LevelSource> source = layer.level0;
@@ -237,10 +244,10 @@ uint64_t working_set(const BuildPlan& plan, const LayerPlan& layer, uint32_t wid
 std::vector<bool> choose_level_memory(const BuildPlan& plan, const LayerPlan& layer) {
   const PageGeometry& g = plan.desc.geometry;
   uint64_t limit = plan.options.memory_limit;
-  // A coverage layer also holds its masks (a third more than level 0's) and a dilation's pull
-  // levels beside the level images.
+  // A coverage layer also holds its masks (those small enough to stay in memory) and a
+  // dilation's pull levels beside the level images.
   if (layer.level0->coverage()) {
-    const uint64_t masks = uint64_t(g.width) * g.height * 4 / 3;
+    const uint64_t masks = CoverageMask::pyramid_memory_bytes(g.width, g.height, limit);
     limit -= std::min(limit, masks + dilation_budget(plan.options));
   }
   auto level_bytes = [&](uint32_t l) {
@@ -330,7 +337,11 @@ Expected<uint64_t> plan_hash(const BuildPlan& plan, const std::string& settings)
   for (const LayerInput& in : plan.options.layers) {
     VT_ASSIGN_OR_RETURN(uint64_t content, in.source->content_hash());
     parts.push_back(content);
-    parts.push_back(in.coverage ? XXH3_64bits(in.coverage->data(), in.coverage->size()) : 0);
+    uint64_t coverage = 0;
+    if (in.coverage) {
+      VT_ASSIGN_OR_RETURN(coverage, in.coverage->content_hash());
+    }
+    parts.push_back(coverage);
   }
   return XXH3_64bits(parts.data(), parts.size() * sizeof(uint64_t));
 }

@@ -4,6 +4,7 @@
 #include <memory>
 #include <vector>
 
+#include "bake/coverage_mask.h"
 #include "bake/level_store.h"
 
 namespace vt {
@@ -103,7 +104,7 @@ Status push_level(PullLevel& level, PullLevel* parent) {
 uint32_t band_rows_for(const BandedDilationOptions& o, uint32_t width, uint32_t channels,
                        uint32_t height) {
   if (o.band_rows > 0) return std::min(o.band_rows, height);
-  const uint64_t row = uint64_t(width) * channels * (sizeof(float) + sizeof(double));
+  const uint64_t row = uint64_t(width) * (channels * (sizeof(float) + sizeof(double)) + 1);
   return uint32_t(std::clamp<uint64_t>(o.memory_budget / 8 / std::max<uint64_t>(row, 1), 2,
                                        std::max(height, 2u)));
 }
@@ -114,7 +115,7 @@ uint64_t pull_push_bytes(uint32_t width, uint32_t height, uint32_t channels) {
   return PullLevel::bytes(width, height, channels) * 4 / 3 + uint64_t(width) * height;
 }
 
-Expected<uint64_t> pull_push_banded(LevelStore& level, const uint8_t* coverage,
+Expected<uint64_t> pull_push_banded(LevelStore& level, const CoverageMask& coverage,
                                     const BandedDilationOptions& options) {
   const uint32_t W = level.width(), H = level.height(), ch = level.channels(), n = ch + 1;
   // Pull levels down to 1x1; the coarsest take the memory budget first.
@@ -144,13 +145,15 @@ Expected<uint64_t> pull_push_banded(LevelStore& level, const uint8_t* coverage,
   cascade.set_level0_height(H);
   std::vector<float> rows(size_t(band) * W * ch);
   std::vector<double> sums(size_t(W) * n);
+  std::vector<uint8_t> band_coverage;
   uint64_t uncovered = 0;
   for (uint32_t y0 = 0; y0 < H; y0 += band) {
     const uint32_t y1 = std::min(H, y0 + band);
     VT_RETURN_IF_ERROR(level.read(y0, y1, rows.data()));
+    VT_RETURN_IF_ERROR(coverage.read_rows(y0, y1, band_coverage));
     for (uint32_t y = y0; y < y1; ++y) {
       const float* r = rows.data() + size_t(y - y0) * W * ch;
-      const uint8_t* cov = coverage + size_t(y) * W;
+      const uint8_t* cov = band_coverage.data() + size_t(y - y0) * W;
       for (uint32_t x = 0; x < W; ++x) {
         double* s = sums.data() + size_t(x) * n;
         const bool covered = cov[x] != 0;
@@ -172,13 +175,14 @@ Expected<uint64_t> pull_push_banded(LevelStore& level, const uint8_t* coverage,
   for (uint32_t y0 = 0; y0 < H; y0 += band) {
     const uint32_t y1 = std::min(H, y0 + band);
     VT_RETURN_IF_ERROR(level.read(y0, y1, rows.data()));
+    VT_RETURN_IF_ERROR(coverage.read_rows(y0, y1, band_coverage));
     for (uint32_t y = y0; y < y1; ++y) {
       if (int64_t(y / 2) != up_y) {
         up_y = y / 2;
         VT_RETURN_IF_ERROR(first.read(uint32_t(up_y), up.data()));
       }
       float* r = rows.data() + size_t(y - y0) * W * ch;
-      const uint8_t* cov = coverage + size_t(y) * W;
+      const uint8_t* cov = band_coverage.data() + size_t(y - y0) * W;
       for (uint32_t x = 0; x < W; ++x) {
         if (cov[x]) continue;
         const double* p = up.data() + size_t(x / 2) * n;

@@ -12,6 +12,7 @@
 
 namespace vt {
 
+class CoverageMask;
 class LevelStore;
 
 struct BandedDilationOptions {
@@ -23,9 +24,10 @@ struct BandedDilationOptions {
 // Bytes pull_push needs to dilate a width x height level of `channels` floats in memory.
 uint64_t pull_push_bytes(uint32_t width, uint32_t height, uint32_t channels);
 
-// Dilates `level` in place; `coverage` is width * height bytes, non-zero = covered. Returns the
-// number of texels filled (0 when every texel or none is covered: the level is left as it is).
-Expected<uint64_t> pull_push_banded(LevelStore& level, const uint8_t* coverage,
+// Dilates `level` in place under `coverage` (the level's size, read in the same bands). Returns
+// the number of texels filled (0 when every texel or none is covered: the level is left as it
+// is).
+Expected<uint64_t> pull_push_banded(LevelStore& level, const CoverageMask& coverage,
                                     const BandedDilationOptions& options);
 
 }  // namespace vt

@@ -1,5 +1,7 @@
 #include "bake/level_source.h"
 
+#define XXH_STATIC_LINKING_ONLY  // XXH3_state_t on the stack
+#include <xxhash.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -249,19 +251,19 @@ class StreamedLevel0 final : public LevelSource {
 // Level 0 converted whole, with its coverage mask, and dilated.
 class HeldLevel0 final : public LevelSource {
  public:
-  HeldLevel0(std::unique_ptr<LevelStore> store, NonFiniteReport report, ClipReport clipped)
+  HeldLevel0(std::shared_ptr<LevelStore> store, NonFiniteReport report, ClipReport clipped)
       : store_(std::move(store)), report_(report), clipped_(clipped) {}
   uint32_t width() const override { return store_->width(); }
   uint32_t height() const override { return store_->height(); }
   uint32_t channels() const override { return store_->channels(); }
   Status read(uint32_t y0, uint32_t y1, float* out) override { return store_->read(y0, y1, out); }
-  const uint8_t* coverage() const override { return store_->coverage(); }
+  const CoverageMask* coverage() const override { return store_->coverage(); }
   bool in_memory() const override { return store_->in_memory(); }
   NonFiniteReport non_finite() const override { return report_; }
   ClipReport clipped() const override { return clipped_; }
 
  private:
-  std::unique_ptr<LevelStore> store_;
+  std::shared_ptr<LevelStore> store_;
   NonFiniteReport report_;
   ClipReport clipped_;
 };
@@ -282,9 +284,19 @@ Expected<std::shared_ptr<LevelSource>> hold_level0(const LayerInput& input, cons
   if (in_memory && input.consume_source && plan.source_channels == wc)
     texels = input.source->release_texels();
   const bool in_place = texels.size() == size_t(h) * out_row;
-  std::unique_ptr<LevelStore> store;
+  // A scene bake's scratch-file layer is converted in its own file: no second copy on disk. Its
+  // rows are hashed as read, so the source keeps its identity (the plan hashes it after).
+  auto* stored = dynamic_cast<StoredImageSource*>(input.source.get());
+  std::shared_ptr<LevelStore> own;
+  if (!in_memory && input.consume_source && stored && plan.source_channels == wc)
+    own = stored->scratch_store();
+  XXH3_state_t own_hash;
+  XXH3_64bits_reset(&own_hash);
+  std::shared_ptr<LevelStore> store;
   if (in_place) {
     store = LevelStore::adopt(w, h, wc, std::move(texels));
+  } else if (own) {
+    store = own;
   } else {
     VT_ASSIGN_OR_RETURN(store, LevelStore::create(w, h, wc, in_memory, scratch_dir_for(options)));
   }
@@ -300,6 +312,7 @@ Expected<std::shared_ptr<LevelSource>> hold_level0(const LayerInput& input, cons
       raw.resize(size_t(y1 - y) * in_row);
       VT_RETURN_IF_ERROR(input.source->read_rows(y, y1, raw.data()));
       src = raw.data();
+      if (own) XXH3_64bits_update(&own_hash, src, raw.size() * sizeof(float));
     }
     for (uint32_t r = y; r < y1; ++r)
       VT_RETURN_IF_ERROR(converter.scan_row(r, src + size_t(r - y) * in_row));
@@ -309,6 +322,7 @@ Expected<std::shared_ptr<LevelSource>> hold_level0(const LayerInput& input, cons
       converter.count_clipped(r, src + size_t(r - y) * in_row, dst + size_t(r - y) * out_row);
     if (!in_memory) VT_RETURN_IF_ERROR(store->write_rows(y, y1 - y, dst));
   }
+  if (own) stored->spent(XXH3_64bits_digest(&own_hash));
   VT_RETURN_IF_ERROR(store->set_coverage_and_dilate(input.coverage, dilation_budget(options),
                                                     scratch_dir_for(options)));
   return std::shared_ptr<LevelSource>(

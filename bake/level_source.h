@@ -13,6 +13,7 @@
 
 namespace vt {
 
+class CoverageMask;
 struct LayerPlan;
 
 class LevelSource {
@@ -24,8 +25,8 @@ class LevelSource {
   size_t row_floats() const { return size_t(width()) * channels(); }
   // Rows [y0, y1), width() * channels() floats each. Cheapest in increasing y.
   virtual Status read(uint32_t y0, uint32_t y1, float* out) = 0;
-  // The level's coverage (width * height bytes, non-zero = covered), or nullptr: all covered.
-  virtual const uint8_t* coverage() const { return nullptr; }
+  // The level's coverage, or nullptr: all covered.
+  virtual const CoverageMask* coverage() const { return nullptr; }
   // True when the level's texels are held in memory (not streamed nor in a scratch file).
   virtual bool in_memory() const { return false; }
   // NaN, Inf and negative values the source held (level 0; counted once per texel).

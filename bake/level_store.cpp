@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <xxhash.h>
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -70,23 +71,56 @@ std::unique_ptr<LevelStore> LevelStore::adopt(uint32_t width, uint32_t height, u
   return s;
 }
 
-Status LevelStore::set_coverage_and_dilate(std::shared_ptr<const std::vector<uint8_t>> coverage,
+Status LevelStore::set_coverage_and_dilate(std::shared_ptr<const CoverageMask> coverage,
                                            uint64_t memory_budget, const std::string& scratch_dir) {
-  if (!coverage || coverage->size() != size_t(width_) * height_)
+  if (!coverage || coverage->width() != width_ || coverage->height() != height_)
     return Error(ErrorCode::kInternal, "coverage of a level of another size");
   coverage_ = std::move(coverage);
-  if (in_memory() && pull_push_bytes(width_, height_, channels_) <= memory_budget) {
-    pull_push(memory_.data(), coverage_->data(), width_, height_, channels_);
+  if (in_memory() && coverage_->in_memory() &&
+      pull_push_bytes(width_, height_, channels_) <= memory_budget) {
+    VT_ASSIGN_OR_RETURN(const std::vector<uint8_t> bytes, coverage_->to_bytes());
+    pull_push(memory_.data(), bytes.data(), width_, height_, channels_);
     return Status::Ok();
   }
   BandedDilationOptions o;
   o.memory_budget = memory_budget;
   o.scratch_dir = scratch_dir;
-  return pull_push_banded(*this, coverage_->data(), o).status();
+  return pull_push_banded(*this, *coverage_, o).status();
 }
 
 LevelStore::~LevelStore() {
   if (fd_ >= 0) close(fd_);
+}
+
+Status LevelStore::keep_channels(uint32_t keep) {
+  if (keep >= channels_) return Status::Ok();
+  const uint32_t from = channels_;
+  if (in_memory()) {
+    for (size_t i = 0; i < size_t(width_) * height_; ++i)
+      for (uint32_t c = 0; c < keep; ++c) memory_[keep * i + c] = memory_[from * i + c];
+    memory_.resize(size_t(width_) * height_ * keep);
+    channels_ = keep;
+    return Status::Ok();
+  }
+  // Bands of about 4 MiB; a band is read before any write reaches its bytes.
+  const size_t old_row = size_t(width_) * from;
+  const uint32_t band = uint32_t(
+      std::clamp<size_t>((size_t(4) << 20) / (old_row * sizeof(float)), 1, std::max(height_, 1u)));
+  std::vector<float> rows(band * old_row);
+  for (uint32_t y = 0; y < height_; y += band) {
+    const uint32_t y1 = std::min(height_, y + band);
+    VT_RETURN_IF_ERROR(read(y, y1, rows.data()));
+    for (size_t i = 0; i < size_t(y1 - y) * width_; ++i)
+      for (uint32_t c = 0; c < keep; ++c) rows[keep * i + c] = rows[from * i + c];
+    channels_ = keep;
+    const Status written = write_rows(y, y1 - y, rows.data());
+    channels_ = from;
+    VT_RETURN_IF_ERROR(written);
+  }
+  channels_ = keep;
+  if (ftruncate(fd_, off_t(uint64_t(height_) * row_floats() * sizeof(float))) != 0)
+    return Error(ErrorCode::kIo, path_ + ": scratch truncate failed: " + std::strerror(errno));
+  return Status::Ok();
 }
 
 Status LevelStore::write_rows(uint32_t y0, uint32_t rows, const float* data) {
@@ -114,6 +148,8 @@ Status LevelStore::read(uint32_t y0, uint32_t y1, float* out) {
 }
 
 Status StoredImageSource::read_rows(uint32_t y0, uint32_t y1, float* out) {
+  if (released_hash_)
+    return Error(ErrorCode::kInternal, "layer rows read after the build took them over");
   const uint32_t sc = store_->channels(), c = info_.channels;
   if (sc == c) return store_->read(y0, y1, out);
   rows_.resize(size_t(y1 - y0) * store_->row_floats());

@@ -1,6 +1,6 @@
 // Rows of one pyramid level kept for the next pass: in memory when the budget allows, otherwise
 // in an unlinked scratch file (removed by the OS even if the process dies). Layers with a
-// coverage mask keep the level's mask beside it.
+// coverage mask keep the level's mask (bake/coverage_mask.h) beside it.
 #pragma once
 
 #include <cstdint>
@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "bake/coverage_mask.h"
 #include "bake/image_source.h"
 #include "bake/level_source.h"
 #include "common/status.h"
@@ -41,19 +42,25 @@ class LevelStore final : public LevelSource {
   float* data() { return in_memory() ? memory_.data() : nullptr; }
   // Hands over an in-memory store's texels (empty for a scratch file); the store is empty after.
   std::vector<float> release() { return std::move(memory_); }
+  // Keeps the first `keep` channels of every texel, in place (in memory or in the scratch file,
+  // which shrinks): each texel lands at or before where it was, so no second copy is made.
+  Status keep_channels(uint32_t keep);
 
-  const uint8_t* coverage() const override { return coverage_ ? coverage_->data() : nullptr; }
+  const CoverageMask* coverage() const override { return coverage_.get(); }
   // Sets the level's mask and dilates its uncovered texels (pull-push, same bytes as pull_push
-  // on the whole level). A scratch-file level, or one whose pull levels do not fit
+  // on the whole level). A scratch-file level or mask, or one whose pull levels do not fit
   // `memory_budget` bytes, is dilated in bands (level_dilation.h).
-  Status set_coverage_and_dilate(std::shared_ptr<const std::vector<uint8_t>> coverage,
+  Status set_coverage_and_dilate(std::shared_ptr<const CoverageMask> coverage,
                                  uint64_t memory_budget = ~0ull,
                                  const std::string& scratch_dir = "");
-  Status set_coverage_and_dilate(std::vector<uint8_t> coverage, uint64_t memory_budget = ~0ull,
+  // The same from one byte per texel (tests).
+  Status set_coverage_and_dilate(const std::vector<uint8_t>& coverage,
+                                 uint64_t memory_budget = ~0ull,
                                  const std::string& scratch_dir = "") {
-    return set_coverage_and_dilate(
-        std::make_shared<const std::vector<uint8_t>>(std::move(coverage)), memory_budget,
-        scratch_dir);
+    if (coverage.size() != size_t(width_) * height_)
+      return Error(ErrorCode::kInternal, "coverage of a level of another size");
+    return set_coverage_and_dilate(CoverageMask::from_bytes(width_, height_, coverage.data()),
+                                   memory_budget, scratch_dir);
   }
 
  private:
@@ -62,11 +69,11 @@ class LevelStore final : public LevelSource {
   int fd_ = -1;
   std::string path_;
   std::vector<float> memory_;
-  std::shared_ptr<const std::vector<uint8_t>> coverage_;  // shared with the layer's input
+  std::shared_ptr<const CoverageMask> coverage_;  // shared with the layer's input
 };
 
 // A store's rows as an image source (the scene bake's transferred layers): `info` gives the
-// channels handed out, the first info.channels of the store's (an opaque alpha left behind).
+// channels handed out, the first info.channels of the store's.
 class StoredImageSource final : public ImageSource {
  public:
   StoredImageSource(ImageInfo info, std::shared_ptr<LevelStore> store)
@@ -75,6 +82,15 @@ class StoredImageSource final : public ImageSource {
   Status read_rows(uint32_t y0, uint32_t y1, float* out) override;
   // An in-memory store with as many channels as the source hands its texels over.
   std::vector<float> release_texels() override;
+  // A scratch-file store whose texels are the source's as they are, for the build to convert in
+  // its own file (no second copy on disk); null otherwise. The source is spent once the caller
+  // says so with the hash of the rows it read (content_hash gives it from then on).
+  std::shared_ptr<LevelStore> scratch_store() const {
+    const bool own =
+        !released_hash_ && !store_->in_memory() && store_->channels() == info_.channels;
+    return own ? store_ : nullptr;
+  }
+  void spent(uint64_t content_hash) { released_hash_ = content_hash; }
   // The hash of the rows (kept once the texels are handed over).
   Expected<uint64_t> content_hash() override;
 

@@ -48,17 +48,40 @@ void cut_page_from_level(const PageGeometry& g, const PageId& id, AddressMode mo
   cut_page(g, id, mode, band, out);
 }
 
-bool page_has_coverage(const PageGeometry& g, const PageId& id, const uint8_t* coverage) {
-  const uint32_t w = g.level_width(id.level), h = g.level_height(id.level);
-  const uint32_t x0 = id.x * g.payload, y0 = id.y * g.payload;
-  const uint32_t x1 = std::min(w, x0 + g.payload), y1 = std::min(h, y0 + g.payload);
-  for (uint32_t y = y0; y < y1; ++y) {
-    const uint8_t* row = coverage + size_t(y) * w;
+namespace {
+
+// Whether texels [x0, x1) of `rows` rows of `width` bytes from `band` has a covered one.
+bool any_covered(const uint8_t* band, uint32_t width, uint32_t rows, uint32_t x0, uint32_t x1) {
+  for (uint32_t r = 0; r < rows; ++r) {
+    const uint8_t* row = band + size_t(r) * width;
     for (uint32_t x = x0; x < x1; ++x) {
       if (row[x]) return true;
     }
   }
   return false;
+}
+
+}  // namespace
+
+bool page_has_coverage(const PageGeometry& g, const PageId& id, const uint8_t* coverage) {
+  const uint32_t w = g.level_width(id.level), h = g.level_height(id.level);
+  const uint32_t x0 = id.x * g.payload, y0 = id.y * g.payload;
+  const uint32_t x1 = std::min(w, x0 + g.payload), y1 = std::min(h, y0 + g.payload);
+  return any_covered(coverage + size_t(y0) * w, w, y1 - y0, x0, x1);
+}
+
+Expected<std::vector<uint8_t>> pages_with_coverage(const PageGeometry& g, uint32_t level,
+                                                   uint32_t row, const CoverageMask& coverage) {
+  const uint32_t w = g.level_width(level), h = g.level_height(level);
+  const uint32_t y0 = row * g.payload, y1 = std::min(h, y0 + g.payload);
+  std::vector<uint8_t> band;
+  VT_RETURN_IF_ERROR(coverage.read_rows(y0, y1, band));
+  std::vector<uint8_t> present(g.pages_x(level));
+  for (uint32_t x = 0; x < present.size(); ++x) {
+    const uint32_t x0 = x * g.payload, x1 = std::min(w, x0 + g.payload);
+    present[x] = any_covered(band.data(), w, y1 - y0, x0, x1);
+  }
+  return present;
 }
 
 }  // namespace vt

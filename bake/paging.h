@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "bake/coverage_mask.h"
 #include "bake/pyramid.h"
 #include "format/page_geometry.h"
 
@@ -35,7 +36,12 @@ void cut_page_from_level(const PageGeometry& g, const PageId& id, AddressMode mo
                          const float* level, uint32_t channels, float* out);
 
 // True when some payload texel of the page that lies inside the level is covered
-// (`coverage`: level_width x level_height bytes, non-zero = covered).
+// (`coverage`: level_width x level_height bytes, non-zero = covered; a level held whole).
 bool page_has_coverage(const PageGeometry& g, const PageId& id, const uint8_t* coverage);
+
+// The same for every page of page row `row` of `level`, from the mask's payload rows of that row
+// alone: one byte per page, 1 = some covered texel.
+Expected<std::vector<uint8_t>> pages_with_coverage(const PageGeometry& g, uint32_t level,
+                                                   uint32_t row, const CoverageMask& coverage);
 
 }  // namespace vt

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/build_summary_json.h"
+#include "bake/coverage_mask.h"
 #include "bake/level_source.h"
 #include "bake/level_store.h"
 #include "bake/unwrap/texel_density.h"
@@ -25,30 +26,39 @@ double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-// What a bake holds per atlas texel whatever the bands: the coverage masks of every level.
-constexpr double kFixedBytesPerTexel = 4.0 / 3.0;
-// And beside them: a transfer pass's accumulators (at most 256 MiB, an eighth of the limit)
-// and the libraries, the scene and the build's working set.
+// A bake holds nothing per atlas texel past the memory limit: the layers' levels and the
+// coverage masks (1 bit a texel, bake/coverage_mask.h) go to scratch files. What grows with the
+// atlas is per column: the build's level-0 band of a page row (payload + margins, ~136 rows) of
+// 4 floats, held about 4 times over (window, band, read buffer, slack: level_working_set).
+constexpr uint64_t kBytesPerColumn = 136 * 4 * sizeof(float) * 4;
+// Beside it: a transfer pass's accumulators (at most 256 MiB, an eighth of the limit), the masks
+// small enough to stay in memory (about a 48th of the limit at most), the libraries and the scene.
 uint64_t band_bytes(uint64_t memory_limit) {
   return std::min(uint64_t(256) << 20, memory_limit / 8);
 }
 constexpr uint64_t kFixedBytes = uint64_t(64) << 20;
 
-// Atlas texels a bake fits in `memory_limit` (0 when not even the fixed part does).
-double texels_within(uint64_t memory_limit) {
-  const uint64_t fixed = band_bytes(memory_limit) + kFixedBytes;
-  return memory_limit > fixed ? double(memory_limit - fixed) / kFixedBytesPerTexel : 0.0;
+uint64_t atlas_bytes(uint64_t width, uint64_t height, uint64_t memory_limit) {
+  return width * kBytesPerColumn + CoverageMask::pyramid_memory_bytes(width, height, memory_limit) +
+         band_bytes(memory_limit) + kFixedBytes;
 }
 
-// Refuses an atlas of `side` texels a side whose fixed part passes the memory limit.
+// Atlas texels a bake fits in `memory_limit`, for a square atlas (0 when not even the fixed part
+// does).
+double texels_within(uint64_t memory_limit) {
+  const uint64_t fixed = band_bytes(memory_limit) + kFixedBytes + memory_limit / 48;
+  const double side = memory_limit > fixed ? double(memory_limit - fixed) / kBytesPerColumn : 0.0;
+  return side * side;
+}
+
+// Refuses an atlas whose bands and in-memory masks pass the memory limit.
 Status check_atlas_memory(uint64_t width, uint64_t height, uint64_t memory_limit) {
-  if (double(width) * double(height) <= texels_within(memory_limit)) return Status::Ok();
-  const uint64_t need = uint64_t(double(width) * double(height) * kFixedBytesPerTexel) +
-                        band_bytes(memory_limit) + kFixedBytes;
+  const uint64_t need = atlas_bytes(width, height, memory_limit);
+  if (need <= memory_limit) return Status::Ok();
   return Error(ErrorCode::kResourceLimit,
                "an atlas of " + std::to_string(width) + "x" + std::to_string(height) +
                    " texels needs at least " + std::to_string(need >> 20) +
-                   " MiB (coverage masks and band buffers), over the memory limit of " +
+                   " MiB (band buffers and coverage masks), over the memory limit of " +
                    std::to_string(memory_limit >> 20) +
                    " MiB; raise --memory-limit or lower --texels-per-unit or --size");
 }
@@ -277,6 +287,7 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
   to.texture_cache = texture_cache_bytes(limit);
   to.stores_in_memory = !options.transfer_to_scratch &&
                         level0_fits_memory(transfer_store_bytes(unwrapped->scene, W, H), limit);
+  to.coverage_in_memory = !options.transfer_to_scratch && CoverageMask::fits_memory(W, H, limit);
   auto transfer = guarded("transfer", [&] { return transfer_to_stores(unwrapped->scene, to); });
   if (!transfer.ok()) return transfer.status().with_context("transfer");
   summary.peak_rss.push_back({"transfer", peak_rss_bytes()});

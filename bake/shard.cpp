@@ -97,7 +97,7 @@ class RawFileSource final : public ImageSource {
 // Level 0 in its working form as the plan wrote it (converted and dilated), read by rows.
 class FileLevel0 final : public LevelSource {
  public:
-  FileLevel0(std::shared_ptr<RawFileSource> file, std::shared_ptr<const std::vector<uint8_t>> cov)
+  FileLevel0(std::shared_ptr<RawFileSource> file, std::shared_ptr<const CoverageMask> cov)
       : file_(std::move(file)), coverage_(std::move(cov)) {}
   uint32_t width() const override { return file_->info().width; }
   uint32_t height() const override { return file_->info().height; }
@@ -105,11 +105,11 @@ class FileLevel0 final : public LevelSource {
   Status read(uint32_t y0, uint32_t y1, float* out) override {
     return file_->read_rows(y0, y1, out);
   }
-  const uint8_t* coverage() const override { return coverage_ ? coverage_->data() : nullptr; }
+  const CoverageMask* coverage() const override { return coverage_.get(); }
 
  private:
   std::shared_ptr<RawFileSource> file_;
-  std::shared_ptr<const std::vector<uint8_t>> coverage_;
+  std::shared_ptr<const CoverageMask> coverage_;
 };
 
 // A file written through a staged name: bytes appended with a running XXH3 of all of them.
@@ -153,6 +153,24 @@ Status write_text(const std::string& path, const std::string& text) {
   HashedFile f;
   VT_RETURN_IF_ERROR(f.open(path));
   f.put(text.data(), text.size());
+  return f.close();
+}
+
+// Mask rows moved at a time: about 4 MiB of bytes.
+uint32_t coverage_band(const CoverageMask& c) {
+  return uint32_t(
+      std::clamp<size_t>((size_t(4) << 20) / std::max(c.width(), 1u), 1, std::max(1u, c.height())));
+}
+
+// The mask as one byte per texel (level0/coverage.u8), written in bands.
+Status write_coverage(const CoverageMask& c, const std::string& path) {
+  HashedFile f;
+  VT_RETURN_IF_ERROR(f.open(path));
+  std::vector<uint8_t> rows;
+  for (uint32_t y = 0; y < c.height(); y += coverage_band(c)) {
+    VT_RETURN_IF_ERROR(c.read_rows(y, std::min(c.height(), y + coverage_band(c)), rows));
+    f.put(rows.data(), rows.size());
+  }
   return f.close();
 }
 
@@ -367,8 +385,7 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
   const bool coverage = !bo.layers.empty() && bo.layers[0].coverage;
   if (!dir.empty() && coverage) {
     VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/level0/coverage.u8"));
-    const auto& c = *bo.layers[0].coverage;
-    VT_RETURN_IF_ERROR(write_text(staged, std::string(c.begin(), c.end())));
+    VT_RETURN_IF_ERROR(write_coverage(*bo.layers[0].coverage, staged));
   }
   sum.stages.push_back({"write level 0", seconds_since(t0)});
 
@@ -382,7 +399,7 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
   t0 = Clock::now();
   for (size_t i = 0; i < plan.layers.size() && !dir.empty(); ++i) {
     LevelSource& level0 = *plan.layers[i].level0;
-    if (!coverage || level0.coverage() != bo.layers[i].coverage->data()) continue;
+    if (!coverage || level0.coverage() != bo.layers[i].coverage.get()) continue;
     const std::string file = "level0/" + plan.layers[i].spec.name + ".work.f32";
     VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/" + file));
     VT_RETURN_IF_ERROR(write_level(level0, staged));
@@ -531,16 +548,38 @@ class PartSink final : public PageSink {
   std::map<std::tuple<uint32_t, uint32_t, uint32_t>, uint32_t> task_of_;
 };
 
-Expected<std::vector<LayerInput>> work_layers(const WorkPlan& w) {
-  std::shared_ptr<const std::vector<uint8_t>> coverage;
+// Reads level0/coverage.u8 (one byte per texel of the atlas) in bands into a mask, in memory or
+// a scratch file as `options` allow.
+Expected<std::shared_ptr<const CoverageMask>> read_coverage(const std::string& path, uint32_t w,
+                                                            uint32_t h,
+                                                            const BuildOptions& options) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) return io_error(path, "cannot open");
+  if (uint64_t(in.tellg()) != uint64_t(w) * h)
+    return Error(ErrorCode::kCorrupt, path + ": not the atlas's size");
+  in.seekg(0);
+  VT_ASSIGN_OR_RETURN(
+      std::shared_ptr<CoverageMask> mask,
+      CoverageMask::create(w, h, CoverageMask::fits_memory(w, h, options.memory_limit),
+                           scratch_dir_for(options)));
+  std::vector<uint8_t> rows;
+  for (uint32_t y = 0; y < h; y += coverage_band(*mask)) {
+    const uint32_t n = std::min(h - y, coverage_band(*mask));
+    rows.resize(size_t(n) * w);
+    if (!in.read(reinterpret_cast<char*>(rows.data()), std::streamsize(rows.size())))
+      return io_error(path, "read failed");
+    VT_RETURN_IF_ERROR(mask->write_rows(y, n, rows.data()));
+  }
+  return std::shared_ptr<const CoverageMask>(std::move(mask));
+}
+
+Expected<std::vector<LayerInput>> work_layers(const WorkPlan& w, const BuildOptions& options) {
+  std::shared_ptr<const CoverageMask> coverage;
   const std::string cov = w.json.value("coverage", "");
-  if (!cov.empty()) {
-    const std::string path = w.dir + "/" + cov;
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return io_error(path, "cannot open");
-    auto c = std::make_shared<std::vector<uint8_t>>(std::istreambuf_iterator<char>(in),
-                                                    std::istreambuf_iterator<char>());
-    coverage = std::move(c);
+  if (!cov.empty() && !w.json["layers"].empty()) {
+    const auto& l = w.json["layers"][0];
+    VT_ASSIGN_OR_RETURN(coverage, read_coverage(w.dir + "/" + cov, l.value("width", 0u),
+                                                l.value("height", 0u), options));
   }
   std::vector<LayerInput> layers;
   for (const auto& l : w.json["layers"]) {
@@ -550,7 +589,7 @@ Expected<std::vector<LayerInput>> work_layers(const WorkPlan& w) {
     info.is_float = l.value("is_float", false);
     info.alpha_channel = l.value("alpha_channel", -1);
     info.color_space = l.value("info_color_space", "");
-    if (coverage && coverage->size() != size_t(info.width) * info.height) {
+    if (coverage && (coverage->width() != info.width || coverage->height() != info.height)) {
       return Error(ErrorCode::kCorrupt, w.dir + "/" + cov + ": not the atlas's size");
     }
     LayerInput in;
@@ -604,7 +643,7 @@ Expected<ShardSummary> run_shard(const ShardOptions& options) {
   VT_ASSIGN_OR_RETURN(const std::string staged, outputs.stage(part));
 
   BuildOptions bo = options.build;
-  VT_ASSIGN_OR_RETURN(bo.layers, work_layers(w));
+  VT_ASSIGN_OR_RETURN(bo.layers, work_layers(w, bo));
   bo.output = part;
   bo.address = AddressMode::kClamp;
   bo.metadata_json = w.json.value("metadata", "{}");

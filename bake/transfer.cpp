@@ -338,8 +338,8 @@ class Transfer {
                      const std::function<void(double)>& progress) const;
   void finish_rows(float* const (&acc)[kSlots], const uint8_t* coverage, size_t n,
                    LayerFacts (&facts)[kSlots]) const;
-  std::vector<TransferLayer> make_layers(std::shared_ptr<LevelStore> (&stores)[kSlots],
-                                         const LayerFacts (&facts)[kSlots]) const;
+  Expected<std::vector<TransferLayer>> make_layers(std::shared_ptr<LevelStore> (&stores)[kSlots],
+                                                   const LayerFacts (&facts)[kSlots]) const;
   uint32_t rows_per_pass() const;
 
   const scene::Scene& scene_;
@@ -808,9 +808,9 @@ void Transfer::finish_rows(float* const (&acc)[kSlots], const uint8_t* coverage,
 }
 
 // The layers called for, from their stores: alpha only if some covered texel is not opaque
-// (an in-memory albedo store then loses its alpha; a scratch one is read without it).
-std::vector<TransferLayer> Transfer::make_layers(std::shared_ptr<LevelStore> (&stores)[kSlots],
-                                                 const LayerFacts (&facts)[kSlots]) const {
+// (the albedo store then loses its alpha, in place).
+Expected<std::vector<TransferLayer>> Transfer::make_layers(
+    std::shared_ptr<LevelStore> (&stores)[kSlots], const LayerFacts (&facts)[kSlots]) const {
   std::vector<TransferLayer> layers;
   for (int l = 0; l < kSlots; ++l) {
     if (!want_[l]) continue;
@@ -823,15 +823,9 @@ std::vector<TransferLayer> Transfer::make_layers(std::shared_ptr<LevelStore> (&s
     layer.hdr = (l != kNormalSlot && f.hdr) || l == kLightingSlot;  // lighting: half always
     if (l == kAlbedoSlot) {
       layer.hdr |= f.alpha && f.alpha_hdr;
-      if (!f.alpha) layer.channels = 3;
-      if (!f.alpha && stores[l]->in_memory()) {
-        const uint32_t W = stores[l]->width(), H = stores[l]->height();
-        // In place (each RGB lands at or before its RGBA), so no second copy is alive.
-        std::vector<float> texels = stores[l]->release();
-        for (size_t i = 0; i < size_t(W) * H; ++i)
-          for (int c = 0; c < 3; ++c) texels[3 * i + c] = texels[4 * i + c];
-        texels.resize(size_t(W) * H * 3);
-        stores[l] = LevelStore::adopt(W, H, 3, std::move(texels));
+      if (!f.alpha) {
+        layer.channels = 3;
+        VT_RETURN_IF_ERROR(stores[l]->keep_channels(3).with_context("transfer"));
       }
     }
     layer.store = std::move(stores[l]);
@@ -840,8 +834,8 @@ std::vector<TransferLayer> Transfer::make_layers(std::shared_ptr<LevelStore> (&s
   return layers;
 }
 
-// Rows [r0, r1) of the atlas (r0 a multiple of kBandRows) into `acc` (those rows only) and the
-// coverage; the bands run on all threads.
+// Rows [r0, r1) of the atlas (r0 a multiple of kBandRows) into `acc` and `coverage` (those rows
+// only); the bands run on all threads.
 void Transfer::transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlots],
                              std::vector<uint8_t>& coverage, RowCounts& counts,
                              const std::function<void(double)>& progress) const {
@@ -883,7 +877,7 @@ void Transfer::transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlot
     for (size_t i = 0; i < band.best_tri.size(); ++i) {
       if (band.best_tri[i] < 0) continue;
       const size_t texel = base + i;
-      coverage[size_t(y0) * W + i] = 1;
+      coverage[base + i] = 1;
       n_contested += band.contested[i];
       if (band.inside[i] > 0) {
         ++n_sampled;
@@ -952,7 +946,9 @@ Expected<TransferResult> Transfer::run() {
     VT_ASSIGN_OR_RETURN(
         stores[l], LevelStore::create(W, H, channels_[l], opt_.stores_in_memory, opt_.scratch_dir));
   }
-  auto coverage = std::make_shared<std::vector<uint8_t>>(size_t(W) * H, 0);
+  VT_ASSIGN_OR_RETURN(std::shared_ptr<CoverageMask> coverage,
+                      CoverageMask::create(W, H, opt_.coverage_in_memory, opt_.scratch_dir));
+  std::vector<uint8_t> band_coverage;  // a pass's rows, one byte per texel
   bins_ = bin_by_rows(tris_, H, kBandRows);
   const uint32_t pass = rows_per_pass();
   // Accumulators: an in-memory store's own rows (zero when created), else a pass's buffer
@@ -976,16 +972,20 @@ Expected<TransferResult> Transfer::run() {
     std::function<void(double)> progress;
     if (opt_.progress)
       progress = [&](double f) { opt_.progress((double(r0) + f * double(r1 - r0)) / double(H)); };
-    transfer_rows(r0, r1, acc, *coverage, counts, progress);
-    finish_rows(acc, coverage->data() + size_t(r0) * W, n, facts);
+    band_coverage.assign(n, 0);
+    transfer_rows(r0, r1, acc, band_coverage, counts, progress);
+    finish_rows(acc, band_coverage.data(), n, facts);
+    VT_RETURN_IF_ERROR(
+        coverage->write_rows(r0, r1 - r0, band_coverage.data()).with_context("transfer"));
     for (int l = 0; l < kSlots; ++l) {
       if (!want_[l] || stores[l]->in_memory()) continue;
       VT_RETURN_IF_ERROR(stores[l]->write_rows(r0, r1 - r0, acc[l]).with_context("transfer"));
     }
   }
   for (auto& b : buffer) b = {};
+  band_coverage = {};
 
-  result.layers = make_layers(stores, facts);
+  VT_ASSIGN_OR_RETURN(result.layers, make_layers(stores, facts));
   result.coverage = coverage;
   result.missing_textures = missing_;
   result.stats.triangles = tris_.size();

@@ -7,7 +7,7 @@
 // space per source texel, bake/transfer_texture.h) and filtered at the footprint of the atlas
 // texel (or sub-sample): anisotropic, trilinear, bilinear taps. Normal maps are decoded in the
 // source tangent frame and re-encoded in the atlas UVs' tangent frame. The output is linear
-// (colour) or data texels in memory plus a coverage mask, ready for build_page_file.
+// (colour) or data texels plus a coverage mask, ready for build_page_file.
 #pragma once
 
 #include <cstdint>
@@ -25,6 +25,7 @@
 namespace vt {
 
 class ColorConfig;
+class CoverageMask;
 class LevelStore;
 
 // What a texture that cannot be read does to the transfer.
@@ -55,8 +56,10 @@ struct TransferOptions {
   // scratch files under scratch_dir instead; the texels do not depend on it. The scene bake
   // passes texture_cache_bytes(limit).
   uint64_t texture_cache = uint64_t(2) << 30;
-  // transfer_to_stores: the layers' stores are in memory, or scratch files under scratch_dir.
+  // transfer_to_stores: the layers' stores are in memory, or scratch files under scratch_dir;
+  // the same for the coverage mask (1 bit per texel, bake/coverage_mask.h).
   bool stores_in_memory = true;
+  bool coverage_in_memory = true;
   // Filter for MIP levels made (maketx-style, in the scratch folder) for untiled sources;
   // "" = box-filtered levels (TransferTexture's, colour averaged in linear light). A maketx
   // filter averages the file's encoded values. Measured against the texel-footprint (box)
@@ -92,8 +95,8 @@ struct TransferLayer {
   // Lighting: irradiance RGB (lux), then AO in [0, 1] when asked. Always hdr.
   // Uncovered texels are 0 (the build dilates them away).
   std::vector<float> texels;
-  // transfer_to_stores: the texels in a store instead (memory or scratch file). An albedo store
-  // may keep 4 channels where `channels` is 3: the alpha is then opaque and read past.
+  // transfer_to_stores: the texels in a store instead (memory or scratch file), `channels` a
+  // texel.
   std::shared_ptr<LevelStore> store;
 };
 
@@ -123,7 +126,7 @@ struct MissingTexture {
 
 struct TransferResult {
   uint32_t width = 0, height = 0;
-  std::shared_ptr<const std::vector<uint8_t>> coverage;  // width * height, 1 = covered
+  std::shared_ptr<const CoverageMask> coverage;  // width x height
   std::vector<TransferLayer> layers;  // in LayerSemantic order, only those the scene uses
   std::vector<MissingTexture> missing_textures;  // in material, then slot order
   TransferStats stats;

@@ -157,7 +157,7 @@ Expected<ReferenceLayer> make_reference_layer(uint32_t index, const LayerSpec& s
     VT_ASSIGN_OR_RETURN(r.to_storage, ColorConverter::create("linear", srgb ? "sRGB" : "linear"));
   }
   to_working_form(*t, r, size_t(transfer.width) * transfer.height);
-  r.coverage = *transfer.coverage;
+  VT_ASSIGN_OR_RETURN(r.coverage, transfer.coverage->to_bytes());  // a small atlas, held whole
   pull_push(r.level.data(), r.coverage.data(), transfer.width, transfer.height, r.work_channels);
   return r;
 }

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <vector>
 
+#include "bake/coverage_mask.h"
 #include "bake/lighting.h"
 #include "bake/transfer.h"
 #include "bake/unwrap/unwrap.h"
@@ -80,8 +81,9 @@ std::vector<float> ao_of(const TransferResult& r) {
   for (const TransferLayer& l : r.layers)
     if (l.semantic == LayerSemantic::kLighting) {
       std::vector<float> ao;
+      const std::vector<uint8_t> coverage = *r.coverage->to_bytes();
       for (size_t i = 0; i < l.texels.size() / 4; ++i)
-        if ((*r.coverage)[i]) ao.push_back(l.texels[4 * i + 3]);
+        if (coverage[i]) ao.push_back(l.texels[4 * i + 3]);
       return ao;
     }
   return {};
@@ -146,9 +148,11 @@ void BM_BounceSamples(benchmark::State& state) {
   auto rgb_of = [](const TransferResult& r) {
     std::vector<float> e;
     for (const TransferLayer& l : r.layers)
-      if (l.semantic == LayerSemantic::kLighting)
+      if (l.semantic == LayerSemantic::kLighting) {
+        const std::vector<uint8_t> coverage = *r.coverage->to_bytes();
         for (size_t i = 0; i < l.texels.size() / l.channels; ++i)
-          if ((*r.coverage)[i]) e.push_back(l.texels[l.channels * i]);
+          if (coverage[i]) e.push_back(l.texels[l.channels * i]);
+      }
     return e;
   };
   static const std::vector<float> reference = rgb_of(run_bounce(4096, 0));

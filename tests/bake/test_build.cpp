@@ -200,7 +200,7 @@ TEST(Build, ConstantPagesFoldedAndCoverageMakesAbsentPages) {
   }
   BuildOptions o;
   LayerInput in = test::layer_input(LayerSemantic::kAlbedo, memory_image(w, h, 3, t, false));
-  in.coverage = cov;
+  in.coverage = CoverageMask::from_bytes(w, h, cov->data());
   o.layers.push_back(in);
   o.payload = 8;
   o.codec.codec = CodecKind::kRaw;

@@ -143,7 +143,7 @@ TEST(BuildTasks, CoverageLevelsWaitForTheWholeLevelBefore) {
   for (uint32_t y = 5; y < 30; ++y)
     for (uint32_t x = 3; x < 50; ++x) (*coverage)[size_t(y) * w + x] = 1;
   BuildOptions o = raw_options(memory_image(w, h, procedural_texels(w, h)));
-  o.layers[0].coverage = coverage;
+  o.layers[0].coverage = CoverageMask::from_bytes(w, h, coverage->data());
   auto plan = plan_build(o);
   ASSERT_TRUE(plan.ok());
   const std::vector<BuildTask> tasks = make_build_tasks(*plan);
@@ -202,9 +202,9 @@ TEST(LevelSource, ConsumedSourceIsConvertedInPlaceWithTheSameResult) {
   auto coverage = std::make_shared<std::vector<uint8_t>>(size_t(w) * h, 1);
   for (uint32_t x = 0; x < w; ++x) (*coverage)[x] = 0;
   BuildOptions copy = raw_options(memory_image(w, h, procedural_texels(w, h)));
-  copy.layers[0].coverage = coverage;
+  copy.layers[0].coverage = CoverageMask::from_bytes(w, h, coverage->data());
   BuildOptions consume = raw_options(memory_image(w, h, procedural_texels(w, h)));
-  consume.layers[0].coverage = coverage;
+  consume.layers[0].coverage = copy.layers[0].coverage;
   consume.layers[0].consume_source = true;
   auto source = std::static_pointer_cast<MemoryImageSource>(consume.layers[0].source);
   auto a = test::build_in_memory(copy);
@@ -213,6 +213,45 @@ TEST(LevelSource, ConsumedSourceIsConvertedInPlaceWithTheSameResult) {
   EXPECT_TRUE(source->texels().empty());  // taken, not copied
   EXPECT_EQ(a->sink.pages.size(), b->sink.pages.size());
   for (const auto& [key, page] : a->sink.pages) EXPECT_EQ(page.bytes, b->sink.pages.at(key).bytes);
+}
+
+// A scene bake's scratch-file layer is converted in its own file (no second copy): the plan
+// hash, the pages and the source's content hash are those of a build from a copy.
+TEST(LevelSource, ScratchSourceIsConvertedInItsOwnFileWithTheSameResult) {
+  const uint32_t w = 48, h = 40;
+  const std::vector<float> texels = procedural_texels(w, h);
+  std::vector<uint8_t> coverage(size_t(w) * h, 1);
+  for (uint32_t x = 0; x < w; ++x) coverage[x] = 0;
+  const std::string dir = std::filesystem::temp_directory_path().string();
+  auto store = LevelStore::create(w, h, 3, false, dir);
+  ASSERT_TRUE(store.ok());
+  ASSERT_TRUE((*store)->write_rows(0, h, texels.data()).ok());
+  std::shared_ptr<LevelStore> shared = std::move(*store);
+  auto stored = std::make_shared<StoredImageSource>(memory_image(w, h, {})->info(), shared);
+  const uint64_t source_hash = *stored->content_hash();
+  ASSERT_NE(stored->scratch_store(), nullptr);
+
+  BuildOptions copy = raw_options(memory_image(w, h, texels));
+  copy.layers[0].coverage = CoverageMask::from_bytes(w, h, coverage.data());
+  BuildOptions own = raw_options(stored);
+  own.layers[0].coverage = copy.layers[0].coverage;
+  own.layers[0].consume_source = true;
+  own.memory_limit = copy.memory_limit = 16 << 10;  // level 0 in a scratch file
+  auto a = plan_build(copy), b = plan_build(own);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_FALSE(b->layers[0].level0->in_memory());
+  EXPECT_EQ(a->hash, b->hash);
+  EXPECT_EQ(*stored->content_hash(), source_hash);  // as read, before the conversion
+  EXPECT_EQ(stored->scratch_store(), nullptr);      // taken once
+  std::vector<float> rows(texels.size());
+  EXPECT_FALSE(stored->read_rows(0, h, rows.data()).ok());
+  ASSERT_TRUE(shared->read(0, h, rows.data()).ok());
+  EXPECT_NE(rows, texels);  // the store now holds the working form (linear, dilated)
+  test::MemorySink sa, sb;
+  ASSERT_TRUE(build_pages(*a, sa).ok());
+  ASSERT_TRUE(build_pages(*b, sb).ok());
+  EXPECT_EQ(sa.pages.size(), sb.pages.size());
+  for (const auto& [key, page] : sa.pages) EXPECT_EQ(page.bytes, sb.pages.at(key).bytes);
 }
 
 TEST(LevelStore, MemoryAndScratchHoldTheSameRows) {
@@ -233,6 +272,30 @@ TEST(LevelStore, MemoryAndScratchHoldTheSameRows) {
     EXPECT_FALSE((*store)->write_rows(h - 1, 2, rows.data()).ok());
     // Scratch levels dilate too (in bands: level_dilation.h).
     EXPECT_TRUE((*store)->set_coverage_and_dilate(std::vector<uint8_t>(size_t(w) * h, 1)).ok());
+  }
+}
+
+// An opaque albedo store loses its alpha in place, in memory and in its scratch file (which
+// shrinks to the 3-channel size), with rows that cross the copy's bands.
+TEST(LevelStore, KeepChannelsDropsTheLastChannelsInPlace) {
+  const uint32_t w = 300, h = 9000, ch = 4;  // ~4.3 MiB a scratch band: two bands and a bit
+  std::vector<float> rows(size_t(w) * h * ch);
+  for (size_t i = 0; i < rows.size(); ++i) rows[i] = float(i % 1000003);
+  std::vector<float> want(size_t(w) * h * 3);
+  for (size_t t = 0; t < size_t(w) * h; ++t)
+    for (uint32_t c = 0; c < 3; ++c) want[3 * t + c] = rows[ch * t + c];
+  for (bool in_memory : {true, false}) {
+    auto store =
+        LevelStore::create(w, h, ch, in_memory, std::filesystem::temp_directory_path().string());
+    ASSERT_TRUE(store.ok());
+    ASSERT_TRUE((*store)->write_rows(0, h, rows.data()).ok());
+    ASSERT_TRUE((*store)->keep_channels(3).ok());
+    EXPECT_EQ((*store)->channels(), 3u);
+    EXPECT_EQ((*store)->bytes(), uint64_t(w) * h * 3 * sizeof(float));
+    std::vector<float> back(want.size());
+    ASSERT_TRUE((*store)->read(0, h, back.data()).ok());
+    EXPECT_TRUE(back == want) << "in memory " << in_memory;
+    EXPECT_FALSE((*store)->read(h, h + 1, back.data()).ok());
   }
 }
 

@@ -58,7 +58,8 @@ std::vector<float> banded(const Level& l, bool in_memory, uint32_t band_rows, ui
   o.memory_budget = budget;
   o.scratch_dir = dir;
   o.band_rows = band_rows;
-  auto filled = pull_push_banded(**store, l.coverage.data(), o);
+  auto filled =
+      pull_push_banded(**store, *CoverageMask::from_bytes(l.w, l.h, l.coverage.data()), o);
   EXPECT_TRUE(filled.ok()) << filled.status().message();
   std::vector<float> out(l.texels.size());
   EXPECT_TRUE((*store)->read(0, l.h, out.data()).ok());
@@ -110,8 +111,9 @@ TEST(BandedDilation, ScratchLevelStoreDilatesLikeAnInMemoryOne) {
   ASSERT_NE((*store)->coverage(), nullptr);
 }
 
-// A build of a layer with coverage at a memory limit that puts level 0 and every level in
-// scratch files (dilated in bands) writes the bytes of the build that holds them in memory.
+// A build of a layer with coverage at a memory limit that puts level 0, every level and the
+// coverage masks in scratch files (dilated in bands) writes the bytes of the build that holds
+// them in memory.
 TEST(BandedDilation, OutOfCoreCoverageBuildWritesTheSameBytes) {
   test::ScratchDir dir;
   const uint32_t w = 300, h = 250;
@@ -119,14 +121,18 @@ TEST(BandedDilation, OutOfCoreCoverageBuildWritesTheSameBytes) {
   for (float& v : l.texels) v = std::fabs(v) / 3.0f;
   for (uint32_t y = 40; y < 200; ++y)
     for (uint32_t x = 10; x < 290; x += 1 + (y % 3)) l.coverage[size_t(y) * w + x] = 1;
-  auto coverage = std::make_shared<const std::vector<uint8_t>>(l.coverage);
   std::vector<char> first;
-  for (uint64_t limit : {uint64_t(2) << 30, uint64_t(1) << 20}) {
+  // 64 KiB: the masks of levels 0 and 1 in scratch files too (1/64 of the limit is 1 KiB).
+  for (uint64_t limit : {uint64_t(2) << 30, uint64_t(1) << 20, uint64_t(64) << 10}) {
+    auto coverage = CoverageMask::create(w, h, limit > (1 << 20), dir.file(""));
+    ASSERT_TRUE(coverage.ok());
+    ASSERT_TRUE((*coverage)->write_rows(0, h, l.coverage.data()).ok());
     BuildOptions o;
     LayerInput in;
     in.source =
         std::make_shared<MemoryImageSource>(ImageInfo{w, h, 3, false, -1, "linear"}, l.texels);
-    in.coverage = coverage;
+    in.coverage = *coverage;
+    o.scratch_dir = dir.file("");
     o.layers.push_back(in);
     o.payload = 56;
     o.memory_limit = limit;

@@ -1,0 +1,127 @@
+#include "bake/coverage_mask.h"
+
+#define XXH_STATIC_LINKING_ONLY  // XXH3_state_t on the stack
+#include <xxhash.h>
+#include <algorithm>
+#include <cstring>
+
+#include "bake/level_store.h"
+
+namespace vt {
+namespace {
+
+// Rows of packed words <-> one byte per texel.
+void pack_row(const uint8_t* texels, uint32_t width, uint32_t* words) {
+  std::fill(words, words + (width + 31) / 32, 0u);
+  for (uint32_t x = 0; x < width; ++x)
+    if (texels[x]) words[x / 32] |= 1u << (x % 32);
+}
+void unpack_row(const uint32_t* words, uint32_t width, uint8_t* texels) {
+  for (uint32_t x = 0; x < width; ++x) texels[x] = uint8_t((words[x / 32] >> (x % 32)) & 1u);
+}
+
+}  // namespace
+
+Expected<std::shared_ptr<CoverageMask>> CoverageMask::create(uint32_t width, uint32_t height,
+                                                             bool in_memory,
+                                                             const std::string& scratch_dir) {
+  std::shared_ptr<CoverageMask> m(new CoverageMask());
+  m->width_ = width, m->height_ = height;
+  VT_ASSIGN_OR_RETURN(m->store_, LevelStore::create(m->words(), height, 1, in_memory, scratch_dir));
+  if (!in_memory) {  // a scratch file reads as zeros only where written: write the empty rows
+    const uint32_t band = m->band_rows();
+    const std::vector<float> zeros(size_t(m->words()) * band, 0.0f);
+    for (uint32_t y = 0; y < height; y += band)
+      VT_RETURN_IF_ERROR(m->store_->write_rows(y, std::min(band, height - y), zeros.data()));
+  }
+  return m;
+}
+
+std::shared_ptr<CoverageMask> CoverageMask::from_bytes(uint32_t width, uint32_t height,
+                                                       const uint8_t* bytes) {
+  auto m = create(width, height, true, "");
+  (void)(*m)->write_rows(0, height, bytes);  // in memory: cannot fail
+  return *m;
+}
+
+uint64_t CoverageMask::pyramid_memory_bytes(uint64_t width, uint64_t height,
+                                            uint64_t memory_limit) {
+  uint64_t bytes = 0;
+  for (;; width = (width + 1) / 2, height = (height + 1) / 2) {
+    if (fits_memory(width, height, memory_limit)) bytes += packed_bytes(width, height);
+    if (width <= 1 && height <= 1) return bytes;
+  }
+}
+
+CoverageMask::~CoverageMask() = default;
+
+bool CoverageMask::in_memory() const {
+  return store_->in_memory();
+}
+
+// Rows moved at a time: about 4 MiB of bytes.
+uint32_t CoverageMask::band_rows() const {
+  return uint32_t(
+      std::clamp<uint64_t>((uint64_t(4) << 20) / std::max(width_, 1u), 1, std::max(height_, 1u)));
+}
+
+Status CoverageMask::write_rows(uint32_t y0, uint32_t rows, const uint8_t* texels) {
+  std::vector<uint32_t> packed(size_t(words()) * rows);
+  for (uint32_t r = 0; r < rows; ++r)
+    pack_row(texels + size_t(r) * width_, width_, packed.data() + size_t(r) * words());
+  return store_->write_rows(y0, rows, reinterpret_cast<const float*>(packed.data()));
+}
+
+Status CoverageMask::read_rows(uint32_t y0, uint32_t y1, std::vector<uint8_t>& out) const {
+  std::vector<uint32_t> packed(size_t(words()) * (y1 - y0));
+  VT_RETURN_IF_ERROR(store_->read(y0, y1, reinterpret_cast<float*>(packed.data())));
+  out.resize(size_t(width_) * (y1 - y0));
+  for (uint32_t r = 0; r < y1 - y0; ++r)
+    unpack_row(packed.data() + size_t(r) * words(), width_, out.data() + size_t(r) * width_);
+  return Status::Ok();
+}
+
+Expected<std::vector<uint8_t>> CoverageMask::to_bytes() const {
+  std::vector<uint8_t> out;
+  VT_RETURN_IF_ERROR(read_rows(0, height_, out));
+  return out;
+}
+
+Expected<uint64_t> CoverageMask::content_hash() const {
+  XXH3_state_t state;
+  XXH3_64bits_reset(&state);
+  std::vector<uint8_t> rows;
+  for (uint32_t y = 0; y < height_; y += band_rows()) {
+    VT_RETURN_IF_ERROR(read_rows(y, std::min(height_, y + band_rows()), rows));
+    XXH3_64bits_update(&state, rows.data(), rows.size());
+  }
+  return uint64_t(XXH3_64bits_digest(&state));
+}
+
+Expected<std::shared_ptr<CoverageMask>> CoverageMask::downsample(
+    bool in_memory, const std::string& scratch_dir) const {
+  const uint32_t dw = (width_ + 1) / 2, dh = (height_ + 1) / 2;
+  VT_ASSIGN_OR_RETURN(std::shared_ptr<CoverageMask> out, create(dw, dh, in_memory, scratch_dir));
+  // Bands of an even number of source rows: a destination row's pair never straddles two.
+  const uint32_t band = std::max(2u, band_rows() / 2 * 2);
+  std::vector<uint8_t> src, dst;
+  for (uint32_t y0 = 0; y0 < height_; y0 += band) {
+    const uint32_t y1 = std::min(height_, y0 + band);
+    VT_RETURN_IF_ERROR(read_rows(y0, y1, src));
+    const uint32_t j0 = y0 / 2, j1 = (y1 + 1) / 2;
+    dst.assign(size_t(dw) * (j1 - j0), 0);
+    for (uint32_t j = j0; j < j1; ++j) {
+      const uint8_t* a = src.data() + size_t(2 * j - y0) * width_;
+      const uint8_t* b = src.data() + size_t(std::min(2 * j + 1, height_ - 1) - y0) * width_;
+      uint8_t* d = dst.data() + size_t(j - j0) * dw;
+      for (uint32_t i = 0; i < dw; ++i) {
+        const uint32_t xa = 2 * i, xb = std::min(2 * i + 1, width_ - 1);
+        d[i] = uint8_t(a[xa] | a[xb] | b[xa] | b[xb]);
+      }
+    }
+    VT_RETURN_IF_ERROR(out->write_rows(j0, j1 - j0, dst.data()));
+  }
+  return out;
+}
+
+}  // namespace vt
