@@ -278,6 +278,17 @@ Status add_alpha_caster(const scene::Scene& scene, const scene::Primitive& p,
 
 }  // namespace
 
+Expected<LightingLayer> parse_lighting_layer(const std::string& name) {
+  if (name == "separate") return LightingLayer::kSeparate;
+  if (name == "combined") return LightingLayer::kCombined;
+  return Error(ErrorCode::kInvalidArgument,
+               "lighting: unknown layer mode '" + name + "' (separate or combined)");
+}
+
+const char* to_string(LightingLayer v) {
+  return v == LightingLayer::kCombined ? "combined" : "separate";
+}
+
 bool scene_has_lights(const scene::Scene& scene) {
   return !scene.placed_lights().empty();
 }
@@ -295,6 +306,11 @@ Expected<std::unique_ptr<LightingBaker>> LightingBaker::create(const scene::Scen
     return Error(ErrorCode::kInvalidArgument, "lighting: bounce samples must be 1..65536");
   if (!(options.ao_distance >= 0) || !std::isfinite(options.ao_distance))
     return Error(ErrorCode::kInvalidArgument, "lighting: AO distance must be a finite number >= 0");
+  if (options.layer == LightingLayer::kCombined && options.ao_samples > 0) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "lighting: AO samples need --lighting separate (the combined layer is base colour "
+                 "x irradiance / pi: AO is no light, and it has no channel of its own there)");
+  }
   std::unique_ptr<LightingBaker> b(new LightingBaker());
   b->options_ = options;
   for (const scene::PlacedLight& p : scene.placed_lights()) {
