@@ -7,12 +7,14 @@ Writes OUT_DIR/NAME.gltf: the scene with KHR_lights_punctual lights added at nod
 (listed in extensionsRequired, as Blender exports a lit level): a sun slanted 35 degrees from
 straight down (3 lux), N point lights (40 cd, range a quarter of the scene's size) spread over
 the scene a little above its middle height, and a spot (200 cd, cone 0.3/0.6) over the centre.
-The scene's other files (buffers, images) are linked, not copied. The source is never changed.
+The scene's other files (buffers, images) are copied beside it (a link would point outside the
+scene's folder, which vtbake refuses). The source is never changed.
 """
 import argparse
 import json
 import math
 import os
+import shutil
 
 
 def mat_mul(a, b):  # column-major 4x4
@@ -113,7 +115,7 @@ def main():
     for name in os.listdir(src):
         dst = os.path.join(a.out_dir, name)
         if not name.endswith(".gltf") and not os.path.exists(dst):
-            os.symlink(os.path.join(src, name), dst)
+            shutil.copy(os.path.join(src, name), dst)
     out = os.path.join(a.out_dir, os.path.basename(a.input))
     with open(out, "w") as f:
         json.dump(doc, f)
