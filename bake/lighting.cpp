@@ -295,9 +295,7 @@ bool scene_has_lights(const scene::Scene& scene) {
 
 LightingBaker::~LightingBaker() = default;
 
-Expected<std::unique_ptr<LightingBaker>> LightingBaker::create(const scene::Scene& scene,
-                                                               const LightingOptions& options,
-                                                               int threads) {
+Status check_lighting_options(const LightingOptions& options) {
   if (options.ao_samples < 0 || options.ao_samples > 65536)
     return Error(ErrorCode::kInvalidArgument, "lighting: AO samples must be 0..65536");
   if (options.bounces < 0 || options.bounces > 1)
@@ -311,6 +309,13 @@ Expected<std::unique_ptr<LightingBaker>> LightingBaker::create(const scene::Scen
                  "lighting: AO samples need --lighting separate (the combined layer is base colour "
                  "x irradiance / pi: AO is no light, and it has no channel of its own there)");
   }
+  return Status::Ok();
+}
+
+Expected<std::unique_ptr<LightingBaker>> LightingBaker::create(const scene::Scene& scene,
+                                                               const LightingOptions& options,
+                                                               int threads) {
+  VT_RETURN_IF_ERROR(check_lighting_options(options));
   std::unique_ptr<LightingBaker> b(new LightingBaker());
   b->options_ = options;
   for (const scene::PlacedLight& p : scene.placed_lights()) {

@@ -44,6 +44,10 @@ struct LightingOptions {
   int bounce_samples = 16;
 };
 
+// The options' ranges, and no AO with the combined layer (LightingBaker::create checks them; a
+// scene bake before any work).
+Status check_lighting_options(const LightingOptions& options);
+
 // The largest value the layer keeps: half float's largest finite value. Larger (or non-finite)
 // results are clamped and counted (LightingStats).
 constexpr float kMaxIrradiance = 65504.0f;

@@ -211,6 +211,7 @@ Expected<uint64_t> check_and_key(const scene::Scene& input, const SceneBakeOptio
   VT_RETURN_IF_ERROR(check_texcoord_sets(input));
   // Damaged PNGs fail now, not after the unwrap (the transfer checks them again, from cache).
   VT_RETURN_IF_ERROR(check_scene_textures(input));
+  if (scene_has_lights(input)) VT_RETURN_IF_ERROR(check_lighting_options(options.lighting));
   return scene_bake_key(input, options);
 }
 
