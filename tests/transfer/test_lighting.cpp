@@ -20,6 +20,7 @@
 #include "bake/scene_bake.h"
 #include "bake/transfer.h"
 #include "bake/unwrap/unwrap.h"
+#include "bake/update_scene.h"
 #include "common/half.h"
 #include "format/page_file.h"
 #include "samples/sample_scene.h"
@@ -750,6 +751,28 @@ TEST(Lighting, SceneBakeOfTheCombinedLayer) {
     ++checked;
   }
   EXPECT_GT(checked, 1000);
+}
+
+// The content key (update mode) tells the layer modes and bounces apart on a lit scene, so an
+// update never keeps a bake of the other mode; a light-less scene's key ignores them.
+TEST(Lighting, ContentKeyKnowsTheLayerModeAndBounces) {
+  auto key = [](const scene::Scene& s, LightingOptions lighting) {
+    SceneBakeOptions o;
+    o.lighting = lighting;
+    auto k = scene_bake_key(s, o);
+    EXPECT_TRUE(k.ok()) << k.status().message();
+    return k.ok() ? *k : 0;
+  };
+  LightingOptions combined, bounced;
+  combined.layer = LightingLayer::kCombined;
+  bounced.bounces = 1;
+  const scene::Scene dark = floor_scene();
+  EXPECT_EQ(key(dark, {}), key(dark, combined));
+  EXPECT_EQ(key(dark, {}), key(dark, bounced));
+  scene::Scene lit = floor_scene();
+  add_light(lit, light_of(scene::LightType::kDirectional, 3), scene::kIdentity);
+  EXPECT_NE(key(lit, {}), key(lit, combined));
+  EXPECT_NE(key(lit, {}), key(lit, bounced));
 }
 
 }  // namespace
