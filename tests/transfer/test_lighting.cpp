@@ -547,20 +547,26 @@ std::vector<uint8_t> file_bytes(const std::string& path) {
   return {std::istreambuf_iterator<char>(f), {}};
 }
 
+// `s` baked into a one-page file at `path`.
+SceneBakeSummary bake_one_page(const scene::Scene& s, const std::string& path,
+                               const LightingOptions& lighting) {
+  SceneBakeOptions o;
+  o.build.output = path;
+  o.build.threads = 2;
+  o.unwrapped = "-";
+  o.unwrap.size_pages = 1;
+  o.lighting = lighting;
+  auto summary = bake_scene(s, o);
+  EXPECT_TRUE(summary.ok()) << summary.status().message();
+  return summary.ok() ? *summary : SceneBakeSummary{};
+}
+
 // A light-less scene bakes the same page file whatever the lighting options (no layer, no
 // structure, nothing in the metadata); a lit one gets a half-float lighting layer.
 TEST(Lighting, SceneBakeAddsTheLayerOnlyForLitScenes) {
   test::ScratchDir dir;
   auto bake = [&](const scene::Scene& s, const std::string& name, LightingOptions lighting) {
-    SceneBakeOptions o;
-    o.build.output = dir.file(name);
-    o.build.threads = 2;
-    o.unwrapped = "-";
-    o.unwrap.size_pages = 1;
-    o.lighting = lighting;
-    auto summary = bake_scene(s, o);
-    EXPECT_TRUE(summary.ok()) << summary.status().message();
-    return summary.ok() ? *summary : SceneBakeSummary{};
+    return bake_one_page(s, dir.file(name), lighting);
   };
   LightingOptions ao;
   ao.ao_samples = 8;
@@ -702,15 +708,7 @@ TEST(Lighting, CombinedLayerRefusesAmbientOcclusion) {
 TEST(Lighting, SceneBakeOfTheCombinedLayer) {
   test::ScratchDir dir;
   auto bake = [&](const scene::Scene& s, const std::string& name, LightingOptions lighting) {
-    SceneBakeOptions o;
-    o.build.output = dir.file(name);
-    o.build.threads = 2;
-    o.unwrapped = "-";
-    o.unwrap.size_pages = 1;
-    o.lighting = lighting;
-    auto summary = bake_scene(s, o);
-    EXPECT_TRUE(summary.ok()) << summary.status().message();
-    return summary.ok() ? *summary : SceneBakeSummary{};
+    return bake_one_page(s, dir.file(name), lighting);
   };
   LightingOptions combined;
   combined.layer = LightingLayer::kCombined;
