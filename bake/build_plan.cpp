@@ -27,7 +27,8 @@ namespace {
 constexpr float kFloatMax = std::numeric_limits<float>::max();
 
 bool is_colour(LayerSemantic s) {
-  return s == LayerSemantic::kAlbedo || s == LayerSemantic::kEmissive;
+  return s == LayerSemantic::kAlbedo || s == LayerSemantic::kEmissive ||
+         s == LayerSemantic::kLitAlbedo;
 }
 
 Expected<LayerPlan> plan_layer(const LayerInput& in, const BuildOptions& options) {
@@ -55,8 +56,9 @@ Expected<LayerPlan> plan_layer(const LayerInput& in, const BuildOptions& options
         break;
     }
   }
-  // Lighting is HDR by nature: half float unless 32-bit float is asked.
-  if (in.semantic == LayerSemantic::kLighting && info.is_float && float_type == TexelType::kU8)
+  // Lighting (and lit albedo) is HDR by nature: half float unless 32-bit float is asked.
+  if ((in.semantic == LayerSemantic::kLighting || in.semantic == LayerSemantic::kLitAlbedo) &&
+      info.is_float && float_type == TexelType::kU8)
     float_type = TexelType::kF16;
   const bool want_float = float_type != TexelType::kU8;
   if (in.semantic == LayerSemantic::kNormal) {

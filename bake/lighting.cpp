@@ -278,15 +278,24 @@ Status add_alpha_caster(const scene::Scene& scene, const scene::Primitive& p,
 
 }  // namespace
 
+Expected<LightingLayer> parse_lighting_layer(const std::string& name) {
+  if (name == "separate") return LightingLayer::kSeparate;
+  if (name == "combined") return LightingLayer::kCombined;
+  return Error(ErrorCode::kInvalidArgument,
+               "lighting: unknown layer mode '" + name + "' (separate or combined)");
+}
+
+const char* to_string(LightingLayer v) {
+  return v == LightingLayer::kCombined ? "combined" : "separate";
+}
+
 bool scene_has_lights(const scene::Scene& scene) {
   return !scene.placed_lights().empty();
 }
 
 LightingBaker::~LightingBaker() = default;
 
-Expected<std::unique_ptr<LightingBaker>> LightingBaker::create(const scene::Scene& scene,
-                                                               const LightingOptions& options,
-                                                               int threads) {
+Status check_lighting_options(const LightingOptions& options) {
   if (options.ao_samples < 0 || options.ao_samples > 65536)
     return Error(ErrorCode::kInvalidArgument, "lighting: AO samples must be 0..65536");
   if (options.bounces < 0 || options.bounces > 1)
@@ -295,6 +304,18 @@ Expected<std::unique_ptr<LightingBaker>> LightingBaker::create(const scene::Scen
     return Error(ErrorCode::kInvalidArgument, "lighting: bounce samples must be 1..65536");
   if (!(options.ao_distance >= 0) || !std::isfinite(options.ao_distance))
     return Error(ErrorCode::kInvalidArgument, "lighting: AO distance must be a finite number >= 0");
+  if (options.layer == LightingLayer::kCombined && options.ao_samples > 0) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "lighting: AO samples need --lighting separate (the combined layer is base colour "
+                 "x irradiance / pi: AO is no light, and it has no channel of its own there)");
+  }
+  return Status::Ok();
+}
+
+Expected<std::unique_ptr<LightingBaker>> LightingBaker::create(const scene::Scene& scene,
+                                                               const LightingOptions& options,
+                                                               int threads) {
+  VT_RETURN_IF_ERROR(check_lighting_options(options));
   std::unique_ptr<LightingBaker> b(new LightingBaker());
   b->options_ = options;
   for (const scene::PlacedLight& p : scene.placed_lights()) {

@@ -4,11 +4,13 @@
 // only when the scene places a light: no light, no ray-tracing structure, no time spent.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "common/status.h"
@@ -17,7 +19,17 @@
 
 namespace vt {
 
+// What the baked light becomes (`--lighting`). kSeparate: irradiance in its own lighting layer.
+// kCombined: a lit-albedo layer instead (LayerSemantic::kLitAlbedo), base colour x irradiance /
+// pi per texel sample, for engines that want one texture (docs/ARCHITECTURE.md, "Baked
+// lighting": why / pi, and why no AO).
+enum class LightingLayer { kSeparate, kCombined };
+Expected<LightingLayer> parse_lighting_layer(const std::string& name);  // "separate", "combined"
+const char* to_string(LightingLayer v);
+
 struct LightingOptions {
+  LightingLayer layer = LightingLayer::kSeparate;
+
   bool shadows = true;  // false: every light reaches every texel that faces it
   // Ambient occlusion: cosine-weighted rays per texel sample over the shading normal's
   // hemisphere (0 = none). The lighting layer then has a 4th channel: the fraction of them that
@@ -32,9 +44,21 @@ struct LightingOptions {
   int bounce_samples = 16;
 };
 
+// The options' ranges, and no AO with the combined layer (LightingBaker::create checks them; a
+// scene bake before any work).
+Status check_lighting_options(const LightingOptions& options);
+
 // The largest value the layer keeps: half float's largest finite value. Larger (or non-finite)
 // results are clamped and counted (LightingStats).
 constexpr float kMaxIrradiance = 65504.0f;
+
+// The combined layer's value (LightingLayer::kCombined): the exitant radiance of a Lambertian
+// surface of linear base colour `base` under irradiance `e` (lux), base x e / pi, clamped as
+// irradiance is.
+inline float lit_albedo(double base, double e) {
+  const double v = base * e * 0.31830988618379067;  // 1 / pi
+  return v > 0 ? float(std::min(v, double(kMaxIrradiance))) : 0.0f;
+}
 
 struct LightingStats {
   uint64_t samples = 0;      // texel samples lit

@@ -84,10 +84,14 @@ auto guarded(const char* stage, Fn&& fn) -> decltype(fn()) {
 }
 
 // Bytes of the transfer's layer stores for a W x H atlas of `scene`'s materials.
-uint64_t transfer_store_bytes(const scene::Scene& scene, uint32_t W, uint32_t H) {
+uint64_t transfer_store_bytes(const scene::Scene& scene, LightingLayer lighting, uint32_t W,
+                              uint32_t H) {
   uint64_t channels = 0;
-  for (LayerSemantic l : layers_used(scene))  // lighting: 4 at most (with AO)
-    channels += l == LayerSemantic::kAlbedo || l == LayerSemantic::kLighting ? 4 : 3;
+  for (LayerSemantic l : layers_used(scene, lighting))  // lighting: 4 at most (with AO)
+    channels +=
+        l == LayerSemantic::kNormal || l == LayerSemantic::kOrm || l == LayerSemantic::kEmissive
+            ? 3
+            : 4;
   return uint64_t(W) * H * channels * sizeof(float);
 }
 
@@ -111,8 +115,11 @@ std::string with_thousands(uint64_t n) {
 std::vector<LayerRange> layer_ranges(const std::vector<TransferLayer>& transferred) {
   std::vector<LayerRange> out;
   for (const TransferLayer& t : transferred) {
-    // Irradiance above 1 is what lighting is: nothing to report, and the layer is half float.
-    if (t.texels_above_one == 0 || t.semantic == LayerSemantic::kLighting) continue;
+    // Irradiance above 1 is what lighting is: nothing to report, and the layer is half float
+    // (lit albedo alike).
+    if (t.texels_above_one == 0 || t.semantic == LayerSemantic::kLighting ||
+        t.semantic == LayerSemantic::kLitAlbedo)
+      continue;
     LayerRange r;
     r.semantic = t.semantic;
     r.layer = to_string(t.semantic);
@@ -158,11 +165,12 @@ std::vector<LayerInput> layer_inputs(TransferResult& transfer) {
       case LayerSemantic::kNormal:
         info.is_float = true;  // unit xyz in [-1, 1], not n * 0.5 + 0.5
         break;
+      case LayerSemantic::kLitAlbedo:  // radiance, always hdr: half float (build_plan.cpp)
       case LayerSemantic::kAlbedo:
       case LayerSemantic::kEmissive:
         // Linear colour; values in [0, 1] go in as integer-like data so the build stores sRGB
         // 8-bit texels, HDR values keep float.
-        info.is_float = layer.hdr;
+        info.is_float = layer.hdr;  // lit albedo: always (bake/transfer.h)
         info.color_space = "linear";
         in.color_space = "linear";
         info.alpha_channel = layer.channels == 4 ? 3 : -1;
@@ -213,6 +221,7 @@ Expected<uint64_t> check_and_key(const scene::Scene& input, const SceneBakeOptio
   VT_RETURN_IF_ERROR(check_texcoord_sets(input));
   // Damaged PNGs fail now, not after the unwrap (the transfer checks them again, from cache).
   VT_RETURN_IF_ERROR(check_scene_textures(input));
+  if (scene_has_lights(input)) VT_RETURN_IF_ERROR(check_lighting_options(options.lighting));
   return scene_bake_key(input, options);
 }
 
@@ -285,8 +294,10 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
   to.band_rows = options.transfer_band_rows;
   to.band_memory = band_bytes(limit);
   to.texture_cache = texture_cache_bytes(limit);
-  to.stores_in_memory = !options.transfer_to_scratch &&
-                        level0_fits_memory(transfer_store_bytes(unwrapped->scene, W, H), limit);
+  to.stores_in_memory =
+      !options.transfer_to_scratch &&
+      level0_fits_memory(transfer_store_bytes(unwrapped->scene, options.lighting.layer, W, H),
+                         limit);
   to.coverage_in_memory = !options.transfer_to_scratch && CoverageMask::fits_memory(W, H, limit);
   auto transfer = guarded("transfer", [&] { return transfer_to_stores(unwrapped->scene, to); });
   if (!transfer.ok()) return transfer.status().with_context("transfer");
@@ -301,6 +312,11 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
                                std::to_string(int(kMaxIrradiance)) + " lux clamped to it, " +
                                with_thousands(l.non_finite) +
                                " non-finite (NaN stored as 0, infinity as the maximum)");
+  }
+  if (options.lighting.layer == LightingLayer::kCombined && !scene_has_lights(input)) {
+    summary.warnings.push_back(
+        "--lighting combined: the scene places no light, so there is nothing to combine (no "
+        "lit-albedo layer baked)");
   }
   summary.stages.push_back({"transfer", seconds_since(t0)});
 
@@ -333,6 +349,8 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
       meta["lighting"]["bounces"] = options.lighting.bounces;
       meta["lighting"]["bounce_samples"] = options.lighting.bounce_samples;
     }
+    if (options.lighting.layer != LightingLayer::kSeparate)  // likewise the default layer mode
+      meta["lighting"]["layer"] = to_string(options.lighting.layer);
   }
   bo.metadata_json = meta.dump();
   prepared.unwrapped = std::move(unwrapped).value();

@@ -182,7 +182,8 @@ constexpr SlotInfo kSlotInfo[kSlots] = {{LayerSemantic::kAlbedo, 4},
                                         {LayerSemantic::kNormal, 3},
                                         {LayerSemantic::kOrm, 3},
                                         {LayerSemantic::kEmissive, 3},
-                                        {LayerSemantic::kLighting, 3}};  // 4 with AO
+                                        {LayerSemantic::kLighting, 3}};  // 4 with AO; or
+                                                                         // kLitAlbedo, 4
 constexpr bool slots_in_semantic_order() {
   for (int l = 1; l < kSlots; ++l)
     if (!(kSlotInfo[l - 1].semantic < kSlotInfo[l].semantic)) return false;
@@ -356,6 +357,11 @@ class Transfer {
   bool want_[kSlots] = {};          // by slot
   uint32_t channels_[kSlots] = {};  // accumulated channels by slot (kSlotInfo; lighting: + AO)
   std::unique_ptr<LightingBaker> lighting_;  // only when the scene has lights
+  // The lighting slot holds lit albedo (LightingLayer::kCombined): RGB + alpha, as albedo.
+  bool combined_ = false;
+  bool has_alpha(int slot) const {
+    return slot == kAlbedoSlot || (slot == kLightingSlot && combined_);
+  }
   double sub_scale_ = 1.0;
   uint64_t texture_bytes_ = 0;  // the loaded textures' texels
 };
@@ -579,7 +585,8 @@ Status Transfer::setup_prims() {
   for (int l = 0; l < kSlots; ++l) channels_[l] = kSlotInfo[l].channels;
   if (want_[kLightingSlot]) {
     VT_ASSIGN_OR_RETURN(lighting_, LightingBaker::create(scene_, opt_.lighting, opt_.threads));
-    channels_[kLightingSlot] = lighting_->channels();
+    combined_ = opt_.lighting.layer == LightingLayer::kCombined;
+    channels_[kLightingSlot] = combined_ ? 4 : lighting_->channels();
   }
   return setup_raster();
 }
@@ -772,6 +779,10 @@ void Transfer::evaluate(const TriEval& te, const double l[3], uint64_t seed, Sam
       ls.footprint = te.footprint;
       ls.seed = seed;
       lighting_->evaluate(ls, s.lighting);
+      if (combined_) {
+        for (int c = 0; c < 3; ++c) s.lighting[c] = lit_albedo(albedo[c], s.lighting[c]);
+        s.lighting[3] = albedo[3];
+      }
     }
   }
 }
@@ -792,15 +803,16 @@ void Transfer::finish_rows(float* const (&acc)[kSlots], const uint8_t* coverage,
       }
       continue;
     }
-    // Channels 0-2 of albedo are colour, 3 is alpha (counted before alpha is dropped); those
-    // of lighting are irradiance, 3 is AO.
+    // Channels 0-2 of albedo (and lit albedo) are colour, 3 is alpha (counted before alpha is
+    // dropped); those of lighting are irradiance, 3 is AO.
     const uint32_t counted = l == kAlbedoSlot || l == kLightingSlot ? 3 : channels;
+    const bool alpha = has_alpha(l);
     for (size_t i = 0; i < n; ++i) {
       const float* v = &acc[l][i * channels];
       for (uint32_t c = 0; c < counted; ++c) f.hdr |= v[c] > 1.0f;
-      if (l == kAlbedoSlot) f.alpha_hdr |= v[3] > 1.0f;
+      if (alpha) f.alpha_hdr |= v[3] > 1.0f;
       if (!coverage[i]) continue;
-      if (l == kAlbedoSlot) f.alpha |= v[3] < kOpaque;
+      if (alpha) f.alpha |= v[3] < kOpaque;
       const float top = *std::max_element(v, v + counted);
       if (top > 1.0f) ++f.texels_above_one, f.max_value = std::max(f.max_value, top);
     }
@@ -816,12 +828,13 @@ Expected<std::vector<TransferLayer>> Transfer::make_layers(
     if (!want_[l]) continue;
     const LayerFacts& f = facts[l];
     TransferLayer layer;
-    layer.semantic = kSlotInfo[l].semantic;
+    layer.semantic =
+        l == kLightingSlot && combined_ ? LayerSemantic::kLitAlbedo : kSlotInfo[l].semantic;
     layer.channels = channels_[l];
     layer.texels_above_one = f.texels_above_one;
     layer.max_value = f.max_value;
     layer.hdr = (l != kNormalSlot && f.hdr) || l == kLightingSlot;  // lighting: half always
-    if (l == kAlbedoSlot) {
+    if (has_alpha(l)) {
       layer.hdr |= f.alpha && f.alpha_hdr;
       if (!f.alpha) {
         layer.channels = 3;
@@ -1071,7 +1084,7 @@ std::vector<std::array<double, 2>> supersample_pattern(int supersample) {
   return p;
 }
 
-std::vector<LayerSemantic> layers_used(const scene::Scene& scene) {
+std::vector<LayerSemantic> layers_used(const scene::Scene& scene, LightingLayer lighting) {
   bool normal = false, orm = false, emissive = false;
   scene::Material fallback;
   for (const auto& mesh : scene.meshes) {
@@ -1088,7 +1101,10 @@ std::vector<LayerSemantic> layers_used(const scene::Scene& scene) {
   if (normal) out.push_back(LayerSemantic::kNormal);
   if (orm) out.push_back(LayerSemantic::kOrm);
   if (emissive) out.push_back(LayerSemantic::kEmissive);
-  if (scene_has_lights(scene)) out.push_back(LayerSemantic::kLighting);
+  if (scene_has_lights(scene)) {
+    out.push_back(lighting == LightingLayer::kCombined ? LayerSemantic::kLitAlbedo
+                                                       : LayerSemantic::kLighting);
+  }
   return out;
 }
 

@@ -83,7 +83,8 @@ struct TransferOptions {
 
 struct TransferLayer {
   LayerSemantic semantic = LayerSemantic::kAlbedo;
-  // albedo 3 or 4 (alpha only if a texel is not opaque), normal 3, ..., lighting 3 (+ AO)
+  // albedo 3 or 4 (alpha only if a texel is not opaque), normal 3, ..., lighting 3 (+ AO),
+  // lit albedo 3 or 4 (as albedo)
   uint32_t channels = 0;
   bool hdr = false;  // some value is above 1 (emissive or linear EXR sources)
   // Covered texels with a colour or data channel above 1 (alpha and normals excluded), and
@@ -92,7 +93,9 @@ struct TransferLayer {
   float max_value = 0;
   // width * height * channels floats. Albedo/emissive: linear RGB(A), not premultiplied.
   // ORM: occlusion, roughness, metallic. Normal: unit xyz in the atlas tangent frame.
-  // Lighting: irradiance RGB (lux), then AO in [0, 1] when asked. Always hdr.
+  // Lighting: irradiance RGB (lux), then AO in [0, 1] when asked. Always hdr. Lit albedo
+  // (LightingLayer::kCombined, in the lighting layer's place): linear base colour x irradiance
+  // / pi RGB, then alpha as albedo's. Always hdr.
   // Uncovered texels are 0 (the build dilates them away).
   std::vector<float> texels;
   // transfer_to_stores: the texels in a store instead (memory or scratch file), `channels` a
@@ -157,9 +160,10 @@ Status check_scene_textures(const scene::Scene& scene);
 
 // Which layers the materials of `scene` call for: albedo always; normal if some material has a
 // normal map; ORM if some material has a metallic-roughness or occlusion texture or factors
-// other than glTF's defaults; emissive if some material emits; lighting if a displayed node
-// places a light. (Alpha is decided by texels.)
-std::vector<LayerSemantic> layers_used(const scene::Scene& scene);
+// other than glTF's defaults; emissive if some material emits; lighting (lit albedo when
+// `lighting` is combined) if a displayed node places a light. (Alpha is decided by texels.)
+std::vector<LayerSemantic> layers_used(const scene::Scene& scene,
+                                       LightingLayer lighting = LightingLayer::kSeparate);
 
 // Transfers the materials of an unwrapped scene (meshes carrying atlas UVs in [0,1], glTF
 // orientation: v down, texel row y = v * height). Texture slots honour their sampler (wrap

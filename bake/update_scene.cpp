@@ -135,6 +135,9 @@ Expected<uint64_t> scene_bake_key(const scene::Scene& scene, const SceneBakeOpti
   if (scene_has_lights(scene)) {
     const LightingOptions& l = options.lighting;
     k.add(l.shadows), k.add(l.ao_samples), k.add(l.ao_distance);
+    // Only when not the default, so that the keys of earlier bakes stay as they were.
+    if (l.bounces > 0) k.add(l.bounces), k.add(l.bounce_samples);
+    if (l.layer != LightingLayer::kSeparate) k.add(std::string(to_string(l.layer)));
   }
   // The density file the unwrap reads (the scene's NAME.density.json unless one is named).
   std::string density = options.unwrap.density_file == "-" ? "" : options.unwrap.density_file;

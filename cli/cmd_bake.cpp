@@ -326,6 +326,17 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
                  "Cosine-weighted rays per texel sample for --bounces 1")
       ->check(CLI::Range(1, 65536))
       ->default_val(16);
+  app.add_option_function<std::string>(
+         "--lighting",
+         [&o](const std::string& v) {
+           auto layer = vt::parse_lighting_layer(v);
+           if (!layer.ok()) throw CLI::ValidationError("--lighting", layer.status().message());
+           o.lighting.layer = *layer;
+         },
+         "What a lit scene's light becomes: separate (default: irradiance in its own HDR "
+         "'lighting' layer) or combined (a 'lit_albedo' HDR layer instead: base colour x "
+         "irradiance / pi, for engines that want one texture; no --ao-samples)")
+      ->default_str("separate");
   app.add_flag(
       "--no-shadows", [&o](int64_t) { o.lighting.shadows = false; },
       "Lighting without shadow rays: every light reaches every texel facing it");

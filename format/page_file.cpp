@@ -17,6 +17,8 @@ const char* to_string(LayerSemantic v) {
       return "custom";
     case LayerSemantic::kLighting:
       return "lighting";
+    case LayerSemantic::kLitAlbedo:
+      return "lit_albedo";
   }
   return "unknown";
 }

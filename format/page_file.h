@@ -22,7 +22,8 @@ enum class LayerSemantic : uint8_t {
   kOrm = 2,
   kEmissive = 3,
   kCustom = 4,
-  kLighting = 5,  // baked irradiance (HDR): added after custom, so earlier files read the same
+  kLighting = 5,   // baked irradiance (HDR): added after custom, so earlier files read the same
+  kLitAlbedo = 6,  // base colour x irradiance / pi (HDR): `--lighting combined`, likewise added
 };
 
 // Storage type of one texel channel.

@@ -99,7 +99,7 @@ inline std::vector<uint64_t> morton_order(const PageGeometry& g, uint32_t level)
 
 // Shared validation of a layer description (writer: kInvalidArgument; reader: kCorrupt).
 inline std::string layer_problem(const LayerSpec& l) {
-  if (uint8_t(l.semantic) > uint8_t(LayerSemantic::kLighting)) return "unknown semantic";
+  if (uint8_t(l.semantic) > uint8_t(LayerSemantic::kLitAlbedo)) return "unknown semantic";
   if (l.channels < 1 || l.channels > 4) return "channels must be 1..4";
   if (uint8_t(l.texel_type) > uint8_t(TexelType::kF32)) return "unknown texel type";
   if (uint8_t(l.codec) > uint8_t(PageCodec::kBcZstd)) return "unknown codec";

@@ -31,7 +31,8 @@ double seconds_since(Clock::time_point t) {
 }
 
 bool is_colour(LayerSemantic s) {
-  return s == LayerSemantic::kAlbedo || s == LayerSemantic::kEmissive;
+  return s == LayerSemantic::kAlbedo || s == LayerSemantic::kEmissive ||
+         s == LayerSemantic::kLitAlbedo;
 }
 
 // The settings of the bake the reference must repeat, from the file's metadata.
@@ -71,6 +72,9 @@ LightingOptions baked_lighting_options(const PageFileReader& reader) {
     o.ao_distance = lit.value("ao_distance", 0.0);
     o.bounces = lit.value("bounces", 0);
     o.bounce_samples = lit.value("bounce_samples", 16);
+    // Written only for a combined bake (the default keeps its metadata as it was).
+    o.layer = lit.value("layer", "separate") == "combined" ? LightingLayer::kCombined
+                                                           : LightingLayer::kSeparate;
   }
   return o;
 }
@@ -247,9 +251,11 @@ Status measure_page(const ReferenceLayer& r, const uint8_t* ref, const uint8_t* 
       }
       a = ref_f.data(), b = test_f.data();
     }
-    if (r.spec.semantic == LayerSemantic::kLighting) {
-      // Irradiance in lux has no peak: judged after the tone map x / (1 + x) (as
-      // codec/hdr_metrics.h's tone-mapped figure), where an error is as visible as it looks.
+    if (r.spec.semantic == LayerSemantic::kLighting ||
+        r.spec.semantic == LayerSemantic::kLitAlbedo) {
+      // Irradiance in lux (and the radiance of lit albedo) has no peak: judged after the tone map x
+      // / (1 + x) (as codec/hdr_metrics.h's tone-mapped figure), where an error is as visible as it
+      // looks.
       thread_local std::vector<float> ref_t, test_t;
       const size_t values = n * r.spec.channels;
       ref_t.assign(a, a + values), test_t.assign(b, b + values);

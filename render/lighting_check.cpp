@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/parallel.h"
+#include "common/srgb.h"
 
 namespace vt::render {
 
@@ -100,6 +101,8 @@ Expected<std::unique_ptr<LightingReference>> LightingReference::create(
   VT_ASSIGN_OR_RETURN(r->baker_, LightingBaker::create(scene, options, threads));
   r->meshes_ = draws.meshes;
   r->materials_.assign(materials.begin(), materials.end());
+  r->combined_ = options.layer == LightingLayer::kCombined;
+  if (r->combined_) r->textures_ = draws.textures;
   r->threads_ = threads;
   std::vector<std::vector<float>> positions(r->meshes_.size());
   std::vector<SurfaceCaster::Mesh> meshes;
@@ -172,6 +175,25 @@ Expected<ReferenceFrame> LightingReference::render(const Camera& camera, uint32_
     s.seed = seed;
     return s;
   };
+  // The linear base colour where a ray met a surface, as the bake's albedo: the reference
+  // texture (base colour x factor, sRGB) x the vertex colour.
+  auto base_colour = [&](const SurfaceCaster::Hit& hit, double out[3]) {
+    const MeshData& mesh = meshes_[hit.mesh];
+    const Vertex* v[3];
+    for (int k = 0; k < 3; ++k) v[k] = &mesh.vertices[mesh.indices[3 * size_t(hit.triangle) + k]];
+    const double b[3] = {1.0 - hit.u - hit.v, hit.u, hit.v};
+    auto lerp = [&](auto get) { return get(*v[0]) * b[0] + get(*v[1]) * b[1] + get(*v[2]) * b[2]; };
+    double tex[4] = {1, 1, 1, 1};
+    if (mesh.reference_texture < textures_.size()) {
+      sample_bilinear(textures_[mesh.reference_texture],
+                      lerp([](const Vertex& x) { return double(x.u); }),
+                      lerp([](const Vertex& x) { return double(x.v); }), tex);
+      for (int c = 0; c < 3; ++c) tex[c] = srgb_to_linear(float(tex[c]));
+    }
+    out[0] = tex[0] * lerp([](const Vertex& x) { return double(x.r); });
+    out[1] = tex[1] * lerp([](const Vertex& x) { return double(x.g); });
+    out[2] = tex[2] * lerp([](const Vertex& x) { return double(x.b); });
+  };
   const uint32_t n = std::max(1u, samples_per_side_);
   parallel_for(height, threads_, [&](size_t row) {
     for (uint32_t col = 0; col < width; ++col) {
@@ -203,6 +225,11 @@ Expected<ReferenceFrame> LightingReference::render(const Camera& camera, uint32_
         }
         float e[4] = {0, 0, 0, 1};
         baker_->evaluate(surface(*hit, d, footprint, (uint64_t(row) * width + col) * n * n + k), e);
+        if (combined_) {
+          double base[3];
+          base_colour(*hit, base);
+          for (int c = 0; c < 3; ++c) e[c] = lit_albedo(base[c], e[c]);
+        }
         for (int c = 0; c < 4; ++c) sum[c] += e[c];
         ++count;
       }

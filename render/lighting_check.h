@@ -1,4 +1,5 @@
-// Screen-space check of the lighting layer (issue 21): per view, the baked irradiance rendered
+// Screen-space check of the lighting layer (issue 21): per view, the baked irradiance (or, for a
+// `--lighting combined` bake, the lit albedo: base colour x irradiance / pi) rendered
 // through the virtual-texture path (feedback -> streamer -> page table -> cache, tone-mapped
 // x / (1 + x) in the virtual pass) against a reference computed per pixel from the ORIGINAL
 // scene: each pixel's surface found by a ray through its centre (world position, geometric and
@@ -29,17 +30,19 @@ class LightingReference {
  public:
   // `draws`: reference_scene_draws(scene) with add_shading_frames(scene, draws, true) applied;
   // `materials`: lit_materials(scene) (their normal maps). Both are copied. `options`: the bake's
-  // AO; shadows are always cast (a --no-shadows bake must fail). `texel_size`: the world size of
+  // AO and layer mode (combined: the frame is the lit albedo, the base colour from the draws'
+  // reference textures and vertex colours); shadows are always cast (a --no-shadows bake must
+  // fail). `texel_size`: the world size of
   // a baked texel (1 / the bake's texels_per_unit; 0 = unknown): a pixel's rays spread over it
   // where it is larger than the pixel.
   static Expected<std::unique_ptr<LightingReference>> create(
       const scene::Scene& scene, const SceneDraws& draws, std::span<const LitMaterial> materials,
       LightingOptions options, double texel_size, int threads, uint32_t samples_per_side = 4);
   ~LightingReference();
-  // One frame: rgb = 255 x E / (1 + E) per channel of irradiance E (lux), alpha = 255 x AO (255
-  // without AO), E and AO the means of samples_per_side^2 rays spread over the pixel (or the
-  // baked texel, if larger) that meet the mesh its centre meets; `covered` bit 0 where the
-  // centre's ray met a surface.
+  // One frame: rgb = 255 x E / (1 + E) per channel of irradiance E (lux; combined: of lit
+  // albedo), alpha = 255 x AO (255 without AO), E and AO the means of samples_per_side^2 rays
+  // spread over the pixel (or the baked texel, if larger) that meet the mesh its centre meets;
+  // `covered` bit 0 where the centre's ray met a surface.
   Expected<ReferenceFrame> render(const Camera& camera, uint32_t width, uint32_t height) const;
 
  private:
@@ -48,6 +51,8 @@ class LightingReference {
   std::unique_ptr<SurfaceCaster> caster_;
   std::vector<MeshData> meshes_;
   std::vector<LitMaterial> materials_;
+  std::vector<ReferenceTexture> textures_;  // base colours (combined only)
+  bool combined_ = false;
   int threads_ = 0;
   uint32_t samples_per_side_ = 4;
   double texel_size_ = 0;

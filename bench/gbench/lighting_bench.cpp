@@ -4,12 +4,15 @@
 // once: time per million covered texels, relative RMSE of the AO channel (RMSE / mean of the
 // reference), PSNR of AO (peak 1) and PSNR in log2 space (log2 of AO clamped at 1/1024, peak
 // 10). BM_SampleScene/L: the transfer of the sample scene (samples/) with L of 3 lights (sun,
-// point, spot) placed: what lighting adds; rays per second per thread.
+// point, spot) placed: what lighting adds; rays per second per thread. BM_LitScene*: the same on
+// the lit sample scene and on a real level lit by bench/add_lights.py ($VTBAKE_LIT_LEVEL).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <vector>
 
 #include "bake/coverage_mask.h"
@@ -303,6 +306,164 @@ void BM_RaysPerThread(benchmark::State& state) {
       rays / double(passes) / threads, benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(BM_RaysPerThread)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The lit scenes of the samples-versus-error figures, unwrapped once at 4 x 4 pages (480^2; the
+// level at 8 x 8, 960^2, whose atlas it covers more thinly):
+// 0 = `sample-scene --lights` (64-texel textures), 1 = the glTF at $VTBAKE_LIT_LEVEL (a real
+// level with lights added by bench/add_lights.py). Null when the level is not given.
+const unwrap::UnwrapResult* lit_scene(int which) {
+  static std::map<int, std::optional<unwrap::UnwrapResult>> scenes;
+  auto it = scenes.find(which);
+  if (it == scenes.end()) {
+    std::optional<unwrap::UnwrapResult> u;
+    std::string path;
+    if (which == 0) {
+      path = (std::filesystem::temp_directory_path() / "vtbake-lit-sample").string();
+      SampleSceneOptions so;
+      so.texture_size = 64;
+      so.lights = true;
+      (void)write_sample_scene(path, so);
+      path += "/scene.gltf";
+    } else if (const char* level = std::getenv("VTBAKE_LIT_LEVEL")) {
+      path = level;
+    }
+    if (auto s = path.empty() ? Expected<scene::Scene>(Error(ErrorCode::kNotFound, "no level"))
+                              : scene::load_scene(path);
+        s.ok()) {
+      unwrap::UnwrapOptions uo;
+      uo.size_pages = which == 0 ? 4 : 8;
+      uo.threads = 1;
+      if (auto r = unwrap::unwrap_scene(*s, uo); r.ok()) u = std::move(r).value();
+    }
+    it = scenes.emplace(which, std::move(u)).first;
+  }
+  return it->second ? &*it->second : nullptr;
+}
+
+TransferResult lit_transfer(const unwrap::UnwrapResult& u, const LightingOptions& lo, int threads) {
+  TransferOptions o;
+  o.width = uint32_t(u.stats.atlas_width), o.height = uint32_t(u.stats.atlas_height);
+  o.threads = threads;
+  o.lighting = lo;
+  return std::move(transfer_materials(u.scene, o)).value();
+}
+
+// Channel `c` of the lighting layer at every covered texel.
+std::vector<float> lighting_channel(const TransferResult& r, uint32_t c) {
+  std::vector<float> out;
+  const std::vector<uint8_t> coverage = *r.coverage->to_bytes();
+  for (const TransferLayer& l : r.layers)
+    if (l.semantic == LayerSemantic::kLighting)
+      for (size_t i = 0; i < l.texels.size() / l.channels; ++i)
+        if (coverage[i]) out.push_back(l.texels[l.channels * i + c]);
+  return out;
+}
+
+// Relative RMSE and PSNR in log2 space (values clamped at 1/1024, peak log2 range 10) of `v`
+// against `ref`, into the benchmark's counters.
+void error_counters(benchmark::State& state, const std::vector<float>& v,
+                    const std::vector<float>& ref) {
+  double se = 0, sel = 0, mean = 0;
+  const size_t n = std::min(v.size(), ref.size());
+  for (size_t i = 0; i < n; ++i) {
+    const double d = v[i] - ref[i];
+    const double dl =
+        std::log2(std::max(v[i], 1.0f / 1024)) - std::log2(std::max(ref[i], 1.0f / 1024));
+    se += d * d, sel += dl * dl, mean += ref[i];
+  }
+  const double count = double(std::max<size_t>(n, 1));
+  state.counters["rel_rmse"] = std::sqrt(se / count) / std::max(mean / count, 1e-30);
+  state.counters["psnr_log_db"] = 10 * std::log10(100.0 / std::max(sel / count, 1e-20));
+}
+
+// How far AO looks in each lit scene (metres): the sample scene's objects are about 1 m, the
+// level's streets about 10 m wide.
+constexpr double kAoDistance[2] = {2.0, 10.0};
+
+// BM_LitSceneSamples/SCENE/KIND/N: N AO rays (KIND 0, kAoDistance) or N bounce rays (KIND 1) per
+// texel, all the scene's lights with shadows, against 4096 of them (computed once per scene and
+// kind, on all threads); the error of the AO channel or of the irradiance (green), and wall seconds
+// of the whole transfer per million covered texels on one thread. Registered for AO only: a
+// 4096-ray bounce reference (each ray with its shadow rays) takes minutes per scene here; the
+// corner scene's BM_BounceSamples has the bounce's curve.
+void BM_LitSceneSamples(benchmark::State& state) {
+  const int which = int(state.range(0)), kind = int(state.range(1)), n = int(state.range(2));
+  const unwrap::UnwrapResult* u = lit_scene(which);
+  if (!u) {
+    state.SkipWithError("no level: set VTBAKE_LIT_LEVEL to a lit glTF");
+    return;
+  }
+  auto options = [&](int samples) {
+    LightingOptions lo;
+    if (kind == 0) {
+      lo.ao_samples = samples;
+      lo.ao_distance = kAoDistance[which];
+    } else {
+      lo.bounces = 1;
+      lo.bounce_samples = samples;
+    }
+    return lo;
+  };
+  const uint32_t channel = kind == 0 ? 3 : 1;
+  static std::map<std::pair<int, int>, std::vector<float>> references;
+  std::vector<float>& reference = references[{which, kind}];
+  if (reference.empty()) reference = lighting_channel(lit_transfer(*u, options(4096), 0), channel);
+  std::vector<float> v;
+  uint64_t texels = 0;
+  for (auto _ : state) {
+    TransferResult r = lit_transfer(*u, options(n), 1);
+    texels = r.stats.covered_texels;
+    v = lighting_channel(r, channel);
+  }
+  error_counters(state, v, reference);
+  state.counters["texels"] = double(texels);
+  state.counters["s_per_Mtexel"] =
+      benchmark::Counter(double(texels) / 1e6, benchmark::Counter::kIsIterationInvariantRate |
+                                                   benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_LitSceneSamples)
+    ->ArgsProduct({{0, 1}, {0}, {1, 4, 16, 64, 256, 1024}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+
+// BM_LitSceneCost/SCENE/LIGHTS/AO: the transfer of a lit scene on one thread with its first
+// LIGHTS placed lights (shadows on) and AO rays per texel: what each light and AO ray adds, and
+// the Embree structure's memory.
+void BM_LitSceneCost(benchmark::State& state) {
+  const int which = int(state.range(0)), keep = int(state.range(1));
+  const unwrap::UnwrapResult* u = lit_scene(which);
+  if (!u) {
+    state.SkipWithError("no level: set VTBAKE_LIT_LEVEL to a lit glTF");
+    return;
+  }
+  scene::Scene s = u->scene;
+  int placed = 0;
+  for (scene::Node& node : s.nodes)
+    if (node.light >= 0 && placed++ >= keep) node.light = -1;
+  TransferOptions o;
+  o.width = uint32_t(u->stats.atlas_width), o.height = uint32_t(u->stats.atlas_height);
+  o.threads = 1;
+  o.lighting.ao_samples = int(state.range(2));
+  o.lighting.ao_distance = kAoDistance[which];
+  uint64_t rays = 0, texels = 0, bvh = 0;
+  double structure = 0;
+  for (auto _ : state) {
+    TransferResult r = std::move(transfer_materials(s, o)).value();
+    rays = r.stats.lighting.shadow_rays + r.stats.lighting.ao_rays;
+    texels = r.stats.covered_texels, bvh = r.stats.lighting.bvh_bytes;
+    structure = r.stats.lighting.build_seconds;
+  }
+  state.counters["texels"] = double(texels);
+  state.counters["rays"] = double(rays);
+  state.counters["bvh_MiB"] = double(bvh) / (1 << 20);
+  state.counters["bvh_ms"] = structure * 1e3;
+}
+BENCHMARK(BM_LitSceneCost)
+    ->ArgsProduct({{0, 1}, {0, 1, 5}, {0}})
+    ->ArgsProduct({{0, 1}, {5}, {4, 16}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace vt

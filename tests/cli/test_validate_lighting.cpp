@@ -40,6 +40,17 @@ class ValidateLighting : public ::testing::Test {
         node["matrix"][12] = 3.0, node["matrix"][13] = 2.0, node["matrix"][14] = -2.0;
       }
     std::ofstream(dir_ + "/scene/moved.gltf") << doc.dump();
+    // The lit scene with its materials' base colours swapped round (a lit albedo baked from
+    // another albedo: its light is right, its colour is not).
+    doc = nlohmann::json::parse(read_file(dir_ + "/scene/lit.gltf"));
+    auto& materials = doc["materials"];
+    if (materials.size() < 2) {
+      setup_error_ = "the sample scene has fewer than 2 materials";
+      return;
+    }
+    for (size_t m = 0; m + 1 < materials.size(); m += 2)
+      std::swap(materials[m]["pbrMetallicRoughness"], materials[m + 1]["pbrMetallicRoughness"]);
+    std::ofstream(dir_ + "/scene/recoloured.gltf") << doc.dump();
     // The same scene without its lights (for the light-less check).
     const std::string unlit = write_sample_scene(dir_ + "/unlit");
     if (!unlit.empty()) setup_error_ = unlit;
@@ -88,11 +99,11 @@ class ValidateLighting : public ::testing::Test {
     return false;
   }
 
-  static nlohmann::json lighting_report(const RunResult& r) {
+  static nlohmann::json lighting_report(const RunResult& r, const std::string& name = "lighting") {
     const auto j = nlohmann::json::parse(r.out, nullptr, false);
     if (!j.is_object()) return {};
     for (const auto& layer : j["atlas"]["layers"])
-      if (layer["name"] == "lighting") return layer;
+      if (layer["name"] == name) return layer;
     return {};
   }
 
@@ -193,6 +204,38 @@ TEST_F(ValidateLighting, AViewsCheckWithoutALightingLayerHasNoLightingObject) {
                                  false);
   if (no_vulkan(r)) GTEST_SKIP() << "no Vulkan device: " << r.out;
   for (const nlohmann::json& l : lighting_views(r)) EXPECT_TRUE(l.is_null()) << r.out;
+}
+
+// --lighting combined: the lit-albedo layer is judged against base colour x irradiance / pi
+// recomputed from the original scene (atlas pages and views); a light moved or a base colour
+// changed fails on it.
+TEST_F(ValidateLighting, ACombinedBakePassesAndItsWrongVariantsFail) {
+  const RunResult ok = bake_and_check("lit.gltf", "combined", "--lighting combined");
+  EXPECT_EQ(ok.exit_code, 0) << ok.out;
+  const nlohmann::json l = lighting_report(ok, "lit_albedo");
+  ASSERT_TRUE(l.is_object()) << ok.out;
+  EXPECT_EQ(l["passed"], true);
+  EXPECT_GT(l["pages_checked"].get<int>(), 0);
+  EXPECT_TRUE(lighting_report(ok).is_null()) << "a combined bake has no lighting layer";
+  for (const char* scene : {"moved.gltf", "recoloured.gltf"}) {
+    const std::string name = std::string("combined_") + scene;
+    const RunResult bad =
+        bake_and_check(scene, name.substr(0, name.size() - 5), "--lighting combined");
+    EXPECT_EQ(bad.exit_code, 1) << bad.out;
+    const nlohmann::json b = lighting_report(bad, "lit_albedo");
+    ASSERT_TRUE(b.is_object()) << bad.out;
+    EXPECT_EQ(b["passed"], false) << scene;
+    EXPECT_GT(b["pages_failed"].get<int>(), 0) << scene;
+  }
+  const RunResult views = views_check("combined");
+  if (no_vulkan(views)) GTEST_SKIP() << "no Vulkan device: " << views.out;
+  EXPECT_FALSE(lighting_failed(views)) << views.out;
+  EXPECT_EQ(lighting_views(views).size(), 2u) << views.out;
+  for (const char* bad : {"combined_moved", "combined_recoloured"}) {
+    const RunResult r = views_check(bad);
+    EXPECT_EQ(r.exit_code, 1) << r.out;
+    EXPECT_TRUE(lighting_failed(r)) << bad << ": " << r.out;
+  }
 }
 
 }  // namespace

@@ -203,6 +203,12 @@ TEST(PageFileWriter, RejectsBadDescriptions) {
   desc.layers[0].name = std::string(256, 'a');
   EXPECT_FALSE(PageFileWriter::create(path, desc).ok());
   desc = mixed_desc();
+  desc.layers[0].semantic = LayerSemantic::kLitAlbedo;  // the last semantic known
+  desc.layers[0].name = "lit";
+  EXPECT_TRUE(PageFileWriter::create(path, desc).ok());
+  desc.layers[0].semantic = LayerSemantic(uint8_t(LayerSemantic::kLitAlbedo) + 1);
+  EXPECT_FALSE(PageFileWriter::create(path, desc).ok());
+  desc = mixed_desc();
   desc.layers.resize(17, desc.layers[0]);
   EXPECT_FALSE(PageFileWriter::create(path, desc).ok());
   EXPECT_FALSE(std::filesystem::exists(path));

@@ -13,12 +13,15 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <numbers>
 #include <vector>
 
 #include "bake/lighting.h"
 #include "bake/scene_bake.h"
 #include "bake/transfer.h"
 #include "bake/unwrap/unwrap.h"
+#include "bake/update_scene.h"
+#include "common/half.h"
 #include "format/page_file.h"
 #include "samples/sample_scene.h"
 #include "tests/transfer/transfer_test_util.h"
@@ -544,20 +547,26 @@ std::vector<uint8_t> file_bytes(const std::string& path) {
   return {std::istreambuf_iterator<char>(f), {}};
 }
 
+// `s` baked into a one-page file at `path`.
+SceneBakeSummary bake_one_page(const scene::Scene& s, const std::string& path,
+                               const LightingOptions& lighting) {
+  SceneBakeOptions o;
+  o.build.output = path;
+  o.build.threads = 2;
+  o.unwrapped = "-";
+  o.unwrap.size_pages = 1;
+  o.lighting = lighting;
+  auto summary = bake_scene(s, o);
+  EXPECT_TRUE(summary.ok()) << summary.status().message();
+  return summary.ok() ? *summary : SceneBakeSummary{};
+}
+
 // A light-less scene bakes the same page file whatever the lighting options (no layer, no
 // structure, nothing in the metadata); a lit one gets a half-float lighting layer.
 TEST(Lighting, SceneBakeAddsTheLayerOnlyForLitScenes) {
   test::ScratchDir dir;
   auto bake = [&](const scene::Scene& s, const std::string& name, LightingOptions lighting) {
-    SceneBakeOptions o;
-    o.build.output = dir.file(name);
-    o.build.threads = 2;
-    o.unwrapped = "-";
-    o.unwrap.size_pages = 1;
-    o.lighting = lighting;
-    auto summary = bake_scene(s, o);
-    EXPECT_TRUE(summary.ok()) << summary.status().message();
-    return summary.ok() ? *summary : SceneBakeSummary{};
+    return bake_one_page(s, dir.file(name), lighting);
   };
   LightingOptions ao;
   ao.ao_samples = 8;
@@ -598,6 +607,171 @@ TEST(Lighting, SceneBakeAddsTheLayerOnlyForLitScenes) {
     ++checked;
   }
   EXPECT_GT(checked, 1000);
+}
+
+// A floor whose base colour varies per texel (factor x a gradient texture x vertex colours),
+// lit by a sun (colour and slant) and a bulb (shading varies over the floor), with a half-
+// transparent or opaque material.
+scene::Scene lit_colour_floor(const test::ScratchDir& dir, scene::AlphaMode mode) {
+  const std::string png = dir.file("gradient.png");
+  const int w = 16;
+  std::vector<uint8_t> rgba(size_t(w) * w * 4, 255);
+  for (int j = 0; j < w; ++j)
+    for (int i = 0; i < w; ++i) {
+      uint8_t* t = &rgba[(size_t(j) * w + i) * 4];
+      t[0] = uint8_t(40 + 13 * i), t[1] = uint8_t(250 - 11 * j), t[2] = uint8_t(90 + 7 * (i ^ j));
+      t[3] = uint8_t(100 + 9 * i);
+    }
+  auto out = OIIO::ImageOutput::create(png);
+  OIIO::ImageSpec spec(w, w, 4, OIIO::TypeDesc::UINT8);
+  EXPECT_TRUE(out && out->open(png, spec) && out->write_image(OIIO::TypeDesc::UINT8, rgba.data()) &&
+              out->close());
+  scene::Primitive p = floor_square();
+  p.uvs.insert(p.uvs.begin(), p.uvs[0]);  // set 0 reads the texture, the last is the atlas
+  for (const scene::Vec3& v : p.positions)
+    p.colors.push_back({0.5f + 0.25f * v[0], 0.75f, 0.5f - 0.25f * v[1], 1.0f});
+  scene::Material m;
+  m.base_color_factor = {0.9f, 0.6f, 0.8f, 1.0f};
+  m.alpha_mode = mode;
+  scene::Scene s = test::textured_scene(p, png, m);
+  scene::Light sun = light_of(scene::LightType::kDirectional, 900);
+  sun.color = {1, 0.8f, 0.6f};
+  add_light(s, sun, turned_about_x(0.4));
+  add_light(s, light_of(scene::LightType::kPoint, 40), at(0.3, -0.2, 0.6));
+  return s;
+}
+
+const TransferLayer* layer_of(const TransferResult& r, LayerSemantic semantic) {
+  for (const TransferLayer& l : r.layers)
+    if (l.semantic == semantic) return &l;
+  return nullptr;
+}
+
+// --lighting combined: a lit-albedo layer in the lighting layer's place, each texel the separate
+// bake's albedo x irradiance / pi (one sample per texel: the product of the two layers' texels,
+// to float rounding), alpha kept as albedo keeps it.
+TEST(Lighting, CombinedLayerIsAlbedoTimesIrradianceOverPi) {
+  test::ScratchDir dir;
+  for (scene::AlphaMode mode : {scene::AlphaMode::kOpaque, scene::AlphaMode::kBlend}) {
+    const scene::Scene s = lit_colour_floor(dir, mode);
+    LightingOptions combined;
+    combined.layer = LightingLayer::kCombined;
+    EXPECT_EQ(layers_used(s, combined.layer),
+              (std::vector<LayerSemantic>{LayerSemantic::kAlbedo, LayerSemantic::kLitAlbedo}));
+    const TransferResult sep = transfer(s), com = transfer(s, combined);
+    const TransferLayer* albedo = layer_of(sep, LayerSemantic::kAlbedo);
+    const TransferLayer* light = layer_of(sep, LayerSemantic::kLighting);
+    const TransferLayer* lit = layer_of(com, LayerSemantic::kLitAlbedo);
+    ASSERT_TRUE(albedo && light && lit);
+    EXPECT_EQ(layer_of(com, LayerSemantic::kLighting), nullptr);
+    EXPECT_TRUE(lit->hdr);
+    const uint32_t alpha = mode == scene::AlphaMode::kOpaque ? 3u : 4u;
+    ASSERT_EQ(albedo->channels, alpha);
+    ASSERT_EQ(lit->channels, alpha);
+    // The albedo layer is the same in both bakes.
+    EXPECT_EQ(albedo->texels, layer_of(com, LayerSemantic::kAlbedo)->texels);
+    int n = 0;
+    double lo = 1e9, hi = 0;
+    const std::vector<uint8_t> coverage = *sep.coverage->to_bytes();
+    for (size_t i = 0; i < size_t(kAtlas) * kAtlas; ++i) {
+      if (!coverage[i]) continue;
+      for (int c = 0; c < 3; ++c) {
+        const double want =
+            double(albedo->texels[i * alpha + c]) * light->texels[i * 3 + c] / std::numbers::pi;
+        ASSERT_NEAR(lit->texels[i * alpha + c], want, 1e-6 * want + 1e-9) << i << " " << c;
+        lo = std::min(lo, want), hi = std::max(hi, want);
+      }
+      if (alpha == 4) ASSERT_EQ(lit->texels[i * 4 + 3], albedo->texels[i * 4 + 3]);
+      ++n;
+    }
+    EXPECT_GT(n, 1000);
+    EXPECT_GT(hi, 2 * lo);  // the product varies: a constant would not test it
+  }
+}
+
+// AO is no light: a combined bake refuses it rather than dropping it unseen.
+TEST(Lighting, CombinedLayerRefusesAmbientOcclusion) {
+  scene::Scene s = floor_scene();
+  add_light(s, light_of(scene::LightType::kDirectional, 3), scene::kIdentity);
+  LightingOptions o;
+  o.layer = LightingLayer::kCombined;
+  o.ao_samples = 4;
+  TransferOptions t;
+  t.width = t.height = kAtlas;
+  t.lighting = o;
+  auto r = transfer_materials(s, t);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("separate"), std::string::npos) << r.status().message();
+}
+
+// The scene bake of a combined layer: 'lit_albedo', half float, level 0 the product to half
+// rounding, the mode in the metadata; a light-less scene bakes the same bytes in either mode.
+TEST(Lighting, SceneBakeOfTheCombinedLayer) {
+  test::ScratchDir dir;
+  auto bake = [&](const scene::Scene& s, const std::string& name, LightingOptions lighting) {
+    return bake_one_page(s, dir.file(name), lighting);
+  };
+  LightingOptions combined;
+  combined.layer = LightingLayer::kCombined;
+  const scene::Scene dark = floor_scene();
+  bake(dark, "a.vtpf", {});
+  const SceneBakeSummary b = bake(dark, "b.vtpf", combined);
+  EXPECT_EQ(file_bytes(dir.file("a.vtpf")), file_bytes(dir.file("b.vtpf")));
+  bool warned = false;
+  for (const std::string& w : b.warnings)
+    warned |= w.find("nothing to combine") != std::string::npos;
+  EXPECT_TRUE(warned);
+
+  // A grey floor under a 3-lux sun: every texel 0.5 x 3 / pi.
+  scene::Scene lit = floor_scene();
+  lit.materials[0].base_color_factor = {0.5f, 0.5f, 0.5f, 1.0f};
+  add_light(lit, light_of(scene::LightType::kDirectional, 3), scene::kIdentity);
+  bake(lit, "c.vtpf", combined);
+  auto rc = PageFileReader::open(dir.file("c.vtpf"));
+  ASSERT_TRUE(rc.ok()) << rc.status().message();
+  int found = -1;
+  for (uint32_t i = 0; i < (*rc)->layers().size(); ++i) {
+    EXPECT_NE((*rc)->layers()[i].semantic, LayerSemantic::kLighting);
+    if ((*rc)->layers()[i].semantic == LayerSemantic::kLitAlbedo) found = int(i);
+  }
+  ASSERT_GE(found, 0);
+  const LayerSpec& spec = (*rc)->layers()[found];
+  EXPECT_EQ(spec.name, "lit_albedo");
+  EXPECT_EQ(spec.texel_type, TexelType::kF16);
+  EXPECT_EQ(spec.channels, 3);
+  EXPECT_EQ(spec.color_space, ColorSpace::kLinear);
+  EXPECT_NE((*rc)->metadata_json().find("\"layer\":\"combined\""), std::string::npos);
+  const float want = half_to_float(float_to_half(float(0.5 * 3 / std::numbers::pi)));
+  test::Level0 level = test::read_level0(**rc, uint32_t(found));
+  int checked = 0;
+  for (size_t i = 0; i < level.present.size(); ++i) {
+    if (!level.present[i]) continue;
+    ASSERT_EQ(level.texels[3 * i], want) << i;
+    ++checked;
+  }
+  EXPECT_GT(checked, 1000);
+}
+
+// The content key (update mode) tells the layer modes and bounces apart on a lit scene, so an
+// update never keeps a bake of the other mode; a light-less scene's key ignores them.
+TEST(Lighting, ContentKeyKnowsTheLayerModeAndBounces) {
+  auto key = [](const scene::Scene& s, LightingOptions lighting) {
+    SceneBakeOptions o;
+    o.lighting = lighting;
+    auto k = scene_bake_key(s, o);
+    EXPECT_TRUE(k.ok()) << k.status().message();
+    return k.ok() ? *k : 0;
+  };
+  LightingOptions combined, bounced;
+  combined.layer = LightingLayer::kCombined;
+  bounced.bounces = 1;
+  const scene::Scene dark = floor_scene();
+  EXPECT_EQ(key(dark, {}), key(dark, combined));
+  EXPECT_EQ(key(dark, {}), key(dark, bounced));
+  scene::Scene lit = floor_scene();
+  add_light(lit, light_of(scene::LightType::kDirectional, 3), scene::kIdentity);
+  EXPECT_NE(key(lit, {}), key(lit, combined));
+  EXPECT_NE(key(lit, {}), key(lit, bounced));
 }
 
 }  // namespace
