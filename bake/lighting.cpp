@@ -13,6 +13,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <string>
 
 #include "common/srgb.h"
@@ -68,8 +69,6 @@ struct LightingBaker::Rays {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 Vec3d v3(const std::array<double, 3>& a) {
   return {a[0], a[1], a[2]};
 }
@@ -99,7 +98,7 @@ Vec3d lattice_direction(const Vec3d& t, const Vec3d& b, const Vec3d& n, double r
                         int i) {
   double u1 = r0 + 0.7548776662466927 * i, u2 = r1 + 0.5698402909980532 * i;
   u1 -= std::floor(u1), u2 -= std::floor(u2);
-  const double r = std::sqrt(u1), phi = 2.0 * kPi * u2;
+  const double r = std::sqrt(u1), phi = 2.0 * std::numbers::pi * u2;
   return t * (r * std::cos(phi)) + b * (r * std::sin(phi)) + n * std::sqrt(std::max(0.0, 1.0 - u1));
 }
 

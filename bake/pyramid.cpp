@@ -3,15 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <numbers>
 
 namespace vt {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 double sinc(double x) {
   if (std::abs(x) < 1e-12) return 1.0;
-  return std::sin(kPi * x) / (kPi * x);
+  return std::sin(std::numbers::pi * x) / (std::numbers::pi * x);
 }
 
 // Modified Bessel function of the first kind, order 0 (series; converges fast for alpha <= 8).

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 
 namespace vt::render {
@@ -99,7 +100,6 @@ std::vector<Camera> orbit_views(Vec3f lo, Vec3f hi, int count, float aspect) {
 
 namespace {
 
-constexpr float kPi = 3.14159265358979f;
 constexpr size_t kMaxCameraFileBytes = 1 << 20;
 
 bool finite(Vec3f v) {
@@ -203,8 +203,9 @@ Expected<Camera> camera_from_spec(const CameraSpec& spec, float aspect) {
     return bad("far (" + fmt(z_far) + ") must be greater than near (" + fmt(z_near) + ")");
   }
   Camera cam;
-  cam.view_proj = perspective(spec.fov_y_deg * kPi / 180.0f, aspect, z_near, z_far) *
-                  look_at(spec.eye, spec.target, spec.up);
+  cam.view_proj =
+      perspective(spec.fov_y_deg * std::numbers::pi_v<float> / 180.0f, aspect, z_near, z_far) *
+      look_at(spec.eye, spec.target, spec.up);
   for (float v : cam.view_proj.m) {
     if (!std::isfinite(v))
       return bad("the view-projection matrix is not finite (values too large?)");

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <numbers>
 
 #include "bake/image_source.h"
 #include "format/atomic_output.h"
@@ -10,8 +11,6 @@
 
 namespace vt {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // How scene.gltf has always been spelled: samplers name their filters, texture references
 // their UV set, materials their sidedness (users' incremental builds hash the file).
@@ -139,9 +138,9 @@ scene::Primitive make_uv_sphere(float radius, uint32_t segments) {
   segments = std::max(4u, segments);
   uint32_t rings = std::max(2u, segments / 2);
   for (uint32_t j = 0; j <= rings; ++j) {
-    double theta = kPi * j / rings;  // 0 at the north pole (top of the image)
+    double theta = std::numbers::pi * j / rings;  // 0 at the north pole (top of the image)
     for (uint32_t i = 0; i <= segments; ++i) {
-      double phi = 2 * kPi * i / segments;
+      double phi = 2 * std::numbers::pi * i / segments;
       Vec3 n = {float(std::sin(theta) * std::cos(phi)), float(std::cos(theta)),
                 float(-std::sin(theta) * std::sin(phi))};
       p.positions.push_back({n[0] * radius, n[1] * radius, n[2] * radius});
@@ -165,9 +164,9 @@ scene::Primitive make_torus(float major, float minor, uint32_t segments) {
   segments = std::max(6u, segments);
   uint32_t sides = std::max(3u, segments / 2);
   for (uint32_t j = 0; j <= sides; ++j) {
-    double b = 2 * kPi * j / sides;
+    double b = 2 * std::numbers::pi * j / sides;
     for (uint32_t i = 0; i <= segments; ++i) {
-      double a = 2 * kPi * i / segments;
+      double a = 2 * std::numbers::pi * i / segments;
       Vec3 n = {float(std::cos(b) * std::cos(a)), float(std::sin(b)),
                 float(-std::cos(b) * std::sin(a))};
       double r = major + minor * std::cos(b);
@@ -258,15 +257,16 @@ Status write_sample_textures(const std::string& dir, uint32_t S) {
   // Sphere: a linear (scene-referred) EXR with fine bands, to exercise colour spaces.
   VT_RETURN_IF_ERROR(
       write_texture(file("sphere_albedo.exr"), S, S / 2, 3, [&](double u, double v, float* t) {
-        double band = 0.5 + 0.5 * std::sin(u * 2 * kPi * 24) * std::sin(v * kPi * 12);
+        double band = 0.5 + 0.5 * std::sin(u * 2 * std::numbers::pi * 24) *
+                                std::sin(v * std::numbers::pi * 12);
         t[0] = float(0.05 + 0.6 * band), t[1] = float(0.1 + 0.3 * fbm(u, v, 64, 2)),
         t[2] = float(0.6 - 0.5 * band);
       }));
   // Torus: emissive fine lines.
   VT_RETURN_IF_ERROR(
       write_texture(file("torus_emissive.png"), S, S / 4, 3, [&](double u, double v, float* t) {
-        double line = std::abs(std::sin(u * 2 * kPi * 16)) > 0.97 ||
-                              std::abs(std::sin(v * 2 * kPi * 4)) > 0.97
+        double line = std::abs(std::sin(u * 2 * std::numbers::pi * 16)) > 0.97 ||
+                              std::abs(std::sin(v * 2 * std::numbers::pi * 4)) > 0.97
                           ? 1
                           : 0;
         t[0] = float(line), t[1] = float(0.6 * line), t[2] = float(0.2 * line);

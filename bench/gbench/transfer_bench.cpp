@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <numbers>
 
 #include "bake/transfer.h"
 #include "bake/unwrap/unwrap.h"
@@ -17,10 +18,8 @@
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 double stripes(double u, double v) {
-  return 0.5 + 0.45 * std::sin(2 * kPi * (37 * u + 11 * v));
+  return 0.5 + 0.45 * std::sin(2 * std::numbers::pi * (37 * u + 11 * v));
 }
 
 struct Fixture {

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <numbers>
 
 #include "bake/build_summary_json.h"
 #include "bake/coverage_mask.h"
@@ -21,14 +22,14 @@
 namespace vt {
 namespace {
 
-using test::kPi;
-
 // Smooth colour (8-bit sRGB-encoded values) that bilinear resampling reproduces well.
 void smooth_colour(double u, double v, float* t) {
-  t[0] = float(std::round((0.5 + 0.35 * std::sin(2 * kPi * (2 * u + v))) * 255) / 255);
-  t[1] = float(std::round((0.5 + 0.35 * std::cos(2 * kPi * (u - 3 * v))) * 255) / 255);
-  t[2] = float(
-      std::round((0.5 + 0.3 * std::sin(2 * kPi * 4 * u) * std::cos(2 * kPi * 2 * v)) * 255) / 255);
+  t[0] = float(std::round((0.5 + 0.35 * std::sin(2 * std::numbers::pi * (2 * u + v))) * 255) / 255);
+  t[1] = float(std::round((0.5 + 0.35 * std::cos(2 * std::numbers::pi * (u - 3 * v))) * 255) / 255);
+  t[2] = float(std::round((0.5 + 0.3 * std::sin(2 * std::numbers::pi * 4 * u) *
+                                     std::cos(2 * std::numbers::pi * 2 * v)) *
+                          255) /
+               255);
 }
 
 // The transfer's private copies of images (embedded bytes, .tx levels) still in `dir`.
@@ -178,7 +179,8 @@ TEST(SceneBake, LayersFollowTheMaterials) {
 // Tangent-space normal map of ridges; the expected object-space normal is computed from the
 // analytic sphere frame, independently of the transfer's tangent generation.
 void ridge_normal(double u, double v, float* t) {
-  double x = 0.35 * std::sin(2 * kPi * 6 * u), y = 0.35 * std::cos(2 * kPi * 3 * v), z = 1;
+  double x = 0.35 * std::sin(2 * std::numbers::pi * 6 * u),
+         y = 0.35 * std::cos(2 * std::numbers::pi * 3 * v), z = 1;
   double l = std::sqrt(x * x + y * y + z * z);
   t[0] = float(x / l * 0.5 + 0.5), t[1] = float(y / l * 0.5 + 0.5), t[2] = float(z / l * 0.5 + 0.5);
 }
@@ -194,7 +196,7 @@ TEST(SceneBake, NormalMappedSphereKeepsItsNormals) {
   scene::Primitive sphere = make_uv_sphere(1.0f, 32);
   // glTF tangents: +u direction; w so that cross(N, T) * w points up the image (-v).
   for (size_t i = 0; i < sphere.positions.size(); ++i) {
-    double phi = 2 * kPi * sphere.uvs[0][i][0];
+    double phi = 2 * std::numbers::pi * sphere.uvs[0][i][0];
     V t = {-std::sin(phi), 0, -std::cos(phi)};
     sphere.tangents.push_back({float(t.x), float(t.y), float(t.z), 1.0f});
   }
@@ -227,7 +229,7 @@ TEST(SceneBake, NormalMappedSphereKeepsItsNormals) {
                  V{p.normals[v[1]][0], p.normals[v[1]][1], p.normals[v[1]][2]} * l[1] +
                  V{p.normals[v[2]][0], p.normals[v[2]][1], p.normals[v[2]][2]} * l[2]);
         // Expected: the source map in the analytic frame.
-        double phi = 2 * kPi * u, theta = kPi * vv;
+        double phi = 2 * std::numbers::pi * u, theta = std::numbers::pi * vv;
         V t = unit(V{-std::sin(phi), 0, -std::cos(phi)} -
                    n * dot(n, V{-std::sin(phi), 0, -std::cos(phi)}));
         V down = {std::cos(theta) * std::cos(phi), -std::sin(theta),
@@ -251,7 +253,7 @@ TEST(SceneBake, NormalMappedSphereKeepsItsNormals) {
         double x = level.at(px, py, 0) * 2.0 - 1, y = level.at(px, py, 1) * 2.0 - 1;
         double z = std::sqrt(std::max(0.0, 1 - x * x - y * y));
         V got = unit(ta * x + ba * y + n * z);
-        angles.push_back(std::acos(std::clamp(dot(got, want), -1.0, 1.0)) * 180 / kPi);
+        angles.push_back(std::acos(std::clamp(dot(got, want), -1.0, 1.0)) * 180 / std::numbers::pi);
       });
   ASSERT_GT(angles.size(), 4000u);
   std::sort(angles.begin(), angles.end());
@@ -273,7 +275,7 @@ TEST(SceneBake, NormalMappedSphereKeepsItsNormals) {
 TEST(SceneBake, SupersamplingNeverLosesAccuracy) {
   test::ScratchDir dir;
   auto stripes = [](double u, double v, float* t) {
-    double s = 0.5 + 0.45 * std::sin(2 * kPi * (37 * u + 11 * v));
+    double s = 0.5 + 0.45 * std::sin(2 * std::numbers::pi * (37 * u + 11 * v));
     t[0] = t[1] = t[2] = float(s);
   };
   ASSERT_TRUE(write_texture(dir.file("stripes.exr"), 512, 512, 3, stripes).ok());

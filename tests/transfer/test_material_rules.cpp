@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -21,8 +22,6 @@
 
 namespace vt {
 namespace {
-
-using test::kPi;
 
 constexpr uint32_t kAtlas = 64;
 
@@ -82,9 +81,9 @@ TEST(TransferRules, TextureTransformMovesTheLookup) {
   test::ScratchDir dir;
   const int w = 32, h = 32;
   auto img = write_rgb(dir.file("wave.png"), w, h, [](int i, int j, uint8_t* t) {
-    t[0] = uint8_t(std::lround(128 + 100 * std::sin(2 * kPi * (i + 0.5) / 32)));
-    t[1] = uint8_t(std::lround(128 + 100 * std::cos(2 * kPi * (j + 0.5) / 32)));
-    t[2] = uint8_t(std::lround(128 + 80 * std::sin(2 * kPi * (i + 2 * j + 1.0) / 32)));
+    t[0] = uint8_t(std::lround(128 + 100 * std::sin(2 * std::numbers::pi * (i + 0.5) / 32)));
+    t[1] = uint8_t(std::lround(128 + 100 * std::cos(2 * std::numbers::pi * (j + 0.5) / 32)));
+    t[2] = uint8_t(std::lround(128 + 80 * std::sin(2 * std::numbers::pi * (i + 2 * j + 1.0) / 32)));
   });
   scene::Scene s = test::textured_scene(atlas_quad(), dir.file("wave.png"));
   scene::TextureTransform& tf = s.materials[0].base_color_texture.transform;

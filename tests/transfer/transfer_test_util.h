@@ -22,8 +22,6 @@
 
 namespace vt::test {
 
-constexpr double kPi = 3.14159265358979323846;
-
 // One-mesh scene at the origin with a material of its own.
 inline scene::Scene single_mesh_scene(scene::Primitive prim, scene::Material mat) {
   scene::Scene s;
