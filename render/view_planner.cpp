@@ -5,13 +5,13 @@
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <numeric>
 
 namespace vt::render {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
+constexpr double kDeg = std::numbers::pi / 180.0;
 // A view leans this far off the framed surface's normal: enough perspective to see relief and
 // anisotropic filtering, far from grazing.
 constexpr double kSurfaceTiltDeg = 25.0;
@@ -214,6 +214,7 @@ Expected<PlannedView> make_view(const Context& c, ViewKind kind, Vec3d eye, Vec3
 // the target.
 Expected<PlannedView> framed_view(const Context& c, ViewKind kind, int cluster, Vec3d target,
                                   Vec3d n, double dist, double tilt_deg, bool may_approach) {
+  constexpr double kPi = std::numbers::pi;
   const double spins[] = {0, kPi / 2, -kPi / 2, kPi};
   const double scales[] = {1.0, 0.5, 0.25};
   Vec3d eye = target + lean(n, c.up, tilt_deg, 0) * dist;
