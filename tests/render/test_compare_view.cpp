@@ -1,7 +1,6 @@
 // compare_view on frames the test paints itself (no Vulkan): which pixels enter the tiles.
 #include <gtest/gtest.h>
 
-#include "codec/metrics.h"
 #include "render/validate.h"
 
 namespace vt::render {
@@ -34,7 +33,7 @@ struct Frames {
   }
 };
 
-TEST(CompareView, OutlineStaysOutOfTheTilesButNotTheView) {
+TEST(CompareView, OutlineIsCappedInTheTilesNotInTheView) {
   Frames f;
   // Every outline pixel of the square 100 steps off, as taps that ran off the surface read.
   for (uint32_t y = 8; y < 40; ++y)
@@ -44,8 +43,11 @@ TEST(CompareView, OutlineStaysOutOfTheTilesButNotTheView) {
   ASSERT_TRUE(m.ok()) << m.status().message();
   EXPECT_EQ(m->pixels, 32u * 32u);
   EXPECT_EQ(m->outline_pixels, 32u * 32u - 28u * 28u);  // the two-pixel ring
-  EXPECT_EQ(m->worst_tile_psnr, kPsnrIdentical);        // the interior is identical
-  EXPECT_LT(m->psnr_rgb, 20.0);                         // the whole view still sees the outline
+  // In the tiles the outline counts 24 steps off, so no tile of it alone falls below 20.5 dB
+  // (10 log10(255^2 / 24^2)); the interior is identical.
+  EXPECT_GT(m->worst_tile_psnr, 20.5);
+  EXPECT_LT(m->worst_tile_psnr, 30.0);
+  EXPECT_LT(m->psnr_rgb, 20.0);  // the whole view sees the outline as it is
 
   // A 4 x 4 patch inside, two pixels from the outline, sinks its tile.
   Frames g;
@@ -58,9 +60,9 @@ TEST(CompareView, OutlineStaysOutOfTheTilesButNotTheView) {
   EXPECT_EQ(m->worst_tile_y, 16u);
 }
 
-// A pixel whose taps read page border texels stays in the tiles even on the outline (a zeroed
+// A pixel whose taps read page border texels counts fully even on the outline (a zeroed
 // border shows there first on a small object); a hole only one render drew is no background.
-TEST(CompareView, BorderReadsAndOneRenderHolesStayInTheTiles) {
+TEST(CompareView, BorderReadsAndOneRenderHolesAreNoOutline) {
   Frames f;
   f.reference.covered[20 * kW + 30] = 0;  // a hole in the reference only
   for (uint32_t y = 10; y < 38; ++y) f.virt.status[y * kW + 16] |= 0x20000000u;
