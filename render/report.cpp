@@ -170,6 +170,7 @@ std::string report_json(const ValidationReport& r) {
                      {"ssim", m.ssim},
                      {"max_abs_error", m.max_abs},
                      {"pixels_compared", m.pixels},
+                     {"outline_pixels", m.outline_pixels},
                      {"coarser_share", m.coarser_share},
                      {"unresident_pixels", m.unresident_pixels},
                      {"coverage_mismatch_share", m.coverage_mismatch_share},
