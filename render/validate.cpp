@@ -172,12 +172,11 @@ Expected<ViewMetrics> compare_view(const ReferenceFrame& reference_frame, const 
       test_px.insert(test_px.end(), t, t + 4);
       // The outline (pixels within two of background, one neither render drew) counts fully in
       // the whole-view figures, capped in the tiles: there the screen-space footprint runs off the
-      // surface (an edge-on strip's reaches 40+ level-0 texels, over its first two pixels on
-      // CesiumMilkTruck), so each render reads texels beyond the
-      // surface's own, the source image's neighbours in one and the atlas's neighbouring charts
-      // in the other, and no gutter short of the footprint separates them (docs/BENCHMARKS.md,
-      // "The outline"). A pixel whose taps read page border texels stays in: a bad border
-      // shows first along the outline of a small object.
+      // surface (an edge-on strip's reaches 40+ level-0 texels over its first two pixels on
+      // CesiumMilkTruck), so each render reads beyond the surface, the source image's neighbours
+      // in one and the atlas's neighbouring charts in the other, and no gutter short of the
+      // footprint separates them (docs/BENCHMARKS.md, "The outline"). A pixel whose taps read
+      // page border texels stays in: a bad border shows first along a small object's outline.
       const bool border_read = (st & 0x20000000u) != 0;
       const bool outline = !border_read && near_background(x, y);
       m.outline_pixels += outline;
