@@ -26,11 +26,6 @@ namespace {
 
 constexpr float kFloatMax = std::numeric_limits<float>::max();
 
-bool is_colour(LayerSemantic s) {
-  return s == LayerSemantic::kAlbedo || s == LayerSemantic::kEmissive ||
-         s == LayerSemantic::kLitAlbedo;
-}
-
 Expected<LayerPlan> plan_layer(const LayerInput& in, const BuildOptions& options) {
   LayerPlan p;
   const ImageInfo& info = in.source->info();

@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "bake/level_store.h"
+#include "bake/pyramid.h"
 
 namespace vt {
 namespace {
@@ -100,26 +101,18 @@ Expected<uint64_t> CoverageMask::content_hash() const {
 
 Expected<std::shared_ptr<CoverageMask>> CoverageMask::downsample(
     bool in_memory, const std::string& scratch_dir) const {
-  const uint32_t dw = (width_ + 1) / 2, dh = (height_ + 1) / 2;
-  VT_ASSIGN_OR_RETURN(std::shared_ptr<CoverageMask> out, create(dw, dh, in_memory, scratch_dir));
+  VT_ASSIGN_OR_RETURN(std::shared_ptr<CoverageMask> out,
+                      create((width_ + 1) / 2, (height_ + 1) / 2, in_memory, scratch_dir));
   // Bands of an even number of source rows: a destination row's pair never straddles two.
   const uint32_t band = std::max(2u, band_rows() / 2 * 2);
-  std::vector<uint8_t> src, dst;
+  std::vector<uint8_t> src;
   for (uint32_t y0 = 0; y0 < height_; y0 += band) {
     const uint32_t y1 = std::min(height_, y0 + band);
     VT_RETURN_IF_ERROR(read_rows(y0, y1, src));
-    const uint32_t j0 = y0 / 2, j1 = (y1 + 1) / 2;
-    dst.assign(size_t(dw) * (j1 - j0), 0);
-    for (uint32_t j = j0; j < j1; ++j) {
-      const uint8_t* a = src.data() + size_t(2 * j - y0) * width_;
-      const uint8_t* b = src.data() + size_t(std::min(2 * j + 1, height_ - 1) - y0) * width_;
-      uint8_t* d = dst.data() + size_t(j - j0) * dw;
-      for (uint32_t i = 0; i < dw; ++i) {
-        const uint32_t xa = 2 * i, xb = std::min(2 * i + 1, width_ - 1);
-        d[i] = uint8_t(a[xa] | a[xb] | b[xa] | b[xb]);
-      }
-    }
-    VT_RETURN_IF_ERROR(out->write_rows(j0, j1 - j0, dst.data()));
+    // Only the last band can be odd, and its last row is the level's: the band's clamp is the
+    // level's.
+    const std::vector<uint8_t> dst = downsample_coverage(src.data(), width_, y1 - y0);
+    VT_RETURN_IF_ERROR(out->write_rows(y0 / 2, (y1 - y0 + 1) / 2, dst.data()));
   }
   return out;
 }

@@ -49,6 +49,9 @@ class CoverageMask {
   Status read_rows(uint32_t y0, uint32_t y1, std::vector<uint8_t>& out) const;
   // The whole mask as bytes (tests and the validator's small levels).
   Expected<std::vector<uint8_t>> to_bytes() const;
+  // Rows moved at a time by the mask's own loops (about 4 MiB as bytes); callers that stream a
+  // mask to or from a file use it too.
+  uint32_t band_rows() const;
   // XXH3 of to_bytes(), computed in bands (the plan hash's, as when masks were bytes).
   Expected<uint64_t> content_hash() const;
   // The half-size level's mask: a texel is covered when any of its 2x2 footprint is (the
@@ -59,7 +62,6 @@ class CoverageMask {
  private:
   CoverageMask() = default;
   uint32_t words() const { return (width_ + 31) / 32; }
-  uint32_t band_rows() const;
   uint32_t width_ = 0, height_ = 0;
   std::unique_ptr<LevelStore> store_;  // words() 32-bit words a row (moved as floats' bytes)
 };

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <span>
 #include <string>
@@ -56,7 +57,7 @@ constexpr float kMaxIrradiance = 65504.0f;
 // surface of linear base colour `base` under irradiance `e` (lux), base x e / pi, clamped as
 // irradiance is.
 inline float lit_albedo(double base, double e) {
-  const double v = base * e * 0.31830988618379067;  // 1 / pi
+  const double v = base * e * std::numbers::inv_pi;
   return v > 0 ? float(std::min(v, double(kMaxIrradiance))) : 0.0f;
 }
 

@@ -115,10 +115,8 @@ Expected<PageEncoder> PageEncoder::create(LayerSpec& layer, const PageEncoderOpt
         dct.adaptive = options.dct_adaptive;
         dct.channels = int(layer.channels);
         // Chroma subsampling suits colour only; packed data and normals lose too much to it.
-        bool colour =
-            layer.semantic == LayerSemantic::kAlbedo || layer.semantic == LayerSemantic::kEmissive;
-        dct.layout =
-            colour && layer.channels >= 3 ? DctPlaneLayout::kYCoCg420 : DctPlaneLayout::kPlanes;
+        dct.layout = is_colour(layer.semantic) && layer.channels >= 3 ? DctPlaneLayout::kYCoCg420
+                                                                      : DctPlaneLayout::kPlanes;
         auto made = dct_make_tables(dct, int(page_size), int(page_size));
         if (!made.ok()) return made.status().with_context("layer '" + layer.name + "'");
         layer.codec_tables = dct_serialize_tables(**made);

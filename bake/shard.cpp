@@ -156,19 +156,13 @@ Status write_text(const std::string& path, const std::string& text) {
   return f.close();
 }
 
-// Mask rows moved at a time: about 4 MiB of bytes.
-uint32_t coverage_band(const CoverageMask& c) {
-  return uint32_t(
-      std::clamp<size_t>((size_t(4) << 20) / std::max(c.width(), 1u), 1, std::max(1u, c.height())));
-}
-
 // The mask as one byte per texel (level0/coverage.u8), written in bands.
 Status write_coverage(const CoverageMask& c, const std::string& path) {
   HashedFile f;
   VT_RETURN_IF_ERROR(f.open(path));
   std::vector<uint8_t> rows;
-  for (uint32_t y = 0; y < c.height(); y += coverage_band(c)) {
-    VT_RETURN_IF_ERROR(c.read_rows(y, std::min(c.height(), y + coverage_band(c)), rows));
+  for (uint32_t y = 0; y < c.height(); y += c.band_rows()) {
+    VT_RETURN_IF_ERROR(c.read_rows(y, std::min(c.height(), y + c.band_rows()), rows));
     f.put(rows.data(), rows.size());
   }
   return f.close();
@@ -563,8 +557,8 @@ Expected<std::shared_ptr<const CoverageMask>> read_coverage(const std::string& p
       CoverageMask::create(w, h, CoverageMask::fits_memory(w, h, options.memory_limit),
                            scratch_dir_for(options)));
   std::vector<uint8_t> rows;
-  for (uint32_t y = 0; y < h; y += coverage_band(*mask)) {
-    const uint32_t n = std::min(h - y, coverage_band(*mask));
+  for (uint32_t y = 0; y < h; y += mask->band_rows()) {
+    const uint32_t n = std::min(h - y, mask->band_rows());
     rows.resize(size_t(n) * w);
     if (!in.read(reinterpret_cast<char*>(rows.data()), std::streamsize(rows.size())))
       return io_error(path, "read failed");

@@ -67,9 +67,7 @@ Status write_level_png(const std::string& path, const LevelImage& image, const L
     put_u32(header, image.height);
     header.insert(header.end(), {8, kColourType[image.channels], 0, 0, 0});
     png.chunk("IHDR", header.data(), header.size());
-    const bool colour =
-        layer.semantic == LayerSemantic::kAlbedo || layer.semantic == LayerSemantic::kEmissive;
-    if (colour && layer.color_space == ColorSpace::kSrgb) {
+    if (is_colour(layer.semantic) && layer.color_space == ColorSpace::kSrgb) {
       const uint8_t perceptual = 0;
       png.chunk("sRGB", &perceptual, 1);
     }

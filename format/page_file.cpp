@@ -23,6 +23,11 @@ const char* to_string(LayerSemantic v) {
   return "unknown";
 }
 
+bool is_colour(LayerSemantic v) {
+  return v == LayerSemantic::kAlbedo || v == LayerSemantic::kEmissive ||
+         v == LayerSemantic::kLitAlbedo;
+}
+
 const char* to_string(TexelType v) {
   switch (v) {
     case TexelType::kU8:

@@ -40,6 +40,9 @@ enum class PageCodec : uint8_t {
 enum class ColorSpace : uint8_t { kLinear = 0, kSrgb = 1 };
 
 const char* to_string(LayerSemantic v);
+// Colour layers (albedo, emissive, lit albedo): linear colour, filtered in linear light, sRGB
+// when stored in 8 bits; their 4th channel is alpha.
+bool is_colour(LayerSemantic v);
 const char* to_string(TexelType v);
 const char* to_string(PageCodec v);
 const char* to_string(ColorSpace v);

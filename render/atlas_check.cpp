@@ -30,11 +30,6 @@ double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-bool is_colour(LayerSemantic s) {
-  return s == LayerSemantic::kAlbedo || s == LayerSemantic::kEmissive ||
-         s == LayerSemantic::kLitAlbedo;
-}
-
 // The settings of the bake the reference must repeat, from the file's metadata.
 struct BakeSettings {
   int supersample = 1;
