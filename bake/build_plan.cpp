@@ -52,8 +52,7 @@ Expected<LayerPlan> plan_layer(const LayerInput& in, const BuildOptions& options
     }
   }
   // Lighting (and lit albedo) is HDR by nature: half float unless 32-bit float is asked.
-  if ((in.semantic == LayerSemantic::kLighting || in.semantic == LayerSemantic::kLitAlbedo) &&
-      info.is_float && float_type == TexelType::kU8)
+  if (is_light(in.semantic) && info.is_float && float_type == TexelType::kU8)
     float_type = TexelType::kF16;
   const bool want_float = float_type != TexelType::kU8;
   if (in.semantic == LayerSemantic::kNormal) {

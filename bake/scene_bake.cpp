@@ -117,9 +117,7 @@ std::vector<LayerRange> layer_ranges(const std::vector<TransferLayer>& transferr
   for (const TransferLayer& t : transferred) {
     // Irradiance above 1 is what lighting is: nothing to report, and the layer is half float
     // (lit albedo alike).
-    if (t.texels_above_one == 0 || t.semantic == LayerSemantic::kLighting ||
-        t.semantic == LayerSemantic::kLitAlbedo)
-      continue;
+    if (t.texels_above_one == 0 || is_light(t.semantic)) continue;
     LayerRange r;
     r.semantic = t.semantic;
     r.layer = to_string(t.semantic);

@@ -23,9 +23,7 @@ OIIO::TypeDesc oiio_type(vt::TexelType type) {
 OIIO::ImageSpec output_spec(const vt::LevelImage& image, const vt::LayerSpec& layer) {
   OIIO::ImageSpec spec(int(image.width), int(image.height), int(image.channels),
                        oiio_type(image.texel_type));
-  const bool colour = layer.semantic == vt::LayerSemantic::kAlbedo ||
-                      layer.semantic == vt::LayerSemantic::kEmissive;
-  const bool alpha = colour && (image.channels == 2 || image.channels == 4);
+  const bool alpha = vt::is_colour(layer.semantic) && (image.channels == 2 || image.channels == 4);
   spec.alpha_channel = alpha ? int(image.channels) - 1 : -1;
   if (!alpha && image.channels == 4) spec.channelnames[3] = "W";  // data, not an alpha
   // The page file never premultiplies: without this, the PNG writer divides colour by the last

@@ -28,6 +28,10 @@ bool is_colour(LayerSemantic v) {
          v == LayerSemantic::kLitAlbedo;
 }
 
+bool is_light(LayerSemantic v) {
+  return v == LayerSemantic::kLighting || v == LayerSemantic::kLitAlbedo;
+}
+
 const char* to_string(TexelType v) {
   switch (v) {
     case TexelType::kU8:

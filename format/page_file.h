@@ -43,6 +43,9 @@ const char* to_string(LayerSemantic v);
 // Colour layers (albedo, emissive, lit albedo): linear colour, filtered in linear light, sRGB
 // when stored in 8 bits; their 4th channel is alpha.
 bool is_colour(LayerSemantic v);
+// Light layers (irradiance, lit albedo): unbounded HDR radiometry, half float unless asked for
+// 32-bit, judged after a tone map.
+bool is_light(LayerSemantic v);
 const char* to_string(TexelType v);
 const char* to_string(PageCodec v);
 const char* to_string(ColorSpace v);

@@ -246,8 +246,7 @@ Status measure_page(const ReferenceLayer& r, const uint8_t* ref, const uint8_t* 
       }
       a = ref_f.data(), b = test_f.data();
     }
-    if (r.spec.semantic == LayerSemantic::kLighting ||
-        r.spec.semantic == LayerSemantic::kLitAlbedo) {
+    if (is_light(r.spec.semantic)) {
       // Irradiance in lux (and the radiance of lit albedo) has no peak: judged after the tone map x
       // / (1 + x) (as codec/hdr_metrics.h's tone-mapped figure), where an error is as visible as it
       // looks.

@@ -521,9 +521,7 @@ Status check_lighting_views(Renderer& renderer, const std::shared_ptr<const Page
   const std::vector<LayerSpec>& specs = in.reader->layers();
   std::optional<uint32_t> layer;
   for (uint32_t l = 0; l < specs.size() && !layer; ++l)
-    if (specs[l].semantic == LayerSemantic::kLighting ||
-        specs[l].semantic == LayerSemantic::kLitAlbedo)
-      layer = l;
+    if (is_light(specs[l].semantic)) layer = l;
   if (!layer) return Status::Ok();
   const nlohmann::json meta = nlohmann::json::parse(in.reader->metadata_json(), nullptr, false);
   const double texels_per_unit = meta.is_object() ? meta.value("texels_per_unit", 0.0) : 0.0;

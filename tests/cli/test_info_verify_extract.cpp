@@ -228,5 +228,32 @@ TEST(CliExtract, HalfFloatLayerToExrIsExact) {
   EXPECT_EQ(halves, levels[0]);
 }
 
+// A 4-channel layer's last channel is alpha only in colour layers: lit albedo's is (an RGBA
+// radiance), lighting with ambient occlusion's is not (irradiance + AO).
+TEST(CliExtract, ExrNamesAlphaOnlyInColourLayers) {
+  for (const LayerSemantic semantic : {LayerSemantic::kLitAlbedo, LayerSemantic::kLighting}) {
+    PageFileDesc desc;
+    desc.geometry = {20, 12, 8, 2};
+    desc.layers = {layer(to_string(semantic), 4, TexelType::kF16, PageCodec::kRawZstd)};
+    desc.layers[0].semantic = semantic;
+    const PageGeometry& g = desc.geometry;
+    const std::string path = temp_path("light.vtpf");
+    {
+      auto w = PageFileWriter::create(path, desc);
+      ASSERT_TRUE(w.ok());
+      ASSERT_TRUE((*w)->finish().ok());
+    }
+    const std::string exr = temp_path("light.exr");
+    ASSERT_EQ(run("-q extract " + path + " --level 0 -o " + exr).exit_code, 0);
+    auto in = OIIO::ImageInput::open(exr);
+    ASSERT_TRUE(in);
+    ASSERT_EQ(uint32_t(in->spec().width), g.level_width(0));
+    ASSERT_EQ(in->spec().nchannels, 4);
+    const bool colour = semantic == LayerSemantic::kLitAlbedo;
+    EXPECT_EQ(in->spec().alpha_channel, colour ? 3 : -1) << to_string(semantic);
+    EXPECT_EQ(in->spec().channelnames[3], colour ? "A" : "W") << to_string(semantic);
+  }
+}
+
 }  // namespace
 }  // namespace vt
