@@ -99,15 +99,22 @@ class LayerRun {
   Status begin_level(uint32_t level) {
     if (level == 0) {
       current_ = layer_.level0;
+      VT_RETURN_IF_ERROR(take_given_levels());
+    } else if (!given_.empty()) {
+      current_ = given_[level].source;
+      alpha_.scale = given_[level].alpha_scale;
     } else {
       current_ = std::move(next_);
+      if (plan_.options.level_done) {
+        VT_RETURN_IF_ERROR(plan_.options.level_done(li_, level, *current_, alpha_.scale));
+      }
     }
     level_ = level;
     window_ = std::make_unique<RowWindow>(*current_, plan_.options.address);
     if (plan_.options.address == AddressMode::kWrap) {
       VT_RETURN_IF_ERROR(window_->pin(g_.payload + 2 * plan_.margin, plan_.margin));
     }
-    if (level + 1 == g_.level_count()) return Status::Ok();
+    if (level + 1 == g_.level_count() || !given_.empty()) return Status::Ok();
     const bool in_memory = layer_.level_in_memory[level + 1];
     std::unique_ptr<LevelStore> next;
     VT_ASSIGN_OR_RETURN(next,
@@ -131,6 +138,7 @@ class LayerRun {
   Expected<uint64_t> run_band(uint32_t row, bool encode, uint32_t& pages, double& t_read,
                               double& t_encode, double& t_pyramid) {
     const uint32_t P = g_.payload, m = plan_.margin, l = level_;
+    if (!encode && !given_.empty()) return uint64_t(0);  // another shard's, and no pyramid to feed
     auto t0 = Clock::now();
     VT_ASSIGN_OR_RETURN(RowBand band, window_->fetch(int64_t(row) * P - m, P + 2 * m));
     t_read += seconds_since(t0);
@@ -210,6 +218,34 @@ class LayerRun {
     XXH3_64bits_update(&state, band.data,
                        size_t(band.rows) * band.width * band.channels * sizeof(float));
     return XXH3_64bits_digest(&state);
+  }
+
+  // BuildOptions::level_from's coarser levels, all or none, checked against the geometry.
+  Status take_given_levels() {
+    given_.clear();
+    if (!plan_.options.level_from) return Status::Ok();
+    std::vector<BuildOptions::GivenLevel> given(g_.level_count());
+    uint32_t count = 0;
+    for (uint32_t l = 1; l < g_.level_count(); ++l) {
+      VT_ASSIGN_OR_RETURN(given[l], plan_.options.level_from(li_, l));
+      const LevelSource* s = given[l].source.get();
+      if (!s) continue;
+      ++count;
+      if (s->width() != g_.level_width(l) || s->height() != g_.level_height(l) ||
+          s->channels() != layer_.work_channels) {
+        return Status(ErrorCode::kInvalidArgument, layer_.spec.name + ": the given level " +
+                                                       std::to_string(l) +
+                                                       " is not the layer's working form");
+      }
+    }
+    if (count == 0) return Status::Ok();
+    if (count + 1 != g_.level_count()) {
+      return Status(ErrorCode::kInvalidArgument, layer_.spec.name + ": " + std::to_string(count) +
+                                                     " of " + std::to_string(g_.level_count() - 1) +
+                                                     " coarser levels given");
+    }
+    given_ = std::move(given);
+    return Status::Ok();
   }
 
   void count_level0_alpha(const RowBand& band, uint32_t row) {
@@ -349,6 +385,7 @@ class LayerRun {
   uint32_t level_ = 0;
   std::shared_ptr<LevelSource> current_;
   std::unique_ptr<LevelStore> next_;
+  std::vector<BuildOptions::GivenLevel> given_;  // empty, or one per level (0 unused)
   std::unique_ptr<RowWindow> window_;
   std::vector<float> next_rows_;
   AlphaCoverage alpha_;

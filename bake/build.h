@@ -98,14 +98,24 @@ struct BuildOptions {
   bool retrain_tables = false;
   uint64_t input_key = 0;
   // Sharding over a build farm (bake/shard.h): when set, one flag per task of make_build_tasks.
-  // A band task not flagged still reads its rows and writes its share of the next level (every
-  // shard holds the whole pyramid), but encodes and emits none of its pages: they are another
-  // shard's. Its key is computed all the same.
+  // A band task not flagged encodes and emits none of its pages (they are another shard's); it
+  // still reads its rows, computes its key and writes its share of the next level, unless the
+  // coarser levels are given (level_from): then it does nothing.
   std::shared_ptr<const std::vector<uint8_t>> task_subset;
-  // Sharding: level 0 of layer i in its working form, converted and dilated as open_level0 gives
-  // it (a farm's plan job wrote it), so that a shard does not redo that; a null result = open
-  // it from the layer's source as usual.
-  std::function<Expected<std::shared_ptr<LevelSource>>(size_t layer)> level0_from;
+  // Sharding: the levels of layer i in their working form as a farm's plan job wrote them (level 0
+  // converted and dilated as open_level0 gives it; each coarser level dilated as the pyramid makes
+  // it, with the alpha scale its pages are stored with), so that a shard reads its pages' rows
+  // instead of redoing the pyramid. A null source = made here as usual; the coarser levels are
+  // given all or none.
+  struct GivenLevel {
+    std::shared_ptr<LevelSource> source;
+    float alpha_scale = 1.0f;
+  };
+  std::function<Expected<GivenLevel>(size_t layer, uint32_t level)> level_from;
+  // The plan job's side: each coarser level (1, 2, ...) of layer i once it is complete, before its
+  // pages are cut.
+  std::function<Status(size_t layer, uint32_t level, LevelSource& texels, float alpha_scale)>
+      level_done;
   std::function<void(const BuildProgress&)> progress;
 };
 

@@ -580,8 +580,9 @@ Expected<BuildPlan> plan_build(const BuildOptions& options) {
   for (size_t i = 0; i < plan.layers.size(); ++i) {
     LayerPlan& layer = plan.layers[i];
     const LayerInput& in = options.layers[i];
-    if (options.level0_from) {
-      VT_ASSIGN_OR_RETURN(layer.level0, options.level0_from(i));
+    if (options.level_from) {
+      VT_ASSIGN_OR_RETURN(BuildOptions::GivenLevel given, options.level_from(i, 0));
+      layer.level0 = std::move(given.source);
       if (layer.level0 && (layer.level0->channels() != layer.work_channels ||
                            layer.level0->width() != in.source->info().width ||
                            layer.level0->height() != in.source->info().height)) {

@@ -94,10 +94,10 @@ class RawFileSource final : public ImageSource {
   ImageInfo info_;
 };
 
-// Level 0 in its working form as the plan wrote it (converted and dilated), read by rows.
-class FileLevel0 final : public LevelSource {
+// A level in its working form as the plan wrote it (converted, dilated), read by rows.
+class FileLevel final : public LevelSource {
  public:
-  FileLevel0(std::shared_ptr<RawFileSource> file, std::shared_ptr<const CoverageMask> cov)
+  FileLevel(std::shared_ptr<RawFileSource> file, std::shared_ptr<const CoverageMask> cov)
       : file_(std::move(file)), coverage_(std::move(cov)) {}
   uint32_t width() const override { return file_->info().width; }
   uint32_t height() const override { return file_->info().height; }
@@ -338,6 +338,7 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
   if (!dir.empty()) {
     std::error_code ec;
     fs::create_directories(fs::path(dir) / "level0", ec);
+    fs::create_directories(fs::path(dir) / "levels", ec);
     fs::create_directories(fs::path(dir) / "parts", ec);
     if (ec) return Error(ErrorCode::kIo, dir + ": cannot create the work folder: " + ec.message());
   }
@@ -404,9 +405,30 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
   t0 = Clock::now();
   const std::vector<BuildTask> tasks = make_build_tasks(plan);
   plan.options.task_subset = std::make_shared<const std::vector<uint8_t>>(tasks.size(), 0);
+  // The coarser levels as this pass makes them, so that no shard redoes the pyramid (each would
+  // read and filter the whole atlas, however few pages it encodes).
+  double t_levels = 0;
+  if (!dir.empty()) {
+    plan.options.level_done = [&](size_t li, uint32_t level, LevelSource& texels,
+                                  float alpha_scale) -> Status {
+      const auto t = Clock::now();
+      const std::string file =
+          "levels/" + plan.layers[li].spec.name + "." + std::to_string(level) + ".f32";
+      VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/" + file));
+      VT_RETURN_IF_ERROR(write_level(texels, staged));
+      nlohmann::json& l = layers[li];
+      if (!l.contains("levels")) l["levels"] = nlohmann::json::array();
+      l["levels"].push_back({{"file", file}, {"alpha_scale", alpha_scale}});
+      l["levels_coverage"] = texels.coverage() != nullptr;
+      l["work_channels"] = texels.channels();
+      t_levels += seconds_since(t);
+      return Status::Ok();
+    };
+  }
   NullSink none;
   VT_ASSIGN_OR_RETURN(BuildSummary keys, build_pages(plan, none));
-  sum.stages.push_back({"keys", seconds_since(t0)});
+  sum.stages.push_back({"keys", seconds_since(t0) - t_levels});
+  sum.stages.push_back({"write levels", t_levels});
 
   t0 = Clock::now();
   if (!dir.empty()) {
@@ -597,6 +619,57 @@ Expected<std::vector<LayerInput>> work_layers(const WorkPlan& w, const BuildOpti
   return layers;
 }
 
+// The levels in their working form as the plan wrote them: level 0 (converted and dilated) of
+// the layers that carry a coverage mask, and every coarser level of every layer; the masks of
+// the coarser levels are derived here as the pyramid derives them.
+Expected<std::function<Expected<BuildOptions::GivenLevel>(size_t, uint32_t)>> given_levels(
+    const WorkPlan& w, const BuildOptions& options) {
+  const nlohmann::json& layers = w.json["layers"];
+  std::vector<std::vector<BuildOptions::GivenLevel>> given(layers.size());
+  std::vector<std::shared_ptr<const CoverageMask>> masks;
+  for (size_t i = 0; i < layers.size() && i < options.layers.size(); ++i) {
+    const auto& l = layers[i];
+    const uint32_t w0 = l.value("width", 0u), h0 = l.value("height", 0u);
+    ImageInfo info;
+    info.channels = l.value("work_channels", 0u);
+    auto open = [&](const std::string& file, uint32_t width, uint32_t height,
+                    std::shared_ptr<const CoverageMask> mask,
+                    float alpha_scale) -> Expected<BuildOptions::GivenLevel> {
+      info.width = width, info.height = height;
+      VT_ASSIGN_OR_RETURN(auto raw, RawFileSource::open(w.dir + "/" + file, info));
+      return BuildOptions::GivenLevel{std::make_shared<FileLevel>(std::move(raw), std::move(mask)),
+                                      alpha_scale};
+    };
+    given[i].resize(1);
+    if (const std::string file = l.value("work_file", ""); !file.empty()) {
+      VT_ASSIGN_OR_RETURN(given[i][0], open(file, w0, h0, options.layers[i].coverage, 1.0f));
+    }
+    const auto& levels = l.value("levels", nlohmann::json::array());
+    const bool covered = l.value("levels_coverage", false) && options.layers[i].coverage;
+    if (covered && masks.empty()) masks.push_back(options.layers[i].coverage);
+    uint32_t width = w0, height = h0;
+    for (size_t k = 0; k < levels.size(); ++k) {
+      width = (width + 1) / 2, height = (height + 1) / 2;
+      if (covered && masks.size() <= k + 1) {
+        VT_ASSIGN_OR_RETURN(
+            std::shared_ptr<CoverageMask> half,
+            masks[k]->downsample(CoverageMask::fits_memory(width, height, options.memory_limit),
+                                 scratch_dir_for(options)));
+        masks.push_back(std::move(half));
+      }
+      given[i].push_back({});
+      VT_ASSIGN_OR_RETURN(given[i].back(), open(levels[k].value("file", ""), width, height,
+                                                covered ? masks[k + 1] : nullptr,
+                                                levels[k].value("alpha_scale", 1.0f)));
+    }
+  }
+  return std::function<Expected<BuildOptions::GivenLevel>(size_t, uint32_t)>(
+      [given = std::move(given)](size_t i, uint32_t level) -> Expected<BuildOptions::GivenLevel> {
+        if (i < given.size() && level < given[i].size()) return given[i][level];
+        return BuildOptions::GivenLevel{};
+      });
+}
+
 }  // namespace
 
 Expected<ShardSummary> run_shard(const ShardOptions& options) {
@@ -644,21 +717,7 @@ Expected<ShardSummary> run_shard(const ShardOptions& options) {
   bo.input_key = unhex(w.json["input_key"]);
   bo.update = false;
   bo.tables_from = w.dir + "/tables.vtpf";
-  // Level 0 as the plan converted and dilated it, where it wrote that.
-  std::vector<std::shared_ptr<LevelSource>> level0(bo.layers.size());
-  for (size_t i = 0; i < bo.layers.size() && i < w.json["layers"].size(); ++i) {
-    const auto& l = w.json["layers"][i];
-    const std::string file = l.value("work_file", "");
-    if (file.empty()) continue;
-    ImageInfo info;
-    info.width = l.value("width", 0u), info.height = l.value("height", 0u);
-    info.channels = l.value("work_channels", 0u);
-    VT_ASSIGN_OR_RETURN(auto raw, RawFileSource::open(w.dir + "/" + file, info));
-    level0[i] = std::make_shared<FileLevel0>(std::move(raw), bo.layers[i].coverage);
-  }
-  bo.level0_from = [level0](size_t i) -> Expected<std::shared_ptr<LevelSource>> {
-    return i < level0.size() ? level0[i] : nullptr;
-  };
+  VT_ASSIGN_OR_RETURN(bo.level_from, given_levels(w, bo));
   sum.stages.push_back({"read", seconds_since(t0)});
   t0 = Clock::now();
   VT_RETURN_IF_ERROR(drop_opaque_alpha(bo));

@@ -3,10 +3,11 @@
 //  1. plan (plan_bake): load, unwrap, transfer, train the DCT tables, and run the pyramid once
 //     without encoding for the task keys. Writes the task graph (plan.json: tasks, keys,
 //     dependencies, estimated cost) and, with a work folder, what the shards read: level0/ (the
-//     transferred layers and their coverage), tables.vtpf (a page file with no pages: the final
-//     header, tables included) and unwrapped.glb.
-//  2. shards (run_shard): each reads level 0 and the tables, rebuilds the pyramid (pull-push
-//     dilation needs whole levels) and encodes only its own band tasks' pages into
+//     transferred layers and their coverage), levels/ (every level in working form), tables.vtpf (a
+//     page file with no pages: the final header, tables included) and unwrapped.glb.
+//  2. shards (run_shard): each reads the tables and every level as the plan's pyramid pass
+//     wrote it (levels/; pull-push dilation needs whole levels, so only one process can make
+//     them) and cuts and encodes only its own band tasks' pages into
 //     parts/NAME.part: the pages, their keys and checksums, its task keys, and one checksum
 //     over the whole file, written under a temporary name and renamed when complete.
 //  3. merge (merge_shards): the page file from the parts and the unwrapped scene beside it,

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Build farm figures (docs/BENCHMARKS.md, "Build farm"): the sample scene baked in one process
 # (--threads 2) and through Slurm (a one-node cluster, tests/farm/local_cluster.sh; 2 shards of
-# 1 CPU at once, the plan job on 2), wall times as medians of RUNS; then the same steps by hand
+# 1 CPU at once, the plan job on 2), wall times as medians of RUNS alternating rounds; then the same steps by hand
 # with --json for what the farm's time is made of, and the per-core rates the 128K model uses
 # (bench/farm_model.py). Run as root, through `heavy`.
 #   bench/farm_bench.sh VTBAKE [SIZE_PAGES=16] [RUNS=3] [BAKE FLAGS...]   (e.g. --codec bc:high)
@@ -21,23 +21,23 @@ now() { date +%s.%N; }
 median() { sort -g | awk '{a[NR] = $1} END {print a[int((NR + 1) / 2)]}'; }
 
 mkdir -p "$tmp/local"
+start_cluster "$tmp/cluster"
+# Alternating rounds (one process, then the farm), so both see the same load.
+: >"$tmp/local.times"
+: >"$tmp/farm.times"
 for r in $(seq "$runs"); do
   t0=$(now)
   "$vtbake" -q --threads 2 bake "$tmp/scene/scene.gltf" -o "$tmp/local/out.vtpf" "${flags[@]}" >/dev/null
-  echo "$(now) - $t0" | bc
-done >"$tmp/local.times"
-echo "one process (--threads 2): median $(median <"$tmp/local.times") s of $(paste -sd' ' "$tmp/local.times")"
-
-start_cluster "$tmp/cluster"
-for r in $(seq "$runs"); do
+  echo "$(now) - $t0" | bc >>"$tmp/local.times"
   rm -rf "$tmp/farm"
   t0=$(now)
   PATH="$(dirname "$vtbake"):$PATH" "$src/scripts/farm.sh" --work "$tmp/farm/work" --shards 2 \
     --cpus 1 --plan-cpus 2 --poll 0.2 --vtbake "$vtbake" \
     -- "$tmp/scene/scene.gltf" -o "$tmp/farm/out.vtpf" "${flags[@]}" >/dev/null
-  echo "$(now) - $t0" | bc
+  echo "$(now) - $t0" | bc >>"$tmp/farm.times"
   cmp "$tmp/local/out.vtpf" "$tmp/farm/out.vtpf"
-done >"$tmp/farm.times"
+done
+echo "one process (--threads 2): median $(median <"$tmp/local.times") s of $(paste -sd' ' "$tmp/local.times")"
 echo "Slurm, 2 shards x 1 CPU: median $(median <"$tmp/farm.times") s of $(paste -sd' ' "$tmp/farm.times") (merged file byte-identical)"
 stop_cluster
 

@@ -4,8 +4,9 @@
 Per-core rates come from the sample-scene runs bench/farm_bench.sh makes (plan at 1 thread:
 transfer and key pass per texel; one shard of all tasks at 1 thread: encode per page; merge per
 page); they are scaled to a 131,072^2 atlas with the sample's coverage and layers, and combined
-along the task graph's critical path: plan (serial) -> shards (in parallel, each reads all of
-level 0 and rebuilds the pyramid, encodes 1/M of the pages) -> merge (serial).
+along the task graph's critical path: plan (serial: transfer, the pyramid pass, every level
+written) -> shards (in parallel, each reads its own pages' rows of every level and encodes 1/M
+of the pages) -> merge (serial).
 Storage assumptions are parameters, printed with the table."""
 import argparse
 import json
@@ -45,7 +46,7 @@ def main():
     # Per-core rates at 1 thread.
     transfer_s_per_texel = plan1["transfer"] / texels
     keys_s_per_texel = plan1["keys"] / texels  # the pyramid pass without encoding
-    encode_s_per_page = max(shard_all["build"] - plan1["keys"], 0.0) / pages
+    encode_s_per_page = shard_all["build"] / pages  # a shard no longer runs the pyramid
     merge_s_per_page = merge["seconds"]["total"] / pages
     tables_s = plan1["plan"]
     print("measured on the sample scene (%dx%d atlas, %d layers, %d pages to encode):"
@@ -70,36 +71,36 @@ def main():
     print("\nmodel: %d^2 atlas (%.3g texels, %.3g pages, level 0 %.0f GB as float), %d cores a "
           "machine, %.1f GB/s a node, %.0f GB/s storage in all, %.0f s Slurm latency a step"
           % (o.side, T, P, L0 / 1e9, c, o.node_gbps, o.storage_gbps, o.slurm_s))
-    plan_s = (transfer_s_per_texel + keys_s_per_texel) * T / c + tables_s + L0 / (o.node_gbps * 1e9)
+    levels = L0 * 4 / 3  # every level in working form, written once by the plan
+    pyramid = keys_s_per_texel * T / c
+    plan_s = transfer_s_per_texel * T / c + pyramid + tables_s + levels / (o.node_gbps * 1e9)
     merge_s = merge_s_per_page * P
-    print("| machines | plan (serial) | shard: read level 0 | shard: pyramid | shard: encode | merge | "
-          "total | speed-up |")
-    print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    print("| machines | plan (serial: transfer, pyramid, levels written) | shard: read its rows | "
+          "shard: encode | merge | total | speed-up |")
+    print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     one = None
     for m in (1, 8, 64, 512):
-        read = L0 / (min(o.node_gbps, o.storage_gbps / m) * 1e9)
-        pyramid = keys_s_per_texel * T / c
+        read = levels / m / (min(o.node_gbps, o.storage_gbps / m) * 1e9)
         encode = encode_s_per_page * P / (m * c)
-        if m == 1:  # one machine: no farm, the one-process bake (no level-0 round trip)
+        if m == 1:  # one machine: no farm, the one-process bake (no level round trip)
             total = (transfer_s_per_texel * T + encode_s_per_page * P + keys_s_per_texel * T) / c
             one = total
-            print("| 1 (one process) | - | - | %.0f s | %.0f s | - | %.0f s (%.1f h) | 1.0 |"
-                  % (pyramid, encode, total, total / 3600))
+            print("| 1 (one process) | - | - | %.0f s | - | %.0f s (%.1f h) | 1.0 |"
+                  % (encode, total, total / 3600))
             continue
-        total = plan_s + read + pyramid + encode + merge_s + 3 * o.slurm_s
-        print("| %d | %.0f s | %.0f s | %.0f s | %.0f s | %.0f s | %.0f s (%.1f h) | %.1f |"
-              % (m, plan_s, read, pyramid, encode, merge_s, total, total / 3600, one / total))
+        total = plan_s + read + encode + merge_s + 3 * o.slurm_s
+        print("| %d | %.0f s | %.0f s | %.0f s | %.0f s | %.0f s (%.1f h) | %.1f |"
+              % (m, plan_s, read, encode, merge_s, total, total / 3600, one / total))
 
-    # On paper, the cut this design would need to scale (not built): the transfer sharded by
-    # bands of rows (it already runs in bands), one gather job that dilates and builds the
-    # pyramid once and writes every level, and encode shards that read only their own rows.
-    print("\nthe same on paper with the transfer sharded by row bands, one gather job (dilation + "
-          "pyramid once, every level written) and encode shards reading only their rows:")
+    # On paper, the cut still needed to scale (not built): the transfer sharded by bands of rows
+    # (it already runs in bands) ahead of one gather job that dilates, builds the pyramid once and
+    # writes every level (what the plan does now after its own transfer).
+    print("\nthe same on paper with the transfer sharded by row bands and one gather job "
+          "(dilation + pyramid once, every level written) before the encode shards:")
     print("| machines | transfer shards | gather (serial) | encode shards | merge | total | "
           "speed-up |")
     print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
-    levels = L0 * 4 / 3
-    gather = L0 / (o.node_gbps * 1e9) + keys_s_per_texel * T / c + levels / (o.node_gbps * 1e9)
+    gather = L0 / (o.node_gbps * 1e9) + pyramid + levels / (o.node_gbps * 1e9)
     for m in (8, 64, 512):
         bw = min(o.node_gbps * m, o.storage_gbps) * 1e9
         transfer = transfer_s_per_texel * T / (m * c) + L0 / bw

@@ -30,7 +30,7 @@ class FarmCli : public ::testing::Test {
                                       "--ground-cells 4 --sphere-segments 12 --texture-size 64");
     if (!setup_error_.empty()) return;
     fs::create_directories(dir_ + "/local");
-    for (const char* name : {"four", "tasks", "one", "kill", "a", "b"})
+    for (const char* name : {"four", "tasks", "one", "kill", "a", "b", "alpha", "alpha_local"})
       fs::create_directories(dir_ + "/" + name);
     RunResult b =
         run_vtbake("-q bake " + scene() + " -o " + dir_ + "/local/out.vtpf " + flags(), true);
@@ -197,6 +197,48 @@ TEST_F(FarmCli, MergeRefusesPartsOfAnotherPlan) {
   EXPECT_NE(m.out.find("another plan"), std::string::npos) << m.out;
   EXPECT_FALSE(fs::exists(dir_ + "/a/out.vtpf"));
   EXPECT_EQ(run_vtbake("merge " + work("a") + " --missing 2", true).out, "1\n");
+}
+
+// The plan writes every coarser level as its pyramid pass makes it (dilated, with the alpha
+// scale of coverage-preserving alpha), and the shards read them instead of redoing the pyramid:
+// the merge stays byte-identical with a per-level alpha scale, and a damaged level file fails the
+// shard, naming it, before anything is written.
+TEST_F(FarmCli, ShardsReadThePlansLevelsAndAlphaScales) {
+  const std::string alpha = "--alpha-coverage 0.5";
+  RunResult local = run_vtbake(
+      "-q bake " + scene() + " -o " + dir_ + "/alpha_local/out.vtpf " + flags() + " " + alpha,
+      true);
+  ASSERT_EQ(local.exit_code, 0) << local.out;
+  ASSERT_EQ(bake("alpha", "--plan " + work("alpha") + "/plan.json", alpha).exit_code, 0);
+  auto plan = nlohmann::json::parse(read_file(work("alpha") + "/plan.json"));
+  const uint32_t levels = plan["geometry"]["levels"].get<uint32_t>();
+  bool scaled = false;
+  for (const auto& l : plan["layers"]) {
+    ASSERT_EQ(l["levels"].size(), levels - 1) << l["name"];
+    for (const auto& level : l["levels"]) {
+      EXPECT_TRUE(fs::exists(work("alpha") + "/" + level["file"].get<std::string>()));
+      scaled |= level["alpha_scale"].get<float>() != 1.0f;
+    }
+  }
+  EXPECT_TRUE(scaled) << "no level's alpha was rescaled: the test does not reach that path";
+  ASSERT_EQ(bake("alpha", "--shard 0/2", alpha).exit_code, 0);
+  ASSERT_EQ(bake("alpha", "--shard 1/2", alpha).exit_code, 0);
+  ASSERT_EQ(merge("alpha").exit_code, 0);
+  EXPECT_TRUE(read_file(dir_ + "/alpha/out.vtpf") == read_file(dir_ + "/alpha_local/out.vtpf"))
+      << "the merged page file differs from the one-process bake";
+
+  const std::string level1 = plan["layers"][0]["levels"][0]["file"].get<std::string>();
+  const std::string whole = read_file(work("alpha") + "/" + level1);
+  {
+    std::ofstream(work("alpha") + "/" + level1, std::ios::binary)
+        .write(whole.data(), std::streamsize(whole.size() / 2));
+  }
+  const std::string part = work("alpha") + "/parts/shard-0-of-2.part";
+  fs::remove(part);
+  RunResult cut = bake("alpha", "--shard 0/2", alpha);
+  EXPECT_NE(cut.exit_code, 0);
+  EXPECT_NE(cut.out.find(level1), std::string::npos) << cut.out;
+  EXPECT_FALSE(fs::exists(part));
 }
 
 }  // namespace
