@@ -14,6 +14,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "bake/build_plan.h"
@@ -71,6 +72,13 @@ class RawFileSource final : public ImageSource {
   }
   ~RawFileSource() override { ::close(fd_); }
   const ImageInfo& info() const override { return info_; }
+  // The plan wrote the file with the hash of its bytes, which is the default content hash
+  // (XXH3 of the rows in order): taken from the plan instead of reading the whole level again.
+  void set_content_hash(uint64_t hash) { hash_ = hash; }
+  Expected<uint64_t> content_hash() override {
+    if (hash_) return *hash_;
+    return ImageSource::content_hash();
+  }
   Status read_rows(uint32_t y0, uint32_t y1, float* out) override {
     if (y0 > y1 || y1 > info_.height) return Error(ErrorCode::kInvalidArgument, path_ + ": rows");
     const size_t row = size_t(info_.width) * info_.channels * sizeof(float);
@@ -92,6 +100,7 @@ class RawFileSource final : public ImageSource {
   int fd_;
   std::string path_;
   ImageInfo info_;
+  std::optional<uint64_t> hash_;
 };
 
 // A level in its working form as the plan wrote it (converted, dilated), read by rows.
@@ -168,7 +177,9 @@ Status write_coverage(const CoverageMask& c, const std::string& path) {
   return f.close();
 }
 
-Status write_source(ImageSource& source, const std::string& path) {
+// Returns the XXH3 of the bytes written: the source's rows in order, as ImageSource::content_hash
+// hashes them.
+Expected<uint64_t> write_source(ImageSource& source, const std::string& path) {
   const ImageInfo& info = source.info();
   HashedFile f;
   VT_RETURN_IF_ERROR(f.open(path));
@@ -181,7 +192,9 @@ Status write_source(ImageSource& source, const std::string& path) {
     VT_RETURN_IF_ERROR(source.read_rows(y, y1, rows.data()));
     f.put(rows.data(), size_t(y1 - y) * row * sizeof(float));
   }
-  return f.close();
+  const uint64_t digest = f.digest();
+  VT_RETURN_IF_ERROR(f.close());
+  return digest;
 }
 
 Status write_level(LevelSource& level, const std::string& path) {
@@ -357,6 +370,7 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
   t0 = Clock::now();
   BuildOptions bo = prepared->build;
   nlohmann::json layers = nlohmann::json::array();
+  std::vector<uint64_t> layer_hashes;
   for (size_t i = 0; i < bo.layers.size(); ++i) {
     const LayerInput& in = bo.layers[i];
     const ImageInfo& info = in.source->info();
@@ -364,7 +378,8 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
     const std::string file = "level0/" + name + ".f32";
     if (!dir.empty()) {
       VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/" + file));
-      VT_RETURN_IF_ERROR(write_source(*in.source, staged));
+      VT_ASSIGN_OR_RETURN(const uint64_t hash, write_source(*in.source, staged));
+      layer_hashes.push_back(hash);
     }
     layers.push_back({{"name", name},
                       {"semantic", int(in.semantic)},
@@ -389,6 +404,11 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
   VT_RETURN_IF_ERROR(drop_opaque_alpha(bo));
   VT_ASSIGN_OR_RETURN(BuildPlan plan, plan_build(bo));
   sum.stages.push_back({"plan", seconds_since(t0)});
+  // What a shard would otherwise read the whole of level 0 for: its hash and the alpha scan.
+  for (size_t i = 0; i < layer_hashes.size(); ++i) {
+    layers[i]["content_hash"] = hex(layer_hashes[i]);
+    layers[i]["alpha_dropped"] = bo.layers[i].alpha_dropped;
+  }
   // Level 0 in its working form (converted, dilated) for the shards, which would otherwise each
   // redo it: for the layers whose held level 0 carries the input's coverage mask.
   t0 = Clock::now();
@@ -612,8 +632,15 @@ Expected<std::vector<LayerInput>> work_layers(const WorkPlan& w, const BuildOpti
     in.semantic = LayerSemantic(l.value("semantic", 0));
     in.color_space = l.value("color_space", "");
     in.coverage = coverage;
-    VT_ASSIGN_OR_RETURN(in.source,
+    const uint32_t channels = info.channels;
+    VT_ASSIGN_OR_RETURN(std::shared_ptr<RawFileSource> raw,
                         RawFileSource::open(w.dir + "/" + l.value("file", ""), std::move(info)));
+    if (l.contains("content_hash")) raw->set_content_hash(unhex(l["content_hash"]));
+    in.source = std::move(raw);
+    if (l.value("alpha_dropped", false)) {
+      in.source = std::make_shared<DropChannelSource>(in.source, channels - 1);
+      in.alpha_dropped = true;
+    }
     layers.push_back(std::move(in));
   }
   return layers;
@@ -720,7 +747,10 @@ Expected<ShardSummary> run_shard(const ShardOptions& options) {
   VT_ASSIGN_OR_RETURN(bo.level_from, given_levels(w, bo));
   sum.stages.push_back({"read", seconds_since(t0)});
   t0 = Clock::now();
-  VT_RETURN_IF_ERROR(drop_opaque_alpha(bo));
+  // The plan's opaque-alpha decisions where it recorded them (plans before 2026-12-04: scan).
+  bool decided = true;
+  for (const auto& l : w.json["layers"]) decided &= l.contains("alpha_dropped");
+  if (!decided) VT_RETURN_IF_ERROR(drop_opaque_alpha(bo));
   VT_ASSIGN_OR_RETURN(BuildPlan plan, plan_build(bo));
   if (plan.hash != w.hash) {
     return Error(ErrorCode::kInvalidArgument,

@@ -20,6 +20,6 @@ echo "load before: $(cut -d' ' -f1-3 /proc/loadavg)"
 for r in $(seq $rounds); do for v in A B; do
   cp $t/plan.$v.json $t/work/plan.json
   s=$( { /usr/bin/time -f "%e %M" $V --json --threads 1 "${b[@]}" --shard 0/$shards > $t/s.json; } 2>&1 )
-  echo "$v round $r: wall/maxrss $s build $(python3 -c "import json;print(json.load(open('$t/s.json'))['seconds']['build'])")"
+  echo "$v round $r: wall/maxrss $s stages $(python3 -c "import json;s=json.load(open('$t/s.json'))['seconds'];print('build %.2f plan %.2f read %.2f' % (s['build'],s['plan'],s['read']))")"
 done; done
 echo "load after: $(cut -d' ' -f1-3 /proc/loadavg)"

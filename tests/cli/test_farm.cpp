@@ -30,7 +30,8 @@ class FarmCli : public ::testing::Test {
                                       "--ground-cells 4 --sphere-segments 12 --texture-size 64");
     if (!setup_error_.empty()) return;
     fs::create_directories(dir_ + "/local");
-    for (const char* name : {"four", "tasks", "one", "kill", "a", "b", "alpha", "alpha_local"})
+    for (const char* name : {"four", "tasks", "one", "kill", "a", "b", "alpha", "alpha_local",
+                             "opaque", "opaque_local"})
       fs::create_directories(dir_ + "/" + name);
     RunResult b =
         run_vtbake("-q bake " + scene() + " -o " + dir_ + "/local/out.vtpf " + flags(), true);
@@ -239,6 +240,42 @@ TEST_F(FarmCli, ShardsReadThePlansLevelsAndAlphaScales) {
   EXPECT_NE(cut.exit_code, 0);
   EXPECT_NE(cut.out.find(level1), std::string::npos) << cut.out;
   EXPECT_FALSE(fs::exists(part));
+}
+
+// The plan records each layer's content hash and opaque-alpha decision, so that a shard need not
+// read the whole of level 0 for them: with an opaque scene (the transfer stores albedo as RGB)
+// and with the sample's masked material (RGBA kept), the merge equals the one-process bake.
+TEST_F(FarmCli, ShardsTakeHashesAndAlphaDecisionsFromThePlan) {
+  std::string gltf = read_file(scene());
+  const std::string masked = "\"alphaMode\": \"MASK\"";
+  ASSERT_NE(gltf.find(masked), std::string::npos) << "the sample scene has no masked material";
+  gltf.replace(gltf.find(masked), masked.size(), "\"alphaMode\": \"OPAQUE\"");
+  const std::string opaque = dir_ + "/scene/opaque.gltf";
+  { std::ofstream(opaque, std::ios::binary) << gltf; }
+  auto bake_opaque = [&](const std::string& name, const std::string& args) {
+    return run_vtbake(
+        "-q bake " + opaque + " -o " + dir_ + "/" + name + "/out.vtpf " + flags() + " " + args,
+        true);
+  };
+  ASSERT_EQ(bake_opaque("opaque_local", "").exit_code, 0);
+  const std::string w = work("opaque");
+  ASSERT_EQ(bake_opaque("opaque", "--work " + w + " --plan " + w + "/plan.json").exit_code, 0);
+  for (const std::string& part : {"0/2", "1/2"})
+    ASSERT_EQ(bake_opaque("opaque", "--work " + w + " --shard " + part).exit_code, 0);
+  ASSERT_EQ(merge("opaque").exit_code, 0);
+  EXPECT_TRUE(read_file(dir_ + "/opaque/out.vtpf") == read_file(dir_ + "/opaque_local/out.vtpf"))
+      << "the merged page file differs from the one-process bake";
+
+  for (const std::string& name : {std::string("opaque"), std::string("four")}) {
+    if (name == "four" && !fs::exists(work(name) + "/plan.json"))
+      ASSERT_EQ(bake(name, "--plan " + work(name) + "/plan.json").exit_code, 0);
+    auto plan = nlohmann::json::parse(read_file(work(name) + "/plan.json"));
+    const auto& albedo = plan["layers"][0];
+    ASSERT_EQ(albedo["name"], "albedo");
+    EXPECT_EQ(albedo["content_hash"].get<std::string>().size(), 16u);
+    EXPECT_FALSE(albedo["alpha_dropped"].get<bool>()) << name;  // the transfer decided already
+    EXPECT_EQ(albedo["channels"].get<int>(), name == "opaque" ? 3 : 4) << name;
+  }
 }
 
 }  // namespace
