@@ -18,7 +18,7 @@ std::vector<BuildTask> make_build_tasks(const BuildPlan& plan) {
   std::vector<BuildTask> tasks;
   for (uint32_t li = 0; li < plan.layers.size(); ++li) {
     if (plan.layers[li].copy_previous) continue;  // its pages are the previous file's
-    std::vector<uint32_t> previous;  // band tasks of the level before, by row
+    std::vector<uint32_t> previous;               // band tasks of the level before, by row
     for (uint32_t l = 0; l < g.level_count(); ++l) {
       std::vector<uint32_t> bands;
       const bool needs_whole = level_needs_whole(plan, li, l);

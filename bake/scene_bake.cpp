@@ -415,8 +415,7 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   if (!summary.unwrapped.empty()) {
     VT_ASSIGN_OR_RETURN(staged_scene, outputs.stage(summary.unwrapped));
   }
-  VT_RETURN_IF_ERROR(
-      unwrap_and_transfer(input, options, input_key, cache_dir(options), prepared));
+  VT_RETURN_IF_ERROR(unwrap_and_transfer(input, options, input_key, cache_dir(options), prepared));
   const unwrap::UnwrapResult* unwrapped = &prepared.unwrapped;
 
   // Pyramid, paging, encode.

@@ -907,9 +907,8 @@ Expected<MergeSummary> merge_shards(const MergeOptions& options) {
   for (size_t i = 0; i < desc.layers.size(); ++i) {
     record.layer_names.push_back(desc.layers[i].name);
     const auto& layers = w.json["layers"];
-    record.layer_inputs.push_back(i < layers.size() && layers[i].contains("input_key")
-                                      ? unhex(layers[i]["input_key"])
-                                      : 0);
+    record.layer_inputs.push_back(
+        i < layers.size() && layers[i].contains("input_key") ? unhex(layers[i]["input_key"]) : 0);
   }
   record.page_keys.assign(desc.layers.size(),
                           std::vector<uint64_t>(desc.geometry.total_pages(), 0));

@@ -128,6 +128,8 @@ struct ImageSlot {
   std::string name;
   std::string tried;  // the file opened (for an embedded image, its scratch copy)
   std::string error;  // why it could not be read
+  // Readable, but its levels are not loaded: only bands read from the band cache use it.
+  bool deferred = false;
 };
 
 constexpr TextureSlot kTextureSlots[] = {
@@ -329,7 +331,7 @@ class Transfer {
   Expected<TransferResult> run();
 
  private:
-  Status setup_images();
+  Status setup_images(const std::vector<bool>* wanted = nullptr);
   Status check_missing_textures();
   Status set_colour_space(ImageSlot& slot, const std::string& path,
                           const OIIO::ImageSpec& spec) const;
@@ -339,15 +341,16 @@ class Transfer {
   void evaluate(const TriEval& te, const double l[3], uint64_t seed, Sample& s) const;
   void make_eval(uint32_t t, TriEval& te) const;
   Status setup_cache();
+  std::vector<bool> images_for_uncached_bands() const;
   void transfer_band(uint32_t b, float* const (&acc)[kSlots], uint8_t* coverage,
                      RowCounts& counts) const;
   void pack_band(const BandBytes& f, float* const (&acc)[kSlots], const uint8_t* coverage,
                  const RowCounts& counts, const LayerFacts (&facts)[kSlots], uint8_t* out) const;
   void unpack_band(const BandBytes& f, const uint8_t* in, float* const (&acc)[kSlots],
                    uint8_t* coverage, RowCounts& counts, LayerFacts (&facts)[kSlots]) const;
-  void transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlots],
-                     std::vector<uint8_t>& coverage, RowCounts& counts,
-                     LayerFacts (&facts)[kSlots], const std::function<void(double)>& progress);
+  Status transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlots],
+                       std::vector<uint8_t>& coverage, RowCounts& counts,
+                       LayerFacts (&facts)[kSlots], const std::function<void(double)>& progress);
   void finish_rows(float* const (&acc)[kSlots], const uint8_t* coverage, size_t n,
                    LayerFacts (&facts)[kSlots]) const;
   Expected<std::vector<TransferLayer>> make_layers(std::shared_ptr<LevelStore> (&stores)[kSlots],
@@ -419,7 +422,10 @@ Status Transfer::set_colour_space(ImageSlot& slot, const std::string& path,
   return Status::Ok();
 }
 
-Status Transfer::setup_images() {
+// Opens every image a material in use reads and loads the levels of those `wanted` names (null:
+// all); the others are deferred. Run again, it loads the deferred ones.
+Status Transfer::setup_images(const std::vector<bool>* wanted) {
+  const bool first = images_.empty();
   // Before OpenImageIO opens them: libpng would print its own line for a damaged file.
   VT_RETURN_IF_ERROR(check_scene_textures(scene_));
   std::vector<bool> used(scene_.images.size(), false);
@@ -440,13 +446,14 @@ Status Transfer::setup_images() {
   fs::path scratch =
       opt_.scratch_dir.empty() ? fs::temp_directory_path() : fs::path(opt_.scratch_dir);
   for (size_t i = 0; i < scene_.images.size(); ++i) {
-    if (!used[i]) continue;
+    if (!used[i] || (!first && !images_[i].deferred)) continue;
     const scene::Image& img = scene_.images[i];
     ImageSlot& slot = images_[i];
-    std::string path = img.path;
+    slot.deferred = false;
+    std::string path = img.embedded() ? slot.tried : img.path;
     slot.name =
         img.embedded() ? "embedded image " + std::to_string(i) + " '" + img.name + "'" : img.path;
-    if (img.embedded()) {
+    if (img.embedded() && path.empty()) {
       // OpenImageIO reads by file name: a private copy is the robust way.
       const std::string ext = img.embedded_extension();
       // Unique per process and per call, so concurrent transfers never share a copy.
@@ -476,6 +483,10 @@ Status Transfer::setup_images() {
       if (used_as_colour(scene_, i)) {
         VT_RETURN_IF_ERROR(set_colour_space(slot, img.embedded() ? "" : img.path, spec));
       }
+    }
+    if (wanted && !(*wanted)[i]) {
+      slot.deferred = true;
+      continue;
     }
     // Optionally, untiled sources get MIP levels made with another filter (as maketx does),
     // read back as the texture's levels; should that fail, box-filtered levels are made.
@@ -519,14 +530,14 @@ Status Transfer::setup_images() {
       VT_ASSIGN_OR_RETURN(slot.data_texture, keep(*data));
     }
   }
-  return check_missing_textures();
+  return first ? check_missing_textures() : Status::Ok();
 }
 
 Status Transfer::check_missing_textures() {
   for (const scene::Material* m : materials_in_use(scene_)) {
     for (const TextureSlot& ts : kTextureSlots) {
       const scene::TextureRef& r = m->*ts.ref;
-      if (!r.valid() || images_[r.image].texture) continue;
+      if (!r.valid() || images_[r.image].texture || images_[r.image].deferred) continue;
       const scene::Image& img = scene_.images[r.image];
       MissingTexture miss;
       miss.material = m->name;
@@ -972,19 +983,20 @@ void Transfer::unpack_band(const BandBytes& f, const uint8_t* in, float* const (
 // Rows [r0, r1) of the atlas (r0 a multiple of kBandRows) into `acc` and `coverage` (those rows
 // only), finished (finish_rows); the bands run on all threads, each read from the band cache
 // when it holds it, else transferred (and stored there).
-void Transfer::transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlots],
-                             std::vector<uint8_t>& coverage, RowCounts& counts,
-                             LayerFacts (&facts)[kSlots],
-                             const std::function<void(double)>& progress) {
+Status Transfer::transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlots],
+                               std::vector<uint8_t>& coverage, RowCounts& counts,
+                               LayerFacts (&facts)[kSlots],
+                               const std::function<void(double)>& progress) {
   const uint32_t W = opt_.width, H = opt_.height;
   const uint32_t b0 = r0 / kBandRows, bands = (r1 - r0 + kBandRows - 1) / kBandRows;
   struct Outcome {
     RowCounts counts;
     LayerFacts facts[kSlots];
     bool cached = false;
+    bool unread = false;  // listed in the cache but unreadable there: transferred after
   };
   std::vector<Outcome> outcome(bands);
-  for_each_band(bands, opt_.threads, progress, [&](uint32_t bi) {
+  auto band = [&](uint32_t bi, bool from_cache) {
     const uint32_t b = b0 + bi, y0 = b * kBandRows, y1 = std::min(H, y0 + kBandRows);
     const size_t base = size_t(y0 - r0) * W;  // the band's first texel in `acc`
     float* band_acc[kSlots] = {};
@@ -995,9 +1007,13 @@ void Transfer::transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlot
     const BandBytes layout(size_t(y1 - y0) * W, want_, channels_);
     thread_local std::vector<uint8_t> bytes;
     if (cache_in_ || cache_out_) bytes.resize(layout.size);
-    if (cache_in_ && cache_in_->read(b, band_keys_[b], bytes)) {
-      unpack_band(layout, bytes.data(), band_acc, band_coverage, o.counts, o.facts);
-      o.cached = true;
+    if (from_cache && cache_in_ && cache_in_->has(b, band_keys_[b])) {
+      if (cache_in_->read(b, band_keys_[b], bytes)) {
+        unpack_band(layout, bytes.data(), band_acc, band_coverage, o.counts, o.facts);
+        o.cached = true;
+      } else {
+        o.unread = true;  // its images may be deferred (setup_images)
+      }
       return;
     }
     transfer_band(b, band_acc, band_coverage, o.counts);
@@ -1006,7 +1022,15 @@ void Transfer::transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlot
       pack_band(layout, band_acc, band_coverage, o.counts, o.facts, bytes.data());
       cache_out_->add(b, band_keys_[b], bytes);
     }
-  });
+  };
+  for_each_band(bands, opt_.threads, progress, [&](uint32_t bi) { band(bi, true); });
+  std::vector<uint32_t> unread;
+  for (uint32_t bi = 0; bi < bands; ++bi)
+    if (outcome[bi].unread) unread.push_back(bi);
+  if (!unread.empty()) {
+    VT_RETURN_IF_ERROR(setup_images());  // the deferred images too
+    parallel_for(unread.size(), opt_.threads, [&](size_t i) { band(unread[i], false); });
+  }
   for (const Outcome& o : outcome) {
     counts.sampled += o.counts.sampled, counts.edge_only += o.counts.edge_only;
     counts.contested += o.counts.contested, counts.samples += o.counts.samples;
@@ -1018,6 +1042,7 @@ void Transfer::transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlot
       f.hdr |= g.hdr, f.alpha_hdr |= g.alpha_hdr, f.alpha |= g.alpha;
     }
   }
+  return Status::Ok();
 }
 
 // The band cache's keys: the file's (cache layout, tool version, atlas, settings, layers, how
@@ -1046,7 +1071,7 @@ Status Transfer::setup_cache() {
     add_material(k, *prims_[pi].mat);
     for (const TextureSlot& ts : kTextureSlots) {
       const scene::TextureRef& r = (*prims_[pi].mat).*ts.ref;
-      if (!r.valid()) continue;
+      if (!r.valid() || size_t(r.image) >= scene_.images.size()) continue;  // setup_images fails
       k.add(opt_.image_keys[size_t(r.image)]), k.add(scene_.images[size_t(r.image)].path);
     }
     prim_keys[pi] = k.digest();
@@ -1066,6 +1091,20 @@ Status Transfer::setup_cache() {
     if (writer.ok()) cache_out_ = std::move(writer).value();
   }
   return Status::Ok();
+}
+
+// The images read by the triangles of the bands the band cache lacks.
+std::vector<bool> Transfer::images_for_uncached_bands() const {
+  std::vector<bool> wanted(scene_.images.size(), false);
+  for (size_t b = 0; b < bins_.size(); ++b) {
+    if (cache_in_->has(uint32_t(b), band_keys_[b])) continue;
+    for (uint32_t t : bins_[b])
+      for (const TextureSlot& ts : kTextureSlots) {
+        const scene::TextureRef& r = (*prims_[tri_src_[t].first].mat).*ts.ref;
+        if (r.valid() && size_t(r.image) < wanted.size()) wanted[size_t(r.image)] = true;
+      }
+  }
+  return wanted;
 }
 
 // Rows transferred at a time: a multiple of kBandRows, as many as TransferOptions allow.
@@ -1095,8 +1134,13 @@ Expected<TransferResult> Transfer::run() {
                                                 std::to_string(H) + " texels exceeds the limit");
   }
   sub_scale_ = 1.0 / std::sqrt(double(opt_.supersample));
-  VT_RETURN_IF_ERROR(setup_images());
   VT_RETURN_IF_ERROR(setup_prims());
+  bins_ = bin_by_rows(tris_, H, kBandRows);
+  // With a band cache, only the images that bands it lacks read are loaded.
+  VT_RETURN_IF_ERROR(setup_cache());
+  std::vector<bool> wanted;
+  if (cache_in_) wanted = images_for_uncached_bands();
+  VT_RETURN_IF_ERROR(setup_images(cache_in_ ? &wanted : nullptr));
 
   TransferResult result;
   result.width = W, result.height = H;
@@ -1109,8 +1153,6 @@ Expected<TransferResult> Transfer::run() {
   VT_ASSIGN_OR_RETURN(std::shared_ptr<CoverageMask> coverage,
                       CoverageMask::create(W, H, opt_.coverage_in_memory, opt_.scratch_dir));
   std::vector<uint8_t> band_coverage;  // a pass's rows, one byte per texel
-  bins_ = bin_by_rows(tris_, H, kBandRows);
-  VT_RETURN_IF_ERROR(setup_cache());
   const uint32_t pass = rows_per_pass();
   // Accumulators: an in-memory store's own rows (zero when created), else a pass's buffer
   // written to the scratch store after.
@@ -1134,7 +1176,7 @@ Expected<TransferResult> Transfer::run() {
     if (opt_.progress)
       progress = [&](double f) { opt_.progress((double(r0) + f * double(r1 - r0)) / double(H)); };
     band_coverage.assign(n, 0);
-    transfer_rows(r0, r1, acc, band_coverage, counts, facts, progress);
+    VT_RETURN_IF_ERROR(transfer_rows(r0, r1, acc, band_coverage, counts, facts, progress));
     VT_RETURN_IF_ERROR(
         coverage->write_rows(r0, r1 - r0, band_coverage.data()).with_context("transfer"));
     for (int l = 0; l < kSlots; ++l) {

@@ -143,7 +143,8 @@ Status TransferCacheWriter::finish() {
   fd_ = -1;
   std::error_code ec;
   std::filesystem::rename(temp_, path_, ec);
-  if (ec) return Error(ErrorCode::kIo, path_ + ": cannot replace the transfer cache: " + ec.message());
+  if (ec)
+    return Error(ErrorCode::kIo, path_ + ": cannot replace the transfer cache: " + ec.message());
   finished_ = true;
   return Status::Ok();
 }

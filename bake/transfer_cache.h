@@ -32,6 +32,10 @@ class TransferCacheReader {
   static std::unique_ptr<TransferCacheReader> open(const std::string& path, uint64_t file_key,
                                                    uint32_t bands);
   ~TransferCacheReader();
+  // Whether band `band` is listed under `key` (read() may still find it damaged).
+  bool has(uint32_t band, uint64_t key) const {
+    return band < index_.size() && key != 0 && index_[band].key == key;
+  }
   // Band `band`'s bytes into `out` (exactly out.size() of them) when it was stored under `key`
   // and they check out; false otherwise. Thread-safe.
   bool read(uint32_t band, uint64_t key, std::span<uint8_t> out) const;

@@ -147,7 +147,7 @@ uint64_t PreviousBuild::key(int layer, const PageId& id) const {
 
 uint64_t PreviousBuild::layer_input(int layer) const {
   return layer >= 0 && size_t(layer) < record_.layer_inputs.size() ? record_.layer_inputs[layer]
-                                                                    : 0;
+                                                                   : 0;
 }
 
 std::vector<uint8_t> PreviousBuild::tables(const std::string& name) const {
