@@ -1008,9 +1008,11 @@ Status Transfer::transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSl
     thread_local std::vector<uint8_t> bytes;
     if (cache_in_ || cache_out_) bytes.resize(layout.size);
     if (from_cache && cache_in_ && cache_in_->has(b, band_keys_[b])) {
-      if (cache_in_->read(b, band_keys_[b], bytes)) {
+      thread_local std::vector<uint8_t> frame;
+      if (cache_in_->read(b, band_keys_[b], bytes, &frame)) {
         unpack_band(layout, bytes.data(), band_acc, band_coverage, o.counts, o.facts);
         o.cached = true;
+        if (cache_out_) cache_out_->add_frame(b, band_keys_[b], bytes, frame);  // kept
       } else {
         o.unread = true;  // its images may be deferred (setup_images)
       }

@@ -78,11 +78,13 @@ TransferCacheReader::~TransferCacheReader() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-bool TransferCacheReader::read(uint32_t band, uint64_t key, std::span<uint8_t> out) const {
+bool TransferCacheReader::read(uint32_t band, uint64_t key, std::span<uint8_t> out,
+                               std::vector<uint8_t>* stored) const {
   if (band >= index_.size() || key == 0) return false;
   const CachedBand& b = index_[band];
   if (b.key != key || b.size != out.size()) return false;
-  thread_local std::vector<uint8_t> frame;
+  thread_local std::vector<uint8_t> own;
+  std::vector<uint8_t>& frame = stored ? *stored : own;
   frame.resize(b.stored);
   return read_at(fd_, frame.data(), frame.size(), b.offset) &&
          zstd_decompress_exact(frame, out).ok() &&
@@ -118,10 +120,15 @@ TransferCacheWriter::~TransferCacheWriter() {
 
 void TransferCacheWriter::add(uint32_t band, uint64_t key, std::span<const uint8_t> bytes) {
   thread_local std::vector<uint8_t> frame;
-  const Status packed = zstd_compress(bytes, kZstdLevel, frame);
+  if (!zstd_compress(bytes, kZstdLevel, frame).ok()) frame.clear();
+  add_frame(band, key, bytes, frame);
+}
+
+void TransferCacheWriter::add_frame(uint32_t band, uint64_t key, std::span<const uint8_t> bytes,
+                                    std::span<const uint8_t> frame) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!error_.ok() || band >= index_.size()) return;
-  if (!packed.ok() || !write_at(fd_, frame.data(), frame.size(), end_)) {
+  if (frame.empty() || !write_at(fd_, frame.data(), frame.size(), end_)) {
     error_ = Error(ErrorCode::kIo, temp_ + ": cannot write the transfer cache");
     return;
   }

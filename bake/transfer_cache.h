@@ -38,7 +38,9 @@ class TransferCacheReader {
   }
   // Band `band`'s bytes into `out` (exactly out.size() of them) when it was stored under `key`
   // and they check out; false otherwise. Thread-safe.
-  bool read(uint32_t band, uint64_t key, std::span<uint8_t> out) const;
+  // `frame`, when given, receives the stored zstd frame (for TransferCacheWriter::add_frame).
+  bool read(uint32_t band, uint64_t key, std::span<uint8_t> out,
+            std::vector<uint8_t>* frame = nullptr) const;
 
  private:
   int fd_ = -1;
@@ -52,6 +54,9 @@ class TransferCacheWriter {
   ~TransferCacheWriter();  // removes the temporary file unless finished
   // Stores band `band` under `key`. Thread-safe; the first failure is kept for finish().
   void add(uint32_t band, uint64_t key, std::span<const uint8_t> bytes);
+  // The same with `bytes` already compressed as `frame` (a band read from the previous cache).
+  void add_frame(uint32_t band, uint64_t key, std::span<const uint8_t> bytes,
+                 std::span<const uint8_t> frame);
   // Writes the index and renames the file into place (it replaces the previous cache).
   Status finish();
 

@@ -243,6 +243,11 @@ TEST(CliUpdate, SceneBakeUpdateReadsUnchangedBandsFromTheCacheAndNeverTrustsADam
   EXPECT_LT(cached, bands) << update["transfer"].dump();
   EXPECT_EQ(update["build"]["update"]["full_rebuild"], nullptr);
   EXPECT_EQ(read_bytes(out), expected);
+  // The update's cache keeps the bands it read: a second change of B reuses them again.
+  write_png(dir + "/textures/b.png", 64, 64, 6, {10, 10, 30, 30});
+  auto second = run_json("-q bake " + obj + " -o " + out + " --update" + flags);
+  EXPECT_EQ(second["transfer"]["bands_cached"].get<int>(), cached);
+  write_png(dir + "/textures/b.png", 64, 64, 5, {10, 10, 30, 30});
 
   // Every frame of the previous cache damaged (a byte flipped past the header in each of them):
   // no band passes its checksum, all are transferred again, the bytes are the same.
