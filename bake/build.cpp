@@ -90,7 +90,9 @@ class LayerRun {
         sum_(sum) {
     alpha_.active = plan.options.alpha_coverage_reference > 0 && layer_.alpha >= 0;
     alpha_.reference = plan.options.alpha_coverage_reference;
-    if (plan.previous) previous_layer_ = plan.previous->layer_index(layer_.spec.name);
+    if (plan.previous)
+      previous_layer_ = layer_.copy_previous ? layer_.previous_layer
+                                             : plan.previous->layer_index(layer_.spec.name);
     sum_.page_keys[li].assign(g_.total_pages(), 0);
   }
 
@@ -157,6 +159,27 @@ class LayerRun {
     return key;
   }
 
+  // Update mode, a layer whose pages are the previous file's (LayerPlan::copy_previous): every
+  // one copied, in task order.
+  Status copy_previous() {
+    for (uint32_t l = 0; l < g_.level_count(); ++l)
+      for (uint32_t y = 0; y < g_.pages_y(l); ++y)
+        for (uint32_t x = 0; x < g_.pages_x(l); ++x) {
+          const PageId id{l, x, y};
+          const uint64_t key = plan_.previous->key(previous_layer_, id);
+          EncodedPage e;
+          if (key != 0) {
+            VT_ASSIGN_OR_RETURN(const bool copied, reuse(id, key, e));
+            if (!copied)
+              return Status(ErrorCode::kCorrupt, plan_.previous->reader().path() + ": " +
+                                                     layer_.spec.name + " " + page_name(id) +
+                                                     " has a key but no page");
+          }
+          VT_RETURN_IF_ERROR(emit(id, key != 0, key, e, true));
+        }
+    return Status::Ok();
+  }
+
   // One byte per page of page row `row`: 1 = some payload texel covered (all, without a mask).
   Expected<std::vector<uint8_t>> present_pages(uint32_t row) const {
     if (const CoverageMask* coverage = current_->coverage())
@@ -196,9 +219,13 @@ class LayerRun {
     ls.psnr_db = error_.samples == 0 || error_.sse == 0
                      ? std::numeric_limits<double>::infinity()
                      : 10.0 * std::log10(255.0 * 255.0 * double(error_.samples) / error_.sse);
+    ls.alpha_dropped = plan_.options.layers[li_].alpha_dropped;
+    if (layer_.copy_previous) {
+      ls.psnr_db = std::numeric_limits<double>::quiet_NaN();  // not measured: nothing encoded
+      return ls;
+    }
     ls.non_finite = layer_.level0->non_finite();
     ls.clipped = layer_.level0->clipped();
-    ls.alpha_dropped = plan_.options.layers[li_].alpha_dropped;
     return ls;
   }
 
@@ -319,39 +346,41 @@ class LayerRun {
       errors[x] =
           layer_.encoder->encode(bytes.data(), encoded[x], measure ? reference.data() : nullptr);
     });
-    LevelSummary& lsum = sum_.levels[level_];
-    std::vector<uint64_t>& layer_keys = sum_.page_keys[li_];
     for (uint32_t x = 0; x < px; ++x) {
       const PageId id{level_, x, row};
       VT_RETURN_IF_ERROR(errors[x].with_context(layer_.spec.name + " " + page_name(id)));
-      if (!present[x]) {
-        ++lsum.absent;
-        continue;
-      }
-      layer_keys[page_key_index(g_, id)] = keys[x];
-      ++(reused[x] ? sum_.update.reused : sum_.update.reencoded);
-      const EncodedPage& e = encoded[x];
-      if (e.state == PageState::kConstant) {
-        ++lsum.constant;
-        error_.sse += e.squared_error;  // a clipped constant page's error (else nothing)
-        error_.samples += e.samples;
-        error_.max_error = std::max(error_.max_error, e.max_error);
-        error_.hdr.add(e.hdr);  // a half page's rounding
-        VT_RETURN_IF_ERROR(sink_.add_constant_page(
-            id, li_, std::span<const uint8_t>(e.constant, layer_.spec.texel_bytes())));
-        continue;
-      }
-      ++lsum.stored;
-      lsum.stored_bytes += e.bytes.size();
-      error_.sse += e.squared_error;
-      error_.samples += e.samples;
-      error_.max_error = std::max(error_.max_error, e.max_error);
-      error_.runtime.add(e.runtime);
-      error_.hdr.add(e.hdr);
-      if (layer_.spec.codec == PageCodec::kDct) ++error_.dct_modes[e.dct_mode];
-      VT_RETURN_IF_ERROR(sink_.add_page(id, li_, e.bytes));
+      VT_RETURN_IF_ERROR(emit(id, present[x], keys[x], encoded[x], reused[x]));
     }
     return Status::Ok();
+  }
+
+  // A page to the sink and the summary (absent unless `present`).
+  Status emit(const PageId& id, bool present, uint64_t key, const EncodedPage& e, bool reused) {
+    LevelSummary& lsum = sum_.levels[id.level];
+    if (!present) {
+      ++lsum.absent;
+      return Status::Ok();
+    }
+    sum_.page_keys[li_][page_key_index(g_, id)] = key;
+    ++(reused ? sum_.update.reused : sum_.update.reencoded);
+    if (e.state == PageState::kConstant) {
+      ++lsum.constant;
+      error_.sse += e.squared_error;  // a clipped constant page's error (else nothing)
+      error_.samples += e.samples;
+      error_.max_error = std::max(error_.max_error, e.max_error);
+      error_.hdr.add(e.hdr);  // a half page's rounding
+      return sink_.add_constant_page(
+          id, li_, std::span<const uint8_t>(e.constant, layer_.spec.texel_bytes()));
+    }
+    ++lsum.stored;
+    lsum.stored_bytes += e.bytes.size();
+    error_.sse += e.squared_error;
+    error_.samples += e.samples;
+    error_.max_error = std::max(error_.max_error, e.max_error);
+    error_.runtime.add(e.runtime);
+    error_.hdr.add(e.hdr);
+    if (layer_.spec.codec == PageCodec::kDct) ++error_.dct_modes[e.dct_mode];
+    return sink_.add_page(id, li_, e.bytes);
   }
 
   Status downsample_band(const RowBand& band, uint32_t row) {
@@ -423,7 +452,10 @@ std::string final_metadata(const BuildPlan& plan, const BuildSummary& sum) {
   r.plan_hash = plan.hash;
   r.settings_key = plan.settings_key;
   r.input_key = plan.options.input_key;
-  for (const LayerPlan& layer : plan.layers) r.layer_names.push_back(layer.spec.name);
+  for (const LayerPlan& layer : plan.layers) {
+    r.layer_names.push_back(layer.spec.name);
+    r.layer_inputs.push_back(layer.input_key);
+  }
   r.page_keys = sum.page_keys;
   return with_update_record(merge_metadata(plan.desc.metadata_json, plan.options.provenance_json),
                             r);
@@ -515,6 +547,17 @@ Expected<BuildSummary> build_pages(const BuildPlan& plan, PageSink& sink) {
   }
   std::vector<bool> done(tasks.size());
   std::unique_ptr<LayerRun> run;
+  // Layers before `end` that copy the previous file's pages (they have no tasks), in order.
+  uint32_t copied_up_to = 0;
+  auto copy_layers_before = [&](uint32_t end) -> Status {
+    for (; copied_up_to < end; ++copied_up_to) {
+      if (!plan.layers[copied_up_to].copy_previous) continue;
+      LayerRun copy(plan, copied_up_to, sink, sum);
+      VT_RETURN_IF_ERROR(copy.copy_previous());
+      sum.layers.push_back(copy.summary());
+    }
+    return Status::Ok();
+  };
   for (size_t i = 0; i < tasks.size(); ++i) {
     const BuildTask& t = tasks[i];
     for (uint32_t d : t.deps) {
@@ -523,6 +566,8 @@ Expected<BuildSummary> build_pages(const BuildPlan& plan, PageSink& sink) {
     const auto t_task = Clock::now();
     if (!run || run->layer() != t.layer) {
       if (run) sum.layers.push_back(run->summary());
+      VT_RETURN_IF_ERROR(copy_layers_before(t.layer));
+      copied_up_to = t.layer + 1;
       run = std::make_unique<LayerRun>(plan, t.layer, sink, sum);
       VT_RETURN_IF_ERROR(run->begin_level(0));
     }
@@ -545,6 +590,7 @@ Expected<BuildSummary> build_pages(const BuildPlan& plan, PageSink& sink) {
     done[i] = true;
   }
   if (run) sum.layers.push_back(run->summary());
+  VT_RETURN_IF_ERROR(copy_layers_before(uint32_t(plan.layers.size())));
   for (const LevelSummary& ls : sum.levels) {
     sum.stored += ls.stored, sum.constant += ls.constant, sum.absent += ls.absent;
     sum.stored_bytes += ls.stored_bytes;

@@ -327,10 +327,12 @@ std::string settings_text(const BuildPlan& plan) {
   return j.dump();
 }
 
-// The plan's identity: its settings and every source's content (and coverage).
-Expected<uint64_t> plan_hash(const BuildPlan& plan, const std::string& settings) {
+// The plan's identity: its settings and every source's content (and coverage). Sets each
+// layer's input key (its source's content and coverage) on the way.
+Expected<uint64_t> plan_hash(BuildPlan& plan, const std::string& settings) {
   std::vector<uint64_t> parts{XXH3_64bits(settings.data(), settings.size())};
-  for (const LayerInput& in : plan.options.layers) {
+  for (size_t i = 0; i < plan.options.layers.size(); ++i) {
+    const LayerInput& in = plan.options.layers[i];
     VT_ASSIGN_OR_RETURN(uint64_t content, in.source->content_hash());
     parts.push_back(content);
     uint64_t coverage = 0;
@@ -338,6 +340,7 @@ Expected<uint64_t> plan_hash(const BuildPlan& plan, const std::string& settings)
       VT_ASSIGN_OR_RETURN(coverage, in.coverage->content_hash());
     }
     parts.push_back(coverage);
+    plan.layers[i].input_key = XXH3_64bits(&parts[parts.size() - 2], 2 * sizeof(uint64_t));
   }
   return XXH3_64bits(parts.data(), parts.size() * sizeof(uint64_t));
 }
@@ -427,6 +430,32 @@ Expected<uint64_t> sample_bytes(const PageEncoder& encoder,
     total += bytes[i];
   }
   return total;
+}
+
+// Update mode: a layer whose input, spec and tables (pinned: the previous file's or
+// --tables-from's) are those of the previous file's layer of the same name takes that layer's
+// pages (LayerPlan::copy_previous). Its tables are kept without a fit measurement: they coded
+// this very input before.
+bool copy_previous_layer(BuildPlan& plan, LayerPlan& layer, const std::vector<uint8_t>* pinned) {
+  if (!plan.previous || plan.options.retrain_tables) return false;
+  const int prev = plan.previous->layer_index(layer.spec.name);
+  if (prev < 0 || plan.previous->layer_input(prev) != layer.input_key) return false;
+  LayerSpec spec = layer.spec;
+  if (layer.encoder->wants_training()) {
+    if (!pinned) return false;
+    spec.codec_tables = *pinned;
+  }
+  const LayerSpec& old = plan.previous->reader().layers()[size_t(prev)];
+  if (spec.semantic != old.semantic || spec.channels != old.channels ||
+      spec.texel_type != old.texel_type || spec.codec != old.codec ||
+      spec.runtime_format != old.runtime_format || spec.color_space != old.color_space ||
+      spec.address_mode != old.address_mode || spec.codec_tables != old.codec_tables)
+    return false;
+  layer.spec = std::move(spec);
+  layer.copy_previous = true;
+  layer.previous_layer = prev;
+  plan.update.tables_pinned |= layer.encoder->wants_training();
+  return true;
 }
 
 // A DCT layer's tables: `pinned` when given (in update mode only while they code the training
@@ -580,6 +609,7 @@ Expected<BuildPlan> plan_build(const BuildOptions& options) {
   for (size_t i = 0; i < plan.layers.size(); ++i) {
     LayerPlan& layer = plan.layers[i];
     const LayerInput& in = options.layers[i];
+    if (copy_previous_layer(plan, layer, pinned.find(layer.spec.name))) continue;
     if (options.level_from) {
       VT_ASSIGN_OR_RETURN(BuildOptions::GivenLevel given, options.level_from(i, 0));
       layer.level0 = std::move(given.source);

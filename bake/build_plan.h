@@ -42,6 +42,13 @@ struct LayerPlan {
   std::vector<bool> level_in_memory;
   // Where this layer's task keys start: the settings and the layer's spec, tables included.
   uint64_t task_seed = 0;
+  // The key of the layer's input: its source's content and its coverage (recorded per layer).
+  uint64_t input_key = 0;
+  // Update mode: the previous file's layer `previous_layer` had this input, spec and tables, so
+  // its pages are this layer's (copied; level0 is then null: nothing is read, dilated, trained
+  // or encoded).
+  bool copy_previous = false;
+  int previous_layer = -1;
 
   // Linear working texels of a page (modified) to the layer's stored bytes. Returns true when
   // the storage clipped some value (8 bits: outside [0, 1]; half: beyond +-kHalfMax); for 8-bit

@@ -17,7 +17,8 @@ std::vector<BuildTask> make_build_tasks(const BuildPlan& plan) {
   const uint32_t P = g.payload, half = P / 2, m = plan.margin;
   std::vector<BuildTask> tasks;
   for (uint32_t li = 0; li < plan.layers.size(); ++li) {
-    std::vector<uint32_t> previous;  // band tasks of the level before, by row
+    if (plan.layers[li].copy_previous) continue;  // its pages are the previous file's
+    std::vector<uint32_t> previous;               // band tasks of the level before, by row
     for (uint32_t l = 0; l < g.level_count(); ++l) {
       std::vector<uint32_t> bands;
       const bool needs_whole = level_needs_whole(plan, li, l);

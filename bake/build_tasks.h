@@ -24,7 +24,8 @@ struct BuildTask {
   std::vector<uint32_t> deps;  // indices of the tasks whose output this one reads
 };
 
-// Every task of the plan, in an order that respects the dependencies: layers in order, levels
+// Every task of the plan (none for a layer that copies the previous file's, update mode), in an
+// order that respects the dependencies: layers in order, levels
 // fine to coarse, rows top to bottom. Level-0 bands read the source and depend on nothing
 // (a streamed source is read top to bottom, so they run in order).
 std::vector<BuildTask> make_build_tasks(const BuildPlan& plan);

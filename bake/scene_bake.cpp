@@ -223,9 +223,16 @@ Expected<uint64_t> check_and_key(const scene::Scene& input, const SceneBakeOptio
   return scene_bake_key(input, options);
 }
 
+// The update mode's cache folder of a bake (SceneBakeOptions::cache), "" = none.
+std::string cache_dir(const SceneBakeOptions& options) {
+  if (options.cache == "-") return "";
+  return options.cache.empty() ? options.build.output + ".cache" : options.cache;
+}
+
 // Unwrap and transfer; `prepared.summary` has its warnings and outputs set by the caller.
+// `cache`: the folder of the update mode's cache ("" = none).
 Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& options,
-                           uint64_t input_key, PreparedBake& prepared) {
+                           uint64_t input_key, const std::string& cache, PreparedBake& prepared) {
   SceneBakeSummary& summary = prepared.summary;
   const std::string& output = options.build.output;
   auto report = [&](const char* stage, double f) {
@@ -297,6 +304,15 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
       level0_fits_memory(transfer_store_bytes(unwrapped->scene, options.lighting.layer, W, H),
                          limit);
   to.coverage_in_memory = !options.transfer_to_scratch && CoverageMask::fits_memory(W, H, limit);
+  if (!cache.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(cache, ec);  // a folder it cannot make: no cache
+    if (!ec) {
+      to.cache_out = cache + "/transfer.bin";
+      if (options.build.update) to.cache_in = to.cache_out;
+      to.image_keys = image_content_keys(unwrapped->scene);
+    }
+  }
   auto transfer = guarded("transfer", [&] { return transfer_to_stores(unwrapped->scene, to); });
   if (!transfer.ok()) return transfer.status().with_context("transfer");
   summary.peak_rss.push_back({"transfer", peak_rss_bytes()});
@@ -363,7 +379,7 @@ Expected<PreparedBake> prepare_scene_bake(const scene::Scene& input,
   PreparedBake prepared;
   prepared.summary.warnings = input.warnings;
   prepared.summary.output = options.build.output;
-  VT_RETURN_IF_ERROR(unwrap_and_transfer(input, options, input_key, prepared));
+  VT_RETURN_IF_ERROR(unwrap_and_transfer(input, options, input_key, "", prepared));
   return prepared;
 }
 
@@ -397,7 +413,7 @@ Expected<SceneBakeSummary> bake_scene(const scene::Scene& input, const SceneBake
   if (!summary.unwrapped.empty()) {
     VT_ASSIGN_OR_RETURN(staged_scene, outputs.stage(summary.unwrapped));
   }
-  VT_RETURN_IF_ERROR(unwrap_and_transfer(input, options, input_key, prepared));
+  VT_RETURN_IF_ERROR(unwrap_and_transfer(input, options, input_key, cache_dir(options), prepared));
   const unwrap::UnwrapResult* unwrapped = &prepared.unwrapped;
 
   // Pyramid, paging, encode.
@@ -476,6 +492,8 @@ nlohmann::json to_json(const SceneBakeSummary& s) {
         {"edge_only_texels", t.edge_only_texels},
         {"contested_texels", t.contested_texels},
         {"samples", t.samples},
+        {"bands", t.bands},
+        {"bands_cached", t.bands_cached},
         {"texels_per_second", t.seconds > 0 ? double(t.covered_texels) / t.seconds : 0.0},
         {"above_one", above_one},
         {"missing_textures", missing}}},

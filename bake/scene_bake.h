@@ -44,6 +44,10 @@ struct SceneBakeOptions {
   // tests force small bands.
   uint32_t transfer_band_rows = 0;
   bool transfer_to_scratch = false;
+  // Update mode's cache folder: the transfer's bands (bake/transfer_cache.h) as
+  // `cache`/transfer.bin, written by every bake and read by an update (build.update).
+  // "" = the output's path with ".cache" appended, "-" = none. The output does not depend on it.
+  std::string cache;
   std::function<void(const SceneBakeProgress&)> progress;
 
   // 8 GiB by default rather than the build's 2: the transfer's layers stay in memory (faster)

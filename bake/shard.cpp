@@ -412,6 +412,8 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
   // Level 0 in its working form (converted, dilated) for the shards, which would otherwise each
   // redo it: for the layers whose held level 0 carries the input's coverage mask.
   t0 = Clock::now();
+  for (size_t i = 0; i < plan.layers.size(); ++i)
+    layers[i]["input_key"] = hex(plan.layers[i].input_key);  // for the merged update record
   for (size_t i = 0; i < plan.layers.size() && !dir.empty(); ++i) {
     LevelSource& level0 = *plan.layers[i].level0;
     if (!coverage || level0.coverage() != bo.layers[i].coverage.get()) continue;
@@ -991,7 +993,12 @@ Expected<MergeSummary> merge_shards(const MergeOptions& options) {
   record.plan_hash = w.hash;
   record.settings_key = unhex(w.json["settings_key"]);
   record.input_key = unhex(w.json["input_key"]);
-  for (const LayerSpec& l : desc.layers) record.layer_names.push_back(l.name);
+  for (size_t i = 0; i < desc.layers.size(); ++i) {
+    record.layer_names.push_back(desc.layers[i].name);
+    const auto& layers = w.json["layers"];
+    record.layer_inputs.push_back(
+        i < layers.size() && layers[i].contains("input_key") ? unhex(layers[i]["input_key"]) : 0);
+  }
   record.page_keys.assign(desc.layers.size(),
                           std::vector<uint64_t>(desc.geometry.total_pages(), 0));
   for (size_t pi = 0; pi < parts.size(); ++pi) {

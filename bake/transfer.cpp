@@ -2,9 +2,11 @@
 // the triangles that overlap it in index order, so the result does not depend on threads.
 #include "bake/transfer.h"
 #include "bake/color.h"
+#include "bake/content_key.h"
 #include "bake/level_store.h"
 #include "bake/lighting.h"
 #include "bake/png_check.h"
+#include "bake/transfer_cache.h"
 #include "bake/transfer_texture.h"
 #include "bake/unwrap/atlas_raster.h"
 #include "common/parallel.h"
@@ -126,6 +128,8 @@ struct ImageSlot {
   std::string name;
   std::string tried;  // the file opened (for an embedded image, its scratch copy)
   std::string error;  // why it could not be read
+  // Readable, but its levels are not loaded: only bands read from the band cache use it.
+  bool deferred = false;
 };
 
 constexpr TextureSlot kTextureSlots[] = {
@@ -312,6 +316,8 @@ struct RowCounts {
   uint64_t sampled = 0, edge_only = 0, contested = 0, samples = 0;
 };
 
+struct BandBytes;
+
 class Transfer {
  public:
   Transfer(const scene::Scene& scene, const TransferOptions& opt) : scene_(scene), opt_(opt) {}
@@ -325,7 +331,7 @@ class Transfer {
   Expected<TransferResult> run();
 
  private:
-  Status setup_images();
+  Status setup_images(const std::vector<bool>* wanted = nullptr);
   Status check_missing_textures();
   Status set_colour_space(ImageSlot& slot, const std::string& path,
                           const OIIO::ImageSpec& spec) const;
@@ -334,9 +340,17 @@ class Transfer {
   bool sample_texture(TexSlot slot, const TriEval& te, const double l[3], float out[4]) const;
   void evaluate(const TriEval& te, const double l[3], uint64_t seed, Sample& s) const;
   void make_eval(uint32_t t, TriEval& te) const;
-  void transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlots],
-                     std::vector<uint8_t>& coverage, RowCounts& counts,
-                     const std::function<void(double)>& progress) const;
+  Status setup_cache();
+  std::vector<bool> images_for_uncached_bands() const;
+  void transfer_band(uint32_t b, float* const (&acc)[kSlots], uint8_t* coverage,
+                     RowCounts& counts) const;
+  void pack_band(const BandBytes& f, float* const (&acc)[kSlots], const uint8_t* coverage,
+                 const RowCounts& counts, const LayerFacts (&facts)[kSlots], uint8_t* out) const;
+  void unpack_band(const BandBytes& f, const uint8_t* in, float* const (&acc)[kSlots],
+                   uint8_t* coverage, RowCounts& counts, LayerFacts (&facts)[kSlots]) const;
+  Status transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlots],
+                       std::vector<uint8_t>& coverage, RowCounts& counts,
+                       LayerFacts (&facts)[kSlots], const std::function<void(double)>& progress);
   void finish_rows(float* const (&acc)[kSlots], const uint8_t* coverage, size_t n,
                    LayerFacts (&facts)[kSlots]) const;
   Expected<std::vector<TransferLayer>> make_layers(std::shared_ptr<LevelStore> (&stores)[kSlots],
@@ -364,6 +378,11 @@ class Transfer {
   }
   double sub_scale_ = 1.0;
   uint64_t texture_bytes_ = 0;  // the loaded textures' texels
+  // The band cache (TransferOptions::cache_in, cache_out) and every band's key.
+  std::unique_ptr<TransferCacheReader> cache_in_;
+  std::unique_ptr<TransferCacheWriter> cache_out_;
+  std::vector<uint64_t> band_keys_;
+  uint64_t bands_cached_ = 0;
 };
 
 // Base colour and emissive textures are colour; the other slots are data.
@@ -403,7 +422,10 @@ Status Transfer::set_colour_space(ImageSlot& slot, const std::string& path,
   return Status::Ok();
 }
 
-Status Transfer::setup_images() {
+// Opens every image a material in use reads and loads the levels of those `wanted` names (null:
+// all); the others are deferred. Run again, it loads the deferred ones.
+Status Transfer::setup_images(const std::vector<bool>* wanted) {
+  const bool first = images_.empty();
   // Before OpenImageIO opens them: libpng would print its own line for a damaged file.
   VT_RETURN_IF_ERROR(check_scene_textures(scene_));
   std::vector<bool> used(scene_.images.size(), false);
@@ -424,13 +446,14 @@ Status Transfer::setup_images() {
   fs::path scratch =
       opt_.scratch_dir.empty() ? fs::temp_directory_path() : fs::path(opt_.scratch_dir);
   for (size_t i = 0; i < scene_.images.size(); ++i) {
-    if (!used[i]) continue;
+    if (!used[i] || (!first && !images_[i].deferred)) continue;
     const scene::Image& img = scene_.images[i];
     ImageSlot& slot = images_[i];
-    std::string path = img.path;
+    slot.deferred = false;
+    std::string path = img.embedded() ? slot.tried : img.path;
     slot.name =
         img.embedded() ? "embedded image " + std::to_string(i) + " '" + img.name + "'" : img.path;
-    if (img.embedded()) {
+    if (img.embedded() && path.empty()) {
       // OpenImageIO reads by file name: a private copy is the robust way.
       const std::string ext = img.embedded_extension();
       // Unique per process and per call, so concurrent transfers never share a copy.
@@ -460,6 +483,10 @@ Status Transfer::setup_images() {
       if (used_as_colour(scene_, i)) {
         VT_RETURN_IF_ERROR(set_colour_space(slot, img.embedded() ? "" : img.path, spec));
       }
+    }
+    if (wanted && !(*wanted)[i]) {
+      slot.deferred = true;
+      continue;
     }
     // Optionally, untiled sources get MIP levels made with another filter (as maketx does),
     // read back as the texture's levels; should that fail, box-filtered levels are made.
@@ -503,14 +530,14 @@ Status Transfer::setup_images() {
       VT_ASSIGN_OR_RETURN(slot.data_texture, keep(*data));
     }
   }
-  return check_missing_textures();
+  return first ? check_missing_textures() : Status::Ok();
 }
 
 Status Transfer::check_missing_textures() {
   for (const scene::Material* m : materials_in_use(scene_)) {
     for (const TextureSlot& ts : kTextureSlots) {
       const scene::TextureRef& r = m->*ts.ref;
-      if (!r.valid() || images_[r.image].texture) continue;
+      if (!r.valid() || images_[r.image].texture || images_[r.image].deferred) continue;
       const scene::Image& img = scene_.images[r.image];
       MissingTexture miss;
       miss.material = m->name;
@@ -847,16 +874,11 @@ Expected<std::vector<TransferLayer>> Transfer::make_layers(
   return layers;
 }
 
-// Rows [r0, r1) of the atlas (r0 a multiple of kBandRows) into `acc` and `coverage` (those rows
-// only); the bands run on all threads.
-void Transfer::transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlots],
-                             std::vector<uint8_t>& coverage, RowCounts& counts,
-                             const std::function<void(double)>& progress) const {
+// Band `b` (rows y0..y1) into `acc` and `coverage` (those rows only), counted in `counts`.
+void Transfer::transfer_band(uint32_t b, float* const (&acc)[kSlots], uint8_t* coverage,
+                             RowCounts& counts) const {
   const uint32_t W = opt_.width, H = opt_.height;
   const auto pattern = supersample_pattern(opt_.supersample);
-  const uint32_t b0 = r0 / kBandRows, bands = (r1 - r0 + kBandRows - 1) / kBandRows;
-  std::atomic<uint64_t> sampled{0}, edge_only{0}, contested{0}, samples{0};
-
   auto store = [&](size_t texel, const Sample& s, float weight, bool add) {
     for (int l = 0; l < kSlots; ++l) {
       if (!want_[l]) continue;
@@ -866,59 +888,225 @@ void Transfer::transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlot
       for (uint32_t c = 0; c < channels; ++c) d[c] = add ? d[c] + src[c] * weight : src[c];
     }
   };
-
-  for_each_band(bands, opt_.threads, progress, [&](uint32_t bi) {
-    const uint32_t b = b0 + bi;
-    BandRaster band;
-    uint32_t y0 = b * kBandRows, y1 = std::min(H, y0 + kBandRows);
-    band.reset(W, y0, y1);
-    const size_t base = size_t(y0 - r0) * W;  // the band's first texel in `acc`
-    TriEval te;
-    Sample s{};
-    uint64_t n_samples = 0;
-    const float weight = 1.0f / float(pattern.size());
-    for (uint32_t t : bins_[b]) {
-      make_eval(t, te);
-      raster_triangle(tris_[t], int32_t(t), chart_[t], band, pattern, H,
-                      [&](size_t i, const double* l, uint32_t sub) {
-                        evaluate(te, l, (uint64_t(y0) * W + i) * 32 + sub, s);
-                        store(base + i, s, weight, true);
-                        ++n_samples;
-                      });
-    }
-    uint64_t n_sampled = 0, n_edge = 0, n_contested = 0;
-    for (size_t i = 0; i < band.best_tri.size(); ++i) {
-      if (band.best_tri[i] < 0) continue;
-      const size_t texel = base + i;
-      coverage[base + i] = 1;
-      n_contested += band.contested[i];
-      if (band.inside[i] > 0) {
-        ++n_sampled;
-        // Partially covered texels average only the samples that fell inside.
-        float scale = float(pattern.size()) / float(band.inside[i]);
-        if (scale != 1.0f) {
-          for (int l = 0; l < kSlots; ++l) {
-            if (!want_[l]) continue;
-            const uint32_t channels = channels_[l];
-            for (uint32_t c = 0; c < channels; ++c) acc[l][texel * channels + c] *= scale;
-          }
+  BandRaster band;
+  uint32_t y0 = b * kBandRows, y1 = std::min(H, y0 + kBandRows);
+  band.reset(W, y0, y1);
+  TriEval te;
+  Sample s{};
+  const float weight = 1.0f / float(pattern.size());
+  for (uint32_t t : bins_[b]) {
+    make_eval(t, te);
+    raster_triangle(tris_[t], int32_t(t), chart_[t], band, pattern, H,
+                    [&](size_t i, const double* l, uint32_t sub) {
+                      evaluate(te, l, (uint64_t(y0) * W + i) * 32 + sub, s);
+                      store(i, s, weight, true);
+                      ++counts.samples;
+                    });
+  }
+  for (size_t i = 0; i < band.best_tri.size(); ++i) {
+    if (band.best_tri[i] < 0) continue;
+    coverage[i] = 1;
+    counts.contested += band.contested[i];
+    if (band.inside[i] > 0) {
+      ++counts.sampled;
+      // Partially covered texels average only the samples that fell inside.
+      float scale = float(pattern.size()) / float(band.inside[i]);
+      if (scale != 1.0f) {
+        for (int l = 0; l < kSlots; ++l) {
+          if (!want_[l]) continue;
+          const uint32_t channels = channels_[l];
+          for (uint32_t c = 0; c < channels; ++c) acc[l][i * channels + c] *= scale;
         }
-        continue;
       }
-      // Touched but no sample inside: the closest point of the closest triangle.
-      ++n_edge;
-      uint32_t t = uint32_t(band.best_tri[i]);
-      make_eval(t, te);
-      double l[3];
-      tris_[t].closest_barycentrics((i % W) + 0.5, (y0 + i / W) + 0.5, l);
-      evaluate(te, l, (uint64_t(y0) * W + i) * 32 + 16, s);
-      store(texel, s, 1.0f, false);
-      ++n_samples;
+      continue;
     }
-    sampled += n_sampled, edge_only += n_edge, contested += n_contested, samples += n_samples;
-  });
-  counts.sampled += sampled, counts.edge_only += edge_only, counts.contested += contested;
-  counts.samples += samples;
+    // Touched but no sample inside: the closest point of the closest triangle.
+    ++counts.edge_only;
+    uint32_t t = uint32_t(band.best_tri[i]);
+    make_eval(t, te);
+    double l[3];
+    tris_[t].closest_barycentrics((i % W) + 0.5, (y0 + i / W) + 0.5, l);
+    evaluate(te, l, (uint64_t(y0) * W + i) * 32 + 16, s);
+    store(i, s, 1.0f, false);
+    ++counts.samples;
+  }
+}
+
+// A band's finished texels as the band cache stores them: its counts, its layers' facts, its
+// coverage (a byte a texel), then each layer's texels. `n` texels; sizes only with null data.
+struct BandBytes {
+  static constexpr size_t kCounts = 4 * sizeof(uint64_t), kFacts = 16;
+  size_t n = 0, size = 0;
+  size_t offset[kSlots] = {};  // of each wanted layer's texels
+  BandBytes(size_t texels, const bool (&want)[kSlots], const uint32_t (&channels)[kSlots])
+      : n(texels) {
+    size = kCounts + kSlots * kFacts + n;
+    for (int l = 0; l < kSlots; ++l)
+      if (want[l]) offset[l] = size, size += n * channels[l] * sizeof(float);
+  }
+};
+
+void Transfer::pack_band(const BandBytes& f, float* const (&acc)[kSlots], const uint8_t* coverage,
+                         const RowCounts& counts, const LayerFacts (&facts)[kSlots],
+                         uint8_t* out) const {
+  const uint64_t c[4] = {counts.sampled, counts.edge_only, counts.contested, counts.samples};
+  std::memcpy(out, c, sizeof c);
+  for (int l = 0; l < kSlots; ++l) {
+    uint8_t* p = out + BandBytes::kCounts + l * BandBytes::kFacts;
+    std::memset(p, 0, BandBytes::kFacts);
+    std::memcpy(p, &facts[l].texels_above_one, 8);
+    std::memcpy(p + 8, &facts[l].max_value, 4);
+    p[12] = facts[l].hdr, p[13] = facts[l].alpha_hdr, p[14] = facts[l].alpha;
+  }
+  std::memcpy(out + BandBytes::kCounts + kSlots * BandBytes::kFacts, coverage, f.n);
+  for (int l = 0; l < kSlots; ++l)
+    if (want_[l]) std::memcpy(out + f.offset[l], acc[l], f.n * channels_[l] * sizeof(float));
+}
+
+void Transfer::unpack_band(const BandBytes& f, const uint8_t* in, float* const (&acc)[kSlots],
+                           uint8_t* coverage, RowCounts& counts,
+                           LayerFacts (&facts)[kSlots]) const {
+  uint64_t c[4];
+  std::memcpy(c, in, sizeof c);
+  counts.sampled = c[0], counts.edge_only = c[1], counts.contested = c[2], counts.samples = c[3];
+  for (int l = 0; l < kSlots; ++l) {
+    const uint8_t* p = in + BandBytes::kCounts + l * BandBytes::kFacts;
+    std::memcpy(&facts[l].texels_above_one, p, 8);
+    std::memcpy(&facts[l].max_value, p + 8, 4);
+    facts[l].hdr = p[12], facts[l].alpha_hdr = p[13], facts[l].alpha = p[14];
+  }
+  std::memcpy(coverage, in + BandBytes::kCounts + kSlots * BandBytes::kFacts, f.n);
+  for (int l = 0; l < kSlots; ++l)
+    if (want_[l]) std::memcpy(acc[l], in + f.offset[l], f.n * channels_[l] * sizeof(float));
+}
+
+// Rows [r0, r1) of the atlas (r0 a multiple of kBandRows) into `acc` and `coverage` (those rows
+// only), finished (finish_rows); the bands run on all threads, each read from the band cache
+// when it holds it, else transferred (and stored there).
+Status Transfer::transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlots],
+                               std::vector<uint8_t>& coverage, RowCounts& counts,
+                               LayerFacts (&facts)[kSlots],
+                               const std::function<void(double)>& progress) {
+  const uint32_t W = opt_.width, H = opt_.height;
+  const uint32_t b0 = r0 / kBandRows, bands = (r1 - r0 + kBandRows - 1) / kBandRows;
+  struct Outcome {
+    RowCounts counts;
+    LayerFacts facts[kSlots];
+    bool cached = false;
+    bool unread = false;  // listed in the cache but unreadable there: transferred after
+  };
+  std::vector<Outcome> outcome(bands);
+  auto band = [&](uint32_t bi, bool from_cache) {
+    const uint32_t b = b0 + bi, y0 = b * kBandRows, y1 = std::min(H, y0 + kBandRows);
+    const size_t base = size_t(y0 - r0) * W;  // the band's first texel in `acc`
+    float* band_acc[kSlots] = {};
+    for (int l = 0; l < kSlots; ++l)
+      if (want_[l]) band_acc[l] = acc[l] + base * channels_[l];
+    uint8_t* band_coverage = coverage.data() + base;
+    Outcome& o = outcome[bi];
+    const BandBytes layout(size_t(y1 - y0) * W, want_, channels_);
+    thread_local std::vector<uint8_t> bytes;
+    if (cache_in_ || cache_out_) bytes.resize(layout.size);
+    if (from_cache && cache_in_ && cache_in_->has(b, band_keys_[b])) {
+      thread_local std::vector<uint8_t> frame;
+      if (cache_in_->read(b, band_keys_[b], bytes, &frame)) {
+        unpack_band(layout, bytes.data(), band_acc, band_coverage, o.counts, o.facts);
+        o.cached = true;
+        if (cache_out_) cache_out_->add_frame(b, band_keys_[b], bytes, frame);  // kept
+      } else {
+        o.unread = true;  // its images may be deferred (setup_images)
+      }
+      return;
+    }
+    transfer_band(b, band_acc, band_coverage, o.counts);
+    finish_rows(band_acc, band_coverage, layout.n, o.facts);
+    if (cache_out_) {
+      pack_band(layout, band_acc, band_coverage, o.counts, o.facts, bytes.data());
+      cache_out_->add(b, band_keys_[b], bytes);
+    }
+  };
+  for_each_band(bands, opt_.threads, progress, [&](uint32_t bi) { band(bi, true); });
+  std::vector<uint32_t> unread;
+  for (uint32_t bi = 0; bi < bands; ++bi)
+    if (outcome[bi].unread) unread.push_back(bi);
+  if (!unread.empty()) {
+    VT_RETURN_IF_ERROR(setup_images());  // the deferred images too
+    parallel_for(unread.size(), opt_.threads, [&](size_t i) { band(unread[i], false); });
+  }
+  for (const Outcome& o : outcome) {
+    counts.sampled += o.counts.sampled, counts.edge_only += o.counts.edge_only;
+    counts.contested += o.counts.contested, counts.samples += o.counts.samples;
+    bands_cached_ += o.cached;
+    for (int l = 0; l < kSlots; ++l) {
+      LayerFacts& f = facts[l];
+      const LayerFacts& g = o.facts[l];
+      f.texels_above_one += g.texels_above_one, f.max_value = std::max(f.max_value, g.max_value);
+      f.hdr |= g.hdr, f.alpha_hdr |= g.alpha_hdr, f.alpha |= g.alpha;
+    }
+  }
+  return Status::Ok();
+}
+
+// The band cache's keys: the file's (cache layout, tool version, atlas, settings, layers, how
+// each image is used), and each band's (the file key, the band, and per triangle it reads: its
+// index, chart and face, and the key of its primitive: vertex data, material, the content and
+// path of the images that reads). Opens the cache to read and the one to write.
+Status Transfer::setup_cache() {
+  if ((opt_.cache_in.empty() && opt_.cache_out.empty()) || want_[kLightingSlot])
+    return Status::Ok();
+  if (opt_.image_keys.size() != scene_.images.size())
+    return Error(ErrorCode::kInvalidArgument, "transfer: the band cache needs a key per image");
+  KeyStream f;
+  f.add(std::string("transfer bands 1 " VTBAKE_VERSION));
+  f.add(opt_.width), f.add(opt_.height), f.add(opt_.atlas_uv_set), f.add(opt_.supersample);
+  f.add(opt_.mip_filter), f.add(opt_.missing_textures), f.add(kBandRows);
+  f.add(opt_.color_config && !opt_.color_config->is_builtin() ? opt_.color_config->cache_id()
+                                                              : std::string());
+  for (int l = 0; l < kSlots; ++l) f.add(want_[l]), f.add(channels_[l]);
+  for (size_t i = 0; i < scene_.images.size(); ++i)
+    f.add(used_as_colour(scene_, i)), f.add(used_as_data(scene_, i));
+  const uint64_t file_key = f.digest();
+  std::vector<uint64_t> prim_keys(prims_.size());
+  for (size_t pi = 0; pi < prims_.size(); ++pi) {
+    KeyStream k;
+    add_primitive(k, *prims_[pi].prim);
+    add_material(k, *prims_[pi].mat);
+    for (const TextureSlot& ts : kTextureSlots) {
+      const scene::TextureRef& r = (*prims_[pi].mat).*ts.ref;
+      if (!r.valid() || size_t(r.image) >= scene_.images.size()) continue;  // setup_images fails
+      k.add(opt_.image_keys[size_t(r.image)]), k.add(scene_.images[size_t(r.image)].path);
+    }
+    prim_keys[pi] = k.digest();
+  }
+  band_keys_.resize(bins_.size());
+  for (size_t b = 0; b < bins_.size(); ++b) {
+    KeyStream k;
+    k.add(file_key), k.add(uint64_t(b));
+    for (uint32_t t : bins_[b])
+      k.add(t), k.add(chart_[t]), k.add(tri_src_[t].second), k.add(prim_keys[tri_src_[t].first]);
+    band_keys_[b] = k.digest() | 1;  // never 0, which marks a band not stored
+  }
+  const uint32_t bands = uint32_t(bins_.size());
+  if (!opt_.cache_in.empty()) cache_in_ = TransferCacheReader::open(opt_.cache_in, file_key, bands);
+  if (!opt_.cache_out.empty()) {
+    auto writer = TransferCacheWriter::create(opt_.cache_out, file_key, bands);
+    if (writer.ok()) cache_out_ = std::move(writer).value();
+  }
+  return Status::Ok();
+}
+
+// The images read by the triangles of the bands the band cache lacks.
+std::vector<bool> Transfer::images_for_uncached_bands() const {
+  std::vector<bool> wanted(scene_.images.size(), false);
+  for (size_t b = 0; b < bins_.size(); ++b) {
+    if (cache_in_->has(uint32_t(b), band_keys_[b])) continue;
+    for (uint32_t t : bins_[b])
+      for (const TextureSlot& ts : kTextureSlots) {
+        const scene::TextureRef& r = (*prims_[tri_src_[t].first].mat).*ts.ref;
+        if (r.valid() && size_t(r.image) < wanted.size()) wanted[size_t(r.image)] = true;
+      }
+  }
+  return wanted;
 }
 
 // Rows transferred at a time: a multiple of kBandRows, as many as TransferOptions allow.
@@ -948,8 +1136,13 @@ Expected<TransferResult> Transfer::run() {
                                                 std::to_string(H) + " texels exceeds the limit");
   }
   sub_scale_ = 1.0 / std::sqrt(double(opt_.supersample));
-  VT_RETURN_IF_ERROR(setup_images());
   VT_RETURN_IF_ERROR(setup_prims());
+  bins_ = bin_by_rows(tris_, H, kBandRows);
+  // With a band cache, only the images that bands it lacks read are loaded.
+  VT_RETURN_IF_ERROR(setup_cache());
+  std::vector<bool> wanted;
+  if (cache_in_) wanted = images_for_uncached_bands();
+  VT_RETURN_IF_ERROR(setup_images(cache_in_ ? &wanted : nullptr));
 
   TransferResult result;
   result.width = W, result.height = H;
@@ -962,7 +1155,6 @@ Expected<TransferResult> Transfer::run() {
   VT_ASSIGN_OR_RETURN(std::shared_ptr<CoverageMask> coverage,
                       CoverageMask::create(W, H, opt_.coverage_in_memory, opt_.scratch_dir));
   std::vector<uint8_t> band_coverage;  // a pass's rows, one byte per texel
-  bins_ = bin_by_rows(tris_, H, kBandRows);
   const uint32_t pass = rows_per_pass();
   // Accumulators: an in-memory store's own rows (zero when created), else a pass's buffer
   // written to the scratch store after.
@@ -986,8 +1178,7 @@ Expected<TransferResult> Transfer::run() {
     if (opt_.progress)
       progress = [&](double f) { opt_.progress((double(r0) + f * double(r1 - r0)) / double(H)); };
     band_coverage.assign(n, 0);
-    transfer_rows(r0, r1, acc, band_coverage, counts, progress);
-    finish_rows(acc, band_coverage.data(), n, facts);
+    VT_RETURN_IF_ERROR(transfer_rows(r0, r1, acc, band_coverage, counts, facts, progress));
     VT_RETURN_IF_ERROR(
         coverage->write_rows(r0, r1 - r0, band_coverage.data()).with_context("transfer"));
     for (int l = 0; l < kSlots; ++l) {
@@ -997,6 +1188,8 @@ Expected<TransferResult> Transfer::run() {
   }
   for (auto& b : buffer) b = {};
   band_coverage = {};
+  // A cache that cannot be written only costs the next update its reuse.
+  if (cache_out_) (void)cache_out_->finish();
 
   VT_ASSIGN_OR_RETURN(result.layers, make_layers(stores, facts));
   result.coverage = coverage;
@@ -1009,6 +1202,8 @@ Expected<TransferResult> Transfer::run() {
   result.stats.samples = counts.samples;
   if (lighting_) result.stats.lighting = lighting_->stats();
   result.stats.texture_bytes = texture_bytes_;
+  result.stats.bands = bins_.size();
+  result.stats.bands_cached = bands_cached_;
   result.stats.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -78,6 +78,14 @@ struct TransferOptions {
   std::shared_ptr<const ColorConfig> color_config;
   // The lighting layer, baked when the scene places a light (bake/lighting.h).
   LightingOptions lighting;
+  // Band cache (bake/transfer_cache.h; not with a lighting layer, whose texels depend on the
+  // whole scene): a band of rows whose key (its triangles, their primitives' data and
+  // materials, the images those read, the settings) `cache_in` holds is read from it rather
+  // than transferred; every band is stored in `cache_out`. "" = none. image_keys: a content key
+  // per scene image (update_scene.h image_content_keys), needed by either. The texels do not
+  // depend on the cache.
+  std::string cache_in, cache_out;
+  std::vector<uint64_t> image_keys;
   std::function<void(double fraction)> progress;  // from the calling thread, 0..1
 };
 
@@ -112,6 +120,8 @@ struct TransferStats {
   uint64_t samples = 0;           // material evaluations
   LightingStats lighting;         // the lighting layer's samples and rays (none: all 0)
   uint64_t texture_bytes = 0;     // the source textures' MIP levels (memory or mapped scratch)
+  uint64_t bands = 0;             // bands of rows, and those read from the band cache
+  uint64_t bands_cached = 0;
   double seconds = 0;
 };
 

@@ -57,8 +57,11 @@ bool parse_record(const std::string& metadata, const PageGeometry& g, UpdateReco
     std::vector<uint64_t> parsed(pages);
     for (uint64_t i = 0; i < pages; ++i)
       if (!parse_hex64(keys.data() + i * 16, &parsed[i])) return false;
+    uint64_t input = 0;
+    if (layer.contains("input") && !parse_hex_field(layer, "input", &input)) return false;
     r->layer_names.push_back(layer["name"].get<std::string>());
     r->page_keys.push_back(std::move(parsed));
+    r->layer_inputs.push_back(input);
   }
   return true;
 }
@@ -107,6 +110,7 @@ std::string with_update_record(const std::string& metadata_json, const UpdateRec
     keys.reserve(r.page_keys[i].size() * 16);
     for (uint64_t k : r.page_keys[i]) keys += hex64(k);
     layers.push_back({{"name", r.layer_names[i]}, {"keys", std::move(keys)}});
+    if (i < r.layer_inputs.size()) layers.back()["input"] = hex64(r.layer_inputs[i]);
   }
   meta["update"] = {{"tool", r.tool},
                     {"plan", hex64(r.plan_hash)},
@@ -139,6 +143,11 @@ uint64_t PreviousBuild::key(int layer, const PageId& id) const {
   const PageGeometry& g = reader_->geometry();
   if (layer < 0 || size_t(layer) >= record_.page_keys.size() || !g.contains(id)) return 0;
   return record_.page_keys[size_t(layer)][page_key_index(g, id)];
+}
+
+uint64_t PreviousBuild::layer_input(int layer) const {
+  return layer >= 0 && size_t(layer) < record_.layer_inputs.size() ? record_.layer_inputs[layer]
+                                                                   : 0;
 }
 
 std::vector<uint8_t> PreviousBuild::tables(const std::string& name) const {

@@ -51,6 +51,9 @@ struct UpdateRecord {
   // then x) of layer `layer`; 0 = absent.
   std::vector<std::string> layer_names;
   std::vector<std::vector<uint64_t>> page_keys;
+  // Per layer: the key of its input (source content and coverage; LayerPlan::input_key), 0 =
+  // not recorded (files before it).
+  std::vector<uint64_t> layer_inputs;
 };
 
 // Page i of the key tables: levels fine to coarse, rows top to bottom, then x.
@@ -77,6 +80,8 @@ class PreviousBuild {
   // The recorded task key of a page of the previous file's layer `layer` (0 = absent or
   // outside its grid).
   uint64_t key(int layer, const PageId& id) const;
+  // The recorded input key of layer `layer` (0 = not recorded).
+  uint64_t layer_input(int layer) const;
   // DCT tables of the layer named `name` ("" when it has none).
   std::vector<uint8_t> tables(const std::string& name) const;
 

@@ -1,64 +1,14 @@
 #include "bake/update_scene.h"
 
-#define XXH_STATIC_LINKING_ONLY  // XXH3_state_t on the stack
-#include <xxhash.h>
-
 #include <filesystem>
-#include <type_traits>
 
 #include "bake/color.h"
+#include "bake/content_key.h"
 #include "bake/image_source.h"
 #include "bake/unwrap/texel_density.h"
 
 namespace vt {
 namespace {
-
-// Feeds values to one XXH3 stream; strings and arrays with their length, so that no two
-// different inputs give the same byte stream.
-class KeyStream {
- public:
-  KeyStream() { XXH3_64bits_reset(&state_); }
-  template <typename T>
-  void add(const T& v) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    XXH3_64bits_update(&state_, &v, sizeof v);
-  }
-  void add(const std::string& s) {
-    add(uint64_t(s.size()));
-    XXH3_64bits_update(&state_, s.data(), s.size());
-  }
-  template <typename T>
-  void add(const std::vector<T>& v) {
-    add(uint64_t(v.size()));
-    if constexpr (std::is_trivially_copyable_v<T>) {
-      XXH3_64bits_update(&state_, v.data(), v.size() * sizeof(T));
-    } else {
-      for (const T& e : v) add(e);
-    }
-  }
-  uint64_t digest() const { return XXH3_64bits_digest(&state_); }
-
- private:
-  XXH3_state_t state_;
-};
-
-void add_texture(KeyStream& k, const scene::TextureRef& t) {
-  k.add(t.image), k.add(t.texcoord), k.add(t.wrap_s), k.add(t.wrap_t), k.add(t.mag_filter);
-  k.add(t.transform.offset), k.add(t.transform.rotation), k.add(t.transform.scale);
-}
-
-void add_material(KeyStream& k, const scene::Material& m) {
-  k.add(m.name), k.add(m.base_color_factor);
-  add_texture(k, m.base_color_texture);
-  k.add(m.metallic_factor), k.add(m.roughness_factor);
-  add_texture(k, m.metallic_roughness_texture);
-  add_texture(k, m.normal_texture);
-  k.add(m.normal_scale);
-  add_texture(k, m.occlusion_texture);
-  k.add(m.occlusion_strength), k.add(m.emissive_factor), k.add(m.emissive_strength);
-  add_texture(k, m.emissive_texture);
-  k.add(m.alpha_mode), k.add(m.alpha_cutoff), k.add(m.double_sided), k.add(m.texels_per_unit);
-}
 
 // A file's content, or a marker for a file that cannot be read (a missing texture bakes from
 // the factor alone; the key changes when it appears).
@@ -68,23 +18,24 @@ void add_file(KeyStream& k, const std::string& path) {
   k.add(h.ok() ? *h : uint64_t(0));
 }
 
+void add_image(KeyStream& k, const scene::Image& image) {
+  // The uri as written (relative to the scene) is in the unwrapped scene; the path is not.
+  k.add(image.name), k.add(image.uri), k.add(image.mime_type), k.add(image.bytes);
+  if (!image.embedded()) add_file(k, image.path);
+}
+
 void add_scene(KeyStream& k, const scene::Scene& s) {
   k.add(uint64_t(s.meshes.size()));
   for (const scene::Mesh& mesh : s.meshes) {
     k.add(mesh.name), k.add(uint64_t(mesh.primitives.size()));
     for (const scene::Primitive& p : mesh.primitives) {
-      k.add(p.positions), k.add(p.normals), k.add(p.tangents), k.add(p.uvs), k.add(p.colors);
-      k.add(p.indices), k.add(p.material);
+      add_primitive(k, p);
     }
   }
   k.add(uint64_t(s.materials.size()));
   for (const scene::Material& m : s.materials) add_material(k, m);
   k.add(uint64_t(s.images.size()));
-  for (const scene::Image& image : s.images) {
-    // The uri as written (relative to the scene) is in the unwrapped scene; the path is not.
-    k.add(image.name), k.add(image.uri), k.add(image.mime_type), k.add(image.bytes);
-    if (!image.embedded()) add_file(k, image.path);
-  }
+  for (const scene::Image& image : s.images) add_image(k, image);
   k.add(uint64_t(s.nodes.size()));
   for (const scene::Node& n : s.nodes) {
     k.add(n.name), k.add(n.local), k.add(n.mesh), k.add(n.children), k.add(n.texels_per_unit);
@@ -148,6 +99,16 @@ Expected<uint64_t> scene_bake_key(const scene::Scene& scene, const SceneBakeOpti
   k.add(uint8_t(has_density));
   if (has_density) add_file(k, density);
   return k.digest();
+}
+
+std::vector<uint64_t> image_content_keys(const scene::Scene& scene) {
+  std::vector<uint64_t> keys;
+  for (const scene::Image& image : scene.images) {
+    KeyStream k;
+    add_image(k, image);
+    keys.push_back(k.digest());
+  }
+  return keys;
 }
 
 std::optional<SceneBakeSummary> unchanged_bake(const SceneBakeOptions& options,

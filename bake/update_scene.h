@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "bake/scene_bake.h"
 #include "common/status.h"
@@ -15,6 +16,10 @@ namespace vt {
 
 // The content key of a bake of `scene` with `options`. Errors name an unreadable texture.
 Expected<uint64_t> scene_bake_key(const scene::Scene& scene, const SceneBakeOptions& options);
+
+// A content key per image of `scene`: its name, uri, embedded bytes or file content (a marker
+// when it cannot be read), for the transfer's band cache (TransferOptions::image_keys).
+std::vector<uint64_t> image_content_keys(const scene::Scene& scene);
 
 // With options.build.update: the summary of the previous output (at options.build.output,
 // with its unwrapped scene at `unwrapped` when one is wanted) when it was baked from `key`

@@ -235,6 +235,7 @@ int run_batch(BakeArgs& a, const vt::cli::GlobalOptions& global) {
       vt::SceneBakeOptions o = a.options;
       o.build.output = it.output;
       if (o.unwrapped != "-") o.unwrapped = "";  // beside each output
+      if (o.cache != "-") o.cache = "";
       if (!global.quiet)
         std::fprintf(stderr, "bake %zu/%zu %s -> %s\n", i + 1, items.size(), it.scene.c_str(),
                      it.output.c_str());
@@ -295,6 +296,9 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
                "Batch: bake the other scenes when one fails (exit 1 if any failed)");
   app.add_option("--unwrapped", o.unwrapped,
                  "Where to write the unwrapped scene (.glb; default OUT.glb; '-' = not written)");
+  app.add_option("--cache", o.cache,
+                 "Folder of the transfer's band cache that --update reads (written by every bake; "
+                 "default OUT.cache; '-' = none)");
   app.add_option("--supersample", o.supersample, "Transfer samples per texel: 1, 4 or 16")
       ->check(CLI::IsMember({1, 4, 16}));
   app.add_option_function<std::string>(

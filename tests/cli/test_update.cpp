@@ -215,5 +215,68 @@ TEST(CliUpdate, SceneBakeBySpellingsAndUpdateEqualsCleanBakeWithPinnedTables) {
   EXPECT_EQ(read_bytes(dir + "/s1.glb"), read_bytes(dir + "/clean.glb"));
 }
 
+// The band cache beside the output (OUT.cache/transfer.bin): an update after a texture change
+// reads the bands that do not see the texture from it and gives the bytes of a clean bake; a
+// damaged cache is never trusted (its bad bands, or all of it, are transferred again: the same
+// bytes); a settings change rebuilds everything, the cache included, and says so.
+TEST(CliUpdate, SceneBakeUpdateReadsUnchangedBandsFromTheCacheAndNeverTrustsADamagedOne) {
+  const std::string obj = two_textured_quads();
+  const std::string dir = dir_of(obj);
+  const std::string flags = " --size 3", out = dir + "/u.vtpf";
+  const std::string cache = out + ".cache/transfer.bin";
+  auto clean = run_json("-q bake " + obj + " -o " + out + flags);
+  EXPECT_EQ(clean["transfer"]["bands_cached"], 0);  // a bake without --update reads no cache
+  ASSERT_TRUE(std::filesystem::exists(cache));
+  std::filesystem::copy_file(out, dir + "/before.vtpf");
+  std::filesystem::copy_file(cache, dir + "/before.bin");
+  write_png(dir + "/textures/b.png", 64, 64, 5, {10, 10, 30, 30});
+  run_json("-q bake " + obj + " -o " + dir + "/clean.vtpf --tables-from " + dir + "/before.vtpf" +
+           flags + " --cache -");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/clean.vtpf.cache"));
+  const std::vector<uint8_t> expected = read_bytes(dir + "/clean.vtpf");
+
+  // Some bands see only quad A: read from the cache; those that see B are transferred.
+  auto update = run_json("-q bake " + obj + " -o " + out + " --update" + flags);
+  const int bands = update["transfer"]["bands"].get<int>();
+  const int cached = update["transfer"]["bands_cached"].get<int>();
+  EXPECT_GT(cached, 0) << update["transfer"].dump();
+  EXPECT_LT(cached, bands) << update["transfer"].dump();
+  EXPECT_EQ(update["build"]["update"]["full_rebuild"], nullptr);
+  EXPECT_EQ(read_bytes(out), expected);
+  // The update's cache keeps the bands it read: a second change of B reuses them again.
+  write_png(dir + "/textures/b.png", 64, 64, 6, {10, 10, 30, 30});
+  auto second = run_json("-q bake " + obj + " -o " + out + " --update" + flags);
+  EXPECT_EQ(second["transfer"]["bands_cached"].get<int>(), cached);
+  write_png(dir + "/textures/b.png", 64, 64, 5, {10, 10, 30, 30});
+
+  // Every frame of the previous cache damaged (a byte flipped past the header in each of them):
+  // no band passes its checksum, all are transferred again, the bytes are the same.
+  auto damage = [&](auto&& change) {
+    std::filesystem::copy_file(dir + "/before.vtpf", out,
+                               std::filesystem::copy_options::overwrite_existing);
+    std::vector<uint8_t> bytes = read_bytes(dir + "/before.bin");
+    change(bytes);
+    std::ofstream(cache, std::ios::binary | std::ios::trunc)
+        .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    auto again = run_json("-q bake " + obj + " -o " + out + " --update" + flags);
+    EXPECT_EQ(read_bytes(out), expected);
+    return again["transfer"]["bands_cached"].get<int>();
+  };
+  EXPECT_EQ(damage([](std::vector<uint8_t>&) {}), cached);  // undamaged: the same reuse
+  EXPECT_EQ(damage([&](std::vector<uint8_t>& b) {
+              for (size_t i = 24; i + 1000 < b.size(); i += 7) b[i] ^= 0x5a;
+            }),
+            0);
+  EXPECT_EQ(damage([](std::vector<uint8_t>& b) { b.resize(b.size() / 2); }), 0);  // truncated
+  EXPECT_EQ(damage([](std::vector<uint8_t>& b) { b.assign(100, 7); }), 0);        // garbage
+
+  // Another setting: a full rebuild that says why, and no band of the old cache is used.
+  auto other = run_json("-q bake " + obj + " -o " + out + " --update --supersample 4" + flags);
+  EXPECT_EQ(other["build"]["update"]["full_rebuild"], "settings changed");
+  EXPECT_EQ(other["transfer"]["bands_cached"], 0);
+  run_json("-q bake " + obj + " -o " + dir + "/clean4.vtpf --supersample 4" + flags);
+  EXPECT_EQ(read_bytes(out), read_bytes(dir + "/clean4.vtpf"));
+}
+
 }  // namespace
 }  // namespace vt

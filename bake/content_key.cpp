@@ -1,0 +1,31 @@
+#include "bake/content_key.h"
+
+namespace vt {
+namespace {
+
+void add_texture(KeyStream& k, const scene::TextureRef& t) {
+  k.add(t.image), k.add(t.texcoord), k.add(t.wrap_s), k.add(t.wrap_t), k.add(t.mag_filter);
+  k.add(t.transform.offset), k.add(t.transform.rotation), k.add(t.transform.scale);
+}
+
+}  // namespace
+
+void add_material(KeyStream& k, const scene::Material& m) {
+  k.add(m.name), k.add(m.base_color_factor);
+  add_texture(k, m.base_color_texture);
+  k.add(m.metallic_factor), k.add(m.roughness_factor);
+  add_texture(k, m.metallic_roughness_texture);
+  add_texture(k, m.normal_texture);
+  k.add(m.normal_scale);
+  add_texture(k, m.occlusion_texture);
+  k.add(m.occlusion_strength), k.add(m.emissive_factor), k.add(m.emissive_strength);
+  add_texture(k, m.emissive_texture);
+  k.add(m.alpha_mode), k.add(m.alpha_cutoff), k.add(m.double_sided), k.add(m.texels_per_unit);
+}
+
+void add_primitive(KeyStream& k, const scene::Primitive& p) {
+  k.add(p.positions), k.add(p.normals), k.add(p.tangents), k.add(p.uvs), k.add(p.colors);
+  k.add(p.indices), k.add(p.material);
+}
+
+}  // namespace vt
