@@ -388,11 +388,11 @@ void encode_realtime_lanes(const uint32_t (&texels)[16][kLanes], uint16_t c0_out
   }
 
   uint32_t idx[kLanes];
-  float err[kLanes];
+  int32_t err[kLanes];  // exact integers: compared as such
   // Palette of 565 levels q0, q1 as the decoder builds it; nearest entry per texel, returned as
   // the block's packed 2-bit indices (texel i at bits 2i).
   auto select = [&](const float(&a)[3][kLanes], const float(&c)[3][kLanes], uint32_t(&out)[kLanes],
-                    float(&e)[kLanes]) {
+                    int32_t(&e)[kLanes]) {
     float p[4][3][kLanes];
     for (int ch = 0; ch < 3; ++ch) {
       const float mul = ch == 1 ? 4.0f : 8.0f, shift = ch == 1 ? 1.0f / 16.0f : 1.0f / 4.0f;
@@ -443,7 +443,7 @@ void encode_realtime_lanes(const uint32_t (&texels)[16][kLanes], uint16_t c0_out
         ei[l] += (s >> 2) + xx[i][l];
       }
     }
-    for (int l = 0; l < kLanes; ++l) e[l] = float(ei[l]);
+    for (int l = 0; l < kLanes; ++l) e[l] = ei[l];
   };
   select(q0, q1, idx, err);
 
@@ -464,7 +464,7 @@ void encode_realtime_lanes(const uint32_t (&texels)[16][kLanes], uint16_t c0_out
     }
   }
   float n0[3][kLanes], n1[3][kLanes];
-  bool solvable[kLanes];
+  int32_t solvable[kLanes];  // 0 or 1, as wide as the lanes it masks
   for (int l = 0; l < kLanes; ++l) {
     const float det = aa[l] * bb[l] - ab[l] * ab[l];
     solvable[l] = std::fabs(det) > 1e-3f;
@@ -476,16 +476,25 @@ void encode_realtime_lanes(const uint32_t (&texels)[16][kLanes], uint16_t c0_out
     }
   }
   uint32_t idx2[kLanes];
-  float err2[kLanes];
+  int32_t err2[kLanes];
   select(n0, n1, idx2, err2);
 
+  // The choice as selects on values, the conversions after it: lane by lane with a branch
+  // here (the compare mispredicts) this loop cost about a tenth of the kernel.
+  int32_t take[kLanes], e0[3][kLanes], e1[3][kLanes];
+  uint32_t chosen[kLanes];
+  for (int l = 0; l < kLanes; ++l) take[l] = solvable[l] & int32_t(err2[l] < err[l]);
+  for (int ch = 0; ch < 3; ++ch) {
+    for (int l = 0; l < kLanes; ++l) {
+      e0[ch][l] = take[l] ? int32_t(n0[ch][l]) : int32_t(q0[ch][l]);
+      e1[ch][l] = take[l] ? int32_t(n1[ch][l]) : int32_t(q1[ch][l]);
+    }
+  }
+  for (int l = 0; l < kLanes; ++l) chosen[l] = take[l] ? idx2[l] : idx[l];
   for (int l = 0; l < kLanes; ++l) {
-    const bool take = solvable[l] && err2[l] < err[l];
-    const int a = (int(take ? n0[0][l] : q0[0][l]) << 11) | (int(take ? n0[1][l] : q0[1][l]) << 5) |
-                  int(take ? n0[2][l] : q0[2][l]);
-    const int c = (int(take ? n1[0][l] : q1[0][l]) << 11) | (int(take ? n1[1][l] : q1[1][l]) << 5) |
-                  int(take ? n1[2][l] : q1[2][l]);
-    const uint32_t bits = take ? idx2[l] : idx[l];
+    const int a = (e0[0][l] << 11) | (e0[1][l] << 5) | e0[2][l];
+    const int c = (e1[0][l] << 11) | (e1[1][l] << 5) | e1[2][l];
+    const uint32_t bits = chosen[l];
     // 4-colour mode needs c0 > c1: swapping the endpoints maps index 0<->1 and 2<->3.
     c0_out[l] = uint16_t(a < c ? c : a);
     c1_out[l] = uint16_t(a < c ? a : c);
