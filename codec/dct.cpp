@@ -178,6 +178,13 @@ struct BucketTables {
 };
 constexpr BucketTables kBuckets;
 
+// kBuckets.pair_token[t].nonzeros, 2 bits per token t.
+constexpr uint32_t kPairNonzeros = [] {
+  uint32_t v = 0;
+  for (int t = 0; t < kTokens; t++) v |= uint32_t(kBuckets.pair_token[t].nonzeros) << (2 * t);
+  return v;
+}();
+
 int plane_count(const DctSettings& s) {
   return s.channels;
 }
@@ -794,27 +801,26 @@ template <bool kAdaptive>
       if (res != 0 && bits.take(1, 1)) res = -res;
       z[0] = int16_t(std::clamp(n.dc_pred + res, -kMaxQuantized, kMaxQuantized));
       // Models for the first eight pairs up front: most blocks end within them, and a
-      // data-dependent "next four pairs?" branch would mispredict. Pair j's model offset gains
-      // its nonzeros-left term when token j - 2 is decoded (the first two take the block's
-      // count), so that the history needs no registers.
-      uint16_t pair_ctx[kPairs + 2], esc_ctx[kPairs];
-      pair_ctx[kPairs] = pair_ctx[kPairs + 1] = 0;  // only added to, by the last two pairs
+      // data-dependent "next four pairs?" branch would mispredict. Pair j's model is its
+      // neighbour part (pair_ctx, off the token chain) plus the nonzeros-left term after token
+      // j - 2 (the first two take the block's count), kept in registers: a token's model
+      // address waits on the token two back through a shift, a subtraction and one load only.
+      uint16_t pair_ctx[kPairs], esc_ctx[kPairs];
       if (nz > 0) {
         pair_contexts(n.left, n.up, 0, sizeof(TokenModel), pair_ctx, esc_ctx);
         pair_contexts(n.left, n.up, 4, sizeof(TokenModel), pair_ctx + 4, esc_ctx + 4);
-        pair_ctx[0] = uint16_t(pair_ctx[0] + kBuckets.rem_bytes[nz]);
-        pair_ctx[1] = uint16_t(pair_ctx[1] + kBuckets.rem_bytes[nz]);
       }
       uint8_t escaped[kPairs * 2 + 1];
       int rem = nz, j = 0;
+      size_t rem_now = kBuckets.rem_bytes[nz], rem_next = rem_now;  // pairs j and j + 1
       size_t escapes = 0;
       for (; rem > 0 && j < kPairs; j++) {
-        // The next four before j adds to j + 2: at j = 6, 10, ..., 26.
+        // The next four two pairs ahead: at j = 6, 10, ..., 26.
         if ((0x4444440u >> j) & 1) {
           pair_contexts(n.left, n.up, j + 2, sizeof(TokenModel), pair_ctx + j + 2, esc_ctx + j + 2);
         }
         TokenModel& m =
-            *reinterpret_cast<TokenModel*>(reinterpret_cast<char*>(models) + pair_ctx[j]);
+            *reinterpret_cast<TokenModel*>(reinterpret_cast<char*>(models) + pair_ctx[j] + rem_now);
         const unsigned t = decode_token<kAdaptive>(rans, m);
         const PairToken& e = kBuckets.pair_token[t];
         // A refill gives 56 bits: enough for 16 pairs' signs.
@@ -829,9 +835,11 @@ template <bool kAdaptive>
         escapes += e.escape0;
         escaped[escapes] = uint8_t(2 * j + 2);
         escapes += e.escape1;
-        rem -= e.nonzeros;
-        // rem < 0 only in damaged data, and then the loop ends.
-        pair_ctx[j + 2] = uint16_t(pair_ctx[j + 2] + kBuckets.rem_bytes[rem & 63]);
+        // The token's nonzeros from a register (2 bits per token) rather than e: one load
+        // fewer on the chain. rem < 0 only in damaged data, and then the loop ends.
+        rem -= int((kPairNonzeros >> (2 * t)) & 3u);
+        rem_now = rem_next;
+        rem_next = kBuckets.rem_bytes[rem & 63];
       }
       // The escapes follow the block's pairs (see code_plane): each adds to a magnitude of 3.
       for (size_t i = 0; i < escapes; i++) {

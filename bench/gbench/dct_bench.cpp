@@ -6,6 +6,8 @@
 //   dct_bench --runtime [KODAK_DIR]                 DCT decode + BC1 real-time, pages/s
 //   dct_bench --transcode [ROUNDS [BASIS_BC1_DIR [SET]]]  issue 22: decode vs JPEG and DCT + BC1
 //                                       on Kodak and PBR maps, interleaved (SET: a name's part)
+//   dct_bench --profile [PASSES]            Kodak fold 0's DCT + BC1 transcode alone, PASSES
+//                                           times (a loop for perf)
 //   dct_bench [google benchmark flags]             per-page decode / encode timings
 //
 // Report: bits per texel, PSNR (RGB, per page), single-thread encode / decode Mtexel/s (median
@@ -665,6 +667,47 @@ int transcode(int rounds, const std::string& basis_dir, const std::string& only)
   return 0;
 }
 
+// `dct_bench --profile PASSES`: the transcode loop of --transcode's Kodak row and nothing else
+// timed, so that a profiler's shares are the runtime path's.
+int profile(int passes) {
+  std::vector<Page> folds[2];
+  const auto files = list_pngs(g_kodak_dir);
+  for (size_t i = 0; i < files.size(); i++)
+    for (Page& p : load_pages(files[i], 3)) folds[i % 2].push_back(std::move(p));
+  if (folds[0].empty()) return 1;
+  const TranscodeSet set = make_transcode_set("Kodak fold 0", std::move(folds[0]), folds[1]);
+  Page out(set.pages[0].size());
+  std::vector<uint8_t> bc(bc_image_bytes(BcFormat::kBc1, kPage, kPage));
+  // FNV-1a over every decoded page and its BC1 bytes: builds that must not change an output
+  // print the same digest.
+  uint64_t digest = 0xcbf29ce484222325ull;
+  auto hash = [&](const std::vector<uint8_t>& v) {
+    for (uint8_t b : v) digest = (digest ^ b) * 0x100000001b3ull;
+  };
+  for (const auto& c : set.dct) {
+    (void)dct_decode_page(*set.tables, c, kPage, kPage, out.data());
+    (void)bc_encode_image(BcFormat::kBc1, BcQuality::kRealtime, out.data(), kPage, kPage, 3,
+                          bc.data());
+    hash(out), hash(bc);
+  }
+  double decode = 0, both = 0;
+  for (int r = 0; r < passes; r++) {
+    const double t0 = now_s();
+    for (const auto& c : set.dct) (void)dct_decode_page(*set.tables, c, kPage, kPage, out.data());
+    const double t1 = now_s();
+    for (const auto& c : set.dct) {
+      (void)dct_decode_page(*set.tables, c, kPage, kPage, out.data());
+      (void)bc_encode_image(BcFormat::kBc1, BcQuality::kRealtime, out.data(), kPage, kPage, 3,
+                            bc.data());
+    }
+    decode += t1 - t0, both += now_s() - t1;
+  }
+  const double n = double(set.pages.size()) * passes;
+  std::printf("decode %.0f pages/s, decode + BC1 %.0f pages/s, output digest %016llx\n", n / decode,
+              n / both, (unsigned long long)digest);
+  return 0;
+}
+
 // ---- Google Benchmark timings: one page at a time ----
 
 struct Fixture {
@@ -762,6 +805,8 @@ int main(int argc, char** argv) {
     return transcode(argc > 2 ? std::atoi(argv[2]) : 7, argc > 3 ? argv[3] : "",
                      argc > 4 ? argv[4] : "");
   }
+  if (argc > 1 && std::strcmp(argv[1], "--profile") == 0)
+    return profile(argc > 2 ? std::atoi(argv[2]) : 100);
   if (argc > 1 && std::strcmp(argv[1], "--speed") == 0) {
     if (argc > 2) g_kodak_dir = argv[2];
     return speed(7);

@@ -496,5 +496,33 @@ TEST(Bc1, RealtimeRowsMatchRgbaBlocks) {
   }
 }
 
+// Real-time BC1 on 3-channel rows of content that drives the kernel's choices both ways
+// (noise, noisy gradients, four-level palettes, near-flat blocks; 17 blocks a row: a full batch
+// of 16 and a partial one), pinned to the bytes of the kernel before its 2026-12-04 rewrite on
+// lane vectors (the same digest from its AVX-512, AVX2 and baseline builds).
+TEST(Bc1, RealtimeRowsArePinnedOnMixedContent) {
+  const int w = 68, h = 64;
+  std::vector<uint8_t> px(size_t(w) * h * 3);
+  uint32_t s = 22;
+  auto next = [&s] { return (s = s * 1664525u + 1013904223u) >> 8; };
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        const int kind = (x / 4 + y / 4) % 4;
+        const uint32_t v = kind == 0   ? next() & 255u
+                           : kind == 1 ? (uint32_t(x * 7 + y * 3 + c * 40) + next() % 9) & 255u
+                           : kind == 2 ? (next() % 4) * 80
+                                       : uint32_t(c * 60) + next() % 3;
+        px[(size_t(y) * w + x) * 3 + c] = uint8_t(v);
+      }
+    }
+  }
+  std::vector<uint8_t> blocks(bc_image_bytes(BcFormat::kBc1, w, h));
+  ASSERT_TRUE(
+      bc_encode_image(BcFormat::kBc1, BcQuality::kRealtime, px.data(), w, h, 3, blocks.data())
+          .ok());
+  EXPECT_EQ(fnv1a(blocks), 0x737a91ce3cf6a9beull) << "0x" << std::hex << fnv1a(blocks);
+}
+
 }  // namespace
 }  // namespace vt
