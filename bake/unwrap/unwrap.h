@@ -26,7 +26,10 @@ struct UnwrapOptions {
   double texels_per_unit = 0.0;
   int size_pages = 0;      // fit the atlas to size_pages × size_pages pages; 0 = not asked
   int page_payload = 120;  // the atlas is a whole number of pages of this many texels
-  int padding = 4;         // empty texels kept between any two charts (the gutter)
+  // Empty texels kept between any two charts (the gutter). 8: texels of two charts are then 9
+  // apart, so no 8x8 DCT block of level 0 and no 4x4 BC block of level 1 holds both (with 4,
+  // quantisation rang one chart's colour into its neighbour: ClearCoatTest, docs/BENCHMARKS.md).
+  int padding = 8;
   Method method = Method::kLscm;
   bool share_instances = false;       // false: every instance gets its own texels (megatexture)
   double max_chart_angle_deg = 60.0;  // a face joins a chart only within this cone of normals

@@ -160,6 +160,31 @@ TEST(StreamingBoundsCheck, PixelsAtPageBordersAreBoundedApart) {
   EXPECT_EQ(check_streaming(interior, b).size(), 2u);
 }
 
+// Pixels drawn by one render only: a flipped alpha test when the render that drew it flagged
+// its alpha as within a few steps of the cutoff (the closed masked box at padding 8: a row of
+// pixels at 128/255 in one render, 1/65535 below 0.5 in the other), a coverage mismatch when not.
+TEST(StreamingCompare, OneRenderPixelsAreAlphaFlipsOnlyWhereTheDrawingRenderFlaggedThem) {
+  // Per pixel: virtual status, reference covered.
+  const uint32_t status[] = {0xC0000000u, 0x80000000u, 0, 0, 0x80000000u, 0xC0000000u};
+  const uint32_t covered[] = {0, 0, 3, 1, 1, 3};
+  ReferenceFrame levels;
+  VirtualFrame frame;
+  levels.color.width = frame.color.width = 6;
+  levels.color.height = frame.color.height = 1;
+  levels.color.texels.assign(24, 128);
+  frame.color.texels.assign(24, 128);
+  levels.covered.assign(std::begin(covered), std::end(covered));
+  frame.status.assign(std::begin(status), std::end(status));
+  LevelTexture texture;
+  texture.texture.levels.resize(1);
+  texture.level_count = 1;
+  auto m = compare_streaming(levels, frame, texture, 4);
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  EXPECT_EQ(m->coverage_mismatch, 2u);    // pixels 1 (virtual only) and 3 (reference only)
+  EXPECT_EQ(m->excluded_alpha_edge, 3u);  // 0 and 2 (one render, flagged), 5 (both, flagged)
+  EXPECT_EQ(m->pixels, 1u);               // 4: both drew it, no flag
+}
+
 // A page source that passes another one through, except for what `edit` changes in an upload.
 class EditedSource : public PageSource {
  public:
