@@ -7,6 +7,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -264,7 +265,11 @@ TEST(CliUpdate, SceneBakeUpdateReadsUnchangedBandsFromTheCacheAndNeverTrustsADam
   };
   EXPECT_EQ(damage([](std::vector<uint8_t>&) {}), cached);  // undamaged: the same reuse
   EXPECT_EQ(damage([&](std::vector<uint8_t>& b) {
-              for (size_t i = 24; i + 1000 < b.size(); i += 7) b[i] ^= 0x5a;
+              // Every 7th byte between the header and the index (the trailer's first field).
+              uint64_t index_offset = 0;
+              std::memcpy(&index_offset, b.data() + b.size() - 24, sizeof index_offset);
+              ASSERT_LE(index_offset, b.size());
+              for (size_t i = 24; i < index_offset; i += 7) b[i] ^= 0x5a;
             }),
             0);
   EXPECT_EQ(damage([](std::vector<uint8_t>& b) { b.resize(b.size() / 2); }), 0);  // truncated
