@@ -165,7 +165,7 @@ struct Renderer::Impl {
   VkDescriptorPool vt_pool = VK_NULL_HANDLE;
 
   Image color, status, depth, fb, fb_depth;
-  Buffer color_rb, status_rb, fb_rb;
+  Buffer color_rb, status_rb, depth_rb, fb_rb;
 
   struct GpuMesh {
     Buffer vertices, indices;
@@ -211,8 +211,10 @@ struct Renderer::Impl {
   Expected<Image> make_target(uint32_t w, uint32_t h, VkFormat f, bool depth_target);
   void begin_pass(VkCommandBuffer cmd, std::span<const Image* const> targets, const Image& depth,
                   uint32_t w, uint32_t h, std::span<const VkClearColorValue> clears);
+  // `depth_readback` (may be null) receives the depth target.
   void end_pass(VkCommandBuffer cmd, std::span<const Image* const> targets,
-                std::span<const Buffer* const> readbacks, uint32_t w, uint32_t h);
+                std::span<const Buffer* const> readbacks, const Image& depth,
+                const Buffer* depth_readback, uint32_t w, uint32_t h);
 
   // One render pass: clear the targets, bind `pipe`, draw, copy each target to its readback.
   struct PassTargets {
@@ -221,6 +223,7 @@ struct Renderer::Impl {
     const Image* depth;
     uint32_t width, height;
     std::span<const VkClearColorValue> clears;
+    const Buffer* depth_readback = nullptr;
   };
   Status run_pass(const PassTargets& pass, VkPipeline pipe,
                   const std::function<void(VkCommandBuffer)>& draw);
@@ -228,6 +231,7 @@ struct Renderer::Impl {
   Status run_color_pass(uint32_t w, uint32_t h, VkPipeline pipe,
                         const std::function<void(VkCommandBuffer)>& draw);
   Rgba8Image read_color(uint32_t w, uint32_t h) const;
+  std::vector<float> read_view_depth(const Camera& camera, uint32_t w, uint32_t h) const;
 
   // Stages `bytes` and copies them into `image`, which is in `from` before and shader-readable
   // after.
@@ -342,8 +346,9 @@ Expected<Image> Renderer::Impl::make_target(uint32_t w, uint32_t h, VkFormat f, 
   d.width = w;
   d.height = h;
   d.format = f;
-  d.usage = depth_target ? VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT
-                         : (VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+  d.usage = (depth_target ? VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT
+                          : VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT) |
+            VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
   d.aspect = depth_target ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
   return ctx.create_image(d);
 }
@@ -497,6 +502,7 @@ Status Renderer::Impl::init(const RenderOptions& o) {
   const VkDeviceSize full = VkDeviceSize(o.width) * o.height * 4;
   VT_ASSIGN_OR_RETURN(color_rb, ctx.create_buffer(full, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true));
   VT_ASSIGN_OR_RETURN(status_rb, ctx.create_buffer(full, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true));
+  VT_ASSIGN_OR_RETURN(depth_rb, ctx.create_buffer(full, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true));
   VT_ASSIGN_OR_RETURN(
       fb_rb, ctx.create_buffer(VkDeviceSize(fw) * fh * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true));
   return Status::Ok();
@@ -523,7 +529,7 @@ void Renderer::Impl::begin_pass(VkCommandBuffer cmd, std::span<const Image* cons
   da.imageView = depth_image.view();
   da.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
   da.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-  da.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+  da.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
   da.clearValue.depthStencil = {1.0f, 0};
   VkRenderingInfo ri{VK_STRUCTURE_TYPE_RENDERING_INFO};
   ri.renderArea = {{0, 0}, {w, h}};
@@ -539,8 +545,18 @@ void Renderer::Impl::begin_pass(VkCommandBuffer cmd, std::span<const Image* cons
 }
 
 void Renderer::Impl::end_pass(VkCommandBuffer cmd, std::span<const Image* const> targets,
-                              std::span<const Buffer* const> readbacks, uint32_t w, uint32_t h) {
+                              std::span<const Buffer* const> readbacks, const Image& depth_image,
+                              const Buffer* depth_readback, uint32_t w, uint32_t h) {
   vkCmdEndRendering(cmd);
+  if (depth_readback != nullptr) {
+    VulkanContext::transition(cmd, depth_image, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                              VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+    VkBufferImageCopy c{};
+    c.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
+    c.imageExtent = {w, h, 1};
+    vkCmdCopyImageToBuffer(cmd, depth_image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                           depth_readback->handle(), 1, &c);
+  }
   for (size_t i = 0; i < targets.size(); ++i) {
     VulkanContext::transition(cmd, *targets[i], VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                               VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
@@ -868,7 +884,8 @@ Status Renderer::Impl::run_pass(const PassTargets& pass, VkPipeline pipe,
     begin_pass(cmd, pass.targets, *pass.depth, pass.width, pass.height, pass.clears);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
     draw(cmd);
-    end_pass(cmd, pass.targets, pass.readbacks, pass.width, pass.height);
+    end_pass(cmd, pass.targets, pass.readbacks, *pass.depth, pass.depth_readback, pass.width,
+             pass.height);
   });
 }
 
@@ -877,7 +894,7 @@ Status Renderer::Impl::run_color_pass(uint32_t w, uint32_t h, VkPipeline pipe,
   const Image* targets[] = {&color, &status};
   const Buffer* readbacks[] = {&color_rb, &status_rb};
   const VkClearColorValue clears[] = {{{0.0f, 0.0f, 0.0f, 0.0f}}, {}};
-  return run_pass({targets, readbacks, &depth, w, h, clears}, pipe, draw);
+  return run_pass({targets, readbacks, &depth, w, h, clears, &depth_rb}, pipe, draw);
 }
 
 Rgba8Image Renderer::Impl::read_color(uint32_t w, uint32_t h) const {
@@ -885,6 +902,25 @@ Rgba8Image Renderer::Impl::read_color(uint32_t w, uint32_t h) const {
   out.width = w;
   out.height = h;
   out.texels.assign(color_rb.mapped(), color_rb.mapped() + size_t(w) * h * 4);
+  return out;
+}
+
+std::vector<float> Renderer::Impl::read_view_depth(const Camera& camera, uint32_t w,
+                                                   uint32_t h) const {
+  // A perspective view_proj's depth row is -a times its w row plus b (w: distance along the view
+  // axis), so window depth d = z / w = -a + b / w and w = b / (d + a); both recovered from the
+  // matrix, so every camera (planned, file, jittered) is read alike.
+  const auto& m = camera.view_proj.m;
+  float ww = 0, zw = 0;
+  for (int c = 0; c < 3; ++c) {
+    ww += m[c * 4 + 3] * m[c * 4 + 3];
+    zw += m[c * 4 + 2] * m[c * 4 + 3];
+  }
+  const float a = ww > 0 ? -zw / ww : 0.0f;
+  const float b = m[14] + a * m[15];
+  std::vector<float> out(size_t(w) * h);
+  std::memcpy(out.data(), depth_rb.mapped(), out.size() * 4);
+  for (float& d : out) d = d >= 1.0f ? 0.0f : b / (d + a);
   return out;
 }
 
@@ -917,6 +953,7 @@ Expected<ReferenceFrame> Renderer::render_reference(const Camera& camera) {
   ReferenceFrame out;
   out.color = s.read_color(w, h);
   out.covered = read_u32(s.status_rb, size_t(w) * h);
+  out.depth = s.read_view_depth(camera, w, h);
   return out;
 }
 
@@ -1269,6 +1306,7 @@ Expected<ReferenceFrame> Renderer::render_lit_reference(const Camera& camera,
   ReferenceFrame out;
   out.color = s.read_color(w, h);
   out.covered = read_u32(s.status_rb, size_t(w) * h);
+  out.depth = s.read_view_depth(camera, w, h);
   return out;
 }
 

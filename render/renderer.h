@@ -119,6 +119,8 @@ struct ReferenceFrame {
   // Per pixel: bit 0 where the surface was drawn (after alpha test); bit 1 where its alpha was
   // within a few steps above the cutoff (VirtualFrame::status bit 30).
   std::vector<uint32_t> covered;
+  // Per pixel: distance along the view axis of the surface drawn, 0 where none was.
+  std::vector<float> depth;
 };
 
 struct FeedbackImage {

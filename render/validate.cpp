@@ -123,7 +123,8 @@ Expected<ViewMetrics> compare_view(const ReferenceFrame& reference_frame, const 
   const size_t n = size_t(test.width) * test.height;
   if (reference.width != test.width || reference.height != test.height ||
       reference.texels.size() != n * 4 || test.texels.size() != n * 4 || frame.status.size() != n ||
-      reference_frame.covered.size() != n) {
+      reference_frame.covered.size() != n ||
+      (!reference_frame.depth.empty() && reference_frame.depth.size() != n)) {
     return Error(ErrorCode::kInvalidArgument, "render: compared images differ in size");
   }
   ViewMetrics m;
@@ -137,19 +138,37 @@ Expected<ViewMetrics> compare_view(const ReferenceFrame& reference_frame, const 
   const uint32_t tiles_y = (test.height + kTile - 1) / kTile;
   std::vector<double> sse(size_t(tiles_x) * tiles_y, 0.0);
   std::vector<uint32_t> count(size_t(tiles_x) * tiles_y, 0);
-  // Within kOutline pixels (Manhattan) of background, a pixel neither render drew; such a
-  // pixel's difference enters the tiles capped at kOutlineSteps per channel (a tile of outline
-  // alone then reads >= 20.5 dB; a tile keeps all its pixels, so no tile reads lower than
-  // without the cap).
+  // Within kOutline pixels (Manhattan) of an edge, the outline: a pixel's difference enters the
+  // tiles capped at kOutlineSteps per channel (a tile of outline alone then reads >= 20.5 dB; a
+  // tile keeps all its pixels, so no tile reads lower than without the cap). An edge pixel is
+  // background (neither render drew it) or either side of a silhouette in front of another
+  // surface: a step of over kDepthStep (relative) in the reference's depth to the next pixel.
   constexpr int kOutline = 2;
   constexpr int kOutlineSteps = 24;
-  auto near_background = [&](uint32_t x, uint32_t y) {
+  constexpr float kDepthStep = 0.05f;
+  std::vector<uint8_t> edge(n, 0);
+  const std::vector<float>& depth = reference_frame.depth;
+  auto depth_step = [&](size_t i, size_t j) {
+    const float a = depth[i], b = depth[j];
+    return a > 0 && b > 0 && std::max(a, b) > std::min(a, b) * (1.0f + kDepthStep);
+  };
+  for (uint32_t y = 0; y < test.height; ++y) {
+    for (uint32_t x = 0; x < test.width; ++x) {
+      const size_t i = size_t(y) * test.width + x;
+      if ((frame.status[i] & 0x80000000u) == 0 && reference_frame.covered[i] == 0) edge[i] = 1;
+      if (depth.empty()) continue;
+      for (const size_t j :
+           {x + 1 < test.width ? i + 1 : i, y + 1 < test.height ? i + test.width : i}) {
+        if (j != i && depth_step(i, j)) edge[i] = edge[j] = 1;
+      }
+    }
+  }
+  auto near_edge = [&](uint32_t x, uint32_t y) {
     for (int dy = -kOutline; dy <= kOutline; ++dy)
       for (int dx = std::abs(dy) - kOutline; dx <= kOutline - std::abs(dy); ++dx) {
         const int64_t nx = int64_t(x) + dx, ny = int64_t(y) + dy;
         if (nx < 0 || ny < 0 || nx >= int64_t(test.width) || ny >= int64_t(test.height)) continue;
-        const size_t j = size_t(ny) * test.width + size_t(nx);
-        if ((frame.status[j] & 0x80000000u) == 0 && reference_frame.covered[j] == 0) return true;
+        if (edge[size_t(ny) * test.width + size_t(nx)]) return true;
       }
     return false;
   };
@@ -170,7 +189,7 @@ Expected<ViewMetrics> compare_view(const ReferenceFrame& reference_frame, const 
       const uint8_t* t = &test.texels[i * 4];
       ref_px.insert(ref_px.end(), r, r + 4);
       test_px.insert(test_px.end(), t, t + 4);
-      // The outline (pixels within two of background, one neither render drew) counts fully in
+      // The outline (pixels within two of background or of a silhouette) counts fully in
       // the whole-view figures, capped in the tiles: there the screen-space footprint runs off the
       // surface (an edge-on strip's reaches 40+ level-0 texels over its first two pixels on
       // CesiumMilkTruck), so each render reads beyond the surface, the source image's neighbours
@@ -178,7 +197,7 @@ Expected<ViewMetrics> compare_view(const ReferenceFrame& reference_frame, const 
       // footprint separates them (docs/BENCHMARKS.md, "The outline"). A pixel whose taps read
       // page border texels stays in: a bad border shows first along a small object's outline.
       const bool border_read = (st & 0x20000000u) != 0;
-      const bool outline = !border_read && near_background(x, y);
+      const bool outline = !border_read && near_edge(x, y);
       m.outline_pixels += outline;
       const size_t k = size_t(y / kTile) * tiles_x + x / kTile;
       for (int c = 0; c < 3; ++c) {

@@ -72,5 +72,54 @@ TEST(CompareView, BorderReadsAndOneRenderHolesAreNoOutline) {
   EXPECT_EQ(m->outline_pixels, 32u * 32u - 28u * 28u - 32u);
 }
 
+// A silhouette in front of another surface (both renders drew every pixel): a step in the
+// reference's depth makes an outline as background does; a shallow one and the interior do not.
+TEST(CompareView, DepthStepIsOutlineAShallowOneIsNot) {
+  auto frames = [](float square_depth) {
+    Frames f;
+    f.reference.depth.assign(size_t(kW) * kH, 10.0f);
+    for (uint32_t y = 0; y < kH; ++y)
+      for (uint32_t x = 0; x < kW; ++x) {
+        const size_t i = size_t(y) * kW + x;
+        const bool square = x >= 16 && x < 48 && y >= 8 && y < 40;
+        if (!square)
+          Frames::set(f.reference.color, x, y, 128), Frames::set(f.virt.color, x, y, 128);
+        f.reference.covered[i] = 1;
+        f.virt.status[i] = 0x80000000u;
+        if (square) f.reference.depth[i] = square_depth;
+      }
+    // The square's edge ring 100 steps off, as taps that ran off the silhouette read.
+    for (uint32_t y = 8; y < 40; ++y)
+      for (uint32_t x = 16; x < 48; ++x)
+        if (x == 16 || x == 47 || y == 8 || y == 39) Frames::set(f.virt.color, x, y, 28);
+    return f;
+  };
+  Frames step = frames(5.0f);  // twice as near as the surface behind
+  auto m = compare_view(step.reference, step.virt);
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  EXPECT_EQ(m->pixels, size_t(kW) * kH);
+  EXPECT_GE(m->outline_pixels, 32u * 32u - 26u * 26u);  // three rings inside, more outside
+  EXPECT_GT(m->worst_tile_psnr, 20.5);
+  EXPECT_LT(m->psnr_rgb, 25.0);
+
+  Frames shallow = frames(9.8f);  // 2 % nearer: one surface's relief, no silhouette
+  m = compare_view(shallow.reference, shallow.virt);
+  ASSERT_TRUE(m.ok());
+  EXPECT_EQ(m->outline_pixels, 0u);
+  EXPECT_LT(m->worst_tile_psnr, 20.0);
+
+  // Away from the step, an error counts fully.
+  Frames inner = frames(5.0f);
+  for (uint32_t y = 8; y < 40; ++y)
+    for (uint32_t x = 16; x < 48; ++x) Frames::set(inner.virt.color, x, y, 128);
+  for (uint32_t y = 20; y < 24; ++y)
+    for (uint32_t x = 20; x < 24; ++x) Frames::set(inner.virt.color, x, y, 28);
+  m = compare_view(inner.reference, inner.virt);
+  ASSERT_TRUE(m.ok());
+  EXPECT_LT(m->worst_tile_psnr, 20.5);  // 20.2 dB; capped, it would read 32.6
+  EXPECT_EQ(m->worst_tile_x, 16u);
+  EXPECT_EQ(m->worst_tile_y, 16u);
+}
+
 }  // namespace
 }  // namespace vt::render
