@@ -73,7 +73,7 @@ struct ViewMetrics {
   // explains (render/coverage_tolerance.h).
   double coverage_mismatch_share = 0;
   uint64_t alpha_edge_pixels = 0;  // drawn by one render only, explained by an alpha cutoff
-  uint64_t outline_pixels = 0;     // compared, within 2 of background, no border tap: not in tiles
+  uint64_t outline_pixels = 0;  // compared, within 2 of background or a silhouette, no border tap
 };
 
 // `alpha_cutoffs`: the scene's MASK cutoffs, which explain pixels drawn by one render only.
