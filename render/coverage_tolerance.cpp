@@ -17,7 +17,7 @@ CoverageMismatch classify_coverage(const ReferenceFrame& reference, const Virtua
   const auto alpha = [](const Rgba8Image& img, size_t i) { return img.texels[i * 4 + 3] / 255.0; };
   std::vector<double> diffs;
   for (size_t i = 0; i < n; ++i) {
-    if (!(frame.status[i] & 0x80000000u) || !reference.covered[i]) continue;
+    if (!(frame.status[i] & VirtualFrame::kStatusDrawn) || !reference.covered[i]) continue;
     const double ra = alpha(reference.color, i), va = alpha(frame.color, i);
     if (std::min(ra, va) < 1.0) diffs.push_back(std::abs(ra - va));
   }
@@ -28,7 +28,8 @@ CoverageMismatch classify_coverage(const ReferenceFrame& reference, const Virtua
     out.alpha_tolerance = std::clamp(*p99, out.alpha_tolerance, kMaxAlphaTolerance);
   }
   for (size_t i = 0; i < n; ++i) {
-    const bool vcov = (frame.status[i] & 0x80000000u) != 0, rcov = reference.covered[i] != 0;
+    const bool vcov = (frame.status[i] & VirtualFrame::kStatusDrawn) != 0,
+               rcov = reference.covered[i] != 0;
     if (vcov || rcov) ++out.either;
     if (vcov == rcov) continue;
     // The render that drew it passed the test: its alpha is at or above the cutoff.

@@ -43,7 +43,7 @@ Expected<EmissiveMetrics> compare_emissive(const ReferenceFrame& reference,
   for (uint32_t y = 0; y < t.height; ++y)
     for (uint32_t x = 0; x < t.width; ++x) {
       const size_t i = size_t(y) * t.width + x;
-      if (!(frame.status[i] & 0x80000000u) || !(reference.covered[i] & 1u)) continue;
+      if (!(frame.status[i] & VirtualFrame::kStatusDrawn) || !(reference.covered[i] & 1u)) continue;
       const uint8_t* a = &r.texels[i * 4];
       const uint8_t* b = &t.texels[i * 4];
       for (int c = 0; c < 3; ++c) energy_ref += linear[a[c]], energy_test += linear[b[c]];

@@ -35,7 +35,7 @@ Expected<NormalMetrics> compare_normals(const ReferenceFrame& reference,
   NormalMetrics m;
   double sum_deg = 0, dot_rv = 0, sq_r = 0, sq_v = 0, sq_angle_r = 0;
   for (size_t i = 0; i < n; ++i) {
-    if (!(frame.status[i] & 0x80000000u) || !(reference.covered[i] & 1u)) continue;
+    if (!(frame.status[i] & VirtualFrame::kStatusDrawn) || !(reference.covered[i] & 1u)) continue;
     double a[3], b[3], diff = 0, la = 0, lb = 0, ab = 0;
     for (int c = 0; c < 3; ++c) {
       a[c] = r.texels[i * 4 + c] / 127.5 - 1.0, b[c] = t.texels[i * 4 + c] / 127.5 - 1.0;

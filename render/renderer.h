@@ -131,10 +131,16 @@ struct FeedbackImage {
 
 struct VirtualFrame {
   Rgba8Image color;
-  // Per pixel: bit 31 covered, bit 30 alpha-tested with alpha a few steps above the cutoff (a
-  // rounding apart from failing it), bits 0-7 the level wanted, bits 8-15 the coarsest level a
-  // fine tap actually sampled (31: nothing resident).
+  // Per pixel: the kStatus* bits below, bits 0-7 the level wanted, bits 8-15 the coarsest level
+  // a fine tap actually sampled (31: nothing resident).
   std::vector<uint32_t> status;
+  // The bits the virtual shaders write (shaders/virtual.frag, lit_virtual.frag).
+  static constexpr uint32_t kStatusDrawn = 0x80000000u;
+  // Alpha-tested with alpha a few steps above the cutoff: a rounding apart from failing it.
+  static constexpr uint32_t kStatusAlphaEdge = 0x40000000u;
+  static constexpr uint32_t kStatusBorderRead = 0x20000000u;  // a tap read page-border texels
+  // A tap of the coarser level read an ancestor of its page (a fallback too).
+  static constexpr uint32_t kStatusCoarseFallback = 0x10000000u;
 };
 
 // Lit passes (shaders/lit.glsl): metal-roughness shading with a key and a fill light fixed

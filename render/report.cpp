@@ -36,7 +36,7 @@ Rgba8Image residency_heat_map(const VirtualFrame& frame) {
     uint8_t* p = &out.texels[i * 4];
     p[3] = 255;
     uint32_t s = frame.status[i];
-    if (!(s & 0x80000000u)) continue;
+    if (!(s & VirtualFrame::kStatusDrawn)) continue;
     uint32_t wanted = s & 0xFF, sampled = (s >> 8) & 0xFF;
     if (sampled == 31) {
       p[0] = 255, p[1] = 0, p[2] = 255;

@@ -169,13 +169,15 @@ Expected<StreamingViewMetrics> compare_streaming(const ReferenceFrame& levels,
   for (uint32_t y = 0; y < test.height; ++y)
     for (uint32_t x = 0; x < test.width; ++x) {
       const size_t i = size_t(y) * test.width + x;
-      const bool vcov = (frame.status[i] & 0x80000000u) != 0, rcov = levels.covered[i] != 0;
+      const bool vcov = (frame.status[i] & VirtualFrame::kStatusDrawn) != 0,
+                 rcov = levels.covered[i] != 0;
       // A masked fragment a rounding above the cutoff in one render may be discarded by the
       // other, which then shows the surface behind (both draw the pixel) or nothing (one does):
       // a flipped alpha test, not a wrong texel. Measured on a closed masked box (padding 8):
       // the filtered alpha lay 1/65535 below the cutoff in one render where the other drew it
       // at 128/255, along a whole row of pixels midway between texels of alpha 127 and 128.
-      const bool vedge = frame.status[i] & 0x40000000u, redge = levels.covered[i] & 2u;
+      const bool vedge = frame.status[i] & VirtualFrame::kStatusAlphaEdge,
+                 redge = levels.covered[i] & 2u;
       if (vcov != rcov) {
         if (vcov ? vedge : redge)
           ++m.excluded_alpha_edge;
@@ -196,7 +198,7 @@ Expected<StreamingViewMetrics> compare_streaming(const ReferenceFrame& levels,
       // pass runs at a quarter of the resolution), so the cache serves an ancestor. The loose
       // check bounds these pixels (coarser_share).
       const uint32_t sampled = (frame.status[i] >> 8) & 0xFF;
-      if (sampled > wanted || (frame.status[i] & 0x10000000u)) {
+      if (sampled > wanted || (frame.status[i] & VirtualFrame::kStatusCoarseFallback)) {
         ++m.excluded_fallback;
         continue;
       }
@@ -214,7 +216,7 @@ Expected<StreamingViewMetrics> compare_streaming(const ReferenceFrame& levels,
         if (c < 3) px_sse += double(d) * d;
       }
       ++m.pixels;
-      if (frame.status[i] & 0x20000000u) {
+      if (frame.status[i] & VirtualFrame::kStatusBorderRead) {
         ++m.border_pixels;
         m.border_beyond += worst > steps;
         m.border_max_abs = std::max(m.border_max_abs, worst);

@@ -155,7 +155,8 @@ Expected<ViewMetrics> compare_view(const ReferenceFrame& reference_frame, const 
   for (uint32_t y = 0; y < test.height; ++y) {
     for (uint32_t x = 0; x < test.width; ++x) {
       const size_t i = size_t(y) * test.width + x;
-      if ((frame.status[i] & 0x80000000u) == 0 && reference_frame.covered[i] == 0) edge[i] = 1;
+      if ((frame.status[i] & VirtualFrame::kStatusDrawn) == 0 && reference_frame.covered[i] == 0)
+        edge[i] = 1;
       if (depth.empty()) continue;
       for (const size_t j :
            {x + 1 < test.width ? i + 1 : i, y + 1 < test.height ? i + test.width : i}) {
@@ -176,7 +177,7 @@ Expected<ViewMetrics> compare_view(const ReferenceFrame& reference_frame, const 
     for (uint32_t x = 0; x < test.width; ++x) {
       const size_t i = size_t(y) * test.width + x;
       const uint32_t st = frame.status[i];
-      const bool vcov = (st & 0x80000000u) != 0;
+      const bool vcov = (st & VirtualFrame::kStatusDrawn) != 0;
       const bool rcov = reference_frame.covered[i] != 0;
       if (vcov) {
         ++covered;
@@ -196,7 +197,7 @@ Expected<ViewMetrics> compare_view(const ReferenceFrame& reference_frame, const 
       // in one and the atlas's neighbouring charts in the other, and no gutter short of the
       // footprint separates them (docs/BENCHMARKS.md, "The outline"). A pixel whose taps read
       // page border texels stays in: a bad border shows first along a small object's outline.
-      const bool border_read = (st & 0x20000000u) != 0;
+      const bool border_read = (st & VirtualFrame::kStatusBorderRead) != 0;
       const bool outline = !border_read && near_edge(x, y);
       m.outline_pixels += outline;
       const size_t k = size_t(y / kTile) * tiles_x + x / kTile;

@@ -25,6 +25,7 @@ void main() {
   bool edge = tested && c.a < pc.tex.w + kAlphaEdge;
   if (pc.misc.w == 1) c.rgb = max(c.rgb, vec3(0.0)) / (1.0 + max(c.rgb, vec3(0.0)));
   out_color = c;
+  // The status bits: VirtualFrame::kStatus* (render/renderer.h).
   out_status = 0x80000000u | (edge ? 0x40000000u : 0u) |
                (vt_border_read ? 0x20000000u : 0u) | (vt_coarse_fallback ? 0x10000000u : 0u) | uint(int(floor(f.lod))) |
                (uint(sampled) << 8);
