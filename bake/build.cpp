@@ -97,7 +97,8 @@ class LayerRun {
   }
 
   // Makes `level` the one being paged (level 0 from the plan's source, later ones from the
-  // store the previous level wrote) and opens the next level's store.
+  // store the previous level wrote, or BuildOptions::level_from's) and opens the next level's
+  // store (none with given levels).
   Status begin_level(uint32_t level) {
     if (level == 0) {
       current_ = layer_.level0;

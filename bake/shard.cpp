@@ -177,19 +177,19 @@ Status write_coverage(const CoverageMask& c, const std::string& path) {
   return f.close();
 }
 
-// Returns the XXH3 of the bytes written: the source's rows in order, as ImageSource::content_hash
-// hashes them.
-Expected<uint64_t> write_source(ImageSource& source, const std::string& path) {
-  const ImageInfo& info = source.info();
+// Writes `height` rows of `row` floats, read a band of about 4 MiB at a time by `read(y0, y1,
+// out)`, to `path`; returns the XXH3 of the bytes written (the rows in order, as
+// ImageSource::content_hash hashes them).
+template <class Read>
+Expected<uint64_t> write_rows(const std::string& path, size_t row, uint32_t height, Read read) {
   HashedFile f;
   VT_RETURN_IF_ERROR(f.open(path));
-  const size_t row = size_t(info.width) * info.channels;
-  const uint32_t band = uint32_t(std::clamp<size_t>((size_t(4) << 20) / std::max<size_t>(row, 1), 1,
-                                                    std::max(1u, info.height)));
+  const uint32_t band = uint32_t(
+      std::clamp<size_t>((size_t(4) << 20) / std::max<size_t>(row, 1), 1, std::max(1u, height)));
   std::vector<float> rows(row * band);
-  for (uint32_t y = 0; y < info.height; y += band) {
-    const uint32_t y1 = std::min(info.height, y + band);
-    VT_RETURN_IF_ERROR(source.read_rows(y, y1, rows.data()));
+  for (uint32_t y = 0; y < height; y += band) {
+    const uint32_t y1 = std::min(height, y + band);
+    VT_RETURN_IF_ERROR(read(y, y1, rows.data()));
     f.put(rows.data(), size_t(y1 - y) * row * sizeof(float));
   }
   const uint64_t digest = f.digest();
@@ -197,19 +197,17 @@ Expected<uint64_t> write_source(ImageSource& source, const std::string& path) {
   return digest;
 }
 
+Expected<uint64_t> write_source(ImageSource& source, const std::string& path) {
+  const ImageInfo& info = source.info();
+  return write_rows(
+      path, size_t(info.width) * info.channels, info.height,
+      [&](uint32_t y0, uint32_t y1, float* out) { return source.read_rows(y0, y1, out); });
+}
+
 Status write_level(LevelSource& level, const std::string& path) {
-  HashedFile f;
-  VT_RETURN_IF_ERROR(f.open(path));
-  const size_t row = level.row_floats();
-  const uint32_t band = uint32_t(std::clamp<size_t>((size_t(4) << 20) / std::max<size_t>(row, 1), 1,
-                                                    std::max(1u, level.height())));
-  std::vector<float> rows(row * band);
-  for (uint32_t y = 0; y < level.height(); y += band) {
-    const uint32_t y1 = std::min(level.height(), y + band);
-    VT_RETURN_IF_ERROR(level.read(y, y1, rows.data()));
-    f.put(rows.data(), size_t(y1 - y) * row * sizeof(float));
-  }
-  return f.close();
+  return write_rows(path, level.row_floats(), level.height(),
+                    [&](uint32_t y0, uint32_t y1, float* out) { return level.read(y0, y1, out); })
+      .status();
 }
 
 Expected<nlohmann::json> read_json(const std::string& path) {
@@ -404,16 +402,17 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
   VT_RETURN_IF_ERROR(drop_opaque_alpha(bo));
   VT_ASSIGN_OR_RETURN(BuildPlan plan, plan_build(bo));
   sum.stages.push_back({"plan", seconds_since(t0)});
-  // What a shard would otherwise read the whole of level 0 for: its hash and the alpha scan.
-  for (size_t i = 0; i < layer_hashes.size(); ++i) {
-    layers[i]["content_hash"] = hex(layer_hashes[i]);
-    layers[i]["alpha_dropped"] = bo.layers[i].alpha_dropped;
+  for (size_t i = 0; i < plan.layers.size(); ++i) {
+    layers[i]["input_key"] = hex(plan.layers[i].input_key);  // for the merged update record
+    // What a shard would otherwise read the whole of level 0 for: its hash and the alpha scan.
+    if (i < layer_hashes.size()) {
+      layers[i]["content_hash"] = hex(layer_hashes[i]);
+      layers[i]["alpha_dropped"] = bo.layers[i].alpha_dropped;
+    }
   }
   // Level 0 in its working form (converted, dilated) for the shards, which would otherwise each
   // redo it: for the layers whose held level 0 carries the input's coverage mask.
   t0 = Clock::now();
-  for (size_t i = 0; i < plan.layers.size(); ++i)
-    layers[i]["input_key"] = hex(plan.layers[i].input_key);  // for the merged update record
   for (size_t i = 0; i < plan.layers.size() && !dir.empty(); ++i) {
     LevelSource& level0 = *plan.layers[i].level0;
     if (!coverage || level0.coverage() != bo.layers[i].coverage.get()) continue;
@@ -676,9 +675,10 @@ Expected<std::function<Expected<BuildOptions::GivenLevel>(size_t, uint32_t)>> gi
     const auto& levels = l.value("levels", nlohmann::json::array());
     const bool covered = l.value("levels_coverage", false) && options.layers[i].coverage;
     if (covered && masks.empty()) masks.push_back(options.layers[i].coverage);
-    uint32_t width = w0, height = h0;
+    const PageGeometry g{w0, h0};  // level sizes follow from the atlas's alone
     for (size_t k = 0; k < levels.size(); ++k) {
-      width = (width + 1) / 2, height = (height + 1) / 2;
+      const uint32_t width = g.level_width(uint32_t(k + 1)),
+                     height = g.level_height(uint32_t(k + 1));
       if (covered && masks.size() <= k + 1) {
         VT_ASSIGN_OR_RETURN(
             std::shared_ptr<CoverageMask> half,

@@ -227,8 +227,9 @@ struct Renderer::Impl {
   };
   Status run_pass(const PassTargets& pass, VkPipeline pipe,
                   const std::function<void(VkCommandBuffer)>& draw);
-  // The reference and virtual passes share the colour and status targets.
-  Status run_color_pass(uint32_t w, uint32_t h, VkPipeline pipe,
+  // The reference and virtual passes share the colour and status targets; `read_depth` (the
+  // reference passes: compare_view's silhouettes) also copies the depth target to depth_rb.
+  Status run_color_pass(uint32_t w, uint32_t h, VkPipeline pipe, bool read_depth,
                         const std::function<void(VkCommandBuffer)>& draw);
   Rgba8Image read_color(uint32_t w, uint32_t h) const;
   std::vector<float> read_view_depth(const Camera& camera, uint32_t w, uint32_t h) const;
@@ -889,12 +890,13 @@ Status Renderer::Impl::run_pass(const PassTargets& pass, VkPipeline pipe,
   });
 }
 
-Status Renderer::Impl::run_color_pass(uint32_t w, uint32_t h, VkPipeline pipe,
+Status Renderer::Impl::run_color_pass(uint32_t w, uint32_t h, VkPipeline pipe, bool read_depth,
                                       const std::function<void(VkCommandBuffer)>& draw) {
   const Image* targets[] = {&color, &status};
   const Buffer* readbacks[] = {&color_rb, &status_rb};
   const VkClearColorValue clears[] = {{{0.0f, 0.0f, 0.0f, 0.0f}}, {}};
-  return run_pass({targets, readbacks, &depth, w, h, clears, &depth_rb}, pipe, draw);
+  return run_pass({targets, readbacks, &depth, w, h, clears, read_depth ? &depth_rb : nullptr},
+                  pipe, draw);
 }
 
 Rgba8Image Renderer::Impl::read_color(uint32_t w, uint32_t h) const {
@@ -934,7 +936,7 @@ Expected<ReferenceFrame> Renderer::render_reference(const Camera& camera) {
     }
   }
   const uint32_t w = options_.width, h = options_.height;
-  VT_RETURN_IF_ERROR(s.run_color_pass(w, h, s.ref_pipe, [&](VkCommandBuffer cmd) {
+  VT_RETURN_IF_ERROR(s.run_color_pass(w, h, s.ref_pipe, true, [&](VkCommandBuffer cmd) {
     for (const auto& m : s.reference_meshes()) {
       const auto& t = s.textures[m.texture];
       vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.ref_layout, 0, 1, &t.set, 0,
@@ -997,7 +999,7 @@ Expected<VirtualFrame> Renderer::render_virtual(const Camera& camera) {
   Impl& s = *impl_;
   if (!s.has_vt) return Error(ErrorCode::kInvalidArgument, "render: no virtual texture set");
   const uint32_t w = options_.width, h = options_.height;
-  VT_RETURN_IF_ERROR(s.run_color_pass(w, h, s.vt_pipe, [&](VkCommandBuffer cmd) {
+  VT_RETURN_IF_ERROR(s.run_color_pass(w, h, s.vt_pipe, false, [&](VkCommandBuffer cmd) {
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.vt_layout, 0, 1, &s.vt_set, 0,
                             nullptr);
     for (const auto& m : s.meshes) {
@@ -1282,7 +1284,7 @@ Expected<ReferenceFrame> Renderer::render_lit_reference(const Camera& camera,
   }
   fill_lit_frame(s.lit.frame, o);
   const uint32_t w = options_.width, h = options_.height;
-  VT_RETURN_IF_ERROR(s.run_color_pass(w, h, s.lit.ref_pipe, [&](VkCommandBuffer cmd) {
+  VT_RETURN_IF_ERROR(s.run_color_pass(w, h, s.lit.ref_pipe, true, [&](VkCommandBuffer cmd) {
     for (const auto& m : s.reference_meshes()) {
       const auto& t = s.textures[m.texture];
       const LitState::Material& lm = s.lit.materials[m.texture];
@@ -1324,7 +1326,7 @@ Expected<VirtualFrame> Renderer::render_lit_virtual(const Camera& camera,
   }
   fill_lit_frame(s.lit.frame, o);
   const uint32_t w = options_.width, h = options_.height;
-  VT_RETURN_IF_ERROR(s.run_color_pass(w, h, s.lit.vt_pipe, [&](VkCommandBuffer cmd) {
+  VT_RETURN_IF_ERROR(s.run_color_pass(w, h, s.lit.vt_pipe, false, [&](VkCommandBuffer cmd) {
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, s.lit.vt_layout, 0, 1,
                             &s.lit.vt_set, 0, nullptr);
     for (const auto& m : s.meshes) {
