@@ -445,12 +445,7 @@ bool copy_previous_layer(BuildPlan& plan, LayerPlan& layer, const std::vector<ui
     if (!pinned) return false;
     spec.codec_tables = *pinned;
   }
-  const LayerSpec& old = plan.previous->reader().layers()[size_t(prev)];
-  if (spec.semantic != old.semantic || spec.channels != old.channels ||
-      spec.texel_type != old.texel_type || spec.codec != old.codec ||
-      spec.runtime_format != old.runtime_format || spec.color_space != old.color_space ||
-      spec.address_mode != old.address_mode || spec.codec_tables != old.codec_tables)
-    return false;
+  if (spec != plan.previous->reader().layers()[size_t(prev)]) return false;  // every field
   layer.spec = std::move(spec);
   layer.copy_previous = true;
   layer.previous_layer = prev;

@@ -65,6 +65,7 @@ struct LayerSpec {
   std::vector<uint8_t> codec_tables;
 
   uint32_t texel_bytes() const { return channels * texel_type_bytes(texel_type); }
+  friend bool operator==(const LayerSpec&, const LayerSpec&) = default;
 };
 
 struct PageFileDesc {
