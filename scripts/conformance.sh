@@ -39,7 +39,8 @@ if [[ -z "$corpus" ]]; then
   fi
 fi
 [[ -d "$corpus" ]] || { echo "conformance: corpus folder $corpus does not exist" >&2; exit 2; }
-work="${work:-$cache/work}"
+# One work folder per checkout, so that worktrees running at once never share files.
+work="${work:-$cache/work-$(basename "$root")}"
 mkdir -p "$work"
 exec python3 "$root/scripts/conformance.py" --vtbake "$vtbake" --corpus "$corpus" --work "$work" \
   --out "$out" --only "$only" --timeout "$timeout_s"
