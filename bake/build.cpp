@@ -389,11 +389,20 @@ class LayerRun {
     const uint32_t y0 = row * half, y1 = std::min(next_->height(), y0 + half);
     if (y1 <= y0) return Status::Ok();
     next_rows_.resize(size_t(y1 - y0) * next_->row_floats());
+    // The level's coverage keeps the filter inside each chart (downsample_rows).
+    const CoverageMask* mask = current_->coverage();
+    CoverageBand coverage;
+    if (mask) {
+      VT_RETURN_IF_ERROR(mask->read_addressed_rows(band.y_begin, band.rows, plan_.options.address,
+                                                   band_coverage_));
+      coverage = {band.y_begin, band.rows, band.width, mask->height(), band_coverage_.data()};
+    }
     constexpr uint32_t kRowsPerItem = 8;
     parallel_for((y1 - y0 + kRowsPerItem - 1) / kRowsPerItem, plan_.threads, [&](size_t t) {
       const uint32_t a = y0 + uint32_t(t) * kRowsPerItem, b = std::min(y1, a + kRowsPerItem);
       downsample_rows(plan_.kernel, layer_.rules, band, a, b,
-                      next_rows_.data() + size_t(a - y0) * next_->row_floats());
+                      next_rows_.data() + size_t(a - y0) * next_->row_floats(),
+                      mask ? &coverage : nullptr);
     });
     VT_RETURN_IF_ERROR(next_->write_rows(y0, y1 - y0, next_rows_.data()));
     if (alpha_.active) {
@@ -418,6 +427,7 @@ class LayerRun {
   std::vector<BuildOptions::GivenLevel> given_;  // empty, or one per level (0 unused)
   std::unique_ptr<RowWindow> window_;
   std::vector<float> next_rows_;
+  std::vector<uint8_t> band_coverage_;  // the band's coverage rows (downsample_band)
   AlphaCoverage alpha_;
   ErrorSum error_;
   int previous_layer_ = -1;  // the same layer in the previous file (update mode)

@@ -82,6 +82,26 @@ Status CoverageMask::read_rows(uint32_t y0, uint32_t y1, std::vector<uint8_t>& o
   return Status::Ok();
 }
 
+Status CoverageMask::read_addressed_rows(int64_t y_begin, uint32_t rows, AddressMode mode,
+                                         std::vector<uint8_t>& out) const {
+  out.resize(size_t(width_) * rows);
+  const int64_t y_end = y_begin + rows;
+  const int64_t lo = std::clamp<int64_t>(y_begin, 0, height_);
+  const int64_t hi = std::clamp<int64_t>(y_end, 0, height_);
+  std::vector<uint8_t> part;
+  if (hi > lo) {
+    VT_RETURN_IF_ERROR(read_rows(uint32_t(lo), uint32_t(hi), part));
+    std::copy(part.begin(), part.end(), out.begin() + size_t(lo - y_begin) * width_);
+  }
+  for (int64_t y = y_begin; y < y_end; ++y) {  // the few rows past an edge
+    if (y >= lo && y < hi) continue;
+    const uint32_t a = uint32_t(address_texel(y, height_, mode));
+    VT_RETURN_IF_ERROR(read_rows(a, a + 1, part));
+    std::copy(part.begin(), part.end(), out.begin() + size_t(y - y_begin) * width_);
+  }
+  return Status::Ok();
+}
+
 Expected<std::vector<uint8_t>> CoverageMask::to_bytes() const {
   std::vector<uint8_t> out;
   VT_RETURN_IF_ERROR(read_rows(0, height_, out));

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/status.h"
+#include "format/page_geometry.h"
 
 namespace vt {
 
@@ -47,6 +48,10 @@ class CoverageMask {
   Status write_rows(uint32_t y0, uint32_t rows, const uint8_t* texels);
   // Rows [y0, y1) as one byte per texel, 0 or 1, into `out` (resized). Safe from many threads.
   Status read_rows(uint32_t y0, uint32_t y1, std::vector<uint8_t>& out) const;
+  // Rows [y_begin, y_begin + rows), which may reach past the edges, resolved by `mode` as a
+  // RowWindow resolves a level's rows (the downsample's CoverageBand), into `out` (resized).
+  Status read_addressed_rows(int64_t y_begin, uint32_t rows, AddressMode mode,
+                             std::vector<uint8_t>& out) const;
   // The whole mask as bytes (tests and the validator's small levels).
   Expected<std::vector<uint8_t>> to_bytes() const;
   // Rows moved at a time by the mask's own loops (about 4 MiB as bytes); callers that stream a

@@ -77,6 +77,53 @@ void filter_row(const DownsampleKernel& k, AddressMode mode, const float* src, u
   }
 }
 
+// Per output column of one source row: 1 when the column's taps (the horizontal pass's) reach a
+// texel of `cov` that is not covered. `uncovered_before` is scratch (width + 1 counts).
+void gap_row(const DownsampleKernel& k, AddressMode mode, const uint8_t* cov, uint32_t width,
+             std::vector<uint32_t>& uncovered_before, uint8_t* dst) {
+  const uint32_t dw = (width + 1) / 2;
+  const int taps = k.taps();
+  uncovered_before.resize(size_t(width) + 1);
+  uncovered_before[0] = 0;
+  for (uint32_t x = 0; x < width; ++x) uncovered_before[x + 1] = uncovered_before[x] + !cov[x];
+  if (uncovered_before[width] == 0) {
+    std::fill(dst, dst + dw, uint8_t(0));
+    return;
+  }
+  for (uint32_t i = 0; i < dw; ++i) {
+    const int64_t x0 = int64_t(2) * i + k.first;
+    if (x0 >= 0 && x0 + taps <= int64_t(width)) {
+      dst[i] = uncovered_before[size_t(x0 + taps)] != uncovered_before[size_t(x0)];
+    } else {
+      uint8_t gap = 0;
+      for (int t = 0; t < taps && !gap; ++t) gap = !cov[addr(x0 + t, width, mode)];
+      dst[i] = gap;
+    }
+  }
+}
+
+// The mean of the covered texels of output texel (i, j)'s 2x2 footprint (clamped at odd sizes,
+// each texel once) into `a`; false when none is covered.
+bool covered_box(const RowBand& src, const CoverageBand& cov, uint32_t i, uint32_t j, double* a) {
+  const uint32_t ch = src.channels;
+  const uint32_t xs[2] = {2 * i, std::min(2 * i + 1, src.width - 1)};
+  const uint32_t ys[2] = {2 * j, std::min(2 * j + 1, cov.height - 1)};
+  double sum[4] = {0, 0, 0, 0};
+  int n = 0;
+  for (int r = 0; r < (ys[1] != ys[0] ? 2 : 1); ++r) {
+    const uint8_t* c = cov.row(ys[r]);
+    const float* s = src.row(ys[r]);
+    for (int q = 0; q < (xs[1] != xs[0] ? 2 : 1); ++q) {
+      if (!c[xs[q]]) continue;
+      ++n;
+      for (uint32_t k = 0; k < ch; ++k) sum[k] += double(s[size_t(xs[q]) * ch + k]);
+    }
+  }
+  if (n == 0) return false;
+  for (uint32_t k = 0; k < ch; ++k) a[k] = sum[k] / n;
+  return true;
+}
+
 // The filters' names, written once for to_string and parse_mip_filter.
 struct MipFilterName {
   MipFilter filter;
@@ -121,7 +168,8 @@ DownsampleKernel make_downsample_kernel(MipFilter filter) {
 }
 
 void downsample_rows(const DownsampleKernel& kernel, const DownsampleRules& rules,
-                     const RowBand& src, uint32_t y0, uint32_t y1, float* out) {
+                     const RowBand& src, uint32_t y0, uint32_t y1, float* out,
+                     const CoverageBand* coverage) {
   const uint32_t ch = src.channels;
   const uint32_t dw = (src.width + 1) / 2;
   const int taps = kernel.taps();
@@ -130,6 +178,8 @@ void downsample_rows(const DownsampleKernel& kernel, const DownsampleRules& rule
   constexpr uint32_t kChunk = 8;
   std::vector<double> hrows;
   std::vector<double> acc(drow);
+  std::vector<uint8_t> hgaps, gaps(coverage ? dw : 0);  // gap_row's, per source row; per output
+  std::vector<uint32_t> uncovered_before;
   for (uint32_t c0 = y0; c0 < y1; c0 += kChunk) {
     uint32_t c1 = std::min(y1, c0 + kChunk);
     int64_t s0 = int64_t(2) * c0 + kernel.first;
@@ -139,6 +189,13 @@ void downsample_rows(const DownsampleKernel& kernel, const DownsampleRules& rule
       filter_row(kernel, rules.address, src.row(y), src.width, ch,
                  hrows.data() + size_t(y - s0) * drow);
     }
+    if (coverage) {
+      hgaps.resize(size_t(s1 - s0) * dw);
+      for (int64_t y = s0; y < s1; ++y) {
+        gap_row(kernel, rules.address, coverage->row(y), src.width, uncovered_before,
+                hgaps.data() + size_t(y - s0) * dw);
+      }
+    }
     for (uint32_t j = c0; j < c1; ++j) {
       std::fill(acc.begin(), acc.end(), 0.0);
       int64_t first_row = int64_t(2) * j + kernel.first - s0;
@@ -147,9 +204,17 @@ void downsample_rows(const DownsampleKernel& kernel, const DownsampleRules& rule
         double w = kernel.weights[t];
         for (size_t i = 0; i < drow; ++i) acc[i] += w * h[i];
       }
+      if (coverage) {
+        std::fill(gaps.begin(), gaps.end(), uint8_t(0));
+        for (int t = 0; t < taps; ++t) {
+          const uint8_t* g = hgaps.data() + size_t(first_row + t) * dw;
+          for (uint32_t i = 0; i < dw; ++i) gaps[i] |= g[i];
+        }
+      }
       float* o = out + size_t(j - y0) * drow;
       for (uint32_t i = 0; i < dw; ++i) {
         double* a = acc.data() + size_t(i) * ch;
+        if (coverage && gaps[i]) covered_box(src, *coverage, i, j, a);
         if (rules.renormalize_xyz && ch >= 3) {
           double len = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
           if (len > 1e-30 && std::isfinite(len)) {
@@ -169,20 +234,25 @@ void downsample_rows(const DownsampleKernel& kernel, const DownsampleRules& rule
 
 std::vector<float> downsample_level(const DownsampleKernel& kernel, const DownsampleRules& rules,
                                     const float* texels, uint32_t width, uint32_t height,
-                                    uint32_t channels) {
+                                    uint32_t channels, const uint8_t* coverage) {
   // Build an addressed band covering every tap of every output row.
   const uint32_t dh = (height + 1) / 2, dw = (width + 1) / 2;
   int64_t b0 = kernel.first;
   int64_t b1 = int64_t(2) * (dh - 1) + kernel.first + kernel.taps();
   const size_t row = size_t(width) * channels;
   std::vector<float> band(size_t(b1 - b0) * row);
+  std::vector<uint8_t> cov_band(coverage ? size_t(b1 - b0) * width : 0);
   for (int64_t y = b0; y < b1; ++y) {
     int64_t sy = addr(y, height, rules.address);
     std::memcpy(band.data() + size_t(y - b0) * row, texels + size_t(sy) * row, row * sizeof(float));
+    if (coverage) {
+      std::memcpy(cov_band.data() + size_t(y - b0) * width, coverage + size_t(sy) * width, width);
+    }
   }
   RowBand src{b0, uint32_t(b1 - b0), width, channels, band.data()};
+  const CoverageBand cov{b0, uint32_t(b1 - b0), width, height, cov_band.data()};
   std::vector<float> out(size_t(dw) * dh * channels);
-  downsample_rows(kernel, rules, src, 0, dh, out.data());
+  downsample_rows(kernel, rules, src, 0, dh, out.data(), coverage ? &cov : nullptr);
   return out;
 }
 

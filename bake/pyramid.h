@@ -41,6 +41,18 @@ struct RowBand {
   const float* row(int64_t y) const { return data + size_t(y - y_begin) * width * channels; }
 };
 
+// Which texels of a RowBand's rows some chart covers: one byte per texel (non-zero = covered),
+// the same rows as the band (past the level's edge resolved by the same address mode). `height`
+// is the level's: the 2x2 footprint is clamped at odd sizes as downsample_coverage clamps it.
+struct CoverageBand {
+  int64_t y_begin = 0;
+  uint32_t rows = 0;
+  uint32_t width = 0;
+  uint32_t height = 0;
+  const uint8_t* data = nullptr;
+  const uint8_t* row(int64_t y) const { return data + size_t(y - y_begin) * width; }
+};
+
 // Post-filter treatment of each output texel.
 struct DownsampleRules {
   AddressMode address = AddressMode::kClamp;  // for columns past the row's edge
@@ -52,13 +64,22 @@ struct DownsampleRules {
 // Computes rows [y0, y1) of the half-size level (width (src.width + 1) / 2) into `out`. `src`
 // must hold rows 2*y0 + first .. 2*(y1-1) + first + taps - 1. Each output row depends only on
 // its inputs, so any split of [y0, y1) over threads gives the same bytes.
+//
+// With `coverage` (the source's, same rows as `src`), a covered output texel (some texel of its
+// 2x2 footprint covered) whose filter taps reach an uncovered texel is instead the mean of the
+// covered texels of its 2x2 footprint: the filter never reads the dilated gutter, nor across
+// it a neighbouring chart. Charts `padding` texels apart at level 0 then share no texel through
+// level log2(padding) (levels 1-3 at padding 8); past it the gutter is under one texel and
+// charts meet. Without it every texel is filtered alike (a plain image).
 void downsample_rows(const DownsampleKernel& kernel, const DownsampleRules& rules,
-                     const RowBand& src, uint32_t y0, uint32_t y1, float* out);
+                     const RowBand& src, uint32_t y0, uint32_t y1, float* out,
+                     const CoverageBand* coverage = nullptr);
 
-// Whole-level convenience for small images: returns the (w+1)/2 x (h+1)/2 level.
+// Whole-level convenience for small images: returns the (w+1)/2 x (h+1)/2 level; `coverage`
+// (width x height bytes, or null) as downsample_rows'.
 std::vector<float> downsample_level(const DownsampleKernel& kernel, const DownsampleRules& rules,
                                     const float* texels, uint32_t width, uint32_t height,
-                                    uint32_t channels);
+                                    uint32_t channels, const uint8_t* coverage = nullptr);
 
 // Rescales xyz vectors to unit length; a zero or non-finite vector becomes (0, 0, 1).
 void renormalize_normals(float* texels, size_t count, uint32_t channels);

@@ -434,12 +434,13 @@ Status check_level(const PageSource& source, const PageFileReader& reader, uint3
   return Status::Ok();
 }
 
-// The next level of the reference, as the build makes it: filtered from the dilated level,
-// then dilated under the halved coverage.
+// The next level of the reference, as the build makes it: filtered from the dilated level within
+// each chart (under the level's coverage), then dilated under the halved coverage.
 void next_level(const PageGeometry& g, uint32_t level, const DownsampleKernel& kernel,
                 ReferenceLayer& r) {
   const uint32_t w = g.level_width(level), h = g.level_height(level);
-  r.level = downsample_level(kernel, r.rules, r.level.data(), w, h, r.work_channels);
+  r.level =
+      downsample_level(kernel, r.rules, r.level.data(), w, h, r.work_channels, r.coverage.data());
   r.coverage = downsample_coverage(r.coverage.data(), w, h);
   pull_push(r.level.data(), r.coverage.data(), g.level_width(level + 1), g.level_height(level + 1),
             r.work_channels);

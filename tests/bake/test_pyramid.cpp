@@ -186,6 +186,71 @@ TEST(PullPush, UncoveredColourNeverReachesCoveredTexels) {
   }
 }
 
+// Flat charts 8 texels apart (the default padding) at every alignment: through level 3 each
+// covered texel holds its own chart's colour exactly, whatever the filter; the filter without
+// coverage reads across the gutter (so the check can fail).
+TEST(Filters, ChartsAPaddingApartShareNoTexelThroughLevelLog2Padding) {
+  constexpr uint32_t kPadding = 8, kLevels = 3;
+  std::vector<uint32_t> starts_x, starts_y;  // chart sizes 5..12: every alignment mod 8
+  uint32_t w = 0, h = 0;
+  for (uint32_t size = 5, x = 0; size <= 12; x += size + kPadding, ++size)
+    starts_x.push_back(x), w = x + size;
+  for (uint32_t size = 12, y = 0; size >= 5; y += size + kPadding, --size)
+    starts_y.push_back(y), h = y + size;
+  std::vector<int> chart(size_t(w) * h, -1);
+  for (size_t cy = 0; cy < starts_y.size(); ++cy)
+    for (size_t cx = 0; cx < starts_x.size(); ++cx)
+      for (uint32_t y = starts_y[cy]; y < starts_y[cy] + 12 - cy; ++y)
+        for (uint32_t x = starts_x[cx]; x < starts_x[cx] + 5 + cx; ++x)
+          chart[size_t(y) * w + x] = int(cy * starts_x.size() + cx);
+  auto colour = [](int c, int k) { return float((c * 37 + k * 11) % 23) / 22.0f; };
+  std::vector<float> base(size_t(w) * h * 3, 0.0f);
+  std::vector<uint8_t> base_cov(size_t(w) * h);
+  for (size_t i = 0; i < chart.size(); ++i) {
+    base_cov[i] = chart[i] >= 0;
+    for (int k = 0; k < 3; ++k) base[i * 3 + k] = chart[i] >= 0 ? colour(chart[i], k) : 0.0f;
+  }
+  pull_push(base.data(), base_cov.data(), w, h, 3);
+  for (MipFilter f : kFilters) {
+    for (bool with_coverage : {true, false}) {
+      const DownsampleKernel k = make_downsample_kernel(f);
+      std::vector<float> lvl = base;
+      std::vector<uint8_t> cov = base_cov;
+      uint32_t lw = w, lh = h;
+      double worst = 0;
+      for (uint32_t level = 1; level <= kLevels; ++level) {
+        lvl = downsample_level(k, DownsampleRules{}, lvl.data(), lw, lh, 3,
+                               with_coverage ? cov.data() : nullptr);
+        cov = downsample_coverage(cov.data(), lw, lh);
+        lw = (lw + 1) / 2, lh = (lh + 1) / 2;
+        pull_push(lvl.data(), cov.data(), lw, lh, 3);
+        const uint32_t s = 1u << level;
+        for (uint32_t y = 0; y < lh; ++y) {
+          for (uint32_t x = 0; x < lw; ++x) {
+            if (!cov[size_t(y) * lw + x]) continue;
+            int owner = -1;  // the one chart under the texel's footprint at level 0
+            for (uint32_t v = y * s; v < std::min(h, (y + 1) * s); ++v)
+              for (uint32_t u = x * s; u < std::min(w, (x + 1) * s); ++u) {
+                const int c = chart[size_t(v) * w + u];
+                if (c < 0) continue;
+                ASSERT_TRUE(owner < 0 || owner == c) << "charts meet at level " << level;
+                owner = c;
+              }
+            for (int c = 0; c < 3; ++c)
+              worst = std::max(
+                  worst, std::abs(double(lvl[(size_t(y) * lw + x) * 3 + c]) - colour(owner, c)));
+          }
+        }
+      }
+      if (with_coverage) {
+        EXPECT_LT(worst, 1e-6) << to_string(f);
+      } else if (f != MipFilter::kBox) {
+        EXPECT_GT(worst, 0.01) << to_string(f) << ": the plain filter should cross the gutter";
+      }
+    }
+  }
+}
+
 TEST(PullPush, NothingOrEverythingCoveredIsLeftAlone) {
   std::vector<float> img = {1, 2, 3, 4};
   std::vector<uint8_t> none(4, 0), all(4, 1);
