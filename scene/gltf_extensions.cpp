@@ -12,15 +12,16 @@ namespace {
 
 // How vtbake treats an extension a file uses.
 enum class Support {
-  kRead,     // read for real: never a warning, fine when required
-  kIgnored,  // ignored or approximated with a warning; refused when required
-  kSilent,   // does not change what is baked (metadata, animation): no warning
+  kRead,          // read for real: never a warning, fine when required
+  kIgnored,       // ignored or approximated with a warning; refused when required
+  kApproximated,  // approximated with a warning, fine when required (it is all the file has)
+  kSilent,        // does not change what is baked (metadata, animation): no warning
 };
 
 struct ExtensionRule {
   const char* name;
   Support support;
-  const char* instead;  // what vtbake does instead (kIgnored)
+  const char* instead;  // what vtbake does instead (kIgnored, kApproximated)
 };
 
 // The one list of the extensions vtbake knows.
@@ -56,11 +57,14 @@ constexpr ExtensionRule kExtensions[] = {
     {"KHR_materials_variants", Support::kIgnored, "only the default materials are baked"},
     {"KHR_techniques_webgl", Support::kIgnored,
      "shaders are ignored; the metallic-roughness material is baked"},
-    // The pre-release draft: its materials are glTF 1.0 technique values, with no
-    // metallic-roughness block to fall back on (glTF2/BoxTextured-glTF-techniqueWebGL).
-    {"KHR_technique_webgl", Support::kIgnored,
-     "its materials are shader-technique values with no metallic-roughness block; export the "
-     "file again as glTF 2.0 with pbrMetallicRoughness materials"},
+    // The pre-release draft (glTF2/BoxTextured-glTF-techniqueWebGL): its materials are glTF 1.0
+    // technique values with no metallic-roughness block; the common profile's are mapped
+    // (gltf_materials.cpp).
+    {"KHR_technique_webgl", Support::kApproximated,
+     "shaders are ignored; where a material has no metallic-roughness block, its common-profile "
+     "values are baked as metallic-roughness: diffuse as base colour, emission as emissive, "
+     "transparency as alpha (BLEND below 1), metallic 0, roughness (2 / (shininess + 2))^(1/4) "
+     "(Blinn-Phong to Beckmann); ambient and specular are not baked"},
     {"KHR_materials_cmnBlinnPhong", Support::kIgnored,
      "Blinn-Phong is ignored; the metallic-roughness material is baked"},
     {"KHR_texture_basisu", Support::kIgnored,
@@ -129,7 +133,7 @@ Status check_version(const Gltf& g, Warnings* warnings) {
 Status check_required_extensions(const JsonFields& root) {
   for (const std::string& name : root.strings("extensionsRequired")) {
     const ExtensionRule* rule = find_rule(name);
-    bool ok = rule && rule->support == Support::kRead;
+    bool ok = rule && (rule->support == Support::kRead || rule->support == Support::kApproximated);
     if (!ok)
       return Error(ErrorCode::kUnsupported,
                    root.errors()->gltf().path + ": required extension " + name +
@@ -149,7 +153,7 @@ void warn_about_extensions(const JsonFields& root, const ExtensionUses& material
   const std::string& path = root.errors()->gltf().path;
   for (const std::string& name : names) {
     const ExtensionRule* rule = find_rule(name);
-    if (rule && rule->support != Support::kIgnored) continue;
+    if (rule && (rule->support == Support::kRead || rule->support == Support::kSilent)) continue;
     std::string line = path + ": " + name + ": ";
     auto uses = material_uses.find(name);
     if (!rule)

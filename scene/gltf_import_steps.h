@@ -33,7 +33,8 @@ void warn_about_extensions(const JsonFields& root, const ExtensionUses& material
 void check_mesh_fields(const JsonFields& root, Warnings* warnings);
 
 // Materials with every textureInfo resolved (sampler, texCoord, KHR_texture_transform),
-// KHR_materials_emissive_strength and the specular-glossiness fallback.
+// KHR_materials_emissive_strength, and the specular-glossiness and KHR_technique_webgl
+// (common-profile values) fallbacks.
 std::vector<Material> load_materials(const JsonFields& root, ExtensionUses* uses,
                                      Warnings* warnings);
 

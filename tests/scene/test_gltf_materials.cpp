@@ -1,7 +1,7 @@
 // The glTF 2.0 material model and document rules on small files written by the tests:
 // textureInfo samplers, texCoord sets and KHR_texture_transform, emissive strength, the
-// specular-glossiness fallback, extension rules and warnings, glTF 1.0, node-graph and index
-// checks, and typed errors that name the file and the field.
+// specular-glossiness and KHR_technique_webgl fallbacks, extension rules and warnings, glTF 1.0,
+// node-graph and index checks, and typed errors that name the file and the field.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -258,11 +258,6 @@ TEST(GltfMaterials, UnsupportedRequiredExtensionIsRefusedByName) {
   doc["extensionsRequired"] = {"KHR_materials_clearcoat"};
   expect_error(load("required2.gltf", doc), "required2.gltf", ErrorCode::kUnsupported,
                "required extension KHR_materials_clearcoat is not supported");
-  // The pre-release draft's materials are technique values: the refusal says why.
-  doc["extensionsRequired"] = {"KHR_technique_webgl"};
-  expect_error(load("required3.gltf", doc), "required3.gltf", ErrorCode::kUnsupported,
-               "required extension KHR_technique_webgl is not supported (its materials are "
-               "shader-technique values with no metallic-roughness block");
 }
 
 TEST(GltfMaterials, UsedAppearanceExtensionsWarnOnceEach) {
@@ -312,6 +307,166 @@ TEST(GltfMaterials, SpecularGlossinessFallsBackToDiffuse) {
   EXPECT_EQ(kept->materials[0].base_color_factor, (scene::Vec4{1, 0, 0, 1}));
   EXPECT_EQ(kept->materials[0].metallic_factor, 0.5f);
   EXPECT_FALSE(kept->materials[0].base_color_texture.valid());
+}
+
+// triangle_doc() with its material as the draft KHR_technique_webgl writes it
+// (COLLADA2GLTF, glTF2/BoxTextured-glTF-techniqueWebGL): common-profile values typed by
+// technique 0's parameters, diffuse a texture, every value wrapped in an array.
+json technique_doc() {
+  json doc = triangle_doc();
+  doc["materials"][0] = {{"name", "t"},
+                         {"technique", 0},
+                         {"values",
+                          {{"diffuse", {0}},
+                           {"specular", {0.2, 0.2, 0.2, 1}},
+                           {"shininess", {256}},
+                           {"transparency", {1}}}}};
+  doc["techniques"] = {{{"parameters",
+                         {{"diffuse", {{"type", 35678}}},
+                          {"specular", {{"type", 35666}}},
+                          {"shininess", {{"type", 5126}}},
+                          {"transparency", {{"type", 5126}}},
+                          {"modelViewMatrix", {{"semantic", "MODELVIEW"}, {"type", 35676}}}}},
+                        {"uniforms",
+                         {{"u_diffuse", "diffuse"},
+                          {"u_specular", "specular"},
+                          {"u_shininess", "shininess"},
+                          {"u_transparency", "transparency"},
+                          {"u_modelViewMatrix", "modelViewMatrix"}}},
+                        {"program", 0},
+                        {"states", {{"enable", {2884, 2929}}}}}};
+  doc["programs"] = {{{"fragmentShader", 1}, {"vertexShader", 0}}};
+  doc["extensionsUsed"] = {"KHR_technique_webgl"};
+  doc["extensionsRequired"] = {"KHR_technique_webgl"};
+  return doc;
+}
+
+const char* kTechniqueWarning =
+    "KHR_technique_webgl: shaders are ignored; where a material has no metallic-roughness block, "
+    "its common-profile values are baked as metallic-roughness: diffuse as base colour, emission "
+    "as emissive, transparency as alpha (BLEND below 1), metallic 0, roughness (2 / (shininess + "
+    "2))^(1/4) (Blinn-Phong to Beckmann); ambient and specular are not baked (1 material)";
+
+TEST(GltfMaterials, TechniqueWebglTextureDiffuseBecomesBaseColourTexture) {
+  json doc = technique_doc();
+  doc["samplers"][0] = {{"wrapS", 33071}, {"wrapT", 33648}, {"magFilter", 9728}};
+  auto s = load("technique_tex.gltf", doc);
+  ASSERT_NO_FATAL_FAILURE(expect_warnings(s, "technique_tex.gltf", {kTechniqueWarning}));
+  const scene::Material& m = s->materials[0];
+  EXPECT_EQ(m.base_color_texture.image, 0);
+  EXPECT_EQ(m.base_color_texture.texcoord, 0);
+  EXPECT_EQ(m.base_color_texture.wrap_s, WrapMode::kClampToEdge);
+  EXPECT_EQ(m.base_color_texture.wrap_t, WrapMode::kMirroredRepeat);
+  EXPECT_EQ(m.base_color_texture.mag_filter, FilterMode::kNearest);
+  EXPECT_EQ(m.base_color_factor, (scene::Vec4{1, 1, 1, 1}));
+  EXPECT_EQ(m.metallic_factor, 0.0f);
+  // (2 / 258)^(1/4): Beckmann alpha sqrt(2 / (s + 2)) = roughness^2.
+  EXPECT_NEAR(m.roughness_factor, 0.2967239, 1e-6);
+  EXPECT_EQ(m.alpha_mode, scene::AlphaMode::kOpaque);
+  EXPECT_FALSE(m.double_sided);  // CULL_FACE enabled
+  EXPECT_EQ(m.emissive_factor, (scene::Vec3{0, 0, 0}));
+  EXPECT_FALSE(m.emissive_texture.valid());
+  EXPECT_FALSE(m.metallic_roughness_texture.valid());
+
+  // A material with its own metallic-roughness block keeps it.
+  doc["materials"][0]["pbrMetallicRoughness"] = {{"metallicFactor", 0.5}};
+  auto kept = load("technique_mr.gltf", doc);
+  ASSERT_TRUE(kept.ok()) << kept.status().message();
+  EXPECT_EQ(kept->materials[0].metallic_factor, 0.5f);
+  EXPECT_FALSE(kept->materials[0].base_color_texture.valid());
+
+  // Without the extension declared, `technique` is an unknown property: ignored.
+  doc = technique_doc();
+  doc.erase("extensionsUsed");
+  doc.erase("extensionsRequired");
+  auto plain = load("technique_undeclared.gltf", doc);
+  ASSERT_NO_FATAL_FAILURE(expect_warnings(plain, "technique_undeclared.gltf", {}));
+  EXPECT_FALSE(plain->materials[0].base_color_texture.valid());
+  EXPECT_EQ(plain->materials[0].metallic_factor, 1.0f);
+}
+
+TEST(GltfMaterials, TechniqueWebglColourDiffuseTransparencyAndDefaults) {
+  json doc = technique_doc();
+  json& tech = doc["techniques"][0];
+  tech["parameters"]["diffuse"]["type"] = 35666;
+  // emission only as the parameter's default, an RGB colour.
+  tech["parameters"]["emission"] = {{"type", 35665}, {"value", {0.125, 0.25, 0.5}}};
+  tech.erase("states");  // glTF 1.0: no CULL_FACE, both sides drawn
+  doc["materials"][0]["values"] = {{"diffuse", {0.5, 0.25, 1, 1}},
+                                   {"transparency", 0.5}};  // a bare scalar, as glTF 1.0 allows
+  auto s = load("technique_colour.gltf", doc);
+  ASSERT_NO_FATAL_FAILURE(expect_warnings(s, "technique_colour.gltf", {kTechniqueWarning}));
+  const scene::Material& m = s->materials[0];
+  EXPECT_FALSE(m.base_color_texture.valid());
+  EXPECT_EQ(m.base_color_factor, (scene::Vec4{0.5f, 0.25f, 1, 0.5f}));
+  EXPECT_EQ(m.alpha_mode, scene::AlphaMode::kBlend);
+  EXPECT_TRUE(m.double_sided);
+  EXPECT_EQ(m.emissive_factor, (scene::Vec3{0.125f, 0.25f, 0.5f}));
+  EXPECT_EQ(m.metallic_factor, 0.0f);
+  EXPECT_EQ(m.roughness_factor, 1.0f);  // no shininess: a Lambert surface
+
+  // An emission texture and BLEND from the states alone.
+  doc["materials"][0]["values"] = {{"emission", {0}}, {"diffuse", {0.5, 0.25, 1, 1}}};
+  tech["parameters"]["emission"] = {{"type", 35678}};
+  tech["states"] = {{"enable", {3042}}};
+  auto e = load("technique_emission.gltf", doc);
+  ASSERT_TRUE(e.ok()) << e.status().message();
+  EXPECT_EQ(e->materials[0].emissive_texture.image, 0);
+  EXPECT_EQ(e->materials[0].emissive_factor, (scene::Vec3{1, 1, 1}));
+  EXPECT_EQ(e->materials[0].base_color_factor, (scene::Vec4{0.5f, 0.25f, 1, 1}));
+  EXPECT_EQ(e->materials[0].alpha_mode, scene::AlphaMode::kBlend);
+}
+
+TEST(GltfMaterials, TechniqueWebglBadValuesNameTheirPlace) {
+  struct Case {
+    const char* pointer;
+    json value;
+    const char* part;
+  };
+  const std::vector<Case> cases = {
+      {"/materials/0/values/diffuse",
+       {5},
+       "materials[0] 't'.values.diffuse: texture 5 does not exist (the file has 1 texture)"},
+      {"/materials/0/values/diffuse",
+       {"x"},
+       "materials[0] 't'.values.diffuse: expected a "
+       "texture index"},
+      {"/materials/0/technique", 3,
+       "materials[0] 't'.technique: technique 3 does not exist (the file has 1 technique)"},
+      {"/techniques/0/parameters/diffuse/type", 5126,
+       "techniques[0].parameters.diffuse.type: 5126 is not 35665 FLOAT_VEC3, 35666 FLOAT_VEC4 "
+       "or 35678 SAMPLER_2D"},
+      {"/techniques/0/parameters/shininess/type", 35666,
+       "techniques[0].parameters.shininess.type: 35666 is not 5126 FLOAT"},
+      {"/techniques/0/parameters/diffuse", json::object(),
+       "techniques[0].parameters.diffuse.type: expected a GL type"},
+      {"/materials/0/values/specular",
+       {1, 2},
+       "materials[0] 't'.values.specular: expected an array of 4 numbers"},
+      {"/materials/0/values/shininess",
+       {-1},
+       "materials[0] 't'.values.shininess: expected a number from 0 up"},
+      {"/materials/0/values/transparency",
+       {1.5},
+       "materials[0] 't'.values.transparency: expected a number from 0 to 1"},
+      {"/materials/0/values/bogus",
+       {1},
+       "materials[0] 't'.values.bogus: 'bogus' is not a parameter of technique 0"},
+      {"/techniques/0/uniforms/u_x", "nothing",
+       "techniques[0].uniforms.u_x: 'nothing' is not a parameter of technique 0"},
+      {"/techniques/0/program", 2,
+       "techniques[0].program: program 2 does not exist (the file has 1 program)"},
+      {"/techniques/0/states/enable", "x",
+       "techniques[0].states.enable: expected an array of GL enums"},
+      {"/techniques", json::object(), "techniques: expected an array"},
+  };
+  for (const Case& c : cases) {
+    json doc = technique_doc();
+    doc[json::json_pointer(c.pointer)] = c.value;
+    SCOPED_TRACE(c.part);
+    expect_error(load("bad_technique.gltf", doc), "bad_technique.gltf", ErrorCode::kCorrupt,
+                 c.part);
+  }
 }
 
 TEST(GltfMaterials, TextureSourcesFromImageExtensions) {
