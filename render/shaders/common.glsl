@@ -41,12 +41,28 @@ struct Footprint {
 };
 
 // dx, dy: the pixel's derivatives in texels of level 0; texel: level 0's texel size in uv.
+// The axes are the footprint ellipse's (the singular values of [dx dy]), not the lengths of dx
+// and dy: where a UV map shears hard (a pole vertex shared by a whole fan, earthCylindrical.DAE)
+// dx and dy point almost the same way in the texture, and the shorter one's length taken as the
+// minor axis blurred across the shear what the pixel sees sharp (12 dB against the pixel's
+// supersampled box average in the pole's tile; docs/BENCHMARKS.md, "earthCylindrical's pole").
+// Equal to the lengths where dx and dy are orthogonal.
 Footprint footprint_texels(vec2 dx, vec2 dy, vec2 texel, float max_lod) {
-  float lx = length(dx);
-  float ly = length(dy);
-  vec2 major = lx >= ly ? dx : dy;
-  float lmaj = max(lx, ly);
-  float lmin = min(lx, ly);
+  // J J^T = [a b; b c]; its eigenvalues are the squared axes.
+  float a = dot(vec2(dx.x, dy.x), vec2(dx.x, dy.x));
+  float b = dot(vec2(dx.x, dy.x), vec2(dx.y, dy.y));
+  float c = dot(vec2(dx.y, dy.y), vec2(dx.y, dy.y));
+  float half_sum = 0.5 * (a + c);
+  float root = sqrt(max(0.25 * (a - c) * (a - c) + b * b, 0.0));
+  float lmaj = sqrt(half_sum + root);
+  // The minor axis from the area, which stays exact when the two axes differ by orders.
+  float lmin = abs(dx.x * dy.y - dx.y * dy.x) / max(lmaj, 1e-12);
+  // The major axis' direction: the eigenvector of the larger eigenvalue, from whichever row of
+  // (J J^T - l I) is the longer (any direction where the footprint is round: one tap).
+  float l1 = half_sum + root;
+  vec2 e1 = vec2(b, l1 - a), e2 = vec2(l1 - c, b);
+  vec2 e = dot(e1, e1) >= dot(e2, e2) ? e1 : e2;
+  vec2 major = dot(e, e) > 0.0 ? normalize(e) * lmaj : vec2(lmaj, 0.0);
   Footprint f;
   f.taps = int(clamp(ceil(lmaj / max(lmin, 1e-6)), 1.0, float(kMaxTaps)));
   f.lod = clamp(log2(max(max(lmaj / float(f.taps), lmin), 1e-6)), 0.0, max_lod);

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -283,6 +284,98 @@ TEST(ReferenceRules, AlphaMaskDiscardsBelowTheCutoff) {
       1);
   EXPECT_GT(n, 200);
   EXPECT_GT(empty, 100);
+}
+
+// A UV-sphere pole seen from above (earthCylindrical.DAE's cap): one pole vertex at u = 0.5
+// shared by a fan of kPoleFan triangles whose ring vertices run u = 0 .. 1 at t = 1, so each
+// triangle but the middle ones shears up to half the texture across its height. The texture is
+// kStripes horizontal stripes, constant along u: whatever stretch of u a pixel's footprint
+// sweeps, the pixel's box average is the stripe at its t. The footprint's minor axis taken as the
+// shorter of dx and dy (both point along u there) blurred the stripes into each other.
+constexpr int kPoleFan = 16, kStripes = 8, kStripeTexels = 4;
+constexpr int kPoleWidth = 1024, kPoleHeight = kStripes * kStripeTexels;
+constexpr double kPoleRadius = 1.5;  // clip units: the fan covers the whole render
+
+Texel stripe_texel(int stripe) {
+  return {uint8_t(30 + 28 * stripe), uint8_t(220 - 25 * stripe), uint8_t(stripe % 2 ? 200 : 60),
+          255};
+}
+
+scene::Primitive pole_fan() {
+  scene::Primitive p;
+  p.uvs.resize(1);
+  p.positions.push_back({0, 0, 0.5f});
+  p.uvs[0].push_back({0.5f, 0});
+  for (int i = 0; i <= kPoleFan; ++i) {  // the seam: ring vertex kPoleFan repeats 0 at u = 1
+    const double a = 2 * std::numbers::pi * i / kPoleFan;
+    p.positions.push_back(
+        {float(kPoleRadius * std::cos(a)), float(kPoleRadius * std::sin(a)), 0.5f});
+    p.uvs[0].push_back({float(i) / kPoleFan, 1});
+  }
+  for (uint32_t i = 0; i < kPoleFan; ++i) p.indices.insert(p.indices.end(), {0, i + 1, i + 2});
+  return p;
+}
+
+// The fan triangle under clip point (x, y) and t there (t = 1 minus the pole's barycentric).
+std::pair<int, double> pole_fan_t(double x, double y) {
+  double a = std::atan2(y, x);
+  if (a < 0) a += 2 * std::numbers::pi;
+  const int i = std::min(kPoleFan - 1, int(a / (2 * std::numbers::pi / kPoleFan)));
+  const double a0 = 2 * std::numbers::pi * i / kPoleFan,
+               a1 = 2 * std::numbers::pi * (i + 1) / kPoleFan;
+  const double x1 = kPoleRadius * std::cos(a0), y1 = kPoleRadius * std::sin(a0);
+  const double x2 = kPoleRadius * std::cos(a1), y2 = kPoleRadius * std::sin(a1);
+  // (x, y) = b1 (x1, y1) + b2 (x2, y2): the ring's weights; the pole's is 1 - b1 - b2.
+  const double det = x1 * y2 - x2 * y1;
+  const double b1 = (x * y2 - x2 * y) / det, b2 = (x1 * y - x * y1) / det;
+  return {i, b1 + b2};
+}
+
+TEST(ReferenceRules, PoleFanShearKeepsStripesSharp) {
+  REQUIRE_VULKAN();
+  const std::string dir = test_dir("pole_ref");
+  const std::string png = dir + "/stripes.png";
+  {
+    std::vector<uint8_t> px;
+    for (int y = 0; y < kPoleHeight; ++y)
+      for (int x = 0; x < kPoleWidth; ++x) {
+        const Texel t = stripe_texel(y / kStripeTexels);
+        px.insert(px.end(), t.begin(), t.end());
+      }
+    auto out = OIIO::ImageOutput::create(png);
+    OIIO::ImageSpec spec(kPoleWidth, kPoleHeight, 4, OIIO::TypeDesc::UINT8);
+    ASSERT_TRUE(out && out->open(png, spec) && out->write_image(OIIO::TypeDesc::UINT8, px.data()) &&
+                out->close());
+  }
+  const scene::Material m = textured(scene::WrapMode::kRepeat, scene::WrapMode::kClampToEdge);
+  auto f = render_reference_of(one_primitive_scene(pole_fan(), m, png));
+  ASSERT_TRUE(f.ok()) << f.status().message();
+  // Pixels whose t lies within 0.6 texels of a stripe's centre: the footprint spans 0.7 texels
+  // of t there (32 texels over 47 pixels), so every tap reads that stripe alone.
+  int compared = 0, sheared = 0, bad = 0;
+  for (uint32_t py = 0; py < kSize; ++py)
+    for (uint32_t px = 0; px < kSize; ++px) {
+      const double x = (px + 0.5) / kSize * 2 - 1, y = (py + 0.5) / kSize * 2 - 1;
+      const auto [tri, t] = pole_fan_t(x, y);
+      const double texel = t * kPoleHeight;
+      const int stripe = std::min(kStripes - 1, int(texel / kStripeTexels));
+      if (std::abs(texel - (stripe + 0.5) * kStripeTexels) > 0.6) continue;
+      ++compared;
+      // Ring u at least a quarter from the pole's 0.5: at least 256 texels of shear.
+      if (std::abs((tri + 0.5) / kPoleFan - 0.5) >= 0.25) ++sheared;
+      const size_t i = size_t(py) * kSize + px;
+      const Texel want = stripe_texel(stripe);
+      int worst = 0;
+      for (int c = 0; c < 3; ++c)
+        worst = std::max(worst, std::abs(int(f->color.texels[i * 4 + c]) - int(want[c])));
+      if (worst > 2 && ++bad <= 10) {
+        ADD_FAILURE() << "pixel " << px << "," << py << " (triangle " << tri << ", t " << texel
+                      << " texels) differs from stripe " << stripe << " by " << worst;
+      }
+    }
+  EXPECT_EQ(bad, 0) << "of " << compared << " pixels";
+  EXPECT_GT(compared, 400);
+  EXPECT_GT(sheared, 150);
 }
 
 TEST(CoverageTolerance, ExplainsOnlyAlphaNearACutoff) {
