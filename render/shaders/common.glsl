@@ -41,12 +41,25 @@ struct Footprint {
 };
 
 // dx, dy: the pixel's derivatives in texels of level 0; texel: level 0's texel size in uv.
+// The axes are those of the ellipse dx and dy span (the singular values of [dx dy]), not the
+// lengths of dx and dy: where a UV mapping shears (a sphere map near its pole, a spout's
+// squeezed UVs) dx and dy point nearly the same way, and their lengths (60 and 68 texels) made
+// a 90 x 3 texel footprint 2 taps at LOD 5.9 instead of 16 at LOD 2.5: a blur no render of the
+// surface shows (docs/BENCHMARKS.md, "Sheared footprints"). Perpendicular dx and dy: the same.
 Footprint footprint_texels(vec2 dx, vec2 dy, vec2 texel, float max_lod) {
-  float lx = length(dx);
-  float ly = length(dy);
-  vec2 major = lx >= ly ? dx : dy;
-  float lmaj = max(lx, ly);
-  float lmin = min(lx, ly);
+  // J J^T = [[a, b], [b, c]] for J = [dx dy]; its eigenvalues are the squared axes.
+  float a = dx.x * dx.x + dy.x * dy.x;
+  float b = dx.x * dx.y + dy.x * dy.y;
+  float c = dx.y * dx.y + dy.y * dy.y;
+  float lambda = 0.5 * (a + c) + sqrt(0.25 * (a - c) * (a - c) + b * b);
+  float lmaj = sqrt(lambda);
+  // From the determinant: the eigenvalues' difference cancels in float where they are close.
+  float lmin = abs(dx.x * dy.y - dx.y * dy.x) / max(lmaj, 1e-20);
+  // The major axis: an eigenvector for lambda, from the longer row of J J^T - lambda I; none
+  // (isotropic: any direction, one tap) leaves the longer of dx and dy.
+  vec2 e1 = vec2(b, lambda - a), e2 = vec2(lambda - c, b);
+  vec2 e = dot(e1, e1) >= dot(e2, e2) ? e1 : e2;
+  vec2 major = dot(e, e) > 0.0 ? normalize(e) * lmaj : (dot(dx, dx) >= dot(dy, dy) ? dx : dy);
   Footprint f;
   f.taps = int(clamp(ceil(lmaj / max(lmin, 1e-6)), 1.0, float(kMaxTaps)));
   f.lod = clamp(log2(max(max(lmaj / float(f.taps), lmin), 1e-6)), 0.0, max_lod);
