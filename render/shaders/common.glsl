@@ -44,8 +44,9 @@ struct Footprint {
 // The axes are the footprint ellipse's (the singular values of [dx dy]), not the lengths of dx
 // and dy: where a UV map shears hard (a pole vertex shared by a whole fan, earthCylindrical.DAE;
 // teapots.DAE's squeezed spout) dx and dy point almost the same way in the texture, and the
-// shorter one's length taken as the minor axis blurred across the shear what the pixel sees sharp (12 dB against the pixel's
-// supersampled box average in the pole's tile; docs/BENCHMARKS.md, "earthCylindrical's pole").
+// shorter one's length taken as the minor axis blurred across the shear what the pixel sees
+// sharp (12 dB against the pixel's supersampled box average in the pole's tile;
+// docs/BENCHMARKS.md, "earthCylindrical's pole" and "Sheared footprints").
 // Equal to the lengths where dx and dy are orthogonal.
 Footprint footprint_texels(vec2 dx, vec2 dy, vec2 texel, float max_lod) {
   // J J^T = [a b; b c]; its eigenvalues are the squared axes.
