@@ -115,6 +115,10 @@ TEST(CliUpdate, BuildUpdateAfterAChangeEqualsACleanBuildWithPinnedTables) {
   EXPECT_EQ(u["pages_reencoded"].get<int>(), 3) << u.dump();
   EXPECT_EQ(u["pages_reused"].get<int>(), 2 * 17 - 3) << u.dump();
   EXPECT_EQ(u["pages_dropped"].get<int>(), 0);
+  // The pinned tables' fit is measured on the training sample's new pages alone: the changed
+  // level-0 page (its key as the build computes it; the other 11 are the previous file's).
+  EXPECT_EQ(u["tables_fit_pages"].get<int>(), 1) << u.dump();
+  EXPECT_GT(u["tables_fit"].get<double>(), 0.0) << u.dump();
 
   const std::string clean = set.dir + "/clean.vtpf";
   auto pinned = run_json("-q " + set.args(clean) + " --tables-from " + before);
