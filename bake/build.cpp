@@ -285,17 +285,9 @@ class LayerRun {
     }
   }
 
-  // hash(layer's task seed, page, alpha scale, its bordered working texels): the page's stored
-  // bytes are a function of these alone.
+  // hash(layer's task seed, page, alpha scale, its bordered working texels): page_task_key.
   uint64_t page_key(const PageId& id, const std::vector<float>& texels) const {
-    XXH3_state_t state;
-    XXH3_INITSTATE(&state);
-    XXH3_64bits_reset_withSeed(&state, layer_.task_seed);
-    const uint32_t where[3] = {id.level, id.x, id.y};
-    XXH3_64bits_update(&state, where, sizeof where);
-    XXH3_64bits_update(&state, &alpha_.scale, sizeof alpha_.scale);
-    XXH3_64bits_update(&state, texels.data(), texels.size() * sizeof(float));
-    return XXH3_64bits_digest(&state) | 1;  // never 0, which marks an absent page
+    return page_task_key(layer_.task_seed, id, alpha_.scale, texels);
   }
 
   // The previous file's page under the same key (update mode), as an encoded page.

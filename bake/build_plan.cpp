@@ -162,10 +162,11 @@ Expected<std::vector<PageId>> training_pages(const PageGeometry& g, const Covera
 }
 
 // The texels, as stored, of the training pages that are not constant (those carry no
-// statistics), in raster order.
-Expected<std::vector<std::vector<uint8_t>>> training_sample(const BuildPlan& plan,
-                                                            const LayerInput& in,
-                                                            const LayerPlan& layer, size_t limit) {
+// statistics), in raster order. With `ids` and `keys`, each page's id and task key for a layer
+// whose task seed is `seed` (page_task_key; level 0's alpha scale is 1).
+Expected<std::vector<std::vector<uint8_t>>> training_sample(
+    const BuildPlan& plan, const LayerInput& in, const LayerPlan& layer, size_t limit,
+    uint64_t seed = 0, std::vector<PageId>* ids = nullptr, std::vector<uint64_t>* keys = nullptr) {
   const PageGeometry& g = plan.desc.geometry;
   const uint32_t P = g.payload, S = g.page_size();
   const CoverageMask* coverage = layer.level0->coverage();
@@ -189,15 +190,20 @@ Expected<std::vector<std::vector<uint8_t>>> training_sample(const BuildPlan& pla
     VT_ASSIGN_OR_RETURN(RowBand band,
                         window.fetch(int64_t(r) * P - plan.margin, P + 2 * plan.margin));
     std::vector<std::vector<uint8_t>> row(end - i);
+    std::vector<uint64_t> row_keys(end - i);
     parallel_for(end - i, plan.threads, [&](size_t k) {
       thread_local std::vector<float> texels;
       texels.resize(page_texels * layer.work_channels);
       cut_page(g, chosen[i + k], plan.options.address, band, texels.data());
+      if (keys) row_keys[k] = page_task_key(seed, chosen[i + k], 1.0f, texels);
       row[k].resize(layer.encoder->page_bytes());
       layer.store_page(texels.data(), page_texels, 1.0f, row[k].data());
     });
-    for (auto& page : row)
-      if (!layer.encoder->is_constant(page.data())) pages.push_back(std::move(page));
+    for (size_t k = 0; k < row.size(); ++k) {
+      if (layer.encoder->is_constant(row[k].data())) continue;
+      pages.push_back(std::move(row[k]));
+      if (keys) ids->push_back(chosen[i + k]), keys->push_back(row_keys[k]);
+    }
     i = end;
   }
   return pages;
@@ -457,7 +463,7 @@ bool copy_previous_layer(BuildPlan& plan, LayerPlan& layer, const std::vector<ui
 // sample within kRetrainFitBound of fresh tables), else trained on up to 256 of the layer's own
 // pages or 16 MiB of their texels (all of level 0 for a 2K layer).
 Status plan_tables(BuildPlan& plan, const LayerInput& in, LayerPlan& layer,
-                   const std::vector<uint8_t>* pinned) {
+                   const std::vector<uint8_t>* pinned, const std::string& settings) {
   const BuildOptions& o = plan.options;
   PageEncoder pinned_encoder = *layer.encoder;
   if (pinned) {
@@ -473,15 +479,37 @@ Status plan_tables(BuildPlan& plan, const LayerInput& in, LayerPlan& layer,
     }
   }
   const size_t limit = std::clamp<size_t>((size_t(16) << 20) / layer.encoder->page_bytes(), 1, 256);
-  VT_ASSIGN_OR_RETURN(auto pages, training_sample(plan, in, layer, limit));
+  // Update mode measures the pinned tables on the sample's new pages: those whose task key under
+  // the pinned tables the previous file lacks (it stored the others with these very tables).
+  const bool update = pinned && plan.previous;
+  std::vector<PageId> ids;
+  std::vector<uint64_t> keys;
+  LayerSpec pinned_spec = layer.spec;
+  if (pinned) pinned_spec.codec_tables = *pinned;
+  VT_ASSIGN_OR_RETURN(auto pages,
+                      training_sample(plan, in, layer, limit, task_seed(settings, pinned_spec),
+                                      update ? &ids : nullptr, update ? &keys : nullptr));
+  std::vector<std::vector<uint8_t>> measured;
+  if (update) {
+    const int previous = plan.previous->layer_index(layer.spec.name);
+    for (size_t i = 0; i < pages.size(); ++i)
+      if (previous < 0 || plan.previous->key(previous, ids[i]) != keys[i])
+        measured.push_back(pages[i]);
+    plan.update.fit_pages += measured.size();
+    if (measured.empty()) {  // nothing new to measure them on
+      layer.spec.codec_tables = *pinned;
+      layer.encoder = std::make_shared<const PageEncoder>(std::move(pinned_encoder));
+      return Status::Ok();
+    }
+  }
   std::vector<std::span<const uint8_t>> spans(pages.begin(), pages.end());
   PageEncoder trained = *layer.encoder;
   auto tables = trained.train(spans);
   if (!tables.ok()) return tables.status().with_context(layer.spec.name);
   if (pinned) {
     VT_ASSIGN_OR_RETURN(const uint64_t old_bytes,
-                        sample_bytes(pinned_encoder, pages, plan.threads));
-    VT_ASSIGN_OR_RETURN(const uint64_t new_bytes, sample_bytes(trained, pages, plan.threads));
+                        sample_bytes(pinned_encoder, measured, plan.threads));
+    VT_ASSIGN_OR_RETURN(const uint64_t new_bytes, sample_bytes(trained, measured, plan.threads));
     const double fit = new_bytes ? double(old_bytes) / double(new_bytes) : 1.0;
     plan.update.tables_fit = std::max(plan.update.tables_fit, fit);
     if (fit <= kRetrainFitBound) {
@@ -565,6 +593,18 @@ bool LayerPlan::store_page(float* texels, size_t count, float alpha_scale, uint8
   return clipped;
 }
 
+uint64_t page_task_key(uint64_t task_seed, const PageId& id, float alpha_scale,
+                       const std::vector<float>& texels) {
+  XXH3_state_t state;
+  XXH3_INITSTATE(&state);  // reset_withSeed reads the state's old seed
+  XXH3_64bits_reset_withSeed(&state, task_seed);
+  const uint32_t where[3] = {id.level, id.x, id.y};
+  XXH3_64bits_update(&state, where, sizeof where);
+  XXH3_64bits_update(&state, &alpha_scale, sizeof alpha_scale);
+  XXH3_64bits_update(&state, texels.data(), texels.size() * sizeof(float));
+  return XXH3_64bits_digest(&state) | 1;
+}
+
 Expected<BuildPlan> plan_build(const BuildOptions& options) {
   VT_RETURN_IF_ERROR(check_inputs(options));
   BuildPlan plan;
@@ -620,7 +660,7 @@ Expected<BuildPlan> plan_build(const BuildOptions& options) {
     }
     layer.level_in_memory = choose_level_memory(plan, layer);
     if (!layer.encoder->wants_training()) continue;
-    VT_RETURN_IF_ERROR(plan_tables(plan, in, layer, pinned.find(layer.spec.name)));
+    VT_RETURN_IF_ERROR(plan_tables(plan, in, layer, pinned.find(layer.spec.name), settings));
   }
   for (const LayerPlan& layer : plan.layers) desc.layers.push_back(layer.spec);
   check_memory_floor(plan);

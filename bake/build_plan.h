@@ -21,6 +21,13 @@ namespace vt {
 
 class LevelSource;
 
+// A page's task key: hash(its layer's task seed, the page, the alpha scale of its level, its
+// bordered working texels); the page's stored bytes are a function of these alone (never 0,
+// which marks an absent page). The build keys every page so (update.h); the plan keys its
+// training sample so in update mode.
+uint64_t page_task_key(uint64_t task_seed, const PageId& id, float alpha_scale,
+                       const std::vector<float>& texels);
+
 // How one layer goes from its source to stored texels.
 struct LayerPlan {
   LayerSpec spec;  // as written: codec, runtime format, trained tables

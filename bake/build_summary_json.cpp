@@ -90,7 +90,8 @@ nlohmann::json update_json(const UpdateSummary& u) {
            u.full_rebuild.empty() ? nlohmann::json(nullptr) : nlohmann::json(u.full_rebuild)},
           {"tables_pinned", u.tables_pinned},
           {"tables_retrained", u.tables_retrained},
-          {"tables_fit", u.tables_fit}};
+          {"tables_fit", u.tables_fit},
+          {"tables_fit_pages", u.fit_pages}};
 }
 
 }  // namespace

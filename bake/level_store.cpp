@@ -1,11 +1,13 @@
 #include "bake/level_store.h"
 
 #include <fcntl.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include <xxhash.h>
 #include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 
 #include "bake/level_dilation.h"
@@ -29,6 +31,17 @@ Status move_all(Io io, int fd, Byte* p, size_t left, off_t off, const std::strin
   return Status::Ok();
 }
 
+// A large level asks for transparent huge pages before it is first written: zeroing it then
+// faults 2 MiB at a time rather than 4 KiB (a 1920x1920 RGBA level: 29 faults, not 14,400),
+// which was a fifth of an update's time. Where the kernel does not give them, nothing changes.
+void advise_huge_pages(void* data, size_t bytes) {
+  constexpr uintptr_t kHuge = uintptr_t(2) << 20;
+  if (bytes < 4 * kHuge) return;
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
+  const uintptr_t end = (reinterpret_cast<uintptr_t>(data) + bytes) & ~(kHuge - 1);
+  if (end > begin) (void)madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+}
+
 off_t row_offset(uint32_t y, size_t row_floats) {
   return off_t(uint64_t(y) * row_floats * sizeof(float));
 }
@@ -43,7 +56,10 @@ Expected<std::unique_ptr<LevelStore>> LevelStore::create(uint32_t width, uint32_
   s->height_ = height;
   s->channels_ = channels;
   if (in_memory) {
-    s->memory_.resize(size_t(width) * height * channels);
+    const size_t n = size_t(width) * height * channels;
+    s->memory_.reserve(n);
+    advise_huge_pages(s->memory_.data(), n * sizeof(float));
+    s->memory_.resize(n);
     return s;
   }
   std::string templ =

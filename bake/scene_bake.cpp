@@ -9,12 +9,14 @@
 #include <filesystem>
 #include <new>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "bake/build_summary_json.h"
 #include "bake/coverage_mask.h"
 #include "bake/level_source.h"
 #include "bake/level_store.h"
 #include "bake/unwrap/texel_density.h"
+#include "bake/unwrap_cache.h"
 #include "bake/update_scene.h"
 #include "format/atomic_output.h"
 
@@ -259,8 +261,26 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
   }
   uo.max_size_pages = std::max(
       1, std::min(uo.max_size_pages, unwrap::pages_within(texels_within(limit), uo.page_payload)));
-  auto unwrapped = guarded("unwrap", [&] { return unwrap::unwrap_scene(input, uo); });
+  // Update mode takes the previous bake's unwrap when what the unwrap reads is unchanged (a
+  // repainted texture keeps it); every bake stores its own for the next (bake/unwrap_cache.h).
+  const std::string unwrap_cache = cache.empty() ? "" : cache + "/unwrap.bin";
+  uint64_t unwrap_key = 0;
+  if (!unwrap_cache.empty()) unwrap_key = unwrap_cache_key(input, uo);
+  std::optional<unwrap::UnwrapResult> reused;
+  if (!unwrap_cache.empty() && options.build.update)
+    reused = read_unwrap_cache(unwrap_cache, unwrap_key, input);
+  summary.unwrap_reused = reused.has_value();
+  auto unwrapped = guarded("unwrap", [&]() -> Expected<unwrap::UnwrapResult> {
+    if (reused) return std::move(*reused);
+    return unwrap::unwrap_scene(input, uo);
+  });
   if (!unwrapped.ok()) return unwrapped.status().with_context("unwrap");
+  if (!unwrap_cache.empty() && !summary.unwrap_reused) {
+    std::error_code ec;
+    std::filesystem::create_directories(cache, ec);
+    // A cache that cannot be written only costs the next update its reuse.
+    if (!ec) (void)write_unwrap_cache(unwrap_cache, unwrap_key, input, *unwrapped);
+  }
   summary.unwrap = unwrapped->stats;
   summary.peak_rss.push_back({"unwrap", peak_rss_bytes()});
   summary.triangles = uint64_t(unwrapped->stats.faces);
@@ -485,6 +505,7 @@ nlohmann::json to_json(const SceneBakeSummary& s) {
         {"charts", u.charts},
         {"texels_per_unit", u.texels_per_unit},
         {"utilisation", u.utilisation},
+        {"reused", s.unwrap_reused},
         {"stretch_l2", u.stretch_l2},
         {"density", unwrap::density_json(u)}}},
       {"transfer",

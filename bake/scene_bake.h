@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <nlohmann/json_fwd.hpp>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -44,8 +45,9 @@ struct SceneBakeOptions {
   // tests force small bands.
   uint32_t transfer_band_rows = 0;
   bool transfer_to_scratch = false;
-  // Update mode's cache folder: the transfer's bands (bake/transfer_cache.h) as
-  // `cache`/transfer.bin, written by every bake and read by an update (build.update).
+  // Update mode's cache folder: the unwrap (bake/unwrap_cache.h) as `cache`/unwrap.bin and the
+  // transfer's bands (bake/transfer_cache.h) as `cache`/transfer.bin, written by every bake and
+  // read by an update (build.update).
   // "" = the output's path with ".cache" appended, "-" = none. The output does not depend on it.
   std::string cache;
   std::function<void(const SceneBakeProgress&)> progress;
@@ -70,6 +72,7 @@ struct SceneBakeSummary {
   std::string output, unwrapped;
   uint64_t triangles = 0;  // unwrapped (instances counted separately)
   unwrap::UnwrapStats unwrap;
+  bool unwrap_reused = false;  // update mode: the unwrap taken from the cache (unwrap_cache.h)
   TransferStats transfer;
   std::vector<LayerRange> above_one;             // layers with values above 1 only
   std::vector<MissingTexture> missing_textures;  // MissingTextures::kWarn

@@ -34,7 +34,10 @@ struct UpdateSummary {
   std::string full_rebuild;
   bool tables_pinned = false;     // DCT tables taken from a file rather than trained
   bool tables_retrained = false;  // pinned tables dropped for a poor fit or --retrain-tables
-  double tables_fit = 0;          // pinned / fresh bytes of the training sample, when measured
+  // Pinned / fresh bytes of the training sample's new pages (those the previous file lacks),
+  // when measured; fit_pages: how many pages that was, over all layers.
+  double tables_fit = 0;
+  uint64_t fit_pages = 0;
 };
 
 // One line for a summary: "update: 12 pages reused, 3 re-encoded, 0 dropped" and, when it

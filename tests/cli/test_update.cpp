@@ -115,6 +115,10 @@ TEST(CliUpdate, BuildUpdateAfterAChangeEqualsACleanBuildWithPinnedTables) {
   EXPECT_EQ(u["pages_reencoded"].get<int>(), 3) << u.dump();
   EXPECT_EQ(u["pages_reused"].get<int>(), 2 * 17 - 3) << u.dump();
   EXPECT_EQ(u["pages_dropped"].get<int>(), 0);
+  // The pinned tables' fit is measured on the training sample's new pages alone: the changed
+  // level-0 page (its key as the build computes it; the other 11 are the previous file's).
+  EXPECT_EQ(u["tables_fit_pages"].get<int>(), 1) << u.dump();
+  EXPECT_GT(u["tables_fit"].get<double>(), 0.0) << u.dump();
 
   const std::string clean = set.dir + "/clean.vtpf";
   auto pinned = run_json("-q " + set.args(clean) + " --tables-from " + before);
@@ -281,6 +285,68 @@ TEST(CliUpdate, SceneBakeUpdateReadsUnchangedBandsFromTheCacheAndNeverTrustsADam
   EXPECT_EQ(other["transfer"]["bands_cached"], 0);
   run_json("-q bake " + obj + " -o " + dir + "/clean4.vtpf --supersample 4" + flags);
   EXPECT_EQ(read_bytes(out), read_bytes(dir + "/clean4.vtpf"));
+}
+
+// The unwrap cache beside the output (OUT.cache/unwrap.bin): an update after a texture change
+// takes the previous unwrap (the geometry did not change) and gives the bytes of a clean bake;
+// a damaged, truncated or foreign cache is never trusted (the scene is unwrapped again: the same
+// bytes, and a good cache is written for the next update); a change the unwrap reads (another
+// texture size, moved geometry) unwraps again.
+TEST(CliUpdate, SceneBakeUpdateReusesTheUnwrapWhileTheGeometryStaysAndNeverTrustsADamagedOne) {
+  const std::string obj = two_textured_quads();
+  const std::string dir = dir_of(obj);
+  const std::string flags = " --size 3", out = dir + "/w.vtpf";
+  const std::string cache = out + ".cache/unwrap.bin";
+  auto clean = run_json("-q bake " + obj + " -o " + out + flags);
+  EXPECT_FALSE(clean["atlas"]["reused"].get<bool>());  // a bake without --update reads no cache
+  ASSERT_TRUE(std::filesystem::exists(cache));
+  std::filesystem::copy_file(out, dir + "/before.vtpf");
+  const std::vector<uint8_t> good = read_bytes(cache);
+  write_png(dir + "/textures/b.png", 64, 64, 5, {10, 10, 30, 30});
+  run_json("-q bake " + obj + " -o " + dir + "/clean.vtpf --tables-from " + dir + "/before.vtpf" +
+           flags + " --cache -");
+  const std::vector<uint8_t> expected = read_bytes(dir + "/clean.vtpf");
+  const std::vector<uint8_t> expected_scene = read_bytes(dir + "/clean.glb");
+
+  // The cache as given (unchanged, or damaged), the previous output back in place, an update.
+  auto update_with = [&](auto&& change) {
+    std::filesystem::copy_file(dir + "/before.vtpf", out,
+                               std::filesystem::copy_options::overwrite_existing);
+    std::vector<uint8_t> bytes = good;
+    change(bytes);
+    std::ofstream(cache, std::ios::binary | std::ios::trunc)
+        .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    auto u = run_json("-q bake " + obj + " -o " + out + " --update" + flags);
+    EXPECT_EQ(u["build"]["update"]["full_rebuild"], nullptr) << u["build"]["update"].dump();
+    EXPECT_EQ(read_bytes(out), expected);
+    EXPECT_EQ(read_bytes(dir + "/w.glb"), expected_scene);
+    return u["atlas"]["reused"].get<bool>();
+  };
+  EXPECT_TRUE(update_with([](std::vector<uint8_t>&) {}));
+  EXPECT_EQ(read_bytes(cache), good);  // reused: left as it was
+  ASSERT_GT(good.size(), 100u);
+  // A byte of the compressed result flipped, the header's key changed, truncated, garbage, the
+  // checksum of the packed result changed (header: magic, version, key at 16, sizes, checksum
+  // at 40).
+  EXPECT_FALSE(update_with([](std::vector<uint8_t>& b) { b[b.size() - 5] ^= 0x5a; }));
+  // Unwrapped again and stored again: the next update takes it.
+  const std::vector<uint8_t> rewritten = read_bytes(cache);
+  EXPECT_TRUE(update_with([&](std::vector<uint8_t>& b) { b = rewritten; }));
+  EXPECT_FALSE(update_with([](std::vector<uint8_t>& b) { b[16] ^= 1; }));
+  EXPECT_FALSE(update_with([](std::vector<uint8_t>& b) { b.resize(b.size() / 2); }));
+  EXPECT_FALSE(update_with([](std::vector<uint8_t>& b) { b.assign(100, 7); }));
+  EXPECT_FALSE(update_with([](std::vector<uint8_t>& b) { b[40] ^= 1; }));
+  EXPECT_TRUE(update_with([](std::vector<uint8_t>&) {}));
+
+  // What the unwrap reads changes: unwrapped again, as a clean bake unwraps it.
+  write_png(dir + "/textures/b.png", 32, 32, 5);  // another size: the sources' density may move
+  auto resized = run_json("-q bake " + obj + " -o " + out + " --update" + flags);
+  EXPECT_FALSE(resized["atlas"]["reused"].get<bool>());
+  std::ofstream(obj, std::ios::app) << "v 5 0 0\nv 6 0 0\nv 6 2 0\nf 9/1 10/2 11/3\n";
+  auto moved = run_json("-q bake " + obj + " -o " + out + " --update" + flags);
+  EXPECT_FALSE(moved["atlas"]["reused"].get<bool>());
+  run_json("-q bake " + obj + " -o " + dir + "/clean2.vtpf" + flags + " --cache -");
+  EXPECT_EQ(read_bytes(dir + "/w.glb"), read_bytes(dir + "/clean2.glb"));
 }
 
 }  // namespace
