@@ -44,6 +44,13 @@ class KeyStream {
   XXH3_state_t state_;
 };
 
+// What this build of the baker is, for the caches that must not outlive it (transfer bands, the
+// unwrap): the XXH3 of the file that holds this code (the commands module, or a test program),
+// read once. VTBAKE_VERSION stays the same across commits, and a cache written by other code
+// of the same version could hold other texels. 0 where the file cannot be read (the version
+// string alone then). Not part of the plan hash: output bytes stay comparable across builds.
+uint64_t code_identity();
+
 // Every field of a material (its textures by image index, sampler and transform).
 void add_material(KeyStream& k, const scene::Material& m);
 // Every vertex array, the indices and the material index of a primitive.

@@ -1057,7 +1057,7 @@ Status Transfer::setup_cache() {
   if (opt_.image_keys.size() != scene_.images.size())
     return Error(ErrorCode::kInvalidArgument, "transfer: the band cache needs a key per image");
   KeyStream f;
-  f.add(std::string("transfer bands 1 " VTBAKE_VERSION));
+  f.add(std::string("transfer bands 1 " VTBAKE_VERSION)), f.add(code_identity());
   f.add(opt_.width), f.add(opt_.height), f.add(opt_.atlas_uv_set), f.add(opt_.supersample);
   f.add(opt_.mip_filter), f.add(opt_.missing_textures), f.add(kBandRows);
   f.add(opt_.color_config && !opt_.color_config->is_builtin() ? opt_.color_config->cache_id()

@@ -175,7 +175,7 @@ bool fits(const unwrap::UnwrapResult& r, const scene::Scene& scene) {
 
 uint64_t unwrap_cache_key(const scene::Scene& scene, const unwrap::UnwrapOptions& o) {
   KeyStream k;
-  k.add(std::string("unwrap cache 1 " VTBAKE_VERSION));
+  k.add(std::string("unwrap cache 1 " VTBAKE_VERSION)), k.add(code_identity());
   k.add(o.texels_per_unit), k.add(o.size_pages), k.add(o.page_payload), k.add(o.padding);
   k.add(o.method), k.add(o.share_instances), k.add(o.max_chart_angle_deg);
   k.add(o.max_chart_stretch), k.add(o.max_split_rounds), k.add(o.max_atlas_texels);
