@@ -112,12 +112,16 @@ last=""
 while :; do
   # Progress of the shards from Slurm's records.
   while :; do
+    # Asked before the states, so that the last line printed holds every shard's final state
+    # (a shard that ended between the two queries was reported running, and its failure never).
+    done_now=0
+    finished "$array_job" && done_now=1
     line=$(job_states "$array_job" | awk '{n[$2]++} END {printf "done %d, failed %d, running %d, pending %d",
       n["COMPLETED"], n["FAILED"] + n["CANCELLED"] + n["TIMEOUT"] + n["NODE_FAIL"] + n["OUT_OF_MEMORY"],
       n["RUNNING"] + n["COMPLETING"], n["PENDING"]}')
     [[ "$line" != "$last" ]] && echo "farm: shards (job $array_job): $line"
     last="$line"
-    finished "$array_job" && break
+    [[ $done_now -eq 1 ]] && break
     sleep "$poll"
   done
   missing=$("$vtbake" merge "$work" --missing "$shards" | paste -sd, -)
