@@ -4,24 +4,10 @@
 #include <dlfcn.h>
 #endif
 
-#include <fstream>
+#include "bake/image_source.h"
 
 namespace vt {
 namespace {
-
-uint64_t hash_file(const char* path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return 0;
-  XXH3_state_t state;
-  XXH3_INITSTATE(&state);
-  XXH3_64bits_reset(&state);
-  std::vector<char> buffer(size_t(1) << 20);
-  while (in) {
-    in.read(buffer.data(), std::streamsize(buffer.size()));
-    XXH3_64bits_update(&state, buffer.data(), size_t(in.gcount()));
-  }
-  return in.eof() ? XXH3_64bits_digest(&state) : 0;
-}
 
 void add_texture(KeyStream& k, const scene::TextureRef& t) {
   k.add(t.image), k.add(t.texcoord), k.add(t.wrap_s), k.add(t.wrap_t), k.add(t.mag_filter);
@@ -35,7 +21,7 @@ uint64_t code_identity() {
 #if defined(__linux__) || defined(__APPLE__)
     Dl_info info{};
     if (dladdr(reinterpret_cast<const void*>(&code_identity), &info) && info.dli_fname)
-      return hash_file(info.dli_fname);
+      if (auto h = hash_file(info.dli_fname); h.ok()) return *h;
 #endif
     return uint64_t(0);
   }();

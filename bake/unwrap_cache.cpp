@@ -1,6 +1,5 @@
 #include "bake/unwrap_cache.h"
 
-#include <unistd.h>
 #include <xxhash.h>
 
 #include <array>
@@ -14,6 +13,7 @@
 #include "bake/content_key.h"
 #include "bake/image_source.h"
 #include "bake/unwrap/texel_density.h"
+#include "format/atomic_output.h"
 #include "format/zstd_frame.h"
 
 namespace vt {
@@ -281,24 +281,10 @@ Status write_unwrap_cache(const std::string& path, uint64_t key, const scene::Sc
   std::memcpy(h.magic, kMagic, 8);
   h.version = kVersion, h.key = key, h.packed = p.bytes.size(), h.stored = frame.size();
   h.checksum = XXH3_64bits(p.bytes.data(), p.bytes.size());
-  const std::string temp = path + ".tmp-" + std::to_string(::getpid());
-  {
-    std::ofstream f(temp, std::ios::binary | std::ios::trunc);
-    f.write(reinterpret_cast<const char*>(&h), sizeof h);
-    f.write(reinterpret_cast<const char*>(frame.data()), std::streamsize(frame.size()));
-    if (!f.flush()) {
-      std::error_code ec;
-      std::filesystem::remove(temp, ec);
-      return Error(ErrorCode::kIo, temp + ": cannot write the unwrap cache");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(temp, path, ec);
-  if (ec) {
-    std::filesystem::remove(temp, ec);
-    return Error(ErrorCode::kIo, path + ": cannot replace the unwrap cache");
-  }
-  return Status::Ok();
+  std::string bytes(reinterpret_cast<const char*>(&h), sizeof h);
+  bytes.append(reinterpret_cast<const char*>(frame.data()), frame.size());
+  // Staged beside the target and renamed when complete, as every output (format/atomic_output.h).
+  return write_output_bytes(path, bytes).with_context("unwrap cache");
 }
 
 }  // namespace vt
