@@ -3,7 +3,6 @@
 // or the squeezed UVs of Collada/teapots.DAE's spout. The reference render of a screen-filling
 // quad is checked against the mean of point samples over each pixel, computed here. Skips
 // cleanly where no Vulkan device exists.
-#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -19,6 +18,7 @@
 #include "render/vulkan_context.h"
 #include "scene/scene.h"
 #include "tests/render/one_primitive_scene.h"
+#include "tests/render/png_file.h"
 
 namespace vt::render {
 namespace {
@@ -42,12 +42,7 @@ std::string write_rows_png(const std::string& dir) {
   std::vector<uint8_t> px;
   for (int y = 0; y < kTexels; ++y)
     for (int x = 0; x < kTexels; ++x) px.insert(px.end(), {row_code(y), row_code(y), 96, 255});
-  auto out = OIIO::ImageOutput::create(path);
-  OIIO::ImageSpec spec(kTexels, kTexels, 4, OIIO::TypeDesc::UINT8);
-  if (!out || !out->open(path, spec) || !out->write_image(OIIO::TypeDesc::UINT8, px.data()) ||
-      !out->close())
-    return "";
-  return path;
+  return write_png_file(path, kTexels, kTexels, 4, px) ? path : "";
 }
 
 // Texel rows per pixel: d(s, t)/dx = (16, 1) and d(s, t)/dy = (16, 2) texels. The footprint is

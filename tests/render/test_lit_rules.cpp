@@ -3,7 +3,6 @@
 // A screen quad with an occlusion texture on TEXCOORD_1 (CLAMP_TO_EDGE across, MIRRORED_REPEAT
 // down) is lit by ambient light alone, so each pixel shows the occlusion it read; a transformed
 // normal map's UVs are checked on the CPU. Skips the render where no Vulkan device exists.
-#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -20,6 +19,7 @@
 #include "scene/material_rules.h"
 #include "scene/scene.h"
 #include "tests/render/one_primitive_scene.h"
+#include "tests/render/png_file.h"
 
 namespace vt::render {
 namespace {
@@ -45,12 +45,7 @@ std::string write_occlusion_png(const std::string& dir) {
   std::vector<uint8_t> px;
   for (int y = 0; y < kTexels; ++y)
     for (int x = 0; x < kTexels; ++x) px.push_back(occlusion_cell(x, y));
-  auto out = OIIO::ImageOutput::create(path);
-  OIIO::ImageSpec spec(kTexels, kTexels, 1, OIIO::TypeDesc::UINT8);
-  if (!out || !out->open(path, spec) || !out->write_image(OIIO::TypeDesc::UINT8, px.data()) ||
-      !out->close())
-    return "";
-  return path;
+  return write_png_file(path, kTexels, kTexels, 1, px) ? path : "";
 }
 
 // A quad over the whole clip space: TEXCOORD_0 spans 0..1, TEXCOORD_1 spans (u0, v0) + 0..span.

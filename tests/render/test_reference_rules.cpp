@@ -3,7 +3,6 @@
 // KHR_texture_transform, TEXCOORD_1, COLOR_0 and alpha MASK. For each rule the reference image
 // of a screen-filling quad is checked against the texture sampled on the CPU, and a small box
 // written here as glTF bakes and validates. Skips cleanly where no Vulkan device exists.
-#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -28,6 +27,7 @@
 #include "scene/material_rules.h"
 #include "scene/scene.h"
 #include "tests/render/one_primitive_scene.h"
+#include "tests/render/png_file.h"
 
 namespace vt::render {
 namespace {
@@ -79,12 +79,7 @@ std::string write_png(const std::string& dir, const TexelFn& texel) {
       const Texel t = texel(x, y);
       px.insert(px.end(), t.begin(), t.end());
     }
-  auto out = OIIO::ImageOutput::create(path);
-  OIIO::ImageSpec spec(kTexels, kTexels, 4, OIIO::TypeDesc::UINT8);
-  if (!out || !out->open(path, spec) || !out->write_image(OIIO::TypeDesc::UINT8, px.data()) ||
-      !out->close())
-    return "";
-  return path;
+  return write_png_file(path, kTexels, kTexels, 4, px) ? path : "";
 }
 
 std::string cell_png(const std::string& name, bool alpha = false) {
@@ -342,10 +337,7 @@ TEST(ReferenceRules, PoleFanShearKeepsStripesSharp) {
         const Texel t = stripe_texel(y / kStripeTexels);
         px.insert(px.end(), t.begin(), t.end());
       }
-    auto out = OIIO::ImageOutput::create(png);
-    OIIO::ImageSpec spec(kPoleWidth, kPoleHeight, 4, OIIO::TypeDesc::UINT8);
-    ASSERT_TRUE(out && out->open(png, spec) && out->write_image(OIIO::TypeDesc::UINT8, px.data()) &&
-                out->close());
+    ASSERT_TRUE(write_png_file(png, kPoleWidth, kPoleHeight, 4, px));
   }
   const scene::Material m = textured(scene::WrapMode::kRepeat, scene::WrapMode::kClampToEdge);
   auto f = render_reference_of(one_primitive_scene(pole_fan(), m, png));
