@@ -20,8 +20,8 @@ namespace vt {
 namespace {
 
 constexpr char kMagic[8] = {'V', 'T', 'U', 'N', 'W', 'R', 'A', 'P'};
-constexpr uint32_t kVersion = 1;
-constexpr int kZstdLevel = 1;  // fast: every bake writes it
+constexpr uint32_t kVersion = 2;  // 2: UnwrapStats::objects
+constexpr int kZstdLevel = 1;     // fast: every bake writes it
 // A packed result larger than this is not believed (a damaged size field).
 constexpr uint64_t kMaxPacked = uint64_t(1) << 36;
 
@@ -115,6 +115,8 @@ void put_stats(Packer& p, const unwrap::UnwrapStats& s) {
   p.put(uint64_t(s.materials.size()));
   for (const auto& m : s.materials)
     p.put(m.name), p.put(m.source), p.put(m.requested), p.put(m.requested_scale), p.put(m.achieved);
+  p.put(uint64_t(s.objects.size()));
+  for (const auto& o : s.objects) p.put(o.name), p.put(o.source), p.put(o.scale);
   p.put(s.warnings);
   p.put(s.utilisation), p.put(s.stretch_l2), p.put(s.stretch_linf), p.put(s.flipped_triangles);
   p.put(s.overlapping_triangles), p.put(s.overlapping_texels), p.put(s.unmapped_faces);
@@ -132,6 +134,10 @@ void get_stats(Unpacker& u, unwrap::UnwrapStats& s) {
   s.materials.resize(n);
   for (auto& m : s.materials)
     u.get(m.name), u.get(m.source), u.get(m.requested), u.get(m.requested_scale), u.get(m.achieved);
+  u.get(n);
+  if (!u.ok() || n > (uint64_t(1) << 24)) return;
+  s.objects.resize(n);
+  for (auto& o : s.objects) u.get(o.name), u.get(o.source), u.get(o.scale);
   u.get(s.warnings);
   u.get(s.utilisation), u.get(s.stretch_l2), u.get(s.stretch_linf), u.get(s.flipped_triangles);
   u.get(s.overlapping_triangles), u.get(s.overlapping_texels), u.get(s.unmapped_faces);

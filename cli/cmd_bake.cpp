@@ -113,6 +113,13 @@ void print_summary(const vt::SceneBakeSummary& s) {
   std::printf("  atlas      %u x %u texels, %lld charts, %.3g texels/unit, utilisation %.3f\n",
               g.width, g.height, (long long)s.unwrap.charts, s.unwrap.texels_per_unit,
               s.unwrap.utilisation);
+  if (const auto& objects = s.unwrap.objects; !objects.empty()) {
+    std::printf("  density    %zu object(s) denser than the scene's sources at their own:",
+                objects.size());
+    for (size_t i = 0; i < objects.size() && i < 3; ++i)
+      std::printf("%s '%s' %.2fx", i ? "," : "", objects[i].name.c_str(), objects[i].scale);
+    std::printf("%s\n", objects.size() > 3 ? ", ..." : "");
+  }
   std::printf("  transfer   %llu triangles, %llu covered texels (%llu edge-only, %llu contested)\n",
               (unsigned long long)s.triangles, (unsigned long long)s.transfer.covered_texels,
               (unsigned long long)s.transfer.edge_only_texels,

@@ -48,11 +48,15 @@ nlohmann::json density_json(const UnwrapStats& s) {
                          {"requested", m.requested},
                          {"requested_scale", m.requested_scale},
                          {"achieved", m.achieved}});
+  nlohmann::json objects = nlohmann::json::array();
+  for (const auto& o : s.objects)
+    objects.push_back({{"name", o.name}, {"source", o.source}, {"scale", o.scale}});
   return {{"texels_per_unit", s.texels_per_unit},
           {"source_texels_per_unit", s.source_texels_per_unit},
           {"rule", s.density_rule},
           {"file", s.density_file},
           {"materials", materials},
+          {"objects", objects},
           {"warnings", s.warnings}};
 }
 

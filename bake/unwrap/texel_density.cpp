@@ -160,6 +160,7 @@ SourceDensity measure_source_density(const scene::Scene& scene, bool share_insta
     return size[image];
   };
   std::vector<std::vector<DensitySample>> per_material(scene.materials.size());
+  std::vector<std::vector<DensitySample>> per_node(scene.nodes.size());
   for (const scene::Instance& inst : placements(scene, share_instances)) {
     for (const scene::Primitive& p : scene.meshes[inst.mesh].primitives) {
       if (p.material < 0 || p.material >= static_cast<int>(scene.materials.size())) continue;
@@ -199,7 +200,10 @@ SourceDensity measure_source_density(const scene::Scene& scene, bool share_insta
                                  2 * s.area_scale;
           best = std::max(best, triangle_source_density(s.size[0], s.size[1], uv_area, world_area));
         }
-        if (best > 0) samples.push_back({best, world_area});
+        if (!(best > 0)) continue;
+        samples.push_back({best, world_area});
+        if (inst.node >= 0 && inst.node < static_cast<int>(per_node.size()))
+          per_node[inst.node].push_back({best, world_area});
       }
     }
   }
@@ -210,7 +214,42 @@ SourceDensity measure_source_density(const scene::Scene& scene, bool share_insta
     all.insert(all.end(), per_material[m].begin(), per_material[m].end());
   }
   out.scene = area_percentile(std::move(all), kSourcePercentile);
+  out.node.assign(scene.nodes.size(), 0.0);
+  out.node_area.assign(scene.nodes.size(), 0.0);
+  for (size_t n = 0; n < per_node.size(); ++n) {
+    for (const auto& s : per_node[n]) out.node_area[n] += s.area;
+    out.node[n] = area_percentile(std::move(per_node[n]), kSourcePercentile);
+  }
   return out;
+}
+
+std::vector<double> object_scales(const SourceDensity& source, const std::vector<char>& has_own) {
+  std::vector<double> scale(source.node.size(), 0.0);
+  if (!(source.scene > 0)) return scale;
+  double total = 0;
+  for (size_t n = 0; n < scale.size(); ++n) {
+    total += source.node_area[n];
+    if (!(n < has_own.size() && has_own[n]) && source.node[n] > source.scene)
+      scale[n] = std::min(source.node[n] / source.scene, kMaxObjectScale);
+  }
+  // The texels the scales add (in units of the scene's texels per unit of area) when each is
+  // raised to the power `k`.
+  auto extra = [&](double k) {
+    double e = 0;
+    for (size_t n = 0; n < scale.size(); ++n)
+      if (scale[n] > 0) e += source.node_area[n] * (std::pow(scale[n], 2 * k) - 1);
+    return e;
+  };
+  if (extra(1) > kObjectScaleBudget * total) {
+    double lo = 0, hi = 1;
+    for (int i = 0; i < 40; ++i) {
+      const double mid = (lo + hi) / 2;
+      (extra(mid) > kObjectScaleBudget * total ? hi : lo) = mid;
+    }
+    for (double& s : scale)
+      if (s > 0) s = std::pow(s, lo);
+  }
+  return scale;
 }
 
 Expected<DensityFile> load_density_file(const std::string& path, const scene::Scene& scene) {
@@ -289,8 +328,11 @@ namespace detail {
 
 OwnDensity DensityPlan::wanted(int material, int node) const {
   if (node >= 0 && node < static_cast<int>(nodes.size()) && nodes[node].set()) return nodes[node];
-  if (material >= 0 && material < static_cast<int>(materials.size())) return materials[material];
-  return {};
+  if (material >= 0 && material < static_cast<int>(materials.size()) && materials[material].set())
+    return materials[material];
+  OwnDensity d;
+  if (node >= 0 && node < static_cast<int>(object_scale.size())) d.scale = object_scale[node];
+  return d;
 }
 
 Expected<DensityPlan> plan_density(const scene::Scene& scene, const UnwrapOptions& opt) {
@@ -338,6 +380,10 @@ Expected<DensityPlan> plan_density(const scene::Scene& scene, const UnwrapOption
     plan.mode = DensityPlan::Mode::kBounded;
     plan.texels_per_unit = plan.source.scene * kSourceOversample;
     plan.rule = "sources";
+    // Only here: a density or size the user gave is not second-guessed object by object.
+    std::vector<char> has_own(scene.nodes.size());
+    for (size_t n = 0; n < has_own.size(); ++n) has_own[n] = plan.nodes[n].set();
+    plan.object_scale = object_scales(plan.source, has_own);
   } else {
     plan.mode = DensityPlan::Mode::kFitPages, plan.pages = kDefaultSizePages;
     plan.rule = "default size";
@@ -362,6 +408,12 @@ void report_density(const DensityPlan& plan, const scene::Scene& scene,
     d.achieved = m < achieved.size() ? achieved[m] : 0;
     if (d.source > 0 || d.requested > 0 || d.requested_scale > 0) st->materials.push_back(d);
   }
+  st->objects.clear();
+  for (size_t n = 0; n < plan.object_scale.size(); ++n)
+    if (plan.object_scale[n] > 1)
+      st->objects.push_back(
+          {scene.nodes[n].name.empty() ? "node " + std::to_string(n) : scene.nodes[n].name,
+           plan.source.node[n], plan.object_scale[n]});
   // Materials baked at under half their sources' density, worst first.
   std::vector<const UnwrapStats::MaterialDensity*> coarse;
   for (const auto& d : st->materials)

@@ -25,6 +25,16 @@ constexpr double kSourcePercentile = 0.9;
 // docs/BENCHMARKS.md) for 4x the level-0 texels, which --max-size and the memory limit bound.
 constexpr double kSourceOversample = 2.0;
 
+// An object (node) whose own sources are denser than the scene's percentile gets its density in
+// proportion, at most this many times the scene's: a smaller, nearer copy of a shared texture
+// (Collada/earthCylindrical's second globe) is otherwise baked under its sources' density.
+constexpr double kMaxObjectScale = 4.0;
+
+// The texels those objects add may at most equal this share of the scene's textured texels at
+// its own density; beyond it every object's scale is reduced alike (on a log scale), so that a
+// densely mapped decal cannot decide the atlas's size.
+constexpr double kObjectScaleBudget = 1.0;
+
 // One textured triangle: its linear source density (texels per world unit) and its world area.
 struct DensitySample {
   double texels_per_unit = 0;
@@ -48,7 +58,10 @@ struct SourceDensity {
   // triangles (the slot with the most texels per triangle), 0 = untextured or never drawn.
   std::vector<double> material;
   std::vector<double> material_area;  // world area of each material's textured triangles
-  double scene = 0;                   // kSourcePercentile over every textured triangle, 0 = none
+  // Per node (Scene::nodes order): kSourcePercentile over the textured triangles of the meshes
+  // it holds (not its subtree), and their world area; 0 = none.
+  std::vector<double> node, node_area;
+  double scene = 0;  // kSourcePercentile over every textured triangle, 0 = none
   // Images whose header could not be read ("NAME: why"): their slots give no density. Transfer
   // reports missing textures by its own policy, so this is not an error here.
   std::vector<std::string> unreadable;
@@ -58,6 +71,11 @@ struct SourceDensity {
 // share_instances, each mesh once, placed by its first instance, as the unwrapper does). Reads
 // the header of every image a drawn material uses.
 SourceDensity measure_source_density(const scene::Scene& scene, bool share_instances);
+
+// Per node: the scale of the scene's density its own sources ask for (SourceDensity::node over
+// SourceDensity::scene, capped at kMaxObjectScale and by kObjectScaleBudget), 0 where the node
+// is not denser than the scene or `has_own` (its own density was given) says so.
+std::vector<double> object_scales(const SourceDensity& source, const std::vector<char>& has_own);
 
 // A surface's own density: texels per world unit, or a scale of the scene's density (2 = twice
 // as fine as the rest). Neither set = the scene's.

@@ -80,6 +80,14 @@ struct UnwrapStats {
     double achieved = 0;         // texels per unit its charts got (area-weighted mean)
   };
   std::vector<MaterialDensity> materials;  // materials with a source or a requested density
+  // Objects (nodes) denser than the scene's sources, given a scale of the scene's density of
+  // their own (texel_density.h's object_scales).
+  struct ObjectDensity {
+    std::string name;
+    double source = 0;  // texels per unit of its sources (kSourcePercentile)
+    double scale = 0;   // of the scene's density
+  };
+  std::vector<ObjectDensity> objects;
   // E.g. the bake is more than 2x coarser than its sources, naming the worst materials.
   std::vector<std::string> warnings;
   double utilisation = 0;  // texel centres covered by a triangle / atlas texels

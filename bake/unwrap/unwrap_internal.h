@@ -88,10 +88,13 @@ struct DensityPlan {
   int min_pages = 0, max_pages = 0;
   // Own densities per material (density file, else glTF extras) and per node (subtrees applied).
   std::vector<OwnDensity> materials, nodes;
+  // Per node: the scale its own sources ask for where nothing was given (object_scales), 0 = none.
+  std::vector<double> object_scale;
   SourceDensity source;
   std::string rule, file;  // UnwrapStats::density_rule (before bounds) and density_file
 
-  // The density a surface of `material` under `node` asks for; unset = the scene's.
+  // The density a surface of `material` under `node` asks for: the node's own, else its
+  // material's, else the node's object_scale; unset = the scene's.
   OwnDensity wanted(int material, int node) const;
 };
 Expected<DensityPlan> plan_density(const scene::Scene& scene, const UnwrapOptions& options);

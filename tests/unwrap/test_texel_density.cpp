@@ -4,6 +4,7 @@
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -251,6 +252,68 @@ TEST_F(TexelDensity, MaterialAndObjectDensitiesScaleTheirCharts) {
   EXPECT_EQ(f->stats.density_rule, "size");
   EXPECT_EQ(f->stats.pages_x, 4);
   EXPECT_NEAR(f->stats.materials[1].achieved / f->stats.materials[0].achieved, 4.0, 1e-9);
+}
+
+TEST(TexelDensityMath, ObjectScalesAreCappedAndBudgeted) {
+  unwrap::SourceDensity d;
+  d.scene = 32;
+  d.node = {32, 128, 1000, 0};
+  d.node_area = {16, 1, 0.1, 5};
+  // Only denser objects get a scale: their density over the scene's, at most kMaxObjectScale.
+  auto k = unwrap::object_scales(d, {0, 0, 0, 0});
+  EXPECT_EQ(k, (std::vector<double>{0, 4, unwrap::kMaxObjectScale, 0}));
+  EXPECT_EQ(unwrap::object_scales(d, {0, 1, 0, 0})[1], 0.0);  // its own density was given
+  // A dense object of a quarter of the scene's area would add 4 * (4^2 - 1) = 60 units of area
+  // at the scene's density, over the budget of the scene's own 20 (kObjectScaleBudget 1): its
+  // scale drops to the one that adds 20, sqrt(1 + 20 / 4).
+  d.node = {32, 128};
+  d.node_area = {16, 4};
+  k = unwrap::object_scales(d, {});
+  EXPECT_EQ(k[0], 0.0);
+  EXPECT_NEAR(k[1], std::sqrt(1 + 20.0 / 4), 1e-6);
+}
+
+TEST_F(TexelDensity, AnObjectDenserThanTheSceneGetsItsOwnDensity) {
+  // A 4 x 4 "Earth" and a 1 x 1 "Moon" sharing one 128^2 texture: 32 and 128 texels per unit.
+  Scene s = scene_of(quad(4, 4, 0));
+  s.nodes[0].name = "Earth";
+  scene::Mesh moon;
+  moon.primitives.push_back(quad(1, 1, 0, 1.0f, 6.0f));
+  s.meshes.push_back(moon);
+  scene::Node n;
+  n.name = "Moon";
+  n.mesh = 1;
+  s.nodes.push_back(n);
+  s.roots.push_back(1);
+  textured(s, "globe", png(128, 128));
+  auto r = unwrap::unwrap_scene(s, options());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  expect_valid(s, *r);
+  EXPECT_EQ(r->stats.density_rule, "sources");
+  EXPECT_EQ(r->stats.texels_per_unit, 64.0);  // twice the scene's 32
+  ASSERT_EQ(r->stats.objects.size(), 1u);
+  EXPECT_EQ(r->stats.objects[0].name, "Moon");
+  EXPECT_EQ(r->stats.objects[0].source, 128.0);
+  EXPECT_EQ(r->stats.objects[0].scale, 4.0);
+  // The Moon's two triangles (the second mesh's, last) take 4^2 times the Earth's texels per
+  // unit of area: 256 texels per unit, twice its sources' density like the Earth.
+  EXPECT_NEAR(atlas_area(*r, 2, 2) / 1.0 / (atlas_area(*r, 0, 2) / 16.0), 16.0, 1e-3);
+  EXPECT_TRUE(r->stats.warnings.empty());
+
+  // A density given for the object, or for the whole scene, is not second-guessed.
+  write("m.json", R"({"objects": {"Moon": {"scale": 1}}})");
+  auto o = options();
+  o.density_file = (dir_ / "m.json").string();
+  auto m = unwrap::unwrap_scene(s, o);
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  EXPECT_TRUE(m->stats.objects.empty());
+  EXPECT_NEAR(atlas_area(*m, 2, 2) / (atlas_area(*m, 0, 2) / 16.0), 1.0, 1e-3);
+  o.density_file = "-";
+  o.texels_per_unit = 64;
+  auto t = unwrap::unwrap_scene(s, o);
+  ASSERT_TRUE(t.ok()) << t.status().message();
+  EXPECT_TRUE(t->stats.objects.empty());
+  EXPECT_NEAR(atlas_area(*t, 2, 2) / (atlas_area(*t, 0, 2) / 16.0), 1.0, 1e-3);
 }
 
 TEST_F(TexelDensity, ScalesAndNodesAndGltfExtrasSetOwnDensities) {
