@@ -71,14 +71,12 @@ inline void adapt(TokenModel& m, int t) {
 // before it.
 inline unsigned find_token(const TokenModel& m, uint32_t slot) {
 #if defined(__SSE2__)
-  const __m128i s = _mm_set1_epi16(int16_t(slot));
+  const __m128i s = _mm_set1_epi16(int16_t(slot + 1));
   const __m128i* p = reinterpret_cast<const __m128i*>(m.above());
-  const __m128i lo = _mm_cmpgt_epi16(_mm_load_si128(p), s);
-  const __m128i hi = _mm_cmpgt_epi16(_mm_load_si128(p + 1), s);
-  // The lanes ending after the slot are a suffix (the counts ascend) that holds lane 15
-  // (kFreqTotal): the token is the first of them. Compared this way round, neither the slot
-  // nor the mask needs an extra operation on the token chain.
-  return unsigned(__builtin_ctz(unsigned(_mm_movemask_epi8(_mm_packs_epi16(lo, hi)))));
+  const __m128i lo = _mm_cmpgt_epi16(s, _mm_load_si128(p));
+  const __m128i hi = _mm_cmpgt_epi16(s, _mm_load_si128(p + 1));
+  // The set lanes are a prefix (the counts ascend) and lane 15 is never set: count = first clear.
+  return unsigned(__builtin_ctz(~unsigned(_mm_movemask_epi8(_mm_packs_epi16(lo, hi)))));
 #else
   unsigned t = 0;
   for (int i = 0; i < kTokens; i++) t += m.above()[i] <= slot;
