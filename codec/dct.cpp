@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -872,12 +873,23 @@ bool host_has_avx2_bmi2() {
 }
 #endif
 
+std::atomic<bool> g_force_baseline_plane_decoder{false};
+
+bool avx2_plane_decoder() {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  static const bool avx2 = host_has_avx2_bmi2();
+  return avx2;
+#else
+  return false;
+#endif
+}
+
 template <bool kAdaptive>
 bool decode_plane(RansDecoder& rans, BitReader& bits, TokenModel* models, int bw, int bh,
                   int16_t* coefs, BlockInfo* info) {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-  static const bool avx2 = host_has_avx2_bmi2();
-  if (avx2) return decode_plane_avx2<kAdaptive>(rans, bits, models, bw, bh, coefs, info);
+  if (avx2_plane_decoder() && !g_force_baseline_plane_decoder.load(std::memory_order_relaxed))
+    return decode_plane_avx2<kAdaptive>(rans, bits, models, bw, bh, coefs, info);
 #endif
   return decode_plane_baseline<kAdaptive>(rans, bits, models, bw, bh, coefs, info);
 }
@@ -1043,6 +1055,14 @@ Status decode_tokens(const DctTables& t, std::span<const uint8_t> rans,
 }
 
 }  // namespace
+
+bool dct_detail::plane_decoder_uses_avx2() {
+  return avx2_plane_decoder() && !g_force_baseline_plane_decoder.load();
+}
+
+void dct_detail::force_baseline_plane_decoder(bool on) {
+  g_force_baseline_plane_decoder.store(on);
+}
 
 Expected<DctTablesPtr> dct_make_tables(const DctSettings& settings, int width, int height,
                                        std::span<const std::span<const uint8_t>> training_pages) {
