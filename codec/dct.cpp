@@ -849,8 +849,9 @@ template <bool kAdaptive>
 }
 
 // decode_plane_body built for the baseline target and, on x86-64 hosts that have them, for AVX2
-// and BMI2: three-operand SIMD, a one-instruction broadcast and shifts by any register take
-// about a tenth of the operations off each token. Both builds decode the same tokens.
+// and BMI2: three-operand SIMD, a one-instruction broadcast and shifts by any register take a
+// few operations off each token (about 2% of the decode, docs/BENCHMARKS.md issue 22). Both
+// builds decode the same tokens (Dct.BaselineAndAvx2PlaneDecodersAgree).
 template <bool kAdaptive>
 [[gnu::noinline]] bool decode_plane_baseline(RansDecoder& rans, BitReader& bits, TokenModel* models,
                                              int bw, int bh, int16_t* coefs, BlockInfo* info) {
