@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -78,8 +79,8 @@ constexpr int kEscapeClass = 3;
 struct PairToken {
   uint8_t nonzeros;  // raw sign bits that follow
   uint8_t mask;      // 2^nonzeros - 1
-  uint8_t escape0;   // 1 when the first position's class is kEscapeClass
-  uint8_t escape1;
+  uint8_t escapes;   // bit 0 (1): the first (second) position's class is kEscapeClass
+  uint8_t unused;
 };
 
 // Two int16 coefficients as they lie in memory, first position first.
@@ -150,8 +151,8 @@ struct BucketTables {
     for (int t = 0; t < kTokens; t++) {
       const int a0 = t & 3, a1 = t >> 2;
       const int nonzeros = (a0 != 0) + (a1 != 0);
-      pair_token[t] = {uint8_t(nonzeros), uint8_t((1 << nonzeros) - 1), uint8_t(a0 == kEscapeClass),
-                       uint8_t(a1 == kEscapeClass)};
+      pair_token[t] = {uint8_t(nonzeros), uint8_t((1 << nonzeros) - 1),
+                       uint8_t((a0 == kEscapeClass) | (a1 == kEscapeClass) << 1), 0};
       for (uint32_t signs = 0; signs < 4; signs++) {
         pair_value[t][signs] = signed_pair(a0, a1, signs & ((1u << nonzeros) - 1), a0 != 0);
       }
@@ -177,13 +178,6 @@ struct BucketTables {
   }
 };
 constexpr BucketTables kBuckets;
-
-// kBuckets.pair_token[t].nonzeros, 2 bits per token t.
-constexpr uint32_t kPairNonzeros = [] {
-  uint32_t v = 0;
-  for (int t = 0; t < kTokens; t++) v |= uint32_t(kBuckets.pair_token[t].nonzeros) << (2 * t);
-  return v;
-}();
 
 int plane_count(const DctSettings& s) {
   return s.channels;
@@ -780,9 +774,9 @@ inline void zero_block(int16_t* z) {
 // in registers, no branch per position) with the same context helpers. False when the rANS
 // data ran out.
 template <bool kAdaptive>
-[[gnu::noinline]] bool decode_plane(RansDecoder& rans_state, BitReader& bits_state,
-                                    TokenModel* models, int bw, int bh, int16_t* coefs,
-                                    BlockInfo* info) {
+[[gnu::always_inline]] inline bool decode_plane_body(RansDecoder& rans_state, BitReader& bits_state,
+                                                     TokenModel* models, int bw, int bh,
+                                                     int16_t* coefs, BlockInfo* info) {
   // Local copies stay in registers.
   RansDecoder rans = rans_state;
   BitReader bits = bits_state;
@@ -810,10 +804,12 @@ template <bool kAdaptive>
         pair_contexts(n.left, n.up, 0, sizeof(TokenModel), pair_ctx, esc_ctx);
         pair_contexts(n.left, n.up, 4, sizeof(TokenModel), pair_ctx + 4, esc_ctx + 4);
       }
-      uint8_t escaped[kPairs * 2 + 1];
+      // Bit k - 1 set: position k has an escape. A mask rather than a list: two operations a
+      // pair instead of six (the pair loop is as much bound by its integer operations as by its
+      // token chain).
+      uint64_t escapes = 0;
       int rem = nz, j = 0;
       size_t rem_now = kBuckets.rem_bytes[nz], rem_next = rem_now;  // pairs j and j + 1
-      size_t escapes = 0;
       for (; rem > 0 && j < kPairs; j++) {
         // The next four two pairs ahead: at j = 6, 10, ..., 26.
         if ((0x4444440u >> j) & 1) {
@@ -830,20 +826,15 @@ template <bool kAdaptive>
         // Position 64 of the last pair is the next block's DC, written before it is decoded
         // (the coefficients have a block of slack at the end).
         std::memcpy(z + 2 * j + 1, &pair, sizeof(pair));
-        // Escaped positions, listed without a branch.
-        escaped[escapes] = uint8_t(2 * j + 1);
-        escapes += e.escape0;
-        escaped[escapes] = uint8_t(2 * j + 2);
-        escapes += e.escape1;
-        // The token's nonzeros from a register (2 bits per token) rather than e: one load
-        // fewer on the chain. rem < 0 only in damaged data, and then the loop ends.
-        rem -= int((kPairNonzeros >> (2 * t)) & 3u);
+        escapes |= uint64_t(e.escapes) << (2 * j);
+        // rem < 0 only in damaged data, and then the loop ends.
+        rem -= e.nonzeros;
         rem_now = rem_next;
         rem_next = kBuckets.rem_bytes[rem & 63];
       }
       // The escapes follow the block's pairs (see code_plane): each adds to a magnitude of 3.
-      for (size_t i = 0; i < escapes; i++) {
-        const int k = escaped[i];
+      for (; escapes != 0; escapes &= escapes - 1) {
+        const int k = __builtin_ctzll(escapes) + 1;
         bits.refill();
         const int v = decode_uint<kAdaptive>(rans, bits, models[esc_ctx[(k - 1) >> 1]]);
         z[k] = int16_t(z[k] < 0 ? z[k] - v : z[k] + v);
@@ -855,6 +846,53 @@ template <bool kAdaptive>
   rans_state = rans;
   bits_state = bits;
   return true;
+}
+
+// decode_plane_body built for the baseline target and, on x86-64 hosts that have them, for AVX2
+// and BMI2: three-operand SIMD, a one-instruction broadcast and shifts by any register take a
+// few operations off each token (about 2% of the decode, docs/BENCHMARKS.md issue 22). Both
+// builds decode the same tokens (Dct.BaselineAndAvx2PlaneDecodersAgree).
+template <bool kAdaptive>
+[[gnu::noinline]] bool decode_plane_baseline(RansDecoder& rans, BitReader& bits, TokenModel* models,
+                                             int bw, int bh, int16_t* coefs, BlockInfo* info) {
+  return decode_plane_body<kAdaptive>(rans, bits, models, bw, bh, coefs, info);
+}
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+template <bool kAdaptive>
+[[gnu::noinline, gnu::target("avx2,bmi,bmi2")]] bool decode_plane_avx2(RansDecoder& rans,
+                                                                       BitReader& bits,
+                                                                       TokenModel* models, int bw,
+                                                                       int bh, int16_t* coefs,
+                                                                       BlockInfo* info) {
+  return decode_plane_body<kAdaptive>(rans, bits, models, bw, bh, coefs, info);
+}
+
+bool host_has_avx2_bmi2() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("bmi2");
+}
+#endif
+
+std::atomic<bool> g_force_baseline_plane_decoder{false};
+
+bool avx2_plane_decoder() {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  static const bool avx2 = host_has_avx2_bmi2();
+  return avx2;
+#else
+  return false;
+#endif
+}
+
+template <bool kAdaptive>
+bool decode_plane(RansDecoder& rans, BitReader& bits, TokenModel* models, int bw, int bh,
+                  int16_t* coefs, BlockInfo* info) {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  if (avx2_plane_decoder() && !g_force_baseline_plane_decoder.load(std::memory_order_relaxed))
+    return decode_plane_avx2<kAdaptive>(rans, bits, models, bw, bh, coefs, info);
+#endif
+  return decode_plane_baseline<kAdaptive>(rans, bits, models, bw, bh, coefs, info);
 }
 
 void set_dequantisation(DctTables& t, int p) {
@@ -1018,6 +1056,14 @@ Status decode_tokens(const DctTables& t, std::span<const uint8_t> rans,
 }
 
 }  // namespace
+
+bool dct_detail::plane_decoder_uses_avx2() {
+  return avx2_plane_decoder() && !g_force_baseline_plane_decoder.load();
+}
+
+void dct_detail::force_baseline_plane_decoder(bool on) {
+  g_force_baseline_plane_decoder.store(on);
+}
 
 Expected<DctTablesPtr> dct_make_tables(const DctSettings& settings, int width, int height,
                                        std::span<const std::span<const uint8_t>> training_pages) {

@@ -188,6 +188,12 @@ class RansDecoder {
   uint32_t x0_ = 0, x1_ = 0;
 };
 
+// The plane decoder is built for the baseline target and, on x86-64, for AVX2 + BMI2, picked by
+// the host's CPU (codec/dct.cpp). Whether this host runs the AVX2 build; and, for tests, a switch
+// that makes every decoder thread run the baseline build, so that the two can be compared.
+bool plane_decoder_uses_avx2();
+void force_baseline_plane_decoder(bool on);
+
 // Raw bits, least significant first.
 class BitWriter {
  public:

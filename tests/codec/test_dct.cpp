@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "codec/dct.h"
+#include "codec/dct_rans.h"
 #include "common/hash.h"
 
 namespace vt::dct_test {
@@ -432,6 +433,61 @@ TEST(Dct, InvalidArgumentsAreRejected) {
   std::vector<uint8_t> page(128 * 128 * 3), out;
   EXPECT_EQ(dct_encode_page(*t, page.data(), 130, 128, out).code(), ErrorCode::kInvalidArgument);
   EXPECT_EQ(dct_decode_page(*t, out, 128, 12, page.data()).code(), ErrorCode::kInvalidArgument);
+}
+
+// The plane decoder's two builds (baseline and AVX2 + BMI2, codec/dct.cpp) decode every page
+// alike, valid or damaged: same status, same texels. Only the AVX2 build runs on an AVX2 host
+// otherwise, so without this the baseline one would go untested there.
+TEST(Dct, BaselineAndAvx2PlaneDecodersAgree) {
+  if (!dct_detail::plane_decoder_uses_avx2()) GTEST_SKIP() << "one plane decoder build here";
+  struct Baseline {
+    Baseline() { dct_detail::force_baseline_plane_decoder(true); }
+    ~Baseline() { dct_detail::force_baseline_plane_decoder(false); }
+  };
+  std::vector<std::vector<uint8_t>> training;
+  for (uint64_t seed = 1; seed <= 2; seed++)
+    training.push_back(make_page(Pattern::kMixed, 128, 128, 3, seed));
+  std::vector<std::span<const uint8_t>> spans(training.begin(), training.end());
+  // Static (trained) and adaptive (untrained) models; 4:2:0, full chroma and planes.
+  std::vector<DctTablesPtr> tables;
+  tables.push_back(tables_for(50, {3, DctPlaneLayout::kYCoCg420}, 128, 128, spans));
+  tables.push_back(tables_for(90, {3, DctPlaneLayout::kYCoCg420}, 128, 128, spans));
+  tables.push_back(tables_for(75, {4, DctPlaneLayout::kYCoCg}));
+  tables.push_back(tables_for(30, {2, DctPlaneLayout::kPlanes}));
+  Lcg64 rng{5};
+  int compared = 0, damaged_ok = 0;
+  for (const auto& t : tables) {
+    const int ch = dct_tables_shape(*t).channels;
+    for (Pattern p : {Pattern::kMixed, Pattern::kNoise, Pattern::kText}) {
+      const auto page = make_page(p, 128, 128, ch, 77);
+      std::vector<uint8_t> coded;
+      ASSERT_TRUE(dct_encode_page(*t, page.data(), 128, 128, coded).ok());
+      ASSERT_EQ(coded[0], 0) << "a coded page";  // not stored raw
+      for (int i = 0; i < 40; i++) {
+        auto bytes = coded;
+        if (i > 0) bytes[1 + rng.below(bytes.size() - 1)] ^= uint8_t(1u << rng.below(8));
+        std::vector<uint8_t> a(page.size(), 1), b(page.size(), 1);
+        const Status sa = dct_decode_page(*t, bytes, 128, 128, a.data());
+        Status sb;
+        {
+          Baseline baseline;
+          EXPECT_FALSE(dct_detail::plane_decoder_uses_avx2());
+          sb = dct_decode_page(*t, bytes, 128, 128, b.data());
+        }
+        ASSERT_EQ(sa.code(), sb.code()) << sa.message() << " / " << sb.message();
+        if (i == 0) {
+          ASSERT_TRUE(sa.ok()) << sa.message();
+        }
+        if (sa.ok()) {
+          EXPECT_EQ(a, b);
+        }
+        damaged_ok += i > 0 && sa.ok();
+        compared++;
+      }
+    }
+  }
+  EXPECT_EQ(compared, 4 * 3 * 40);
+  EXPECT_GT(damaged_ok, 0);  // some flipped bits still decode: texels compared on damaged data
 }
 
 TEST(Dct, TruncatedAndCorruptPagesGiveErrorsNotCrashes) {
