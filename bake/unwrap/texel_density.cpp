@@ -229,7 +229,7 @@ std::vector<double> object_scales(const SourceDensity& source, const std::vector
   double total = 0;
   for (size_t n = 0; n < scale.size(); ++n) {
     total += source.node_area[n];
-    if (!(n < has_own.size() && has_own[n]) && source.node[n] > source.scene)
+    if (!(n < has_own.size() && has_own[n]) && source.node[n] > kSourceOversample * source.scene)
       scale[n] = std::min(source.node[n] / source.scene, kMaxObjectScale);
   }
   // The texels the scales add (in units of the scene's texels per unit of area) when each is

@@ -25,9 +25,11 @@ constexpr double kSourcePercentile = 0.9;
 // docs/BENCHMARKS.md) for 4x the level-0 texels, which --max-size and the memory limit bound.
 constexpr double kSourceOversample = 2.0;
 
-// An object (node) whose own sources are denser than the scene's percentile gets its density in
-// proportion, at most this many times the scene's: a smaller, nearer copy of a shared texture
-// (Collada/earthCylindrical's second globe) is otherwise baked under its sources' density.
+// An object (node) whose own sources are more than kSourceOversample times denser than the
+// scene's percentile would be baked coarser than its sources (a smaller, nearer copy of a shared
+// texture: Collada/earthCylindrical's second globe): it gets its density in proportion, at most
+// this many times the scene's. Denser objects short of that keep at least one baked texel per
+// source texel at the scene's density, as the scene's own densest tenth does.
 constexpr double kMaxObjectScale = 4.0;
 
 // The texels those objects add may at most equal this share of the scene's textured texels at
@@ -73,8 +75,8 @@ struct SourceDensity {
 SourceDensity measure_source_density(const scene::Scene& scene, bool share_instances);
 
 // Per node: the scale of the scene's density its own sources ask for (SourceDensity::node over
-// SourceDensity::scene, capped at kMaxObjectScale and by kObjectScaleBudget), 0 where the node
-// is not denser than the scene or `has_own` (its own density was given) says so.
+// SourceDensity::scene, capped at kMaxObjectScale and by kObjectScaleBudget), 0 where that ratio
+// is at most kSourceOversample or `has_own` (its own density was given) says so.
 std::vector<double> object_scales(const SourceDensity& source, const std::vector<char>& has_own);
 
 // A surface's own density: texels per world unit, or a scale of the scene's density (2 = twice

@@ -257,12 +257,14 @@ TEST_F(TexelDensity, MaterialAndObjectDensitiesScaleTheirCharts) {
 TEST(TexelDensityMath, ObjectScalesAreCappedAndBudgeted) {
   unwrap::SourceDensity d;
   d.scene = 32;
-  d.node = {32, 128, 1000, 0};
-  d.node_area = {16, 1, 0.1, 5};
-  // Only denser objects get a scale: their density over the scene's, at most kMaxObjectScale.
-  auto k = unwrap::object_scales(d, {0, 0, 0, 0});
-  EXPECT_EQ(k, (std::vector<double>{0, 4, unwrap::kMaxObjectScale, 0}));
-  EXPECT_EQ(unwrap::object_scales(d, {0, 1, 0, 0})[1], 0.0);  // its own density was given
+  d.node = {32, 128, 1000, 0, 64};
+  d.node_area = {16, 1, 0.1, 5, 1};
+  // Only objects more than kSourceOversample times denser get a scale: their density over the
+  // scene's, at most kMaxObjectScale. At 2x (64) the scene's density still gives one baked
+  // texel per source texel.
+  auto k = unwrap::object_scales(d, {0, 0, 0, 0, 0});
+  EXPECT_EQ(k, (std::vector<double>{0, 4, unwrap::kMaxObjectScale, 0, 0}));
+  EXPECT_EQ(unwrap::object_scales(d, {0, 1, 0, 0, 0})[1], 0.0);  // its own density was given
   // A dense object of a quarter of the scene's area would add 4 * (4^2 - 1) = 60 units of area
   // at the scene's density, over the budget of the scene's own 20 (kObjectScaleBudget 1): its
   // scale drops to the one that adds 20, sqrt(1 + 20 / 4).
