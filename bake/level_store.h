@@ -40,6 +40,8 @@ class LevelStore final : public LevelSource {
   Status read(uint32_t y0, uint32_t y1, float* out) override;
   // The texels of an in-memory store (nullptr for a scratch file).
   float* data() { return in_memory() ? memory_.data() : nullptr; }
+  // Whether an in-memory store still holds all its texels (not handed over by release()).
+  bool holds_texels() const { return in_memory() && memory_.size() * sizeof(float) == bytes(); }
   // Hands over an in-memory store's texels (empty for a scratch file); the store is empty after.
   std::vector<float> release() { return std::move(memory_); }
   // Keeps the first `keep` channels of every texel, in place (in memory or in the scratch file,
