@@ -189,8 +189,7 @@ Expected<uint64_t> StoredImageSource::content_hash() {
   // An in-memory store handing out all its channels is hashed where it lies: the digest of the
   // rows streamed in bands (ImageSource::content_hash) is XXH3 of the same bytes in one piece,
   // without a band buffer to allocate and copy into.
-  if (store_->holds_texels() && store_->channels() == info_.channels)
-    return XXH3_64bits(store_->data(), store_->bytes());
+  if (const float* texels = texels_in_memory()) return XXH3_64bits(texels, store_->bytes());
   return ImageSource::content_hash();
 }
 
