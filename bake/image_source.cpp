@@ -222,6 +222,12 @@ Expected<bool> channel_is_opaque(ImageSource& source, uint32_t channel) {
   const ImageInfo& info = source.info();
   if (channel >= info.channels) return Status(ErrorCode::kInvalidArgument, "no such channel");
   const uint32_t band = band_rows(info), ch = info.channels;
+  if (const float* texels = source.texels_in_memory()) {
+    const size_t n = size_t(info.width) * info.height * ch;
+    for (size_t i = channel; i < n; i += ch)
+      if (!(texels[i] >= 1.0f)) return false;
+    return true;
+  }
   std::vector<float> rows(size_t(band) * info.width * ch);
   for (uint32_t y = 0; y < info.height; y += band) {
     uint32_t y1 = std::min(info.height, y + band);

@@ -38,6 +38,10 @@ class ImageSource {
   // memory, leaving the source empty, so that a build can convert it in place rather than copy
   // it; empty when the source cannot.
   virtual std::vector<float> release_texels() { return {}; }
+  // The whole image as read_rows would give it (width * height * channels floats) where the
+  // source holds it so in memory; null otherwise. Scans read it in place, without a row buffer
+  // to allocate (first touches of fresh memory are most of a scan's cost).
+  virtual const float* texels_in_memory() const { return nullptr; }
   // The file the texels come from, for messages; "" for generated or in-memory texels.
   virtual std::string origin() const { return ""; }
 };
@@ -57,6 +61,10 @@ class MemoryImageSource final : public ImageSource {
   Status read_rows(uint32_t y0, uint32_t y1, float* out) override;
   Expected<uint64_t> content_hash() override;
   std::vector<float> release_texels() override { return std::move(texels_); }
+  const float* texels_in_memory() const override {
+    return texels_.size() == size_t(info_.width) * info_.height * info_.channels ? texels_.data()
+                                                                                 : nullptr;
+  }
   const std::vector<float>& texels() const { return texels_; }
 
  private:

@@ -186,6 +186,10 @@ std::vector<float> StoredImageSource::release_texels() {
 
 Expected<uint64_t> StoredImageSource::content_hash() {
   if (released_hash_) return *released_hash_;
+  // An in-memory store handing out all its channels is hashed where it lies: the digest of the
+  // rows streamed in bands (ImageSource::content_hash) is XXH3 of the same bytes in one piece,
+  // without a band buffer to allocate and copy into.
+  if (const float* texels = texels_in_memory()) return XXH3_64bits(texels, store_->bytes());
   return ImageSource::content_hash();
 }
 

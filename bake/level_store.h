@@ -40,6 +40,8 @@ class LevelStore final : public LevelSource {
   Status read(uint32_t y0, uint32_t y1, float* out) override;
   // The texels of an in-memory store (nullptr for a scratch file).
   float* data() { return in_memory() ? memory_.data() : nullptr; }
+  // Whether an in-memory store still holds all its texels (not handed over by release()).
+  bool holds_texels() const { return in_memory() && memory_.size() * sizeof(float) == bytes(); }
   // Hands over an in-memory store's texels (empty for a scratch file); the store is empty after.
   std::vector<float> release() { return std::move(memory_); }
   // Keeps the first `keep` channels of every texel, in place (in memory or in the scratch file,
@@ -82,6 +84,11 @@ class StoredImageSource final : public ImageSource {
   Status read_rows(uint32_t y0, uint32_t y1, float* out) override;
   // An in-memory store with as many channels as the source hands its texels over.
   std::vector<float> release_texels() override;
+  const float* texels_in_memory() const override {
+    return !released_hash_ && store_->holds_texels() && store_->channels() == info_.channels
+               ? store_->data()
+               : nullptr;
+  }
   // A scratch-file store whose texels are the source's as they are, for the build to convert in
   // its own file (no second copy on disk); null otherwise. The source is spent once the caller
   // says so with the hash of the rows it read (content_hash gives it from then on).

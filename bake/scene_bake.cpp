@@ -478,6 +478,8 @@ nlohmann::json to_json(const SceneBakeSummary& s) {
   for (const auto& [stage, bytes] : s.peak_rss) peak_rss[stage] = bytes;
   const unwrap::UnwrapStats& u = s.unwrap;
   const TransferStats& t = s.transfer;
+  nlohmann::json transfer_seconds = nlohmann::json::object();
+  for (const auto& [name, seconds] : t.stage_seconds) transfer_seconds[name] = seconds;
   nlohmann::json above_one = nlohmann::json::array();
   for (const LayerRange& r : s.above_one) {
     above_one.push_back({{"layer", r.layer},
@@ -516,6 +518,7 @@ nlohmann::json to_json(const SceneBakeSummary& s) {
         {"bands", t.bands},
         {"bands_cached", t.bands_cached},
         {"texels_per_second", t.seconds > 0 ? double(t.covered_texels) / t.seconds : 0.0},
+        {"seconds", transfer_seconds},
         {"above_one", above_one},
         {"missing_textures", missing}}},
       {"build", to_json(s.build)},

@@ -30,6 +30,7 @@
 #include <mutex>
 #include <thread>
 #include <unordered_map>
+#include <utility>
 
 namespace vt {
 namespace {
@@ -58,6 +59,47 @@ void for_each_band(uint32_t bands, int threads, const std::function<void(double)
   parallel_for(
       bands, threads, [&](size_t b) { body(uint32_t(b)); }, on_done);
 }
+
+// The transfer's texture loading (Transfer::setup_images) on a thread of its own: wait() joins
+// it and gives its status (the first call; later ones give Ok). The destructor joins a loading
+// still running, so an early error return never leaves it behind.
+class ImageLoading {
+ public:
+  ImageLoading() = default;
+  ImageLoading(const ImageLoading&) = delete;
+  ImageLoading& operator=(const ImageLoading&) = delete;
+  ~ImageLoading() {
+    if (thread_.joinable()) thread_.join();
+  }
+  void start(std::function<Status()> load) {
+    thread_ = std::thread([this, load = std::move(load)] {
+      const auto t0 = std::chrono::steady_clock::now();
+      try {
+        status_ = load();
+      } catch (const std::bad_alloc&) {
+        status_ = Error(ErrorCode::kResourceLimit, "transfer: out of memory loading the textures");
+      } catch (const std::exception& e) {
+        status_ =
+            Error(ErrorCode::kInternal, std::string("transfer: loading the textures: ") + e.what());
+      }
+      seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    });
+  }
+  Status wait() {
+    if (!thread_.joinable()) return Status::Ok();
+    const auto t0 = std::chrono::steady_clock::now();
+    thread_.join();
+    waited_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return std::exchange(status_, Status::Ok());
+  }
+  double seconds() const { return seconds_; }  // the loading's own time (once waited for)
+  double waited() const { return waited_; }    // what wait() blocked for
+
+ private:
+  std::thread thread_;
+  Status status_;
+  double seconds_ = 0, waited_ = 0;
+};
 
 // Per-texel state of the rasteriser inside one band.
 struct BandRaster {
@@ -350,7 +392,8 @@ class Transfer {
                    uint8_t* coverage, RowCounts& counts, LayerFacts (&facts)[kSlots]) const;
   Status transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlots],
                        std::vector<uint8_t>& coverage, RowCounts& counts,
-                       LayerFacts (&facts)[kSlots], const std::function<void(double)>& progress);
+                       LayerFacts (&facts)[kSlots], const std::function<void(double)>& progress,
+                       ImageLoading& images);
   void finish_rows(float* const (&acc)[kSlots], const uint8_t* coverage, size_t n,
                    LayerFacts (&facts)[kSlots]) const;
   Expected<std::vector<TransferLayer>> make_layers(std::shared_ptr<LevelStore> (&stores)[kSlots],
@@ -986,7 +1029,7 @@ void Transfer::unpack_band(const BandBytes& f, const uint8_t* in, float* const (
 Status Transfer::transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSlots],
                                std::vector<uint8_t>& coverage, RowCounts& counts,
                                LayerFacts (&facts)[kSlots],
-                               const std::function<void(double)>& progress) {
+                               const std::function<void(double)>& progress, ImageLoading& images) {
   const uint32_t W = opt_.width, H = opt_.height;
   const uint32_t b0 = r0 / kBandRows, bands = (r1 - r0 + kBandRows - 1) / kBandRows;
   struct Outcome {
@@ -1025,7 +1068,20 @@ Status Transfer::transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSl
       cache_out_->add(b, band_keys_[b], bytes);
     }
   };
-  for_each_band(bands, opt_.threads, progress, [&](uint32_t bi) { band(bi, true); });
+  // The bands the cache holds first (no texture needed), then, the textures loaded, the rest.
+  std::vector<uint32_t> order[2];
+  for (uint32_t bi = 0; bi < bands; ++bi)
+    order[!(cache_in_ && cache_in_->has(b0 + bi, band_keys_[b0 + bi]))].push_back(bi);
+  for (int phase = 0; phase < 2; ++phase) {
+    if (phase == 1) VT_RETURN_IF_ERROR(images.wait());
+    const std::vector<uint32_t>& these = order[phase];
+    const size_t before = phase == 0 ? 0 : order[0].size();
+    std::function<void(double)> step;
+    if (progress)
+      step = [&](double f) { progress(bands ? (before + f * these.size()) / bands : 1.0); };
+    for_each_band(uint32_t(these.size()), opt_.threads, step,
+                  [&](uint32_t i) { band(these[i], true); });
+  }
   std::vector<uint32_t> unread;
   for (uint32_t bi = 0; bi < bands; ++bi)
     if (outcome[bi].unread) unread.push_back(bi);
@@ -1126,6 +1182,12 @@ uint32_t Transfer::rows_per_pass() const {
 
 Expected<TransferResult> Transfer::run() {
   auto start = std::chrono::steady_clock::now();
+  std::vector<std::pair<const char*, double>> stages;
+  auto lap = [&, t = start](const char* name) mutable {
+    const auto now = std::chrono::steady_clock::now();
+    stages.emplace_back(name, std::chrono::duration<double>(now - t).count());
+    t = now;
+  };
   const uint32_t W = opt_.width, H = opt_.height;
   if (W == 0 || H == 0) return Error(ErrorCode::kInvalidArgument, "transfer: empty atlas");
   if (opt_.supersample != 1 && opt_.supersample != 4 && opt_.supersample != 16) {
@@ -1140,9 +1202,14 @@ Expected<TransferResult> Transfer::run() {
   bins_ = bin_by_rows(tris_, H, kBandRows);
   // With a band cache, only the images that bands it lacks read are loaded.
   VT_RETURN_IF_ERROR(setup_cache());
+  lap("setup");
+  // The textures load on a thread of their own while the stores are made and the bands the cache
+  // holds are read (neither reads a texture; both are mostly first touches of fresh memory), and
+  // are waited for before the first band that samples them. The texels do not depend on it.
   std::vector<bool> wanted;
   if (cache_in_) wanted = images_for_uncached_bands();
-  VT_RETURN_IF_ERROR(setup_images(cache_in_ ? &wanted : nullptr));
+  ImageLoading images;
+  images.start([this, &wanted] { return setup_images(cache_in_ ? &wanted : nullptr); });
 
   TransferResult result;
   result.width = W, result.height = H;
@@ -1154,6 +1221,7 @@ Expected<TransferResult> Transfer::run() {
   }
   VT_ASSIGN_OR_RETURN(std::shared_ptr<CoverageMask> coverage,
                       CoverageMask::create(W, H, opt_.coverage_in_memory, opt_.scratch_dir));
+  lap("stores");
   std::vector<uint8_t> band_coverage;  // a pass's rows, one byte per texel
   const uint32_t pass = rows_per_pass();
   // Accumulators: an in-memory store's own rows (zero when created), else a pass's buffer
@@ -1178,7 +1246,7 @@ Expected<TransferResult> Transfer::run() {
     if (opt_.progress)
       progress = [&](double f) { opt_.progress((double(r0) + f * double(r1 - r0)) / double(H)); };
     band_coverage.assign(n, 0);
-    VT_RETURN_IF_ERROR(transfer_rows(r0, r1, acc, band_coverage, counts, facts, progress));
+    VT_RETURN_IF_ERROR(transfer_rows(r0, r1, acc, band_coverage, counts, facts, progress, images));
     VT_RETURN_IF_ERROR(
         coverage->write_rows(r0, r1 - r0, band_coverage.data()).with_context("transfer"));
     for (int l = 0; l < kSlots; ++l) {
@@ -1188,10 +1256,18 @@ Expected<TransferResult> Transfer::run() {
   }
   for (auto& b : buffer) b = {};
   band_coverage = {};
+  lap("bands");
+  VT_RETURN_IF_ERROR(images.wait());  // (a transfer of no rows)
+  // Beside the stages: the textures' loading, which ran during "stores" and "bands", and what
+  // "bands" waited for it.
+  const std::pair<const char*, double> loading[] = {{"images", images.seconds()},
+                                                    {"images_wait", images.waited()}};
   // A cache that cannot be written only costs the next update its reuse.
   if (cache_out_) (void)cache_out_->finish();
+  lap("cache");
 
   VT_ASSIGN_OR_RETURN(result.layers, make_layers(stores, facts));
+  lap("layers");
   result.coverage = coverage;
   result.missing_textures = missing_;
   result.stats.triangles = tris_.size();
@@ -1206,6 +1282,8 @@ Expected<TransferResult> Transfer::run() {
   result.stats.bands_cached = bands_cached_;
   result.stats.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stages.insert(stages.end(), std::begin(loading), std::end(loading));
+  result.stats.stage_seconds = std::move(stages);
   return result;
 }
 

@@ -15,6 +15,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bake/lighting.h"
@@ -123,6 +124,12 @@ struct TransferStats {
   uint64_t bands = 0;             // bands of rows, and those read from the band cache
   uint64_t bands_cached = 0;
   double seconds = 0;
+  // Where `seconds` went, in order: "setup" (triangles, bins, band keys), "stores" (the layers'
+  // level-0 stores made), "bands" (rasterised and sampled, or read from the band cache), "cache"
+  // (the band cache written), "layers" (finished layers); then, beside them, "images" (the
+  // textures' loading, on its own thread during "stores" and "bands") and "images_wait" (what
+  // "bands" waited for it).
+  std::vector<std::pair<const char*, double>> stage_seconds;
 };
 
 // A material texture slot whose image could not be read (MissingTextures::kWarn).

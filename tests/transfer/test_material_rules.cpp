@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
@@ -16,6 +17,7 @@
 
 #include "bake/scene_bake.h"
 #include "bake/transfer.h"
+#include "bake/update_scene.h"
 #include "common/srgb.h"
 #include "format/page_file.h"
 #include "tests/transfer/transfer_test_util.h"
@@ -209,6 +211,69 @@ TEST(TransferRules, MissingTextureIsAnErrorNamingMaterialSlotAndPath) {
       dir.file("missing.png") + "): ";
   EXPECT_EQ(r.status().message().substr(0, want.size()), want) << r.status().message();
   EXPECT_GT(r.status().message().size(), want.size());  // OpenImageIO's reason follows
+}
+
+// With a band cache, the textures load on a thread of their own beside the cached bands (issue
+// 16): the texels are those of a transfer without a cache whether every band is cached, none is
+// (the texture repainted) or the texture is gone (an error naming it, or its factor alone).
+TEST(TransferRules, TexturesLoadedBesideTheCachedBandsGiveTheSameTexelsAndErrors) {
+  test::ScratchDir dir;
+  const std::string paint = dir.file("paint.png");
+  auto draw = [&](int shift) {
+    write_rgb(paint, 16, 16, [&](int i, int j, uint8_t* t) {
+      t[0] = uint8_t(i * 16 + shift), t[1] = uint8_t(j * 16), t[2] = uint8_t((i ^ j) * 16);
+    });
+  };
+  draw(0);
+  scene::Material m;
+  m.name = "Brick";
+  const scene::Scene s = test::textured_scene(atlas_quad(), paint, m);
+  auto plain = [&](MissingTextures policy) {
+    TransferOptions o = atlas_options();
+    o.missing_textures = policy;
+    return transfer_materials(s, o);
+  };
+  auto cached = [&](MissingTextures policy) {
+    TransferOptions o = atlas_options();
+    o.missing_textures = policy;
+    o.cache_in = o.cache_out = dir.file("bands.bin");
+    o.image_keys = image_content_keys(s);
+    return transfer_materials(s, o);
+  };
+  auto albedo = [](const Expected<TransferResult>& r) {
+    return r.ok() && find(*r, LayerSemantic::kAlbedo) ? find(*r, LayerSemantic::kAlbedo)->texels
+                                                      : std::vector<float>{};
+  };
+  auto first = cached(MissingTextures::kError);  // writes the cache (none to read yet)
+  ASSERT_TRUE(first.ok()) << first.status().message();
+  EXPECT_EQ(first->stats.bands_cached, 0u);
+  const std::vector<float> want = albedo(plain(MissingTextures::kError));
+  ASSERT_FALSE(want.empty());
+  EXPECT_EQ(albedo(first), want);
+  auto again = cached(MissingTextures::kError);  // every band from the cache
+  ASSERT_TRUE(again.ok()) << again.status().message();
+  EXPECT_EQ(again->stats.bands_cached, again->stats.bands);
+  EXPECT_EQ(albedo(again), want);
+
+  draw(7);  // repainted: no band's key holds, every band waits for the texture
+  auto repainted = cached(MissingTextures::kError);
+  ASSERT_TRUE(repainted.ok()) << repainted.status().message();
+  EXPECT_EQ(repainted->stats.bands_cached, 0u);
+  const std::vector<float> want_repainted = albedo(plain(MissingTextures::kError));
+  EXPECT_NE(want_repainted, want);
+  EXPECT_EQ(albedo(repainted), want_repainted);
+
+  std::filesystem::remove(paint);  // gone: the loading thread's error is the transfer's
+  auto missing = cached(MissingTextures::kError);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_EQ(missing.status().code(), ErrorCode::kNotFound);
+  const std::string named = "material 'Brick' baseColorTexture: cannot read image 'paint'";
+  EXPECT_EQ(missing.status().message().substr(0, named.size()), named)
+      << missing.status().message();
+  auto warned = cached(MissingTextures::kWarn);
+  ASSERT_TRUE(warned.ok()) << warned.status().message();
+  EXPECT_EQ(warned->missing_textures.size(), 1u);
+  EXPECT_EQ(albedo(warned), albedo(plain(MissingTextures::kWarn)));
 }
 
 // An embedded PNG with a damaged IDAT is one kCorrupt error naming the material, the slot and
