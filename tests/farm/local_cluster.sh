@@ -60,8 +60,8 @@ ProctrackType=proctrack/linuxproc
 TaskPlugin=task/none
 SelectType=select/cons_tres
 SelectTypeParameters=CR_CPU
-SchedulerType=sched/backfill
-SchedulerParameters=bf_interval=1,sched_interval=1
+SchedulerType=${CLUSTER_SCHEDULER_TYPE:-sched/backfill}
+SchedulerParameters=${CLUSTER_SCHEDULER_PARAMETERS:-bf_interval=1,sched_interval=1}
 JobAcctGatherType=jobacct_gather/none
 AccountingStorageType=accounting_storage/none
 JobCompType=jobcomp/filetxt
