@@ -686,8 +686,8 @@ Expected<std::vector<LayerInput>> work_layers(const WorkPlan& w, const BuildOpti
       in.source = std::make_shared<PlannedSource>(std::move(info), unhex(l["content_hash"]),
                                                   w.dir + "/" + l.value("work_file", ""));
     } else {
-      return Error(ErrorCode::kCorrupt, work_plan_path(w.dir) + ": layer " +
-                                            l.value("name", "") + " has no level 0 file");
+      return Error(ErrorCode::kCorrupt, work_plan_path(w.dir) + ": layer " + l.value("name", "") +
+                                            " has no level 0 file");
     }
     if (l.value("alpha_dropped", false)) {
       in.source = std::make_shared<DropChannelSource>(in.source, channels - 1);
@@ -1171,13 +1171,11 @@ Expected<bool> merge_when_complete(const MergeOptions& options, uint32_t count,
   VT_ASSIGN_OR_RETURN(MergeSummary merged, merge_shards(options));
   OutputSet record;
   VT_ASSIGN_OR_RETURN(const std::string staged, record.stage(work_merged_path(w.dir)));
-  VT_RETURN_IF_ERROR(write_text(
-      staged, nlohmann::json{{"plan_hash", hex(w.hash)},
-                             {"output", output},
-                             {"bytes", merged.file_bytes},
-                             {"parts", merged.parts}}
-                      .dump(1) +
-                  "\n"));
+  const nlohmann::json done = {{"plan_hash", hex(w.hash)},
+                               {"output", output},
+                               {"bytes", merged.file_bytes},
+                               {"parts", merged.parts}};
+  VT_RETURN_IF_ERROR(write_text(staged, done.dump(1) + "\n"));
   VT_RETURN_IF_ERROR(record.commit());
   if (summary) *summary = std::move(merged);
   return true;
