@@ -2,6 +2,7 @@
 #include "bake/shard.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 #define XXH_STATIC_LINKING_ONLY  // XXH3_state_t as a member
 #include <xxhash.h>
@@ -101,6 +102,26 @@ class RawFileSource final : public ImageSource {
   std::string path_;
   ImageInfo info_;
   std::optional<uint64_t> hash_;
+};
+
+// Level 0 of a layer the plan wrote only in working form: its identity (shape, the plan's
+// content hash) without texels; the shard reads the working form instead (given_levels).
+class PlannedSource final : public ImageSource {
+ public:
+  PlannedSource(ImageInfo info, uint64_t hash, std::string what)
+      : info_(std::move(info)), hash_(hash), what_(std::move(what)) {}
+  const ImageInfo& info() const override { return info_; }
+  Expected<uint64_t> content_hash() override { return hash_; }
+  Status read_rows(uint32_t, uint32_t, float*) override {
+    return Error(ErrorCode::kInternal,
+                 what_ + ": the plan wrote this layer's level 0 in working form only");
+  }
+  std::string origin() const override { return what_; }
+
+ private:
+  ImageInfo info_;
+  uint64_t hash_;
+  std::string what_;
 };
 
 // A level in its working form as the plan wrote it (converted, dilated), read by rows.
@@ -364,21 +385,33 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
   for (const StageTime& st : prepared->summary.stages) sum.stages.push_back(st);
 
   // Level 0 as the transfer gave it (before drop_opaque_alpha, which each shard runs again:
-  // the plan hash is of the sources as the build sees them).
+  // the plan hash is of the sources as the build sees them). A layer that carries the coverage
+  // mask gets its level 0 in working form below, which is all its shards read of it: for those
+  // only the content hash is recorded, not the texels (a whole level of writes saved).
   t0 = Clock::now();
   BuildOptions bo = prepared->build;
+  const bool coverage = !bo.layers.empty() && bo.layers[0].coverage;
   nlohmann::json layers = nlohmann::json::array();
   std::vector<uint64_t> layer_hashes;
+  std::vector<bool> raw_written;
   for (size_t i = 0; i < bo.layers.size(); ++i) {
     const LayerInput& in = bo.layers[i];
     const ImageInfo& info = in.source->info();
     const std::string name = in.name.empty() ? to_string(in.semantic) : in.name;
-    const std::string file = "level0/" + name + ".f32";
+    const bool raw = !coverage || in.coverage != bo.layers[0].coverage;
+    const std::string file = raw ? "level0/" + name + ".f32" : "";
     if (!dir.empty()) {
-      VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/" + file));
-      VT_ASSIGN_OR_RETURN(const uint64_t hash, write_source(*in.source, staged));
+      uint64_t hash = 0;
+      if (raw) {
+        VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/" + file));
+        VT_ASSIGN_OR_RETURN(hash, write_source(*in.source, staged));
+      } else {
+        // Before plan_build: a source that hands its texels over to level 0 hashes them first.
+        VT_ASSIGN_OR_RETURN(hash, in.source->content_hash());
+      }
       layer_hashes.push_back(hash);
     }
+    raw_written.push_back(raw);
     layers.push_back({{"name", name},
                       {"semantic", int(in.semantic)},
                       {"file", file},
@@ -390,7 +423,6 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
                       {"info_color_space", info.color_space},
                       {"color_space", in.color_space}});
   }
-  const bool coverage = !bo.layers.empty() && bo.layers[0].coverage;
   if (!dir.empty() && coverage) {
     VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/level0/coverage.u8"));
     VT_RETURN_IF_ERROR(write_coverage(*bo.layers[0].coverage, staged));
@@ -415,7 +447,14 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
   t0 = Clock::now();
   for (size_t i = 0; i < plan.layers.size() && !dir.empty(); ++i) {
     LevelSource& level0 = *plan.layers[i].level0;
-    if (!coverage || level0.coverage() != bo.layers[i].coverage.get()) continue;
+    if (!coverage || level0.coverage() != bo.layers[i].coverage.get()) {
+      if (!raw_written[i]) {
+        return Error(ErrorCode::kInternal, "plan: layer " + plan.layers[i].spec.name +
+                                               " has neither level 0 as transferred nor its "
+                                               "working form in the work folder");
+      }
+      continue;
+    }
     const std::string file = "level0/" + plan.layers[i].spec.name + ".work.f32";
     VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/" + file));
     VT_RETURN_IF_ERROR(write_level(level0, staged));
@@ -503,7 +542,11 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
     VT_RETURN_IF_ERROR(write_text(staged, j.dump(1) + "\n"));
   }
   VT_RETURN_IF_ERROR(outputs.commit());
-  if (!dir.empty()) remove_stale_parts(dir, plan.hash);
+  if (!dir.empty()) {
+    remove_stale_parts(dir, plan.hash);
+    std::error_code ec;
+    fs::remove(work_merged_path(dir), ec);  // no merge of this plan yet
+  }
   sum.stages.push_back({"write", seconds_since(t0)});
   sum.plan_hash = plan.hash;
   sum.seconds = seconds_since(start);
@@ -634,10 +677,18 @@ Expected<std::vector<LayerInput>> work_layers(const WorkPlan& w, const BuildOpti
     in.color_space = l.value("color_space", "");
     in.coverage = coverage;
     const uint32_t channels = info.channels;
-    VT_ASSIGN_OR_RETURN(std::shared_ptr<RawFileSource> raw,
-                        RawFileSource::open(w.dir + "/" + l.value("file", ""), std::move(info)));
-    if (l.contains("content_hash")) raw->set_content_hash(unhex(l["content_hash"]));
-    in.source = std::move(raw);
+    if (const std::string file = l.value("file", ""); !file.empty()) {
+      VT_ASSIGN_OR_RETURN(std::shared_ptr<RawFileSource> raw,
+                          RawFileSource::open(w.dir + "/" + file, std::move(info)));
+      if (l.contains("content_hash")) raw->set_content_hash(unhex(l["content_hash"]));
+      in.source = std::move(raw);
+    } else if (l.contains("content_hash") && !l.value("work_file", "").empty()) {
+      in.source = std::make_shared<PlannedSource>(std::move(info), unhex(l["content_hash"]),
+                                                  w.dir + "/" + l.value("work_file", ""));
+    } else {
+      return Error(ErrorCode::kCorrupt, work_plan_path(w.dir) + ": layer " + l.value("name", "") +
+                                            " has no level 0 file");
+    }
     if (l.value("alpha_dropped", false)) {
       in.source = std::make_shared<DropChannelSource>(in.source, channels - 1);
       in.alpha_dropped = true;
@@ -713,6 +764,9 @@ Expected<ShardSummary> run_shard(const ShardOptions& options) {
   }
   std::vector<uint32_t> mine = options.tasks;
   std::string part;
+  if (options.merge_last && options.count == 0) {
+    return Error(ErrorCode::kInvalidArgument, "merging after a shard needs --shard I/N");
+  }
   if (options.count > 0) {
     if (options.index >= options.count) {
       return Error(ErrorCode::kInvalidArgument, "--shard " + std::to_string(options.index) + "/" +
@@ -807,6 +861,19 @@ Expected<ShardSummary> run_shard(const ShardOptions& options) {
   VT_RETURN_IF_ERROR(f.close());
   VT_RETURN_IF_ERROR(outputs.commit());
   sum.stages.push_back({"write", seconds_since(t0)});
+  if (options.merge_last) {
+    // After the commit: of shards finishing together, at least the last to commit sees every
+    // part.
+    t0 = Clock::now();
+    MergeOptions mo = options.merge;
+    mo.work_dir = w.dir;
+    auto merged = merge_when_complete(mo, options.count, &sum.merge);
+    if (!merged.ok()) {
+      return merged.status().with_context("the shard's part is written; merging " + w.dir);
+    }
+    sum.merged = *merged;
+    sum.stages.push_back({"merge", seconds_since(t0)});
+  }
   sum.pages = sink.counts.pages, sum.stored = sink.counts.stored;
   sum.constant = sink.counts.constant, sum.stored_bytes = sink.counts.stored_bytes;
   sum.seconds = seconds_since(start);
@@ -1059,6 +1126,59 @@ Expected<MergeSummary> merge_shards(const MergeOptions& options) {
   sum.file_bytes = fs::file_size(sum.output, ec);
   sum.seconds = seconds_since(start);
   return sum;
+}
+
+std::string work_merged_path(const std::string& work_dir) {
+  return (fs::path(work_dir) / "merged.json").string();
+}
+
+Expected<bool> merge_when_complete(const MergeOptions& options, uint32_t count,
+                                   MergeSummary* summary) {
+  VT_ASSIGN_OR_RETURN(const WorkPlan w, load_plan(options.work_dir));
+  // Cheap first: a shard that finishes before the others only looks for their parts.
+  auto complete = [&] {
+    std::error_code ec;
+    for (uint32_t i = 0; i < count; ++i)
+      if (!fs::exists(shard_part_path(w.dir, i, count), ec)) return false;
+    return true;
+  };
+  if (!complete()) return false;
+  // One merge at a time: shards finishing together queue here; the first merges, the others
+  // find its record. (flock: local and NFSv4 file systems honour it across nodes.)
+  const std::string lock_path = (fs::path(w.dir) / "merge.lock").string();
+  const int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) return io_error(lock_path, "cannot open");
+  struct Unlock {
+    int fd;
+    ~Unlock() { ::close(fd); }  // closing releases the lock
+  } unlock{fd};
+  while (::flock(fd, LOCK_EX) != 0)
+    if (errno != EINTR) return io_error(lock_path, "cannot lock");
+  const std::string output =
+      absolute(options.output.empty() ? w.json.value("output", "") : options.output);
+  {
+    std::ifstream in(work_merged_path(w.dir), std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    const auto j = nlohmann::json::parse(in ? text.str() : "", nullptr, false);
+    std::error_code ec;
+    if (j.is_object() && unhex(j.value("plan_hash", nlohmann::json())) == w.hash &&
+        j.value("output", "") == output &&
+        fs::file_size(output, ec) == j.value("bytes", uint64_t(0)) && !ec) {
+      return false;  // merged already, by another shard
+    }
+  }
+  VT_ASSIGN_OR_RETURN(MergeSummary merged, merge_shards(options));
+  OutputSet record;
+  VT_ASSIGN_OR_RETURN(const std::string staged, record.stage(work_merged_path(w.dir)));
+  const nlohmann::json done = {{"plan_hash", hex(w.hash)},
+                               {"output", output},
+                               {"bytes", merged.file_bytes},
+                               {"parts", merged.parts}};
+  VT_RETURN_IF_ERROR(write_text(staged, done.dump(1) + "\n"));
+  VT_RETURN_IF_ERROR(record.commit());
+  if (summary) *summary = std::move(merged);
+  return true;
 }
 
 Expected<std::vector<uint32_t>> missing_shards(const std::string& work_dir, uint32_t count) {

@@ -50,27 +50,6 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
 Expected<std::vector<uint32_t>> shard_tasks(const std::string& work_dir, uint32_t index,
                                             uint32_t count);
 
-struct ShardOptions {
-  std::string work_dir;
-  uint32_t index = 0, count = 0;  // --shard I/N, I in [0, N)
-  std::vector<uint32_t> tasks;    // --tasks LIST instead (count == 0)
-  // The build settings, as the plan was made with (flags, memory limit, threads, scratch): the
-  // shard's plan must have the plan's hash. Layers, metadata and keys come from the folder.
-  BuildOptions build;
-};
-
-struct ShardSummary {
-  std::string part;
-  std::vector<uint32_t> tasks;
-  uint64_t pages = 0, stored = 0, constant = 0, stored_bytes = 0;
-  std::vector<StageTime> stages;  // read, plan, build, write
-  double seconds = 0;
-};
-
-// Step 2. Errors: no plan in the folder, a shard index out of range, settings that give another
-// plan hash than the folder's, or a failed write (nothing is left under the part's name).
-Expected<ShardSummary> run_shard(const ShardOptions& options);
-
 struct MergeOptions {
   std::string work_dir;
   std::string output;     // the .vtpf ("" = the plan's output)
@@ -84,9 +63,46 @@ struct MergeSummary {
   double seconds = 0;
 };
 
+struct ShardOptions {
+  std::string work_dir;
+  uint32_t index = 0, count = 0;  // --shard I/N, I in [0, N)
+  std::vector<uint32_t> tasks;    // --tasks LIST instead (count == 0)
+  // The build settings, as the plan was made with (flags, memory limit, threads, scratch): the
+  // shard's plan must have the plan's hash. Layers, metadata and keys come from the folder.
+  BuildOptions build;
+  // With --shard I/N: once its part is written, merge if every part of N is there
+  // (merge_when_complete), so that the last shard to finish writes the page file and a farm
+  // needs no merge job. `merge.work_dir` is taken from `work_dir`.
+  bool merge_last = false;
+  MergeOptions merge;
+};
+
+struct ShardSummary {
+  std::string part;
+  std::vector<uint32_t> tasks;
+  uint64_t pages = 0, stored = 0, constant = 0, stored_bytes = 0;
+  std::vector<StageTime> stages;  // read, plan, build, write (, merge)
+  double seconds = 0;
+  bool merged = false;  // merge_last: this shard merged (`merge` holds the merge's summary)
+  MergeSummary merge;
+};
+
+// Step 2. Errors: no plan in the folder, a shard index out of range, settings that give another
+// plan hash than the folder's, or a failed write (nothing is left under the part's name).
+Expected<ShardSummary> run_shard(const ShardOptions& options);
+
 // Step 3. Refuses (naming the part) a part of another plan, a damaged part, a task whose keys
 // differ between parts; fails listing the tasks no part holds. Nothing is written on failure.
 Expected<MergeSummary> merge_shards(const MergeOptions& options);
+
+// The merge of a complete set of shards, by whichever shard gets there: under an exclusive lock
+// on DIR/merge.lock, merges when every part of `count` is in DIR/parts and DIR/merged.json does
+// not already record this plan's merge into the same output (of the size it had), then records
+// it there. False (nothing written) when a part is absent or the merge is recorded. The plan
+// removes merged.json.
+Expected<bool> merge_when_complete(const MergeOptions& options, uint32_t count,
+                                   MergeSummary* summary);
+std::string work_merged_path(const std::string& work_dir);  // DIR/merged.json
 
 // Shards of `count` (0-based) whose part is absent, damaged or of another plan: the ones a farm
 // must run again.

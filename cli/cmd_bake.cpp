@@ -36,6 +36,7 @@ struct BakeArgs {
   // Sharding over a build farm (bake/shard.h, docs/FARM.md).
   std::string plan, work, shard;
   std::vector<uint32_t> tasks;
+  bool merge_last = false;
 };
 
 // "I/N" -> (I, N) with 0 <= I < N.
@@ -84,25 +85,36 @@ int run_shard(const BakeArgs& a, const vt::cli::GlobalOptions& global) {
     return vt::cli::bad_usage("bake", "--shard " + a.shard + ": expected I/N with 0 <= I < N");
   }
   so.tasks = a.tasks;
+  so.merge_last = a.merge_last;
+  so.merge.output = a.options.build.output;
+  so.merge.unwrapped = a.options.unwrapped;
   auto s = vt::run_shard(so);
   if (!s.ok()) return vt::cli::report_error("bake", s.status());
   if (global.json) {
     nlohmann::json stages = nlohmann::json::object();
     for (const auto& st : s->stages) stages[st.name] = st.seconds;
     stages["total"] = s->seconds;
-    vt::cli::print_json(
-        "bake", vt::cli::kExitOk,
-        {{"input", a.work},
-         {"output", s->part},
-         {"tasks", s->tasks},
-         {"pages", {{"total", s->pages}, {"stored", s->stored}, {"constant", s->constant}}},
-         {"bytes", {{"stored", s->stored_bytes}}},
-         {"seconds", stages}});
+    nlohmann::json report = {
+        {"input", a.work},
+        {"output", s->part},
+        {"tasks", s->tasks},
+        {"pages", {{"total", s->pages}, {"stored", s->stored}, {"constant", s->constant}}},
+        {"bytes", {{"stored", s->stored_bytes}}},
+        {"seconds", stages}};
+    // --merge-last: the page file this shard merged, or null (parts missing, or merged).
+    if (a.merge_last) {
+      report["merged"] = s->merged ? nlohmann::json(s->merge.output) : nlohmann::json(nullptr);
+    }
+    vt::cli::print_json("bake", vt::cli::kExitOk, report);
     return vt::cli::kExitOk;
   }
   std::printf("shard %s: %zu tasks, %llu pages (%llu stored, %llu constant), %.2f s\n",
               s->part.c_str(), s->tasks.size(), (unsigned long long)s->pages,
               (unsigned long long)s->stored, (unsigned long long)s->constant, s->seconds);
+  if (s->merged) {
+    std::printf("merged %s from %zu parts (%llu bytes)\n", s->merge.output.c_str(),
+                s->merge.parts.size(), (unsigned long long)s->merge.file_bytes);
+  }
   return vt::cli::kExitOk;
 }
 
@@ -373,6 +385,11 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
       ->excludes(shard)
       ->excludes(plan);
   shard->excludes(plan);
+  app.add_flag("--merge-last", args->merge_last,
+               "Build farm: with --shard I/N, merge into -o once every part of N is in DIR "
+               "(the last shard to finish merges; DIR/merged.json records it), so a farm needs "
+               "no merge job")
+      ->needs(shard);
   return [args](const vt::cli::GlobalOptions& global) -> int {
     vt::SceneBakeOptions& o = args->options;
     o.build.threads = global.threads;

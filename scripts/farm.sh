@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
-# Bakes one scene on a Slurm cluster (docs/FARM.md): a plan job, a job array of shards, a merge
-# job, chained with --dependency=afterok. Waits, reporting progress from Slurm (squeue for live
-# jobs; sacct when the cluster has accounting, else scontrol's records of finished jobs), and
+# Bakes one scene on a Slurm cluster (docs/FARM.md): a plan job, then a job array of shards
+# chained with --dependency=afterok; the last shard to finish merges (`--merge-last`), so the
+# chain has one dependency step. Waits, reporting progress from Slurm (squeue for live jobs;
+# sacct when the cluster has accounting, else scontrol's records of finished jobs), and
 # resubmits only the shards whose part is missing (`vtbake merge DIR --missing N`) until every
-# shard is there, then merges.
+# shard is there and merged. A merge job runs only when no shard could merge (or --merge-job).
 #
 #   scripts/farm.sh --work DIR [--shards N] [--partition P] [--cpus C] [--plan-cpus C] [--mem M]
-#                   [--time T] [--retries R] [--vtbake PATH] [--poll SECONDS]
+#                   [--time T] [--retries R] [--vtbake PATH] [--poll SECONDS] [--merge-job]
 #                   -- SCENE -o OUT.vtpf [FLAGS]
 # --cpus: CPUs per shard and merge job (default 2); --plan-cpus: for the plan job (default --cpus).
+# --merge-job: merge in a job of its own after the array (a third chained step) instead.
 #
 # Everything after `--` is a `vtbake bake` command line; every job gets the same one. DIR and
 # OUT must be on storage every node sees. Exit 0 when OUT is merged; 1 when shards still fail
@@ -16,8 +18,9 @@
 set -euo pipefail
 
 work="" shards=4 partition="" cpus=2 plan_cpus="" mem="" time_limit="1:00:00" retries=2 poll=1
+merge_step=0
 vtbake="${VTBAKE:-vtbake}"
-usage() { sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
+usage() { sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --work) work="$2"; shift 2 ;;
@@ -30,6 +33,7 @@ while [[ $# -gt 0 ]]; do
     --retries) retries="$2"; shift 2 ;;
     --vtbake) vtbake="$2"; shift 2 ;;
     --poll) poll="$2"; shift 2 ;;
+    --merge-job) merge_step=1; shift ;;
     --) shift; break ;;
     -h|--help) usage ;;
     *) echo "farm.sh: unknown option $1" >&2; usage ;;
@@ -82,19 +86,35 @@ state_of() { job_states "$1" | awk 'NR == 1 {print $2}'; }
 plan_cmd=$(quote "$vtbake" --threads "$plan_cpus" -q bake "${bake_args[@]}" --work "$work" --plan "$work/plan.json")
 plan_job=$("${sb[@]}" --cpus-per-task="$plan_cpus" -J vtbake-plan -o "$work/logs/plan.out" --wrap "$plan_cmd")
 echo "farm: plan job $plan_job"
+merge_last=""
+[[ $merge_step -eq 0 ]] && merge_last=" --merge-last"
 submit_shards() {  # $1 = array spec, $2 = dependency or ""
   local dep=()
   [[ -n "$2" ]] && dep=(--dependency="afterok:$2")
   "${sb[@]}" "${dep[@]}" -J vtbake-shard --array="$1" -o "$work/logs/shard-%a-%j.out" \
-    --wrap "$bake_cmd --shard \$SLURM_ARRAY_TASK_ID/$shards"
+    --wrap "$bake_cmd --shard \$SLURM_ARRAY_TASK_ID/$shards$merge_last"
 }
-submit_merge() {
-  "${sb[@]}" -J vtbake-merge --dependency="afterok:$1" -o "$work/logs/merge-%j.out" \
+submit_merge() {  # $1 = dependency or ""
+  local dep=()
+  [[ -n "$1" ]] && dep=(--dependency="afterok:$1")
+  "${sb[@]}" "${dep[@]}" -J vtbake-merge -o "$work/logs/merge-%j.out" \
     --wrap "$(quote "$vtbake" -q merge "$work" -o "$output")"
 }
 array_job=$(submit_shards "0-$((shards - 1))" "$plan_job")
-merge_job=$(submit_merge "$array_job")
-echo "farm: shard array $array_job (0-$((shards - 1))), merge job $merge_job"
+merge_job=""
+if [[ $merge_step -eq 1 ]]; then
+  merge_job=$(submit_merge "$array_job")
+  echo "farm: shard array $array_job (0-$((shards - 1))), merge job $merge_job"
+else
+  echo "farm: shard array $array_job (0-$((shards - 1))), the last shard merges"
+fi
+# True when a shard recorded the merge of this plan (DIR/merged.json, written by --merge-last).
+plan_hash_of() { sed -n 's/^ *"plan_hash": *"\([0-9a-f]*\)".*/\1/p' "$1" 2>/dev/null | head -1; }
+merged() {
+  local h
+  h=$(plan_hash_of "$work/merged.json")
+  [[ -n "$h" && "$h" == "$(plan_hash_of "$work/plan.json")" ]]
+}
 
 wait_plan() {
   while ! finished "$plan_job"; do sleep "$poll"; done
@@ -102,7 +122,7 @@ wait_plan() {
   s=$(state_of "$plan_job")
   if [[ "$s" != COMPLETED ]]; then
     echo "farm: plan job $plan_job $s (log: $work/logs/plan.out)" >&2
-    scancel "$array_job" "$merge_job" 2>/dev/null || true
+    scancel "$array_job" $merge_job 2>/dev/null || true
     exit 1
   fi
 }
@@ -124,19 +144,33 @@ while :; do
     [[ $done_now -eq 1 ]] && break
     sleep "$poll"
   done
+  # The common end: the last shard merged (no vtbake start-up to ask).
+  if [[ $merge_step -eq 0 ]] && merged; then
+    echo "farm: merged $output (by the last shard)"
+    exit 0
+  fi
   missing=$("$vtbake" merge "$work" --missing "$shards" | paste -sd, -)
   [[ -z "$missing" ]] && break
-  scancel "$merge_job" 2>/dev/null || true
+  [[ -n "$merge_job" ]] && { scancel "$merge_job" 2>/dev/null || true; }
   if [[ $attempt -ge $retries ]]; then
     echo "farm: shards $missing still missing after $retries resubmissions (logs: $work/logs)" >&2
     exit 1
   fi
   attempt=$((attempt + 1))
   array_job=$(submit_shards "$missing" "")
-  merge_job=$(submit_merge "$array_job")
-  echo "farm: resubmitted shards $missing as job $array_job (attempt $attempt), merge job $merge_job"
+  if [[ $merge_step -eq 1 ]]; then
+    merge_job=$(submit_merge "$array_job")
+    echo "farm: resubmitted shards $missing as job $array_job (attempt $attempt), merge job $merge_job"
+  else
+    echo "farm: resubmitted shards $missing as job $array_job (attempt $attempt)"
+  fi
   last=""
 done
+# Every part is there but no shard merged (its merge failed, or --merge-job): a merge job.
+if [[ -z "$merge_job" ]]; then
+  merge_job=$(submit_merge "")
+  echo "farm: every part is there but no shard merged; merge job $merge_job"
+fi
 while ! finished "$merge_job"; do sleep "$poll"; done
 s=$(state_of "$merge_job")
 if [[ "$s" != COMPLETED ]]; then

@@ -31,7 +31,7 @@ class FarmCli : public ::testing::Test {
     if (!setup_error_.empty()) return;
     fs::create_directories(dir_ + "/local");
     for (const char* name : {"four", "tasks", "one", "kill", "a", "b", "alpha", "alpha_local",
-                             "opaque", "opaque_local"})
+                             "opaque", "opaque_local", "last"})
       fs::create_directories(dir_ + "/" + name);
     RunResult b =
         run_vtbake("-q bake " + scene() + " -o " + dir_ + "/local/out.vtpf " + flags(), true);
@@ -276,6 +276,53 @@ TEST_F(FarmCli, ShardsTakeHashesAndAlphaDecisionsFromThePlan) {
     EXPECT_FALSE(albedo["alpha_dropped"].get<bool>()) << name;  // the transfer decided already
     EXPECT_EQ(albedo["channels"].get<int>(), name == "opaque" ? 3 : 4) << name;
   }
+}
+
+// `--merge-last`: the shard that completes the set merges (a farm needs no merge job), once:
+// a shard that finds a part missing merges nothing, the last one writes the one-process bytes
+// and records it in DIR/merged.json, a shard run again after that finds the record and leaves
+// the output alone, and the record no longer counts once the output is gone or the folder is
+// planned again. The plan writes level 0 only in working form (the shards read nothing else).
+TEST_F(FarmCli, TheLastShardMergesOnce) {
+  ASSERT_EQ(bake("last", "--plan " + work("last") + "/plan.json").exit_code, 0);
+  auto plan = nlohmann::json::parse(read_file(work("last") + "/plan.json"));
+  for (const auto& l : plan["layers"]) {
+    EXPECT_EQ(l["file"], "") << l["name"];
+    EXPECT_FALSE(l["work_file"].get<std::string>().empty()) << l["name"];
+    EXPECT_FALSE(fs::exists(work("last") + "/level0/" + l["name"].get<std::string>() + ".f32"));
+  }
+  const std::string out = dir_ + "/last/out.vtpf";
+  auto shard = [&](const std::string& which) {
+    RunResult r = run_vtbake("--json bake " + scene() + " -o " + out + " " + flags() + " --work " +
+                                 work("last") + " --shard " + which + " --merge-last",
+                             false);
+    EXPECT_EQ(r.exit_code, 0) << r.out;
+    auto j = nlohmann::json::parse(r.out, nullptr, false);
+    EXPECT_TRUE(j.is_object() && j.contains("merged")) << r.out;
+    return j.is_object() ? j["merged"] : nlohmann::json();
+  };
+  EXPECT_TRUE(shard("0/2").is_null());
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(work("last") + "/merged.json"));
+  EXPECT_EQ(shard("1/2"), out);
+  expect_same_as_local("last");
+  auto record = nlohmann::json::parse(read_file(work("last") + "/merged.json"));
+  EXPECT_EQ(record["plan_hash"], plan["plan_hash"]);
+  EXPECT_EQ(record["bytes"].get<uint64_t>(), fs::file_size(out));
+  // Run again: the record says merged, the output is not rewritten.
+  const auto written = fs::last_write_time(out);
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_TRUE(shard("0/2").is_null());
+  EXPECT_EQ(fs::last_write_time(out), written);
+  // The output gone: the next shard to finish merges again.
+  fs::remove(out);
+  EXPECT_EQ(shard("0/2"), out);
+  expect_same_as_local("last");
+  // A new plan of the folder drops the record (and the parts of another plan, if any).
+  ASSERT_EQ(bake("last", "--plan " + work("last") + "/plan.json").exit_code, 0);
+  EXPECT_FALSE(fs::exists(work("last") + "/merged.json"));
+  // --merge-last takes --shard, not --tasks.
+  EXPECT_NE(bake("last", "--tasks 0 --merge-last").exit_code, 0);
 }
 
 }  // namespace

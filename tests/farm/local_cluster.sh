@@ -9,6 +9,9 @@
 # Accounting: no slurmdbd; AccountingStorageType=accounting_storage/none (progress comes from
 # squeue and scontrol's job records, kept MinJobAge seconds) and JobCompType=jobcomp/filetxt
 # (one line per finished job in DIR/jobcomp.txt).
+# For scheduling experiments (docs/FARM.md, "Scheduling latency"): CLUSTER_SCHEDULER_TYPE and
+# CLUSTER_SCHEDULER_PARAMETERS replace SchedulerType/SchedulerParameters, CLUSTER_EXTRA_CONF adds
+# slurm.conf lines.
 
 CLUSTER_PIDS=()
 
@@ -60,8 +63,8 @@ ProctrackType=proctrack/linuxproc
 TaskPlugin=task/none
 SelectType=select/cons_tres
 SelectTypeParameters=CR_CPU
-SchedulerType=sched/backfill
-SchedulerParameters=bf_interval=1,sched_interval=1
+SchedulerType=${CLUSTER_SCHEDULER_TYPE:-sched/backfill}
+SchedulerParameters=${CLUSTER_SCHEDULER_PARAMETERS:-bf_interval=1,sched_interval=1}
 JobAcctGatherType=jobacct_gather/none
 AccountingStorageType=accounting_storage/none
 JobCompType=jobcomp/filetxt
@@ -70,6 +73,7 @@ MpiDefault=none
 ReturnToService=2
 MinJobAge=600
 MessageTimeout=20
+${CLUSTER_EXTRA_CONF:-}
 NodeName=$host CPUs=$cpus RealMemory=$mem_mb State=UNKNOWN
 PartitionName=local Nodes=$host Default=YES MaxTime=INFINITE State=UP
 EOF

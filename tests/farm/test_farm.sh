@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The build farm for real (issue 17): a one-node Slurm cluster (local_cluster.sh), the sample
 # scene baked through scripts/farm.sh with 4 shards, one shard killed on purpose on its first
-# run; the farm resubmits it alone and the merged page file and unwrapped scene are byte-identical
-# to a one-process bake. Stops every daemon it started, by PID. Skips (exit 77) only when the
+# run; the farm resubmits it alone, that shard merges (the last one to finish does), and the
+# merged page file and unwrapped scene are byte-identical to a one-process bake. Stops every daemon it started, by PID. Skips (exit 77) only when the
 # Slurm or munge binaries are absent (scripts/setup.sh installs them).
 #   tests/farm/test_farm.sh VTBAKE [SOURCE_DIR]
 set -euo pipefail
@@ -60,6 +60,15 @@ PATH="$(dirname "$vtbake"):$PATH" "$src/scripts/farm.sh" --work "$tmp/farm/work"
 [[ -e "$tmp/killed-once" ]] || fail "shard 2 was never started"
 grep -q "failed 1" "$tmp/farm.log" || fail "Slurm did not report the killed shard as failed"
 grep -q "resubmitted shards 2 as job" "$tmp/farm.log" || fail "the farm did not resubmit shard 2 alone"
+# The resubmitted shard completed the set, so it merged: no merge job was needed.
+grep -q "(by the last shard)" "$tmp/farm.log" || fail "no shard merged (the farm fell back to a merge job)"
+grep -q "merge job" "$tmp/farm.log" && fail "the farm submitted a merge job although a shard merged"
 cmp "$tmp/local/out.vtpf" "$tmp/farm/out.vtpf" || fail "merged page file differs from the local bake"
 cmp "$tmp/local/out.glb" "$tmp/farm/out.glb" || fail "merged unwrapped scene differs from the local bake"
+# --merge-job: the merge as a job of its own after the array (the chain before --merge-last).
+"$src/scripts/farm.sh" --work "$tmp/farm2/work" --shards 2 --cpus 1 --time 10:00 --poll 0.5 \
+  --merge-job --vtbake "$vtbake" -- "$tmp/scene/scene.gltf" -o "$tmp/farm2/out.vtpf" \
+  "${flags[@]}" | tee "$tmp/farm2.log"
+grep -q ", merge job [0-9]" "$tmp/farm2.log" || fail "--merge-job submitted no merge job"
+cmp "$tmp/local/out.vtpf" "$tmp/farm2/out.vtpf" || fail "--merge-job: merged page file differs"
 echo "PASS: 4 shards through Slurm, one killed and resubmitted, merge byte-identical ($(stat -c %s "$tmp/farm/out.vtpf") bytes)"
