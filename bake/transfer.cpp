@@ -183,6 +183,9 @@ constexpr TextureSlot kTextureSlots[] = {
 };
 // Indices into kTextureSlots.
 enum TexSlot { kBaseColorTex, kMetalRoughTex, kNormalTex, kOcclusionTex, kEmissiveTex, kTexSlots };
+// The order Transfer::evaluate samples the slots in.
+constexpr TexSlot kEvalOrder[kTexSlots] = {kBaseColorTex, kEmissiveTex, kOcclusionTex,
+                                           kMetalRoughTex, kNormalTex};
 
 // One primitive as the transfer sees it.
 struct PrimInfo {
@@ -212,6 +215,10 @@ struct TriEval {
     double s[3], t[3];
     TextureLookup q;
     TextureFootprint footprint;
+    // A slot sampled before this one (kEvalOrder) whose sample is this one's bit for bit (the
+    // same texels at the same coordinates, sampler and footprint: VirtualCity's occlusion reads
+    // its base colour image), or -1.
+    int same_as = -1;
   };
   Lookup tex[kTexSlots];
 };
@@ -416,8 +423,12 @@ class Transfer {
   std::unique_ptr<LightingBaker> lighting_;  // only when the scene has lights
   // The lighting slot holds lit albedo (LightingLayer::kCombined): RGB + alpha, as albedo.
   bool combined_ = false;
+  // Every material in use is OPAQUE: alpha is 1 wherever a sample lands, so albedo (and lit
+  // albedo) are accumulated as RGB from the start (the layers make_layers would leave, without
+  // a quarter of their store memory to fault in and compact).
+  bool opaque_ = false;
   bool has_alpha(int slot) const {
-    return slot == kAlbedoSlot || (slot == kLightingSlot && combined_);
+    return !opaque_ && (slot == kAlbedoSlot || (slot == kLightingSlot && combined_));
   }
   double sub_scale_ = 1.0;
   uint64_t texture_bytes_ = 0;  // the loaded textures' texels
@@ -652,11 +663,15 @@ Status Transfer::setup_prims() {
   want_[kOrmSlot] = any_orm;
   want_[kEmissiveSlot] = any_emissive;
   want_[kLightingSlot] = scene_has_lights(scene_);
+  opaque_ = std::all_of(prims_.begin(), prims_.end(), [](const PrimInfo& p) {
+    return p.mat->alpha_mode == scene::AlphaMode::kOpaque;
+  });
   for (int l = 0; l < kSlots; ++l) channels_[l] = kSlotInfo[l].channels;
+  if (opaque_) channels_[kAlbedoSlot] = 3;
   if (want_[kLightingSlot]) {
     VT_ASSIGN_OR_RETURN(lighting_, LightingBaker::create(scene_, opt_.lighting, opt_.threads));
     combined_ = opt_.lighting.layer == LightingLayer::kCombined;
-    channels_[kLightingSlot] = combined_ ? 4 : lighting_->channels();
+    channels_[kLightingSlot] = combined_ ? (opaque_ ? 3 : 4) : lighting_->channels();
   }
   return setup_raster();
 }
@@ -734,6 +749,7 @@ void Transfer::make_eval(uint32_t t, TriEval& te) const {
   for (int k = 0; k < kTexSlots; ++k) {
     const scene::TextureRef& ref = (*pi.mat).*kTextureSlots[k].ref;
     TriEval::Lookup& lk = te.tex[k];
+    lk.same_as = -1;
     const ImageSlot* image = ref.valid() ? &images_[ref.image] : nullptr;
     const bool colour = k == kBaseColorTex || k == kEmissiveTex;
     lk.texture = !image                           ? nullptr
@@ -749,6 +765,27 @@ void Transfer::make_eval(uint32_t t, TriEval& te) const {
     lk.q.nearest = ref.mag_filter == scene::FilterMode::kNearest;
     lk.q.d = scene::texture_uv_derivatives(ref, te.duv[ref.texcoord]);
     lk.footprint = lk.texture->footprint(lk.q.d);
+  }
+  // Slots whose samples equal an earlier slot's: one texture, or a colour image's two pyramids
+  // (ImageSlot::data_texture) while both read level 0 alone (the levels made differ, the file's
+  // level 0 is the same floats); the same coordinates, sampler and footprint.
+  for (int i = 1; i < kTexSlots; ++i) {
+    TriEval::Lookup& lk = te.tex[kEvalOrder[i]];
+    if (!lk.texture) continue;
+    const int image = ((*pi.mat).*kTextureSlots[kEvalOrder[i]].ref).image;
+    for (int j = 0; j < i && lk.same_as < 0; ++j) {
+      const TriEval::Lookup& o = te.tex[kEvalOrder[j]];
+      if (!o.texture) continue;
+      const TextureFootprint &a = lk.footprint, &b = o.footprint;
+      const bool level0 = a.level == 0 && a.blend == 0 && b.level == 0 && b.blend == 0;
+      const bool texels = lk.texture == o.texture ||
+                          (level0 && image == ((*pi.mat).*kTextureSlots[kEvalOrder[j]].ref).image);
+      if (texels && std::equal(lk.s, lk.s + 3, o.s) && std::equal(lk.t, lk.t + 3, o.t) &&
+          lk.q.wrap_s == o.q.wrap_s && lk.q.wrap_t == o.q.wrap_t && lk.q.nearest == o.q.nearest &&
+          a.taps == b.taps && a.level == b.level && a.blend == b.blend && a.step_s == b.step_s &&
+          a.step_t == b.step_t)
+        lk.same_as = kEvalOrder[j];
+    }
   }
 }
 
@@ -781,8 +818,22 @@ void Transfer::evaluate(const TriEval& te, const double l[3], uint64_t seed, Sam
   const scene::Material& m = *te.p->mat;
   const scene::Primitive& p = *te.p->prim;
   float tex[4];
+  // Each slot's sample, kept for the later slots that share it (TriEval::Lookup::same_as).
+  float taken[kTexSlots][4];
+  unsigned have = 0;
+  auto lookup = [&](TexSlot slot, float out[4]) {
+    const int same = te.tex[slot].same_as;
+    if (same >= 0 && (have >> same & 1)) {
+      std::memcpy(out, taken[same], sizeof taken[same]);
+    } else {
+      if (!sample_texture(slot, te, l, out)) return false;
+      std::memcpy(taken[slot], out, sizeof taken[slot]);
+      have |= 1u << slot;
+    }
+    return true;
+  };
   auto colour = [&](TexSlot slot, const scene::TextureRef& ref, float* rgb) {
-    if (!sample_texture(slot, te, l, tex)) return false;
+    if (!lookup(slot, tex)) return false;
     for (int c = 0; c < 4; ++c) rgb[c] = tex[c];
     if (const auto& to_working = images_[ref.image].to_working) to_working->apply_rgb(rgb);
     return true;
@@ -805,10 +856,10 @@ void Transfer::evaluate(const TriEval& te, const double l[3], uint64_t seed, Sam
   }
   if (want_[kOrmSlot]) {
     float occ = 1, rough = m.roughness_factor, metal = m.metallic_factor;
-    if (sample_texture(kOcclusionTex, te, l, tex)) {
+    if (lookup(kOcclusionTex, tex)) {
       occ = 1.0f + m.occlusion_strength * (tex[0] - 1.0f);
     }
-    if (sample_texture(kMetalRoughTex, te, l, tex)) {
+    if (lookup(kMetalRoughTex, tex)) {
       rough *= tex[1], metal *= tex[2];
     }
     s.orm[0] = occ, s.orm[1] = rough, s.orm[2] = metal;
@@ -816,7 +867,7 @@ void Transfer::evaluate(const TriEval& te, const double l[3], uint64_t seed, Sam
   if (want_[kNormalSlot] || want_[kLightingSlot]) {
     Vec3d n = normalized(lerp3(te.p->normals, te.v, l), te.face_normal);
     Vec3d world = n;
-    if (want_[kNormalSlot] && sample_texture(kNormalTex, te, l, tex)) {
+    if (want_[kNormalSlot] && lookup(kNormalTex, tex)) {
       const auto& tg = te.p->tangents;
       Vec3d t = {tg[te.v[0]][0] * l[0] + tg[te.v[1]][0] * l[1] + tg[te.v[2]][0] * l[2],
                  tg[te.v[0]][1] * l[0] + tg[te.v[1]][1] * l[1] + tg[te.v[2]][1] * l[2],

@@ -132,11 +132,24 @@ void TransferTexture::make_box_levels(const ColorConverter* to_linear,
 
 namespace {
 
+// std::floor, exactly, without libm's call (the baseline x86-64 build has no roundsd): doubles
+// of magnitude 2^52 and up are integers already.
+inline double floor_exact(double x) {
+  if (!(std::fabs(x) < 4503599627370496.0)) return x;
+  const double t = double(int64_t(x));
+  return t > x ? t - 1.0 : t;
+}
+
 // Texels i and i + 1 of a level n texels wide as the wrap mode addresses them; one division at
-// most (none inside the level).
+// most (none inside the level, none for REPEAT of a power-of-two side: tiled UVs wrap at every
+// lookup).
 inline void wrap_pair(int64_t i, int64_t n, scene::WrapMode mode, int64_t& a, int64_t& b) {
   if (i >= 0 && i + 1 < n) {
     a = i, b = i + 1;
+    return;
+  }
+  if (mode == scene::WrapMode::kRepeat && (n & (n - 1)) == 0) {
+    a = i & (n - 1), b = (i + 1) & (n - 1);  // two's complement: the non-negative remainder
     return;
   }
   switch (mode) {
@@ -158,14 +171,14 @@ template <int CH>
 inline void tap(const float* base, int64_t w, int64_t h, double s, double t, const TextureLookup& q,
                 float* out) {
   if (q.nearest) {
-    const int64_t x = scene::wrap_texel(q.wrap_s, int64_t(std::floor(s * double(w))), w);
-    const int64_t y = scene::wrap_texel(q.wrap_t, int64_t(std::floor(t * double(h))), h);
+    const int64_t x = scene::wrap_texel(q.wrap_s, int64_t(floor_exact(s * double(w))), w);
+    const int64_t y = scene::wrap_texel(q.wrap_t, int64_t(floor_exact(t * double(h))), h);
     const float* p = base + size_t(y * w + x) * CH;
     for (int k = 0; k < CH; ++k) out[k] += p[k];
     return;
   }
   const double x = s * double(w) - 0.5, y = t * double(h) - 0.5;
-  const double fx0 = std::floor(x), fy0 = std::floor(y);
+  const double fx0 = floor_exact(x), fy0 = floor_exact(y);
   const float fx = float(x - fx0), fy = float(y - fy0);
   int64_t xa, xb, ya, yb;
   wrap_pair(int64_t(fx0), w, q.wrap_s, xa, xb);

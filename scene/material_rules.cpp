@@ -55,13 +55,6 @@ int64_t wrap_texel(WrapMode mode, int64_t i, int64_t n) {
   return m < 0 ? m + n : m;
 }
 
-Vec4 base_color(const Material& m, const Vec4& texture, const Vec4& vertex_color) {
-  Vec4 c;
-  for (int i = 0; i < 4; ++i) c[i] = texture[i] * m.base_color_factor[i] * vertex_color[i];
-  if (m.alpha_mode == AlphaMode::kOpaque) c[3] = 1;
-  return c;
-}
-
 float alpha_test_cutoff(const Material& m) {
   return m.alpha_mode == AlphaMode::kMask ? m.alpha_cutoff : -1.0f;
 }

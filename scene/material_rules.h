@@ -32,7 +32,13 @@ int64_t wrap_texel(WrapMode mode, int64_t i, int64_t n);
 
 // Base colour in linear light, as glTF 2.0 defines it: factor x texture x vertex colour (COLOR_0,
 // {1, 1, 1, 1} when absent). Alpha is 1 for OPAQUE materials whatever the inputs hold.
-Vec4 base_color(const Material& m, const Vec4& texture, const Vec4& vertex_color);
+// Inline: the transfer calls it for every sample.
+inline Vec4 base_color(const Material& m, const Vec4& texture, const Vec4& vertex_color) {
+  Vec4 c;
+  for (int i = 0; i < 4; ++i) c[i] = texture[i] * m.base_color_factor[i] * vertex_color[i];
+  if (m.alpha_mode == AlphaMode::kOpaque) c[3] = 1;
+  return c;
+}
 
 // The alpha test a material asks for: its cutoff in MASK mode, negative otherwise.
 float alpha_test_cutoff(const Material& m);

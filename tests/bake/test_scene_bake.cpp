@@ -342,6 +342,41 @@ TEST(SceneBake, AnImageReadAsColourAndAsDataKeepsEachUsesLevels) {
   EXPECT_GT(n, 100u);
 }
 
+// Magnified (the atlas 4x denser than the image), an occlusion that reads the base colour's
+// image takes the base colour's lookup (TriEval::Lookup::same_as): the texels equal those of a
+// bake whose occlusion reads a copy of the file (its own lookup), bit for bit, and stay the
+// image's codes (not the linear values the base colour is converted to). OPAQUE: albedo is RGB.
+TEST(SceneBake, OcclusionSharingTheBaseColourLookupEqualsItsOwnLookup) {
+  test::ScratchDir dir;
+  ASSERT_TRUE(write_texture(dir.file("a.png"), 32, 32, 3, smooth_colour).ok());
+  ASSERT_TRUE(write_texture(dir.file("b.png"), 32, 32, 3, smooth_colour).ok());
+  std::vector<float> layers[2][2];
+  std::vector<uint8_t> coverage;
+  for (int copy = 0; copy < 2; ++copy) {
+    scene::Scene s = test::textured_scene(make_grid(1.0f, 1, 1), dir.file("a.png"));
+    s.materials[0].occlusion_texture.image =
+        copy ? test::add_image(s, dir.file("b.png")) : s.materials[0].base_color_texture.image;
+    auto un = unwrap::unwrap_scene(s, {.texels_per_unit = 128});
+    ASSERT_TRUE(un.ok());
+    auto t = transfer_materials(un->scene, test::atlas_transfer_options(un->stats));
+    ASSERT_TRUE(t.ok()) << t.status().message();
+    ASSERT_EQ(t->layers.size(), 2u);
+    EXPECT_EQ(t->layers[0].channels, 3u);
+    layers[copy][0] = t->layers[0].texels, layers[copy][1] = t->layers[1].texels;
+    coverage = *t->coverage->to_bytes();
+  }
+  EXPECT_TRUE(layers[0][0] == layers[1][0]);
+  EXPECT_TRUE(layers[0][1] == layers[1][1]);
+  uint64_t n = 0, code_not_linear = 0;
+  for (size_t i = 0; i < coverage.size(); ++i) {
+    if (!coverage[i]) continue;
+    ++n;
+    code_not_linear += layers[0][1][3 * i] > layers[0][0][3 * i] + 0.05f;  // code > linear
+  }
+  EXPECT_GT(n, 1000u);
+  EXPECT_GT(code_not_linear, n * 9 / 10);
+}
+
 TEST(SceneBake, SameTexelsWhateverTheThreadCount) {
   test::ScratchDir dir;
   ASSERT_TRUE(write_texture(dir.file("c.png"), 64, 64, 3, smooth_colour).ok());

@@ -73,6 +73,29 @@ TEST(TransferTexture, WrapModesAndBilinearTaps) {
   EXPECT_TRUE(std::isfinite(at(*t, NAN, INFINITY)));
 }
 
+// REPEAT whole periods away, on either side and far out, samples what the first period does,
+// bit for bit: for a power-of-two side (wrapped with a mask) and for another (wrap_texel).
+TEST(TransferTexture, RepeatPeriodsSampleTheFirstPeriodExactly) {
+  test::ScratchDir dir;
+  for (int w : {8, 6}) {
+    const std::string p = dir.file("noise" + std::to_string(w) + ".png");
+    write_image(p, w, 4, 1, [](int x, int y, int) { return float((x * 37 + y * 11) % 64) / 63; });
+    auto t = TransferTexture::load(p, nullptr);
+    ASSERT_TRUE(t.ok()) << t.status().message();
+    for (double s : {0.0, 0.03125, 0.3125, 0.5, 0.96875}) {  // dyadic: s + k is exact
+      for (double u : {0.0, 0.203125, 0.90625}) {
+        const float first = at(*t, s, u);
+        for (double k : {-3.0, -1.0, 1.0, 2.0, 1024.0}) {
+          EXPECT_EQ(at(*t, s + k, u), first) << w << " " << s << " " << k;
+          EXPECT_EQ(at(*t, s, u + k), first) << w << " " << u << " " << k;
+          EXPECT_EQ(at(*t, s + k, u, WrapMode::kRepeat, WrapMode::kRepeat, true),
+                    at(*t, s, u, WrapMode::kRepeat, WrapMode::kRepeat, true));
+        }
+      }
+    }
+  }
+}
+
 // sRGB codes 0 and 255 side by side: taps filter the codes as stored (the caller converts the
 // sample, as the validator's UNORM reference does), while the made 1x1 level is the mean in
 // linear light, re-encoded: linear_to_srgb(0.5) = 0.7354, not the codes' mean 0.5.
