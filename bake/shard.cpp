@@ -1128,6 +1128,22 @@ Expected<MergeSummary> merge_shards(const MergeOptions& options) {
   return sum;
 }
 
+namespace {
+
+// A file as it is now: size and modification time (null when absent). A merge recorded with
+// the stamp its output still has is the file on disk; one replaced since, even by a file of the
+// same size, is merged again.
+nlohmann::json file_stamp(const std::string& path) {
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  if (ec) return nullptr;
+  const auto time = fs::last_write_time(path, ec);
+  if (ec) return nullptr;
+  return {size, int64_t(time.time_since_epoch().count())};
+}
+
+}  // namespace
+
 std::string work_merged_path(const std::string& work_dir) {
   return (fs::path(work_dir) / "merged.json").string();
 }
@@ -1161,10 +1177,9 @@ Expected<bool> merge_when_complete(const MergeOptions& options, uint32_t count,
     std::stringstream text;
     text << in.rdbuf();
     const auto j = nlohmann::json::parse(in ? text.str() : "", nullptr, false);
-    std::error_code ec;
     if (j.is_object() && unhex(j.value("plan_hash", nlohmann::json())) == w.hash &&
         j.value("output", "") == output &&
-        fs::file_size(output, ec) == j.value("bytes", uint64_t(0)) && !ec) {
+        j.value("file", nlohmann::json()) == file_stamp(output)) {
       return false;  // merged already, by another shard
     }
   }
@@ -1174,6 +1189,7 @@ Expected<bool> merge_when_complete(const MergeOptions& options, uint32_t count,
   const nlohmann::json done = {{"plan_hash", hex(w.hash)},
                                {"output", output},
                                {"bytes", merged.file_bytes},
+                               {"file", file_stamp(output)},
                                {"parts", merged.parts}};
   VT_RETURN_IF_ERROR(write_text(staged, done.dump(1) + "\n"));
   VT_RETURN_IF_ERROR(record.commit());

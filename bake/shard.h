@@ -97,9 +97,9 @@ Expected<MergeSummary> merge_shards(const MergeOptions& options);
 
 // The merge of a complete set of shards, by whichever shard gets there: under an exclusive lock
 // on DIR/merge.lock, merges when every part of `count` is in DIR/parts and DIR/merged.json does
-// not already record this plan's merge into the same output (of the size it had), then records
-// it there. False (nothing written) when a part is absent or the merge is recorded. The plan
-// removes merged.json.
+// not already record this plan's merge into the same output (with the size and modification time it
+// still has), then records it there. False (nothing written) when a part is absent or the merge is
+// recorded. The plan removes merged.json.
 Expected<bool> merge_when_complete(const MergeOptions& options, uint32_t count,
                                    MergeSummary* summary);
 std::string work_merged_path(const std::string& work_dir);  // DIR/merged.json

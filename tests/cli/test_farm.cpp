@@ -318,6 +318,13 @@ TEST_F(FarmCli, TheLastShardMergesOnce) {
   fs::remove(out);
   EXPECT_EQ(shard("0/2"), out);
   expect_same_as_local("last");
+  // Replaced by another file of the same size: not the merge the record names, merged again.
+  const std::string merged_bytes = read_file(out);
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  std::ofstream(out, std::ios::binary | std::ios::trunc) << std::string(merged_bytes.size(), 'x');
+  ASSERT_EQ(fs::file_size(out), merged_bytes.size());
+  EXPECT_EQ(shard("1/2"), out);
+  expect_same_as_local("last");
   // A new plan of the folder drops the record (and the parts of another plan, if any).
   ASSERT_EQ(bake("last", "--plan " + work("last") + "/plan.json").exit_code, 0);
   EXPECT_FALSE(fs::exists(work("last") + "/merged.json"));
