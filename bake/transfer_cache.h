@@ -5,7 +5,8 @@
 // or damaged cache costs time, never wrong texels. Layout: a header (magic, version, the file
 // key of the settings and atlas size, band count), the bands' zstd frames, an index of (key,
 // offset, sizes, checksum) per band and a trailer pointing at it; written under a temporary name
-// and renamed when complete.
+// and renamed when complete, without OutputSet's sync: it is hundreds of MB at a few thousand
+// texels a side, and a cache torn by a crash fails its checksums and is ignored.
 #pragma once
 
 #include <cstdint>
