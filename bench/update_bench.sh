@@ -3,22 +3,24 @@
 # an update with nothing changed (time, file untouched), then one texture's texels all halved
 # (default scene/leaf_albedo.png: the leaf card's only texture, about 1% of the atlas) and an
 # update (time, pages re-encoded), checked byte for byte against a clean bake with --tables-from
-# the previous file. CORNER=1 repaints only the texture's top-left 64x64 texels instead.
+# the previous file. CORNER=1 repaints only the texture's top-left 64x64 texels instead;
+# BAKE_FLAGS (e.g. "--size 48") go to every bake, for the figure on a larger atlas.
 set -euo pipefail
 vt=$(readlink -f "$1"); out=$2
 rm -rf "$out"; mkdir -p "$out"; cd "$out"
 $vt -q sample-scene scene >/dev/null
 tex=${TEXTURE:-scene/leaf_albedo.png}
+read -r -a flags <<< "${BAKE_FLAGS:-}"
 now() { date +%s.%N; }
-t0=$(now); $vt -q --json bake scene/scene.gltf -o b.vtpf > clean.json; t1=$(now)
+t0=$(now); $vt -q --json bake scene/scene.gltf -o b.vtpf "${flags[@]}" > clean.json; t1=$(now)
 cp b.vtpf before.vtpf
 s0=$(stat -c '%i %Y.%y' b.vtpf)
-t2=$(now); $vt -q --json bake scene/scene.gltf -o b.vtpf --update > same.json; t3=$(now)
+t2=$(now); $vt -q --json bake scene/scene.gltf -o b.vtpf "${flags[@]}" --update > same.json; t3=$(now)
 s1=$(stat -c '%i %Y.%y' b.vtpf)
 if [ -n "${CORNER:-}" ]; then oiiotool "$tex" --fill:color=1,0,1 64x64+0+0 -o "$tex"
 else oiiotool "$tex" --mulc 0.5 -o "$tex"; fi
-t4=$(now); $vt -q --json bake scene/scene.gltf -o b.vtpf --update > update.json; t5=$(now)
-$vt -q --json bake scene/scene.gltf -o clean2.vtpf --tables-from before.vtpf > clean2.json
+t4=$(now); $vt -q --json bake scene/scene.gltf -o b.vtpf "${flags[@]}" --update > update.json; t5=$(now)
+$vt -q --json bake scene/scene.gltf -o clean2.vtpf "${flags[@]}" --tables-from before.vtpf > clean2.json
 cmp b.vtpf clean2.vtpf && same_bytes=yes || same_bytes=no
 python3 - "$t0" "$t1" "$t2" "$t3" "$t4" "$t5" "$same_bytes" "$tex" "$s0" "$s1" <<'PY'
 import json, sys
