@@ -232,9 +232,10 @@ std::string cache_dir(const SceneBakeOptions& options) {
 }
 
 // Unwrap and transfer; `prepared.summary` has its warnings and outputs set by the caller.
-// `cache`: the folder of the update mode's cache ("" = none).
+// `cache_folder`: the folder of the update mode's cache ("" = none).
 Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& options,
-                           uint64_t input_key, const std::string& cache, PreparedBake& prepared) {
+                           uint64_t input_key, const std::string& cache_folder,
+                           PreparedBake& prepared) {
   SceneBakeSummary& summary = prepared.summary;
   const std::string& output = options.build.output;
   auto report = [&](const char* stage, double f) {
@@ -263,6 +264,7 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
       1, std::min(uo.max_size_pages, unwrap::pages_within(texels_within(limit), uo.page_payload)));
   // Update mode takes the previous bake's unwrap when what the unwrap reads is unchanged (a
   // repainted texture keeps it); every bake stores its own for the next (bake/unwrap_cache.h).
+  std::string cache = cache_folder;
   const std::string unwrap_cache = cache.empty() ? "" : cache + "/unwrap.bin";
   uint64_t unwrap_key = 0;
   if (!unwrap_cache.empty()) unwrap_key = unwrap_cache_key(input, uo);
@@ -275,12 +277,15 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
     return unwrap::unwrap_scene(input, uo);
   });
   if (!unwrapped.ok()) return unwrapped.status().with_context("unwrap");
-  if (!unwrap_cache.empty() && !summary.unwrap_reused) {
+  // The caches are written from here on; a folder it cannot make means none (a cache that
+  // cannot be written only costs the next update its reuse).
+  if (!cache.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(cache, ec);
-    // A cache that cannot be written only costs the next update its reuse.
-    if (!ec) (void)write_unwrap_cache(unwrap_cache, unwrap_key, input, *unwrapped);
+    if (ec) cache.clear();
   }
+  if (!cache.empty() && !summary.unwrap_reused)
+    (void)write_unwrap_cache(unwrap_cache, unwrap_key, input, *unwrapped);
   summary.unwrap = unwrapped->stats;
   summary.peak_rss.push_back({"unwrap", peak_rss_bytes()});
   summary.triangles = uint64_t(unwrapped->stats.faces);
@@ -325,13 +330,9 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
                          limit);
   to.coverage_in_memory = !options.transfer_to_scratch && CoverageMask::fits_memory(W, H, limit);
   if (!cache.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(cache, ec);  // a folder it cannot make: no cache
-    if (!ec) {
-      to.cache_out = cache + "/transfer.bin";
-      if (options.build.update) to.cache_in = to.cache_out;
-      to.image_keys = image_content_keys(unwrapped->scene);
-    }
+    to.cache_out = cache + "/transfer.bin";
+    if (options.build.update) to.cache_in = to.cache_out;
+    to.image_keys = image_content_keys(unwrapped->scene);
   }
   auto transfer = guarded("transfer", [&] { return transfer_to_stores(unwrapped->scene, to); });
   if (!transfer.ok()) return transfer.status().with_context("transfer");

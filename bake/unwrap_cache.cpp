@@ -208,8 +208,7 @@ uint64_t unwrap_cache_key(const scene::Scene& scene, const unwrap::UnwrapOptions
     k.add(n.name), k.add(n.local), k.add(n.mesh), k.add(n.children), k.add(n.texels_per_unit);
   k.add(scene.roots);
   // The density file the unwrap reads: its path (the report names it) and content.
-  std::string density = o.density_file == "-" ? "" : o.density_file;
-  if (o.density_file.empty()) density = unwrap::default_density_file(scene.source_path);
+  const std::string density = unwrap::density_file_to_read(scene, o.density_file);
   std::error_code ec;
   const bool has_density = !density.empty() && std::filesystem::exists(density, ec);
   k.add(density), k.add(uint8_t(has_density));

@@ -319,6 +319,15 @@ std::string default_density_file(const std::string& scene_path) {
   return p.string();
 }
 
+std::string density_file_to_read(const scene::Scene& scene, const std::string& density_file) {
+  if (density_file == "-") return "";
+  if (!density_file.empty()) return density_file;
+  std::string path = default_density_file(scene.source_path);
+  std::error_code ec;
+  if (!path.empty() && !std::filesystem::exists(path, ec)) path.clear();
+  return path;
+}
+
 int pages_within(double texels, int page_payload) {
   if (!(texels > 0) || page_payload <= 0) return 0;
   return static_cast<int>(std::floor(std::sqrt(texels) / page_payload));
@@ -338,12 +347,7 @@ OwnDensity DensityPlan::wanted(int material, int node) const {
 Expected<DensityPlan> plan_density(const scene::Scene& scene, const UnwrapOptions& opt) {
   DensityPlan plan;
   DensityFile file;
-  std::string path = opt.density_file == "-" ? "" : opt.density_file;
-  if (opt.density_file.empty()) {
-    path = default_density_file(scene.source_path);
-    std::error_code ec;
-    if (!path.empty() && !std::filesystem::exists(path, ec)) path.clear();
-  }
+  const std::string path = density_file_to_read(scene, opt.density_file);
   if (!path.empty()) {
     auto loaded = load_density_file(path, scene);
     if (!loaded.ok()) return loaded.status();

@@ -118,6 +118,11 @@ std::vector<OwnDensity> spread_to_subtrees(const scene::Scene& scene,
 // "DIR/NAME.density.json". "" for a scene with no source path.
 std::string default_density_file(const std::string& scene_path);
 
+// The density file the unwrap of `scene` reads for the option `density_file` (UnwrapOptions):
+// the file named, or "" for "-", or when none is named the default beside the scene if it
+// exists ("" otherwise).
+std::string density_file_to_read(const scene::Scene& scene, const std::string& density_file);
+
 // The largest square atlas side, in pages of `page_payload` texels, whose texels fit `texels`.
 int pages_within(double texels, int page_payload);
 
