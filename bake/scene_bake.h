@@ -44,9 +44,10 @@ struct SceneBakeOptions {
   // tests force small bands.
   uint32_t transfer_band_rows = 0;
   bool transfer_to_scratch = false;
-  // Update mode's cache folder: the unwrap (bake/unwrap_cache.h) as `cache`/unwrap.bin and the
-  // transfer's bands (bake/transfer_cache.h) as `cache`/transfer.bin, written by every bake and
-  // read by an update (build.update).
+  // Update mode's cache folder: the unwrap (bake/unwrap_cache.h) as `cache`/unwrap.bin, written
+  // by every bake, and the transfer's bands (bake/transfer_cache.h) as `cache`/transfer.bin,
+  // written by an update (build.update, a first one included) or when `cache` is given; both
+  // read by an update.
   // "" = the output's path with ".cache" appended, "-" = none. The output does not depend on it.
   std::string cache;
   std::function<void(const SceneBakeProgress&)> progress;

@@ -316,8 +316,9 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
   app.add_option("--unwrapped", o.unwrapped,
                  "Where to write the unwrapped scene (.glb; default OUT.glb; '-' = not written)");
   app.add_option("--cache", o.cache,
-                 "Folder of the transfer's band cache that --update reads (written by every bake; "
-                 "default OUT.cache; '-' = none)");
+                 "Folder of the caches that --update reads (default OUT.cache; '-' = none): the "
+                 "unwrap's, written by every bake, and the transfer's bands, written by --update "
+                 "(a first one too) or when this is given");
   app.add_option("--supersample", o.supersample, "Transfer samples per texel: 1, 4 or 16")
       ->check(CLI::IsMember({1, 4, 16}));
   app.add_option_function<std::string>(

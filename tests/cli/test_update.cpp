@@ -229,9 +229,18 @@ TEST(CliUpdate, SceneBakeUpdateReadsUnchangedBandsFromTheCacheAndNeverTrustsADam
   const std::string dir = dir_of(obj);
   const std::string flags = " --size 3", out = dir + "/u.vtpf";
   const std::string cache = out + ".cache/transfer.bin";
-  auto clean = run_json("-q bake " + obj + " -o " + out + flags);
-  EXPECT_EQ(clean["transfer"]["bands_cached"], 0);  // a bake without --update reads no cache
+  // A plain bake writes no band cache (only the unwrap's); a first --update, with no output to
+  // update yet, is a clean bake that does.
+  auto plain = run_json("-q bake " + obj + " -o " + out + flags);
+  EXPECT_EQ(plain["transfer"]["bands_cached"], 0);
+  EXPECT_FALSE(std::filesystem::exists(cache));
+  EXPECT_TRUE(std::filesystem::exists(out + ".cache/unwrap.bin"));
+  const std::vector<uint8_t> plain_bytes = read_bytes(out);
+  std::filesystem::remove(out);
+  auto clean = run_json("-q bake " + obj + " -o " + out + " --update" + flags);
+  EXPECT_EQ(clean["transfer"]["bands_cached"], 0);
   ASSERT_TRUE(std::filesystem::exists(cache));
+  EXPECT_EQ(read_bytes(out), plain_bytes);
   std::filesystem::copy_file(out, dir + "/before.vtpf");
   std::filesystem::copy_file(cache, dir + "/before.bin");
   write_png(dir + "/textures/b.png", 64, 64, 5, {10, 10, 30, 30});
