@@ -26,21 +26,36 @@ Grid grid_of(const PackChart& c) {
           std::max(1, static_cast<int>(std::ceil(c.height)))};
 }
 
-// Footprint cells (i, j) of a chart in its unrotated grid: every texel a triangle touches with
-// the footprint margin.
-std::vector<char> footprint(const PackChart& chart, const Grid& g) {
-  std::vector<char> cells(static_cast<size_t>(g.gx) * g.gy, 0);
+// A chart's conservative footprint (every texel a triangle touches with the footprint margin)
+// as the extent of each column and each row of its unrotated grid: all a profile reads, in
+// memory linear in the chart's sides (a cell bitmap was quadratic: a ground chart of 20K x 20K
+// texels took 400 MB at a 32K atlas, two of them at once on two threads).
+struct Footprint {
+  std::vector<int> col_min, col_max;  // per column i: lowest and highest occupied row j
+  std::vector<int> row_min, row_max;  // per row j: lowest and highest occupied column i
+};
+
+constexpr int kEmpty = std::numeric_limits<int>::max();
+
+Footprint footprint(const PackChart& chart, const Grid& g) {
+  Footprint f;
+  f.col_min.assign(size_t(g.gx), kEmpty), f.col_max.assign(size_t(g.gx), -1);
+  f.row_min.assign(size_t(g.gy), kEmpty), f.row_max.assign(size_t(g.gy), -1);
   const TexelRect grid = {0, 0, g.gx - 1, g.gy - 1};
   for (const auto& t : chart.tris) {
     const Vec2d& a = chart.points[t[0]];
     const Vec2d& b = chart.points[t[1]];
     const Vec2d& c = chart.points[t[2]];
     const RasterTriangle tri({a.x, a.y, b.x, b.y, c.x, c.y});
-    for_each_touched_texel(tri, kFootprintMargin, grid, [&](int64_t i, int64_t j) {
-      cells[static_cast<size_t>(j) * g.gx + static_cast<size_t>(i)] = 1;
+    for_each_touched_texel(tri, kFootprintMargin, grid, [&](int64_t i64, int64_t j64) {
+      const int i = int(i64), j = int(j64);
+      f.col_min[size_t(i)] = std::min(f.col_min[size_t(i)], j);
+      f.col_max[size_t(i)] = std::max(f.col_max[size_t(i)], j);
+      f.row_min[size_t(j)] = std::min(f.row_min[size_t(j)], i);
+      f.row_max[size_t(j)] = std::max(f.row_max[size_t(j)], i);
     });
   }
-  return cells;
+  return f;
 }
 
 // Column profiles of one rotation of a footprint.
@@ -51,36 +66,27 @@ struct Profile {
   int min_low = 0;
 };
 
-constexpr int kEmpty = std::numeric_limits<int>::max();
-
-Profile profile(const std::vector<char>& cells, const Grid& g, int rotation, int padding) {
+// Rotated cell (x, y) of grid cell (i, j), matching place_point: rotation 0 (x, y) = (i, j),
+// 1 (gy-1-j, i), 2 (gx-1-i, gy-1-j), 3 (j, gx-1-i). A rotated column is then one grid column
+// (rotations 0, 2) or row (1, 3), and its lowest and highest y come from that one's extent.
+Profile profile(const Footprint& f, const Grid& g, int rotation, int padding) {
   Profile pr;
-  bool swap = rotation & 1;
+  const bool swap = rotation & 1;
   pr.width = swap ? g.gy : g.gx;
   pr.height = swap ? g.gx : g.gy;
   std::vector<int> bottom(pr.width, kEmpty);
   pr.top.assign(pr.width, 0);
-  for (int j = 0; j < g.gy; ++j)
-    for (int i = 0; i < g.gx; ++i) {
-      if (!cells[static_cast<size_t>(j) * g.gx + i]) continue;
-      int x, y;  // rotated cell, matching place_point
-      switch (rotation) {
-        case 0:
-          x = i, y = j;
-          break;
-        case 1:
-          x = g.gy - 1 - j, y = i;
-          break;
-        case 2:
-          x = g.gx - 1 - i, y = g.gy - 1 - j;
-          break;
-        default:
-          x = j, y = g.gx - 1 - i;
-          break;
-      }
-      bottom[x] = std::min(bottom[x], y);
-      pr.top[x] = std::max(pr.top[x], y + 1);
-    }
+  for (int x = 0; x < pr.width; ++x) {
+    const bool flip = rotation == 1 || rotation == 2;  // x counts the grid's lines backwards
+    const size_t line = size_t(flip ? pr.width - 1 - x : x);
+    const int lo = swap ? f.row_min[line] : f.col_min[line];
+    const int hi = swap ? f.row_max[line] : f.col_max[line];
+    if (hi < 0) continue;  // empty
+    // Rotations 2 and 3 count y backwards from the grid's other side.
+    const bool back = rotation >= 2;
+    bottom[x] = back ? pr.height - 1 - hi : lo;
+    pr.top[x] = (back ? pr.height - 1 - lo : hi) + 1;
+  }
   pr.low.assign(pr.width + 2 * padding, kEmpty);
   for (int x = 0; x < pr.width; ++x) {
     if (bottom[x] == kEmpty) continue;
@@ -124,8 +130,8 @@ PackResult pack_charts(const std::vector<PackChart>& charts, int width, int padd
   const int workers = std::min(thread_count(threads), int(charts.size() / 64 + 1));
   parallel_for(charts.size(), workers, [&](size_t c) {
     Grid g = grid_of(charts[c]);
-    auto cells = footprint(charts[c], g);
-    for (int r = 0; r < 4; ++r) profiles[c][r] = profile(cells, g, r, padding);
+    const Footprint f = footprint(charts[c], g);
+    for (int r = 0; r < 4; ++r) profiles[c][r] = profile(f, g, r, padding);
   });
 
   std::vector<size_t> order(charts.size());
