@@ -6,6 +6,7 @@
 // texels between.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numeric>
 #include <thread>
@@ -47,12 +48,16 @@ Footprint footprint(const PackChart& chart, const Grid& g) {
     const Vec2d& b = chart.points[t[1]];
     const Vec2d& c = chart.points[t[2]];
     const RasterTriangle tri({a.x, a.y, b.x, b.y, c.x, c.y});
-    for_each_touched_texel(tri, kFootprintMargin, grid, [&](int64_t i64, int64_t j64) {
-      const int i = int(i64), j = int(j64);
-      f.col_min[size_t(i)] = std::min(f.col_min[size_t(i)], j);
-      f.col_max[size_t(i)] = std::max(f.col_max[size_t(i)], j);
-      f.row_min[size_t(j)] = std::min(f.row_min[size_t(j)], i);
-      f.row_max[size_t(j)] = std::max(f.row_max[size_t(j)], i);
+    auto extend = [](std::vector<int>& lo, std::vector<int>& hi, int64_t line, int64_t first,
+                     int64_t last) {
+      lo[size_t(line)] = std::min(lo[size_t(line)], int(first));
+      hi[size_t(line)] = std::max(hi[size_t(line)], int(last));
+    };
+    for_each_touched_run(
+        tri, kFootprintMargin, grid, false,
+        [&](int64_t j, int64_t i0, int64_t i1) { extend(f.row_min, f.row_max, j, i0, i1); });
+    for_each_touched_run(tri, kFootprintMargin, grid, true, [&](int64_t i, int64_t j0, int64_t j1) {
+      extend(f.col_min, f.col_max, i, j0, j1);
     });
   }
   return f;
@@ -63,7 +68,15 @@ struct Profile {
   int width = 0, height = 0;  // rotated grid
   std::vector<int> top;       // per raw column: highest occupied row + 1 (0 = empty column)
   std::vector<int> low;       // per dilated column (width + 2 * padding): lowest row - padding
-  int min_low = 0;
+  // For the search by runs (drop_heights, placement_waste): the maximal runs of dilated columns
+  // of one finite `low`, and the runs [begin, end) of raw columns with top > 0 with their count
+  // and the sum of their `low[d + padding]`.
+  struct LowRun {
+    int begin, length, low;
+  };
+  std::vector<LowRun> low_runs;
+  std::vector<std::pair<int, int>> top_runs;
+  int64_t top_columns = 0, top_low_sum = 0;
 };
 
 // Rotated cell (x, y) of grid cell (i, j), matching place_point: rotation 0 (x, y) = (i, j),
@@ -93,8 +106,23 @@ Profile profile(const Footprint& f, const Grid& g, int rotation, int padding) {
     for (int d = 0; d <= 2 * padding; ++d)
       pr.low[x + d] = std::min(pr.low[x + d], bottom[x] - padding);
   }
-  pr.min_low = kEmpty;
-  for (int v : pr.low) pr.min_low = std::min(pr.min_low, v);
+  for (int d = 0; d < int(pr.low.size());) {
+    int e = d + 1;
+    while (e < int(pr.low.size()) && pr.low[e] == pr.low[d]) ++e;
+    if (pr.low[d] != kEmpty) pr.low_runs.push_back({d, e - d, pr.low[d]});
+    d = e;
+  }
+  for (int d = 0; d < pr.width;) {
+    if (pr.top[d] == 0) {
+      ++d;
+      continue;
+    }
+    int e = d;
+    for (; e < pr.width && pr.top[e] > 0; ++e)
+      ++pr.top_columns, pr.top_low_sum += pr.low[e + padding];
+    pr.top_runs.emplace_back(d, e);
+    d = e;
+  }
   return pr;
 }
 
@@ -120,6 +148,81 @@ Vec2d place_point(const PackChart& chart, const Placement& pl, const Vec2d& p) {
   return {r.x + pl.x, r.y + pl.y};
 }
 
+// The skyline, padded by `padding` columns of "nothing" on each side (sky[-padding .. width +
+// padding)), with a sparse table of its maxima (level k: the maximum of 2^k columns from each
+// one, kept up to date where a placement raises the sky) and column sums for the search by runs.
+class Skyline {
+ public:
+  Skyline(int width, int padding) : width_(width), padding_(padding) {
+    const size_t n = size_t(width) + 2 * size_t(padding);
+    levels_.emplace_back(n, kNothing);
+    for (int x = 0; x < width; ++x) levels_[0][size_t(x + padding)] = 0;
+    while ((size_t(2) << (levels_.size() - 1)) <= n) {
+      const size_t half = size_t(1) << (levels_.size() - 1);
+      const std::vector<int>& below = levels_.back();
+      std::vector<int> level(n - 2 * half + 1);
+      for (size_t i = 0; i < level.size(); ++i) level[i] = std::max(below[i], below[i + half]);
+      levels_.push_back(std::move(level));
+    }
+  }
+  int operator[](int x) const { return levels_[0][size_t(x + padding_)]; }
+  void raise(int x, int height) {
+    int& h = levels_[0][size_t(x + padding_)];
+    h = std::max(h, height);
+    dirty_begin_ = std::min(dirty_begin_, size_t(x + padding_));
+    dirty_end_ = std::max(dirty_end_, size_t(x + padding_) + 1);
+  }
+  // Brings the maxima and sums up to date after the raises of one placement.
+  void placed() {
+    for (size_t k = 1; k < levels_.size() && dirty_begin_ < dirty_end_; ++k) {
+      const size_t span = size_t(1) << k, half = span / 2;
+      std::vector<int>& level = levels_[k];
+      const std::vector<int>& below = levels_[k - 1];
+      const size_t first = dirty_begin_ >= span - 1 ? dirty_begin_ - (span - 1) : 0;
+      const size_t last = std::min(level.size(), dirty_end_);
+      for (size_t i = first; i < last; ++i) level[i] = std::max(below[i], below[i + half]);
+    }
+    dirty_begin_ = SIZE_MAX, dirty_end_ = 0;
+    sums_stale_ = true;
+  }
+  // y(x) = max(0, max over the non-empty dilated columns d of sky[x + d - padding] - low[d]) for
+  // x in [0, x_max]: the height a profile drops to at x, exactly as a column-by-column scan
+  // finds it, in O(runs) a position from one window maximum per run of equal `low`.
+  void drop_heights(const Profile& pr, int x_max, std::vector<int64_t>& y) const {
+    y.assign(size_t(x_max) + 1, 0);
+    for (const Profile::LowRun& run : pr.low_runs) {
+      size_t k = 0;
+      while ((size_t(2) << k) <= size_t(run.length)) ++k;
+      const int* a = levels_[k].data() + run.begin;  // padded index of sky[x + begin - padding]
+      const int* b = a + (run.length - (1 << k));
+      for (int x = 0; x <= x_max; ++x) {
+        const int64_t m = std::max(a[x], b[x]);
+        y[size_t(x)] = std::max(y[size_t(x)], m - run.low);
+      }
+    }
+  }
+  // Sum of sky over the columns x + d of the profile whose top > 0.
+  int64_t sky_under(const Profile& pr, int x) {
+    if (sums_stale_) {
+      prefix_.assign(size_t(width_) + 1, 0);
+      for (int i = 0; i < width_; ++i) prefix_[size_t(i) + 1] = prefix_[size_t(i)] + (*this)[i];
+      sums_stale_ = false;
+    }
+    int64_t s = 0;
+    for (const auto& [b, e] : pr.top_runs) s += prefix_[size_t(x + e)] - prefix_[size_t(x + b)];
+    return s;
+  }
+
+ private:
+  // Padding columns: below any drop, so that they never raise one.
+  static constexpr int kNothing = std::numeric_limits<int>::min() / 4;
+  int width_, padding_;
+  std::vector<std::vector<int>> levels_;
+  size_t dirty_begin_ = SIZE_MAX, dirty_end_ = 0;
+  std::vector<int64_t> prefix_;
+  bool sums_stale_ = true;
+};
+
 PackResult pack_charts(const std::vector<PackChart>& charts, int width, int padding, int threads) {
   PackResult result;
   result.placements.resize(charts.size());
@@ -143,7 +246,8 @@ PackResult pack_charts(const std::vector<PackChart>& charts, int width, int padd
     return static_cast<int64_t>(ga.gx) * ga.gy > static_cast<int64_t>(gb.gx) * gb.gy;
   });
 
-  std::vector<int> sky(width, 0);
+  Skyline sky(width, padding);
+  std::vector<int64_t> drop;
   int top_all = 0;
   for (size_t c : order) {
     int64_t best_top = std::numeric_limits<int64_t>::max(), best_waste = 0;
@@ -151,25 +255,15 @@ PackResult pack_charts(const std::vector<PackChart>& charts, int width, int padd
     for (int r = 0; r < 4; ++r) {
       const Profile& pr = profiles[c][r];
       if (pr.width > width) continue;
-      int x_max = width - pr.width;
-      for (int x = 0; x <= std::max(0, x_max); ++x) {
-        int64_t y = 0;
-        bool pruned = false;
-        for (int d = 0; d < static_cast<int>(pr.low.size()); ++d) {
-          int ax = x + d - padding;
-          if (ax < 0 || ax >= width || pr.low[d] == kEmpty) continue;
-          y = std::max<int64_t>(y, sky[ax] - pr.low[d]);
-          if (y + pr.height > best_top) {
-            pruned = true;
-            break;
-          }
-        }
-        if (pruned) continue;
-        int64_t top = y + pr.height;
-        int64_t waste = 0;
-        for (int d = 0; d < pr.width && x + d < width; ++d)
-          if (pr.top[d] > 0) waste += y + pr.low[d + padding] + padding - sky[x + d];
-        if (top < best_top || (top == best_top && waste < best_waste)) {
+      const int x_max = width - pr.width;
+      // The lowest top, then the least wasted space under the chart, then the first position.
+      sky.drop_heights(pr, x_max, drop);
+      for (int x = 0; x <= x_max; ++x) {
+        const int64_t y = drop[size_t(x)], top = y + pr.height;
+        if (top > best_top) continue;
+        const int64_t waste =
+            pr.top_columns * (y + padding) + pr.top_low_sum - sky.sky_under(pr, x);
+        if (top < best_top || waste < best_waste) {
           best_top = top;
           best_waste = waste;
           best = {r, x, static_cast<int>(y)};
@@ -183,7 +277,8 @@ PackResult pack_charts(const std::vector<PackChart>& charts, int width, int padd
     }
     const Profile& pr = profiles[c][best.rotation];
     for (int d = 0; d < pr.width && best.x + d < width; ++d)
-      if (pr.top[d] > 0) sky[best.x + d] = std::max(sky[best.x + d], best.y + pr.top[d]);
+      if (pr.top[d] > 0) sky.raise(best.x + d, best.y + pr.top[d]);
+    sky.placed();
     top_all = std::max(top_all, best.y + pr.height);
     result.placements[c] = best;
   }

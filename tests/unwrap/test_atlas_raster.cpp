@@ -3,6 +3,7 @@
 // grown open square meets the triangle and nothing far from it, and empty triangles own nothing.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "bake/unwrap/atlas_raster.h"
@@ -138,6 +139,44 @@ TEST(AtlasRaster, ConservativeTouchMatchesPolygonClippingAtEveryMargin) {
     }
     EXPECT_EQ(missing, 0) << "margin " << margin;
     EXPECT_EQ(far, 0) << "margin " << margin;
+  }
+}
+
+// The runs of each row and of each column are exactly the touched texels, in every clip, for
+// ordinary triangles, slivers along and across the lattice, texel-aligned corners and triangles
+// far larger than the clip (the packer's footprints read only the runs).
+TEST(AtlasRaster, TouchedRunsAreTheTouchedTexelsByRowsAndByColumns) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> pos(-6.0, 38.0), size(-20.0, 20.0), eighth(0, 1);
+  const TexelRect clip = {0, 0, 31, 23};
+  std::vector<Corners> corners;
+  for (int n = 0; n < 400; ++n) {
+    const double cx = pos(rng), cy = pos(rng);
+    Corners c = {cx, cy, cx + size(rng), cy + size(rng), cx + size(rng), cy + size(rng)};
+    if (n % 4 == 1)  // on the lattice of eighths: ties with texel centres and square edges
+      for (double& v : c) v = std::round(v * 8) / 8;
+    if (n % 4 == 2) c[5] = c[3] + 1e-9 * eighth(rng);  // a sliver
+    corners.push_back(c);
+  }
+  corners.push_back({-500, -500, 900, -400, 100, 700});       // covers the clip
+  corners.push_back({3.5, 0.5, 3.5, 20.5, 3.5 + 1e-12, 10});  // a vertical sliver
+  for (double margin : {0.0, kFootprintMargin, 0.75}) {
+    for (const Corners& c : corners) {
+      RasterTriangle t(c);
+      std::vector<char> texels(32 * 24, 0), rows(32 * 24, 0), columns(32 * 24, 0);
+      for_each_touched_texel(t, margin, clip,
+                             [&](int64_t x, int64_t y) { texels[size_t(y * 32 + x)] = 1; });
+      for_each_touched_run(t, margin, clip, false, [&](int64_t y, int64_t x0, int64_t x1) {
+        ASSERT_LE(x0, x1);
+        for (int64_t x = x0; x <= x1; ++x) rows[size_t(y * 32 + x)] += 1;
+      });
+      for_each_touched_run(t, margin, clip, true, [&](int64_t x, int64_t y0, int64_t y1) {
+        ASSERT_LE(y0, y1);
+        for (int64_t y = y0; y <= y1; ++y) columns[size_t(y * 32 + x)] += 1;
+      });
+      ASSERT_EQ(rows, texels) << "margin " << margin << " corner " << c[0] << "," << c[1];
+      ASSERT_EQ(columns, texels) << "margin " << margin << " corner " << c[0] << "," << c[1];
+    }
   }
 }
 

@@ -3,6 +3,9 @@
 // deterministic.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+#include <numeric>
 #include <random>
 
 #include "bake/unwrap/atlas_raster.h"
@@ -119,6 +122,117 @@ TEST(Pack, DeterministicWhateverTheThreads) {
     EXPECT_EQ(a.placements[c].rotation, b.placements[c].rotation);
     EXPECT_EQ(a.placements[c].x, b.placements[c].x);
     EXPECT_EQ(a.placements[c].y, b.placements[c].y);
+  }
+}
+
+// The packer's rule written out plainly, cell by cell and column by column (as the packer did
+// before its search by runs): the cells every triangle touches, each rotation's lowest and
+// highest cell per column, and at every x the drop height and wasted space; lowest top, then
+// least waste, then the first position wins.
+PackResult reference_pack(const std::vector<PackChart>& charts, int width, int padding) {
+  constexpr int kNone = std::numeric_limits<int>::max();
+  struct Rotated {
+    int w = 0, h = 0;
+    std::vector<int> top, low;  // top per column (0 = empty); low per dilated column
+  };
+  std::vector<std::array<Rotated, 4>> rotated(charts.size());
+  for (size_t c = 0; c < charts.size(); ++c) {
+    const int gx = std::max(1, int(std::ceil(charts[c].width)));
+    const int gy = std::max(1, int(std::ceil(charts[c].height)));
+    std::vector<char> cell(size_t(gx) * gy, 0);
+    for (const auto& t : charts[c].tris) {
+      const Vec2d &a = charts[c].points[t[0]], &b = charts[c].points[t[1]],
+                  &d = charts[c].points[t[2]];
+      for_each_touched_texel(RasterTriangle({a.x, a.y, b.x, b.y, d.x, d.y}), kFootprintMargin,
+                             {0, 0, gx - 1, gy - 1},
+                             [&](int64_t i, int64_t j) { cell[size_t(j * gx + i)] = 1; });
+    }
+    for (int r = 0; r < 4; ++r) {
+      Rotated& ro = rotated[c][size_t(r)];
+      ro.w = r % 2 ? gy : gx, ro.h = r % 2 ? gx : gy;
+      std::vector<int> bottom(size_t(ro.w), kNone);
+      ro.top.assign(size_t(ro.w), 0);
+      for (int j = 0; j < gy; ++j)
+        for (int i = 0; i < gx; ++i) {
+          if (!cell[size_t(j * gx + i)]) continue;
+          const int x = r == 0 ? i : r == 1 ? gy - 1 - j : r == 2 ? gx - 1 - i : j;
+          const int y = r == 0 ? j : r == 1 ? i : r == 2 ? gy - 1 - j : gx - 1 - i;
+          bottom[size_t(x)] = std::min(bottom[size_t(x)], y);
+          ro.top[size_t(x)] = std::max(ro.top[size_t(x)], y + 1);
+        }
+      ro.low.assign(size_t(ro.w + 2 * padding), kNone);
+      for (int x = 0; x < ro.w; ++x)
+        for (int d = 0; d <= 2 * padding && bottom[size_t(x)] != kNone; ++d)
+          ro.low[size_t(x + d)] = std::min(ro.low[size_t(x + d)], bottom[size_t(x)] - padding);
+    }
+  }
+  std::vector<size_t> order(charts.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  auto grid = [&](size_t c) {
+    return std::pair<int, int>(std::max(1, int(std::ceil(charts[c].width))),
+                               std::max(1, int(std::ceil(charts[c].height))));
+  };
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    const auto [ax, ay] = grid(a);
+    const auto [bx, by] = grid(b);
+    if (std::min(ax, ay) != std::min(bx, by)) return std::min(ax, ay) > std::min(bx, by);
+    return int64_t(ax) * ay > int64_t(bx) * by;
+  });
+  PackResult result;
+  result.placements.resize(charts.size());
+  result.width = width;
+  std::vector<int> sky(size_t(width), 0);
+  for (size_t c : order) {
+    int64_t best_top = std::numeric_limits<int64_t>::max(), best_waste = 0;
+    Placement best;
+    for (int r = 0; r < 4; ++r) {
+      const Rotated& ro = rotated[c][size_t(r)];
+      for (int x = 0; x + ro.w <= width; ++x) {
+        int64_t y = 0;
+        for (int d = 0; d < int(ro.low.size()); ++d) {
+          const int ax = x + d - padding;
+          if (ax >= 0 && ax < width && ro.low[size_t(d)] != kNone)
+            y = std::max<int64_t>(y, sky[size_t(ax)] - ro.low[size_t(d)]);
+        }
+        int64_t waste = 0;
+        for (int d = 0; d < ro.w; ++d)
+          if (ro.top[size_t(d)] > 0)
+            waste += y + ro.low[size_t(d + padding)] + padding - sky[size_t(x + d)];
+        const int64_t top = y + ro.h;
+        if (top < best_top || (top == best_top && waste < best_waste))
+          best_top = top, best_waste = waste, best = {r, x, int(y)};
+      }
+    }
+    if (best_top == std::numeric_limits<int64_t>::max()) {
+      result.overflow = true;
+      best = {0, 0, result.height + padding};
+    }
+    const Rotated& ro = rotated[c][size_t(best.rotation)];
+    for (int d = 0; d < ro.w && best.x + d < width; ++d)
+      if (ro.top[size_t(d)] > 0)
+        sky[size_t(best.x + d)] = std::max(sky[size_t(best.x + d)], best.y + ro.top[size_t(d)]);
+    result.height = std::max(result.height, best.y + ro.h);
+    result.placements[c] = best;
+  }
+  return result;
+}
+
+TEST(Pack, PlacementsAreThoseOfTheCellByCellScan) {
+  for (int padding : {0, 1, 3, 8}) {
+    std::mt19937 rng(21 + padding);
+    std::vector<PackChart> charts;
+    for (int i = 0; i < 120; ++i) charts.push_back(random_chart(rng));
+    for (int width : {40, 97, 256}) {
+      const PackResult got = pack_charts(charts, width, padding, 2);
+      const PackResult want = reference_pack(charts, width, padding);
+      EXPECT_EQ(got.height, want.height) << "padding " << padding << " width " << width;
+      EXPECT_EQ(got.overflow, want.overflow);
+      for (size_t c = 0; c < charts.size(); ++c) {
+        EXPECT_EQ(got.placements[c].rotation, want.placements[c].rotation) << c;
+        EXPECT_EQ(got.placements[c].x, want.placements[c].x) << c;
+        EXPECT_EQ(got.placements[c].y, want.placements[c].y) << c;
+      }
+    }
   }
 }
 
