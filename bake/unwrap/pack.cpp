@@ -188,17 +188,18 @@ class Skyline {
   // y(x) = max(0, max over the non-empty dilated columns d of sky[x + d - padding] - low[d]) for
   // x in [0, x_max]: the height a profile drops to at x, exactly as a column-by-column scan
   // finds it, in O(runs) a position from one window maximum per run of equal `low`.
-  void drop_heights(const Profile& pr, int x_max, std::vector<int64_t>& y) const {
+  // In int: heights stay far below 2^31 and kNothing - low far above -2^31, and the loop
+  // vectorises.
+  void drop_heights(const Profile& pr, int x_max, std::vector<int>& y) const {
     y.assign(size_t(x_max) + 1, 0);
+    int* out = y.data();
     for (const Profile::LowRun& run : pr.low_runs) {
       size_t k = 0;
       while ((size_t(2) << k) <= size_t(run.length)) ++k;
       const int* a = levels_[k].data() + run.begin;  // padded index of sky[x + begin - padding]
       const int* b = a + (run.length - (1 << k));
-      for (int x = 0; x <= x_max; ++x) {
-        const int64_t m = std::max(a[x], b[x]);
-        y[size_t(x)] = std::max(y[size_t(x)], m - run.low);
-      }
+      const int low = run.low;
+      for (int x = 0; x <= x_max; ++x) out[x] = std::max(out[x], std::max(a[x], b[x]) - low);
     }
   }
   // Sum of sky over the columns x + d of the profile whose top > 0.
@@ -247,7 +248,7 @@ PackResult pack_charts(const std::vector<PackChart>& charts, int width, int padd
   });
 
   Skyline sky(width, padding);
-  std::vector<int64_t> drop;
+  std::vector<int> drop;
   int top_all = 0;
   for (size_t c : order) {
     int64_t best_top = std::numeric_limits<int64_t>::max(), best_waste = 0;
