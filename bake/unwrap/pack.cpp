@@ -43,16 +43,16 @@ Footprint footprint(const PackChart& chart, const Grid& g) {
   f.col_min.assign(size_t(g.gx), kEmpty), f.col_max.assign(size_t(g.gx), -1);
   f.row_min.assign(size_t(g.gy), kEmpty), f.row_max.assign(size_t(g.gy), -1);
   const TexelRect grid = {0, 0, g.gx - 1, g.gy - 1};
+  auto extend = [](std::vector<int>& lo, std::vector<int>& hi, int64_t line, int64_t first,
+                   int64_t last) {
+    lo[size_t(line)] = std::min(lo[size_t(line)], int(first));
+    hi[size_t(line)] = std::max(hi[size_t(line)], int(last));
+  };
   for (const auto& t : chart.tris) {
     const Vec2d& a = chart.points[t[0]];
     const Vec2d& b = chart.points[t[1]];
     const Vec2d& c = chart.points[t[2]];
     const RasterTriangle tri({a.x, a.y, b.x, b.y, c.x, c.y});
-    auto extend = [](std::vector<int>& lo, std::vector<int>& hi, int64_t line, int64_t first,
-                     int64_t last) {
-      lo[size_t(line)] = std::min(lo[size_t(line)], int(first));
-      hi[size_t(line)] = std::max(hi[size_t(line)], int(last));
-    };
     for_each_touched_run(
         tri, kFootprintMargin, grid, false,
         [&](int64_t j, int64_t i0, int64_t i1) { extend(f.row_min, f.row_max, j, i0, i1); });
@@ -68,9 +68,9 @@ struct Profile {
   int width = 0, height = 0;  // rotated grid
   std::vector<int> top;       // per raw column: highest occupied row + 1 (0 = empty column)
   std::vector<int> low;       // per dilated column (width + 2 * padding): lowest row - padding
-  // For the search by runs (drop_heights, placement_waste): the maximal runs of dilated columns
-  // of one finite `low`, and the runs [begin, end) of raw columns with top > 0 with their count
-  // and the sum of their `low[d + padding]`.
+  // For the search by runs (Skyline::drop_heights, Skyline::sky_under): the maximal runs of dilated
+  // columns of one finite `low`, and the runs [begin, end) of raw columns with top > 0 with their
+  // count and the sum of their `low[d + padding]`.
   struct LowRun {
     int begin, length, low;
   };
