@@ -329,8 +329,8 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
       level0_fits_memory(transfer_store_bytes(unwrapped->scene, options.lighting.layer, W, H),
                          limit);
   to.coverage_in_memory = !options.transfer_to_scratch && CoverageMask::fits_memory(W, H, limit);
-  // The band cache costs a third of the transfer's time (zstd of every band) and holds about
-  // 14 bytes a texel: written only by a bake that asks for it (--update, or --cache DIR).
+  // The band cache costs a third of the transfer's time (zstd of every band) and 9-17 bytes of
+  // disk a texel: written only by a bake that asks for it (--update, or --cache DIR).
   if (!cache.empty() && (options.build.update || !options.cache.empty())) {
     to.cache_out = cache + "/transfer.bin";
     if (options.build.update) to.cache_in = to.cache_out;

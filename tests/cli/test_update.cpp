@@ -235,6 +235,8 @@ TEST(CliUpdate, SceneBakeUpdateReadsUnchangedBandsFromTheCacheAndNeverTrustsADam
   EXPECT_EQ(plain["transfer"]["bands_cached"], 0);
   EXPECT_FALSE(std::filesystem::exists(cache));
   EXPECT_TRUE(std::filesystem::exists(out + ".cache/unwrap.bin"));
+  run_json("-q bake " + obj + " -o " + dir + "/named.vtpf --cache " + dir + "/named" + flags);
+  EXPECT_TRUE(std::filesystem::exists(dir + "/named/transfer.bin"));  // a cache asked for by name
   const std::vector<uint8_t> plain_bytes = read_bytes(out);
   std::filesystem::remove(out);
   auto clean = run_json("-q bake " + obj + " -o " + out + " --update" + flags);
