@@ -97,6 +97,30 @@ uint64_t transfer_store_bytes(const scene::Scene& scene, LightingLayer lighting,
   return uint64_t(W) * H * channels * sizeof(float);
 }
 
+// Where the bake's scratch files go: --scratch-dir, else beside the output.
+std::string scratch_folder(const SceneBakeOptions& options) {
+  return options.build.scratch_dir.empty()
+             ? std::filesystem::path(options.build.output).parent_path().string()
+             : options.build.scratch_dir;
+}
+
+// Refuses a bake whose level-0 stores (`store_bytes`) go to scratch files in `dir` and do not
+// fit its free space: found before the work, not when a write fails an hour into it. The stores
+// are a lower bound of the scratch (VirtualCity at 32,760²: 28 bytes a texel of stores, 32.2 of
+// scratch with the dilation's pull levels and the coarse levels).
+Status check_scratch_space(uint64_t store_bytes, const std::string& dir) {
+  std::error_code ec;
+  const std::filesystem::space_info space = std::filesystem::space(dir.empty() ? "." : dir, ec);
+  if (ec || space.available >= store_bytes) return Status::Ok();  // unknown: let the writes tell
+  auto gib = [](uint64_t b) { return std::to_string((b + (uint64_t(1) << 29)) >> 30); };
+  return Error(ErrorCode::kResourceLimit,
+               (dir.empty() ? std::string(".") : dir) + ": the atlas's level 0 needs at least " +
+                   gib(store_bytes) + " GiB of scratch files here, and the disk has " +
+                   gib(space.available) +
+                   " GiB free; give --scratch-dir on a larger disk, or lower --size or "
+                   "--texels-per-unit");
+}
+
 std::string default_unwrapped(const std::string& output) {
   std::filesystem::path p(output);
   p.replace_extension(".glb");
@@ -259,6 +283,10 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
                                                   "2^24 texels a side");
     }
     VT_RETURN_IF_ERROR(check_atlas_memory(side, side, limit).with_context("bake"));
+    const uint64_t stores =
+        transfer_store_bytes(input, options.lighting.layer, uint32_t(side), uint32_t(side));
+    if (options.transfer_to_scratch || !level0_fits_memory(stores, limit))
+      VT_RETURN_IF_ERROR(check_scratch_space(stores, scratch_folder(options)).with_context("bake"));
   }
   uo.max_size_pages = std::max(
       1, std::min(uo.max_size_pages, unwrap::pages_within(texels_within(limit), uo.page_payload)));
@@ -316,18 +344,16 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
   to.threads = options.build.threads;
   to.color_config = options.build.color_config;
   to.lighting = options.lighting;
-  to.scratch_dir = options.build.scratch_dir.empty()
-                       ? std::filesystem::path(output).parent_path().string()
-                       : options.build.scratch_dir;
+  to.scratch_dir = scratch_folder(options);
   to.progress = [&](double f) { report("transfer", f); };
   // Bands of rows straight to the layers' stores: in memory where the build holds level 0 so.
   to.band_rows = options.transfer_band_rows;
   to.band_memory = band_bytes(limit);
   to.texture_cache = texture_cache_bytes(limit);
-  to.stores_in_memory =
-      !options.transfer_to_scratch &&
-      level0_fits_memory(transfer_store_bytes(unwrapped->scene, options.lighting.layer, W, H),
-                         limit);
+  const uint64_t stores = transfer_store_bytes(unwrapped->scene, options.lighting.layer, W, H);
+  to.stores_in_memory = !options.transfer_to_scratch && level0_fits_memory(stores, limit);
+  if (!to.stores_in_memory)
+    VT_RETURN_IF_ERROR(check_scratch_space(stores, to.scratch_dir).with_context("transfer"));
   to.coverage_in_memory = !options.transfer_to_scratch && CoverageMask::fits_memory(W, H, limit);
   // The band cache costs a third of the transfer's time (zstd of every band) and 9-17 bytes of
   // disk a texel: written only by a bake that asks for it (--update, or --cache DIR).

@@ -650,5 +650,34 @@ TEST(SceneBake, AnAtlasOverTheMemoryLimitIsRefusedBeforeTheUnwrap) {
       << summary.status().message();
 }
 
+// An atlas whose level-0 stores go to scratch files larger than the scratch disk's free space is
+// refused before the unwrap, naming the folder and both sizes; given a scratch disk that holds
+// them it is not refused for that.
+TEST(SceneBake, AnAtlasWhoseScratchPassesTheFreeSpaceIsRefusedBeforeTheUnwrap) {
+  test::ScratchDir dir;
+  scene::Scene s = test::single_mesh_scene(make_grid(1, 1, 1), {});
+  SceneBakeOptions o;
+  o.build.output = dir.file("big.vtpf");
+  o.build.scratch_dir = dir.path();
+  o.unwrap.size_pages = 1000;  // 120,000 texels a side: 1.44e10 texels, 16 bytes each stored
+  const uint64_t stores = uint64_t(120000) * 120000 * 16;
+  std::error_code ec;
+  const auto space = std::filesystem::space(dir.path(), ec);
+  ASSERT_FALSE(ec);
+  if (space.available >= stores) GTEST_SKIP() << "this disk holds 215 GiB of scratch";
+  auto summary = bake_scene(s, o);
+  ASSERT_FALSE(summary.ok());
+  EXPECT_EQ(summary.status().code(), ErrorCode::kResourceLimit);
+  const std::string& m = summary.status().message();
+  EXPECT_NE(m.find(dir.path() + ": the atlas's level 0 needs at least 215 GiB of scratch"),
+            std::string::npos)
+      << m;
+  EXPECT_NE(m.find(std::to_string((space.available + (uint64_t(1) << 29)) >> 30) + " GiB free"),
+            std::string::npos)
+      << m;
+  EXPECT_TRUE(m.find("unwrap") == std::string::npos) << m;
+  EXPECT_FALSE(std::filesystem::exists(o.build.output));
+}
+
 }  // namespace
 }  // namespace vt
