@@ -97,6 +97,13 @@ uint64_t transfer_store_bytes(const scene::Scene& scene, LightingLayer lighting,
   return uint64_t(W) * H * channels * sizeof(float);
 }
 
+// Whether the transfer's level-0 stores (`store_bytes`) stay in memory rather than scratch
+// files: where the build would hold level 0 in memory too.
+bool stores_in_memory(const SceneBakeOptions& options, uint64_t store_bytes) {
+  return !options.transfer_to_scratch &&
+         level0_fits_memory(store_bytes, options.build.memory_limit);
+}
+
 // Where the bake's scratch files go: --scratch-dir, else beside the output.
 std::string scratch_folder(const SceneBakeOptions& options) {
   return options.build.scratch_dir.empty()
@@ -285,7 +292,7 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
     VT_RETURN_IF_ERROR(check_atlas_memory(side, side, limit).with_context("bake"));
     const uint64_t stores =
         transfer_store_bytes(input, options.lighting.layer, uint32_t(side), uint32_t(side));
-    if (options.transfer_to_scratch || !level0_fits_memory(stores, limit))
+    if (!stores_in_memory(options, stores))
       VT_RETURN_IF_ERROR(check_scratch_space(stores, scratch_folder(options)).with_context("bake"));
   }
   uo.max_size_pages = std::max(
@@ -351,7 +358,7 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
   to.band_memory = band_bytes(limit);
   to.texture_cache = texture_cache_bytes(limit);
   const uint64_t stores = transfer_store_bytes(unwrapped->scene, options.lighting.layer, W, H);
-  to.stores_in_memory = !options.transfer_to_scratch && level0_fits_memory(stores, limit);
+  to.stores_in_memory = stores_in_memory(options, stores);
   if (!to.stores_in_memory)
     VT_RETURN_IF_ERROR(check_scratch_space(stores, to.scratch_dir).with_context("transfer"));
   to.coverage_in_memory = !options.transfer_to_scratch && CoverageMask::fits_memory(W, H, limit);
