@@ -91,9 +91,7 @@ Expected<uint64_t> scene_bake_key(const scene::Scene& scene, const SceneBakeOpti
     if (l.layer != LightingLayer::kSeparate) k.add(std::string(to_string(l.layer)));
   }
   // The density file the unwrap reads (the scene's NAME.density.json unless one is named).
-  std::string density = options.unwrap.density_file == "-" ? "" : options.unwrap.density_file;
-  if (options.unwrap.density_file.empty())
-    density = unwrap::default_density_file(scene.source_path);
+  const std::string density = unwrap::density_file_to_read(scene, options.unwrap.density_file);
   std::error_code ec;
   const bool has_density = !density.empty() && std::filesystem::exists(density, ec);
   k.add(uint8_t(has_density));
