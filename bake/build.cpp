@@ -122,7 +122,8 @@ class LayerRun {
     std::unique_ptr<LevelStore> next;
     VT_ASSIGN_OR_RETURN(next,
                         LevelStore::create(g_.level_width(level + 1), g_.level_height(level + 1),
-                                           layer_.work_channels, in_memory, plan_.scratch_dir));
+                                           layer_.work_channels, in_memory, plan_.scratch_dir,
+                                           plan_.compress_scratch));
     // Levels held at once: this one (unless streamed from the source) and the next.
     const uint64_t cur = level_bytes(*current_), nxt = next->bytes();
     const bool cur_in_memory = layer_.level_in_memory[level],

@@ -79,6 +79,9 @@ struct BuildOptions {
   // scaled so that the fraction of texels with alpha >= this reference matches level 0's.
   float alpha_coverage_reference = 0;
   std::string scratch_dir;  // "" = the output's directory
+  // Scratch levels compressed in chunks whatever their size (else where
+  // scratch_needs_compression says: bake/level_store.h).
+  bool compress_scratch = false;
   // Colour spaces of the colour layers (LayerInput::color_space, metadata) are this config's;
   // its scene_linear role is the working space. Null = the built-in config (bake/color.h).
   std::shared_ptr<const ColorConfig> color_config;

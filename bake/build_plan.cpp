@@ -12,6 +12,7 @@
 #include <limits>
 
 #include "bake/level_source.h"
+#include "bake/level_store.h"
 #include "bake/paging.h"
 #include "bake/row_window.h"
 #include "common/half.h"
@@ -263,6 +264,17 @@ std::vector<bool> choose_level_memory(const BuildPlan& plan, const LayerPlan& la
     in_memory[l + 1] = ws < limit && cur + level_bytes(l + 1) <= limit - ws;
   }
   return in_memory;
+}
+
+// The coarser levels' scratch files in all (floats), before any is written.
+uint64_t scratch_level_bytes(const BuildPlan& plan) {
+  const PageGeometry& g = plan.desc.geometry;
+  uint64_t bytes = 0;
+  for (const LayerPlan& layer : plan.layers)
+    for (uint32_t l = 1; l < layer.level_in_memory.size(); ++l)
+      if (!layer.level_in_memory[l])
+        bytes += uint64_t(g.level_width(l)) * g.level_height(l) * layer.work_channels * sizeof(float);
+  return bytes;
 }
 
 // Below level 0's working set a limit only sends levels to scratch files: the build says what
@@ -663,6 +675,8 @@ Expected<BuildPlan> plan_build(const BuildOptions& options) {
     VT_RETURN_IF_ERROR(plan_tables(plan, in, layer, pinned.find(layer.spec.name), settings));
   }
   for (const LayerPlan& layer : plan.layers) desc.layers.push_back(layer.spec);
+  plan.compress_scratch =
+      options.compress_scratch || scratch_needs_compression(scratch_level_bytes(plan), plan.scratch_dir);
   check_memory_floor(plan);
   for (LayerPlan& layer : plan.layers) layer.task_seed = task_seed(settings, layer.spec);
   return plan;

@@ -76,6 +76,7 @@ struct BuildPlan {
   DownsampleKernel kernel;
   uint32_t margin = 0;  // rows a band reads past its pages: max(border, filter reach)
   std::string scratch_dir;
+  bool compress_scratch = false;  // BuildOptions::compress_scratch, or the levels' scratch needs it
   uint64_t hash = 0;          // the plan's identity: settings, tool version, every source's content
   uint64_t settings_key = 0;  // the settings alone (tool version included)
   // Update mode: the previous output when its pages can be reused (same tool, settings and

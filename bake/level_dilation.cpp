@@ -15,10 +15,11 @@ namespace {
 class PullLevel {
  public:
   static Expected<PullLevel> create(uint32_t w, uint32_t h, uint32_t ch, bool in_memory,
-                                    const std::string& dir) {
+                                    const std::string& dir, bool compressed) {
     PullLevel p;
     p.w = w, p.h = h, p.ch = ch;
-    VT_ASSIGN_OR_RETURN(p.store_, LevelStore::create(w, h, 2 * (ch + 1), in_memory, dir));
+    VT_ASSIGN_OR_RETURN(p.store_,
+                        LevelStore::create(w, h, 2 * (ch + 1), in_memory, dir, compressed));
     return p;
   }
   static uint64_t bytes(uint32_t w, uint32_t h, uint32_t ch) {
@@ -135,8 +136,10 @@ Expected<uint64_t> pull_push_banded(LevelStore& level, const CoverageMask& cover
   }
   std::vector<PullLevel> pull;
   for (size_t k = 0; k < sizes.size(); ++k) {
-    VT_ASSIGN_OR_RETURN(PullLevel l, PullLevel::create(sizes[k].first, sizes[k].second, ch,
-                                                       in_memory[k], options.scratch_dir));
+    // Scratch pull levels are compressed where the level they dilate is.
+    VT_ASSIGN_OR_RETURN(PullLevel l,
+                        PullLevel::create(sizes[k].first, sizes[k].second, ch, in_memory[k],
+                                          options.scratch_dir, level.compressed()));
     pull.push_back(std::move(l));
   }
 

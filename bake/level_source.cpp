@@ -298,7 +298,12 @@ Expected<std::shared_ptr<LevelSource>> hold_level0(const LayerInput& input, cons
   } else if (own) {
     store = own;
   } else {
-    VT_ASSIGN_OR_RETURN(store, LevelStore::create(w, h, wc, in_memory, scratch_dir_for(options)));
+    const std::string dir = scratch_dir_for(options);
+    VT_ASSIGN_OR_RETURN(
+        store, LevelStore::create(w, h, wc, in_memory, dir,
+                                  !in_memory && (options.compress_scratch ||
+                                                 scratch_needs_compression(
+                                                     uint64_t(w) * h * wc * sizeof(float), dir))));
   }
   std::vector<float> raw, converted;
   // Chunks of a few MiB of source rows (at least one row).

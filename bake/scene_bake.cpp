@@ -111,21 +111,16 @@ std::string scratch_folder(const SceneBakeOptions& options) {
              : options.build.scratch_dir;
 }
 
-// Refuses a bake whose level-0 stores (`store_bytes`) go to scratch files in `dir` and do not
-// fit its free space: found before the work, not when a write fails an hour into it. The stores
-// are a lower bound of the scratch (VirtualCity at 32,760²: 28 bytes a texel of stores, 32.2 of
-// scratch with the dilation's pull levels and the coarse levels).
+// Refuses a bake whose level-0 stores (`store_bytes` of floats) go to scratch files in `dir`
+// and cannot fit its free space even compressed as well as any real atlas's levels: found
+// before the work, not when a write fails an hour into it. The transfer checks again from what
+// its stores take once written (TransferOptions::stores_in_memory).
 Status check_scratch_space(uint64_t store_bytes, const std::string& dir) {
-  std::error_code ec;
-  const std::filesystem::space_info space = std::filesystem::space(dir.empty() ? "." : dir, ec);
-  if (ec || space.available >= store_bytes) return Status::Ok();  // unknown: let the writes tell
   auto gib = [](uint64_t b) { return std::to_string((b + (uint64_t(1) << 29)) >> 30); };
-  return Error(ErrorCode::kResourceLimit,
-               (dir.empty() ? std::string(".") : dir) + ": the atlas's level 0 needs at least " +
-                   gib(store_bytes) + " GiB of scratch files here, and the disk has " +
-                   gib(space.available) +
-                   " GiB free; give --scratch-dir on a larger disk, or lower --size or "
-                   "--texels-per-unit");
+  return check_scratch_room(store_bytes / kScratchBestCompression, dir,
+                            "the atlas's level 0 (" + gib(store_bytes) + " GiB of floats, " +
+                                std::to_string(kScratchBestCompression) +
+                                "x compressed at best) needs at least");
 }
 
 std::string default_unwrapped(const std::string& output) {
@@ -359,8 +354,13 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
   to.texture_cache = texture_cache_bytes(limit);
   const uint64_t stores = transfer_store_bytes(unwrapped->scene, options.lighting.layer, W, H);
   to.stores_in_memory = stores_in_memory(options, stores);
-  if (!to.stores_in_memory)
+  if (!to.stores_in_memory) {
     VT_RETURN_IF_ERROR(check_scratch_space(stores, to.scratch_dir).with_context("transfer"));
+    // The build's scratch: the stores, converted in their own files, and a third more of
+    // coarser levels; its levels are compressed as the stores are.
+    to.compress_scratch = options.build.compress_scratch ||
+                          scratch_needs_compression(stores / 3 * 4, to.scratch_dir);
+  }
   to.coverage_in_memory = !options.transfer_to_scratch && CoverageMask::fits_memory(W, H, limit);
   // The band cache costs a third of the transfer's time (zstd of every band) and 9-17 bytes of
   // disk a texel: written only by a bake that asks for it (--update, or --cache DIR).
@@ -394,6 +394,7 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
   BuildOptions& bo = prepared.build;
   bo = options.build;
   bo.layers = layer_inputs(*transfer);
+  bo.compress_scratch = to.compress_scratch;
   bo.address = AddressMode::kClamp;
   bo.update_from = output;
   bo.input_key = input_key;

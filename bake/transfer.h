@@ -61,6 +61,8 @@ struct TransferOptions {
   // the same for the coverage mask (1 bit per texel, bake/coverage_mask.h).
   bool stores_in_memory = true;
   bool coverage_in_memory = true;
+  // Scratch stores compressed in chunks (scratch_needs_compression in bake/level_store.h).
+  bool compress_scratch = false;
   // Filter for MIP levels made (maketx-style, in the scratch folder) for untiled sources;
   // "" = box-filtered levels (TransferTexture's, colour averaged in linear light). A maketx
   // filter averages the file's encoded values. Measured against the texel-footprint (box)

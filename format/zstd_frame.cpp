@@ -12,6 +12,16 @@ namespace {
 struct DctxDeleter {
   void operator()(ZSTD_DCtx* c) const { ZSTD_freeDCtx(c); }
 };
+struct CctxDeleter {
+  void operator()(ZSTD_CCtx* c) const { ZSTD_freeCCtx(c); }
+};
+
+// One per thread too: ZSTD_compress would allocate (and first-touch) a fresh workspace per call,
+// and ZSTD_compressCCtx gives the same bytes.
+ZSTD_CCtx* thread_cctx() {
+  thread_local std::unique_ptr<ZSTD_CCtx, CctxDeleter> ctx(ZSTD_createCCtx());
+  return ctx.get();
+}
 
 // One context per thread: decompression then needs no allocation and no lock.
 ZSTD_DCtx* thread_dctx() {
@@ -27,8 +37,11 @@ Status wrong_size(unsigned long long got, size_t expected) {
 }  // namespace
 
 Status zstd_compress(std::span<const uint8_t> data, int level, std::vector<uint8_t>& out) {
+  ZSTD_CCtx* ctx = thread_cctx();
+  if (!ctx) return Error(ErrorCode::kResourceLimit, "cannot create a zstd context");
   out.resize(ZSTD_compressBound(data.size()));
-  const size_t n = ZSTD_compress(out.data(), out.size(), data.data(), data.size(), level);
+  const size_t n =
+      ZSTD_compressCCtx(ctx, out.data(), out.size(), data.data(), data.size(), level);
   if (ZSTD_isError(n))
     return Error(ErrorCode::kInternal, std::string("zstd: ") + ZSTD_getErrorName(n));
   out.resize(n);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -101,19 +102,21 @@ TEST(BandedDilation, AllOrNothingCoveredLeavesTheLevel) {
 TEST(BandedDilation, ScratchLevelStoreDilatesLikeAnInMemoryOne) {
   test::ScratchDir dir;
   const Level l = random_level(41, 27, 3, 11);
-  auto store = LevelStore::create(l.w, l.h, l.ch, false, dir.file(""));
-  ASSERT_TRUE(store.ok());
-  ASSERT_TRUE((*store)->write_rows(0, l.h, l.texels.data()).ok());
-  ASSERT_TRUE((*store)->set_coverage_and_dilate(l.coverage, 0, dir.file("")).ok());
-  std::vector<float> out(l.texels.size());
-  ASSERT_TRUE((*store)->read(0, l.h, out.data()).ok());
-  EXPECT_EQ(out, whole(l));
-  ASSERT_NE((*store)->coverage(), nullptr);
+  for (bool compressed : {false, true}) {  // (compressed: its pull levels too)
+    auto store = LevelStore::create(l.w, l.h, l.ch, false, dir.file(""), compressed);
+    ASSERT_TRUE(store.ok());
+    ASSERT_TRUE((*store)->write_rows(0, l.h, l.texels.data()).ok());
+    ASSERT_TRUE((*store)->set_coverage_and_dilate(l.coverage, 0, dir.file("")).ok());
+    std::vector<float> out(l.texels.size());
+    ASSERT_TRUE((*store)->read(0, l.h, out.data()).ok());
+    EXPECT_EQ(out, whole(l)) << "compressed " << compressed;
+    ASSERT_NE((*store)->coverage(), nullptr);
+  }
 }
 
 // A build of a layer with coverage at a memory limit that puts level 0, every level and the
 // coverage masks in scratch files (dilated in bands) writes the bytes of the build that holds
-// them in memory.
+// them in memory, raw or compressed.
 TEST(BandedDilation, OutOfCoreCoverageBuildWritesTheSameBytes) {
   test::ScratchDir dir;
   const uint32_t w = 300, h = 250;
@@ -123,7 +126,9 @@ TEST(BandedDilation, OutOfCoreCoverageBuildWritesTheSameBytes) {
     for (uint32_t x = 10; x < 290; x += 1 + (y % 3)) l.coverage[size_t(y) * w + x] = 1;
   std::vector<char> first;
   // 64 KiB: the masks of levels 0 and 1 in scratch files too (1/64 of the limit is 1 KiB).
-  for (uint64_t limit : {uint64_t(2) << 30, uint64_t(1) << 20, uint64_t(64) << 10}) {
+  for (int run = 0; run < 5; ++run) {
+    const uint64_t limit =
+        std::array{uint64_t(2) << 30, uint64_t(1) << 20, uint64_t(64) << 10}[std::min(run, 2)];
     auto coverage = CoverageMask::create(w, h, limit > (1 << 20), dir.file(""));
     ASSERT_TRUE(coverage.ok());
     ASSERT_TRUE((*coverage)->write_rows(0, h, l.coverage.data()).ok());
@@ -136,7 +141,8 @@ TEST(BandedDilation, OutOfCoreCoverageBuildWritesTheSameBytes) {
     o.layers.push_back(in);
     o.payload = 56;
     o.memory_limit = limit;
-    o.output = dir.file("out" + std::to_string(limit) + ".vtpf");
+    o.compress_scratch = run >= 3;
+    o.output = dir.file("out" + std::to_string(run) + ".vtpf");
     auto built = build_page_file(o);
     ASSERT_TRUE(built.ok()) << built.status().message();
     if (limit < (uint64_t(1) << 30)) {

@@ -50,9 +50,10 @@ void expect_banded_equals_in_memory(const scene::Scene& s, TransferOptions o,
   const auto want = texels_of(*whole);
   for (uint32_t rows : {16u, 48u, 17u}) {
     for (int threads : {1, 2}) {
-      for (bool in_memory : {false, true}) {
+      for (int kind = 0; kind < 3; ++kind) {  // scratch, in memory, compressed scratch
         TransferOptions b = o;
-        b.band_rows = rows, b.threads = threads, b.stores_in_memory = in_memory;
+        b.band_rows = rows, b.threads = threads, b.stores_in_memory = kind == 1;
+        b.compress_scratch = kind == 2;
         b.scratch_dir = dir;
         auto banded = transfer_to_stores(s, b);
         ASSERT_TRUE(banded.ok()) << banded.status().message();
@@ -67,7 +68,7 @@ void expect_banded_equals_in_memory(const scene::Scene& s, TransferOptions o,
           EXPECT_EQ(banded->layers[l].texels_above_one, whole->layers[l].texels_above_one);
           ASSERT_EQ(got[l].size(), want[l].size());
           EXPECT_EQ(std::memcmp(got[l].data(), want[l].data(), want[l].size() * 4), 0)
-              << "layer " << l << " rows " << rows << " threads " << threads;
+              << "layer " << l << " rows " << rows << " threads " << threads << " kind " << kind;
         }
       }
     }
