@@ -17,6 +17,7 @@
 
 #include "bake/level_dilation.h"
 #include "bake/pyramid.h"
+#include "common/parallel.h"
 #include "format/zstd_frame.h"
 
 namespace vt {
@@ -108,22 +109,25 @@ class ScratchFile {
       return Status::Ok();
     }
     std::lock_guard lock(mutex_);
+    std::vector<uint32_t> whole;
     for (uint32_t c = y0 / chunk_rows_; rows > 0 && c * chunk_rows_ < y0 + rows; ++c) {
       const auto [cy0, cy1] = chunk_span(c);
       const uint32_t a = std::max(y0, cy0), b = std::min(y0 + rows, cy1);
-      const size_t chunk_bytes = size_t(cy1 - cy0) * row_bytes;
       if (a == cy0 && b == cy1) {
         for (Decoded& d : decoded_)
           if (d.chunk == c) d = Decoded{};
-        VT_RETURN_IF_ERROR(write_chunk(c, {data + size_t(cy0 - y0) * row_bytes, chunk_bytes}));
+        whole.push_back(c);
         continue;
       }
-      VT_ASSIGN_OR_RETURN(Decoded * d, decode(c, chunk_bytes));
+      VT_ASSIGN_OR_RETURN(Decoded * d, decode(c, size_t(cy1 - cy0) * row_bytes));
       std::memcpy(d->raw.data() + size_t(a - cy0) * row_bytes, data + size_t(a - y0) * row_bytes,
                   size_t(b - a) * row_bytes);
       d->dirty = true;
     }
-    return Status::Ok();
+    return on_chunks(whole, [&](uint32_t c) {
+      const auto [cy0, cy1] = chunk_span(c);
+      return write_chunk(c, {data + size_t(cy0 - y0) * row_bytes, size_t(cy1 - cy0) * row_bytes});
+    });
   }
 
   Status read(uint32_t y0, uint32_t y1, size_t row_bytes, uint8_t* out) {
@@ -131,21 +135,24 @@ class ScratchFile {
       return move_all(::pread, fd_, out, size_t(y1 - y0) * row_bytes,
                       off_t(uint64_t(y0) * row_bytes), path_, "read");
     std::lock_guard lock(mutex_);
+    std::vector<uint32_t> whole;
     for (uint32_t c = y0 / chunk_rows_; c * chunk_rows_ < y1; ++c) {
       const auto [cy0, cy1] = chunk_span(c);
       const uint32_t a = std::max(y0, cy0), b = std::min(y1, cy1);
-      const size_t chunk_bytes = size_t(cy1 - cy0) * row_bytes;
       const bool cached = std::any_of(decoded_.begin(), decoded_.end(),
                                       [c](const Decoded& d) { return d.chunk == c; });
       if (a == cy0 && b == cy1 && !cached) {
-        VT_RETURN_IF_ERROR(read_chunk(c, {out + size_t(cy0 - y0) * row_bytes, chunk_bytes}));
+        whole.push_back(c);
         continue;
       }
-      VT_ASSIGN_OR_RETURN(const Decoded* d, decode(c, chunk_bytes));
+      VT_ASSIGN_OR_RETURN(const Decoded* d, decode(c, size_t(cy1 - cy0) * row_bytes));
       std::memcpy(out + size_t(a - y0) * row_bytes, d->raw.data() + size_t(a - cy0) * row_bytes,
                   size_t(b - a) * row_bytes);
     }
-    return Status::Ok();
+    return on_chunks(whole, [&](uint32_t c) {
+      const auto [cy0, cy1] = chunk_span(c);
+      return read_chunk(c, {out + size_t(cy0 - y0) * row_bytes, size_t(cy1 - cy0) * row_bytes});
+    });
   }
 
   // A raw file rewritten in a smaller row size (keep_channels) ends at `bytes`.
@@ -166,6 +173,17 @@ class ScratchFile {
     std::vector<uint8_t> raw;
   };
   ScratchFile() = default;
+
+  // io(c) for whole chunks, on every core: compression is most of a scratch pass's time, and
+  // distinct chunks share nothing but disk_bytes_ (atomic). The first error is returned.
+  template <class Io>
+  Status on_chunks(const std::vector<uint32_t>& chunks, Io&& io) {
+    std::vector<Status> done(chunks.size());
+    parallel_for(chunks.size(), chunks.size() > 1 ? 0 : 1,
+                 [&](size_t i) { done[i] = io(chunks[i]); });
+    for (Status& s : done) VT_RETURN_IF_ERROR(std::move(s));
+    return Status::Ok();
+  }
 
   std::pair<uint32_t, uint32_t> chunk_span(uint32_t c) const {
     return {c * chunk_rows_, std::min(rows_, (c + 1) * chunk_rows_)};
@@ -300,12 +318,10 @@ uint64_t LevelStore::disk_bytes() const { return file_ ? file_->disk_bytes() : 0
 bool LevelStore::compressed() const { return file_ && file_->compressed(); }
 
 bool scratch_needs_compression(uint64_t raw_bytes, const std::string& dir) {
-  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-  if (pages > 0 && page > 0 && raw_bytes > uint64_t(pages) * uint64_t(page) / 2) return true;
   std::error_code ec;
   const std::filesystem::space_info space =
       std::filesystem::space(dir.empty() ? std::string(".") : dir, ec);
-  return !ec && raw_bytes > space.available;
+  return !ec && raw_bytes > space.available / 10 * 9;
 }
 
 Status LevelStore::keep_channels(uint32_t keep) {

@@ -30,9 +30,9 @@ inline constexpr uint64_t kScratchBestCompression = 8;
 Status check_scratch_room(uint64_t needed, const std::string& dir, const std::string& what_needs);
 
 // Whether scratch levels of `raw_bytes` in all (floats) in `dir` are compressed: where they would
-// not stay in the page cache (more than half the machine's memory) or not fit the disk's free
-// space raw. Elsewhere compressing only costs CPU: zstd-1 writes about 0.6 GB/s and reads 1.7
-// GB/s, and a 16,440² VirtualCity build whose 8.6 GB of scratch stayed cached took 2.4x longer.
+// not fit 90% of the disk's free space raw. Elsewhere compressing costs more time than the disk
+// traffic it saves on this project's machines: VirtualCity's build at 16,440² (8.6 GB of raw
+// scratch, in the page cache) took 2.4x longer, at 32,760² (34.6 GB, past it) 1.5x.
 bool scratch_needs_compression(uint64_t raw_bytes, const std::string& dir);
 
 class LevelStore final : public LevelSource {

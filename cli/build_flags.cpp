@@ -90,6 +90,10 @@ void add_build_flags(CLI::App& app, BuildOptions& o) {
       ->default_str(format_byte_size(o.memory_limit));
   app.add_option("--scratch-dir", o.scratch_dir,
                  "Where levels larger than memory go (default: beside the output)");
+  app.add_flag("--compress-scratch", o.compress_scratch,
+               "Compress the levels in scratch files (zstd-1, lossless: the same output) even "
+               "where they fit the scratch disk raw: about 3x less disk for 1.5-2.4x the build "
+               "time (by default only when they would not fit)");
   app.add_flag("--update", o.update,
                "Update the output: copy every page of the existing file whose key (settings, "
                "codec tables, the page's input texels) is unchanged, encode the rest; its DCT "
