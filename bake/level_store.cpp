@@ -54,15 +54,12 @@ uint64_t whole_blocks(uint64_t bytes) { return (bytes + kBlock - 1) / kBlock * k
 
 }  // namespace
 
-// A scratch level: raw rows at their offsets, or (`compressed`, scratch_needs_compression) a
-// sparse file of rows in chunks of about 1 MiB, one zstd-1 frame
-// per chunk in a fixed slot (the frame bound rounded up to whole blocks), so a chunk rewritten
-// smaller frees its old tail by punching a hole, and a chunk never written reads as zeros.
-// VirtualCity's working levels take 1.7x (albedo) to 5.4x (orm) fewer bytes so: at 65,536² the
-// raw floats would need twice this machine's free disk, and a level past the page cache is read
-// and written that much less. Reads and writes of parts of chunks (the dilation's row pairs) go
-// through two decoded chunks written back when evicted: each chunk of a pass is compressed and
-// decompressed once, not once per row (14x the level's bytes before).
+// A scratch level: raw rows at their offsets, or (`compressed`: scratch_needs_compression) a
+// sparse file of rows in chunks of about 1 MiB, one zstd-1 frame per chunk in a fixed slot (the
+// frame bound in whole blocks), so a chunk rewritten smaller frees its old tail by punching a
+// hole and a chunk never written reads as zeros. VirtualCity's working levels take 1.7x (albedo)
+// to 5.4x (orm) fewer bytes so. Parts of chunks (the dilation's row pairs) go through two decoded
+// chunks written back when evicted, so a pass compresses each chunk once, not once per row pair.
 class ScratchFile {
  public:
   static constexpr size_t kChunkBytes = size_t(1) << 20;
