@@ -26,17 +26,52 @@ class PullLevel {
     return uint64_t(w) * h * (ch + 1) * sizeof(double);
   }
   size_t row_doubles() const { return size_t(w) * (ch + 1); }
+  // Rows go to a scratch store a batch of about 4 MiB at a time, and are read so too: a
+  // compressed store then (de)compresses a batch's chunks on every core, not a row at a time on
+  // the dilation's thread. Rows held back are written before rows are read ahead, and a row
+  // written is also seen by the rows read ahead.
   Status write(uint32_t y, const double* row) {
-    return store_->write_rows(y, 1, reinterpret_cast<const float*>(row));
+    if (store_->in_memory()) return store_->write_rows(y, 1, reinterpret_cast<const float*>(row));
+    if (y >= read_y0_ && y < read_y0_ + read_rows_)
+      std::copy_n(row, row_doubles(), read_.data() + size_t(y - read_y0_) * row_doubles());
+    if (pending_rows_ > 0 && y != pending_y0_ + pending_rows_) VT_RETURN_IF_ERROR(flush());
+    if (pending_rows_ == 0) pending_y0_ = y;
+    pending_.resize(size_t(pending_rows_ + 1) * row_doubles());
+    std::copy_n(row, row_doubles(), pending_.data() + size_t(pending_rows_) * row_doubles());
+    return ++pending_rows_ == batch_rows() ? flush() : Status::Ok();
   }
   Status read(uint32_t y, double* row) {
-    return store_->read(y, y + 1, reinterpret_cast<float*>(row));
+    if (store_->in_memory()) return store_->read(y, y + 1, reinterpret_cast<float*>(row));
+    if (y < read_y0_ || y >= read_y0_ + read_rows_) {
+      VT_RETURN_IF_ERROR(flush());
+      read_y0_ = y, read_rows_ = std::min(batch_rows(), h - y);
+      read_.resize(size_t(read_rows_) * row_doubles());
+      VT_RETURN_IF_ERROR(
+          store_->read(y, y + read_rows_, reinterpret_cast<float*>(read_.data())));
+    }
+    std::copy_n(read_.data() + size_t(y - read_y0_) * row_doubles(), row_doubles(), row);
+    return Status::Ok();
   }
 
   uint32_t w = 0, h = 0, ch = 0;
 
  private:
+  // Writes the rows held back (a read of one of them asks first).
+  Status flush() {
+    const uint32_t rows = pending_rows_;
+    pending_rows_ = 0;
+    return rows == 0 ? Status::Ok()
+                     : store_->write_rows(pending_y0_, rows,
+                                          reinterpret_cast<const float*>(pending_.data()));
+  }
+
+  uint32_t batch_rows() const {
+    return uint32_t(std::clamp<size_t>((size_t(4) << 20) / (row_doubles() * sizeof(double)), 1,
+                                       std::max(h, 1u)));
+  }
   std::unique_ptr<LevelStore> store_;
+  std::vector<double> pending_, read_;
+  uint32_t pending_y0_ = 0, pending_rows_ = 0, read_y0_ = 0, read_rows_ = 0;
 };
 
 // The pull: level k's row j is the sum of level k-1's rows 2j and 2j+1, texel i of texels 2i

@@ -51,8 +51,8 @@ std::vector<float> whole(const Level& l) {
 }
 
 std::vector<float> banded(const Level& l, bool in_memory, uint32_t band_rows, uint64_t budget,
-                          const std::string& dir) {
-  auto store = LevelStore::create(l.w, l.h, l.ch, in_memory, dir);
+                          const std::string& dir, bool compressed = false) {
+  auto store = LevelStore::create(l.w, l.h, l.ch, in_memory, dir, compressed);
   EXPECT_TRUE(store.ok());
   EXPECT_TRUE((*store)->write_rows(0, l.h, l.texels.data()).ok());
   BandedDilationOptions o;
@@ -86,6 +86,20 @@ TEST(BandedDilation, SameBytesAsWholeLevelPullPush) {
         }
       }
     }
+  }
+}
+
+// Pull levels of rows wide enough that scratch pull levels move a few rows per batch (1 row of
+// 2.2 MB at level 1, 3 at level 2, ...; a last batch of fewer), raw and compressed.
+TEST(BandedDilation, WideScratchPullLevelsInBatchesGiveTheSameBytes) {
+  test::ScratchDir dir;
+  const Level l = random_level(140000, 26, 3, 3);  // level 2: 7 rows, batches of 3
+  const std::vector<float> want = whole(l);
+  for (bool compressed : {false, true}) {
+    const std::vector<float> got = banded(l, false, 5, 0, dir.file(""), compressed);
+    ASSERT_EQ(got.size(), want.size());
+    EXPECT_EQ(std::memcmp(got.data(), want.data(), want.size() * sizeof(float)), 0)
+        << "compressed " << compressed;
   }
 }
 
