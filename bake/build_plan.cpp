@@ -273,7 +273,8 @@ uint64_t scratch_level_bytes(const BuildPlan& plan) {
   for (const LayerPlan& layer : plan.layers)
     for (uint32_t l = 1; l < layer.level_in_memory.size(); ++l)
       if (!layer.level_in_memory[l])
-        bytes += uint64_t(g.level_width(l)) * g.level_height(l) * layer.work_channels * sizeof(float);
+        bytes +=
+            uint64_t(g.level_width(l)) * g.level_height(l) * layer.work_channels * sizeof(float);
   return bytes;
 }
 
@@ -675,8 +676,8 @@ Expected<BuildPlan> plan_build(const BuildOptions& options) {
     VT_RETURN_IF_ERROR(plan_tables(plan, in, layer, pinned.find(layer.spec.name), settings));
   }
   for (const LayerPlan& layer : plan.layers) desc.layers.push_back(layer.spec);
-  plan.compress_scratch =
-      options.compress_scratch || scratch_needs_compression(scratch_level_bytes(plan), plan.scratch_dir);
+  plan.compress_scratch = options.compress_scratch ||
+                          scratch_needs_compression(scratch_level_bytes(plan), plan.scratch_dir);
   check_memory_floor(plan);
   for (LayerPlan& layer : plan.layers) layer.task_seed = task_seed(settings, layer.spec);
   return plan;

@@ -46,8 +46,7 @@ class PullLevel {
       VT_RETURN_IF_ERROR(flush());
       read_y0_ = y, read_rows_ = std::min(batch_rows(), h - y);
       read_.resize(size_t(read_rows_) * row_doubles());
-      VT_RETURN_IF_ERROR(
-          store_->read(y, y + read_rows_, reinterpret_cast<float*>(read_.data())));
+      VT_RETURN_IF_ERROR(store_->read(y, y + read_rows_, reinterpret_cast<float*>(read_.data())));
     }
     std::copy_n(read_.data() + size_t(y - read_y0_) * row_doubles(), row_doubles(), row);
     return Status::Ok();

@@ -50,7 +50,9 @@ void advise_huge_pages(void* data, size_t bytes) {
 }
 
 constexpr uint64_t kBlock = 4096;
-uint64_t whole_blocks(uint64_t bytes) { return (bytes + kBlock - 1) / kBlock * kBlock; }
+uint64_t whole_blocks(uint64_t bytes) {
+  return (bytes + kBlock - 1) / kBlock * kBlock;
+}
 
 }  // namespace
 
@@ -71,7 +73,8 @@ class ScratchFile {
     name.push_back('\0');
     const int fd = mkstemp(name.data());
     if (fd < 0)
-      return Status(ErrorCode::kIo, templ + ": cannot create scratch file: " + std::strerror(errno));
+      return Status(ErrorCode::kIo,
+                    templ + ": cannot create scratch file: " + std::strerror(errno));
     unlink(name.data());  // the file lives as long as the descriptor
     std::unique_ptr<ScratchFile> f(new ScratchFile());
     f->fd_ = fd;
@@ -79,8 +82,8 @@ class ScratchFile {
     f->rows_ = rows;
     f->compressed_ = compressed;
     if (!compressed) return f;
-    f->chunk_rows_ = uint32_t(std::clamp<size_t>(kChunkBytes / std::max<size_t>(row_bytes, 1), 1,
-                                                 std::max(rows, 1u)));
+    f->chunk_rows_ = uint32_t(
+        std::clamp<size_t>(kChunkBytes / std::max<size_t>(row_bytes, 1), 1, std::max(rows, 1u)));
     f->slot_bytes_ = whole_blocks(ZSTD_COMPRESSBOUND(uint64_t(f->chunk_rows_) * row_bytes));
     f->frame_bytes_.assign((uint64_t(rows) + f->chunk_rows_ - 1) / f->chunk_rows_, 0);
     return f;
@@ -223,8 +226,10 @@ class ScratchFile {
   Status write_chunk(uint32_t c, std::span<const uint8_t> raw) {
     thread_local std::vector<uint8_t> frame;
     VT_RETURN_IF_ERROR(zstd_compress(raw, 1, frame));
-    if (frame.size() > slot_bytes_) return Error(ErrorCode::kInternal, "scratch chunk past its slot");
-    VT_RETURN_IF_ERROR(move_all(::pwrite, fd_, frame.data(), frame.size(), slot(c), path_, "write"));
+    if (frame.size() > slot_bytes_)
+      return Error(ErrorCode::kInternal, "scratch chunk past its slot");
+    VT_RETURN_IF_ERROR(
+        move_all(::pwrite, fd_, frame.data(), frame.size(), slot(c), path_, "write"));
     const uint64_t was = whole_blocks(frame_bytes_[c]), now = whole_blocks(frame.size());
     // Where holes cannot be punched the old tail stays allocated: only disk is lost.
     if (now < was)
@@ -275,9 +280,8 @@ Expected<std::unique_ptr<LevelStore>> LevelStore::create(uint32_t width, uint32_
     s->memory_.resize(n);
     return s;
   }
-  VT_ASSIGN_OR_RETURN(s->file_,
-                      ScratchFile::create(scratch_dir, height, s->row_floats() * sizeof(float),
-                                          compressed));
+  VT_ASSIGN_OR_RETURN(s->file_, ScratchFile::create(scratch_dir, height,
+                                                    s->row_floats() * sizeof(float), compressed));
   return s;
 }
 
@@ -311,8 +315,12 @@ Status LevelStore::set_coverage_and_dilate(std::shared_ptr<const CoverageMask> c
 
 LevelStore::~LevelStore() = default;
 
-uint64_t LevelStore::disk_bytes() const { return file_ ? file_->disk_bytes() : 0; }
-bool LevelStore::compressed() const { return file_ && file_->compressed(); }
+uint64_t LevelStore::disk_bytes() const {
+  return file_ ? file_->disk_bytes() : 0;
+}
+bool LevelStore::compressed() const {
+  return file_ && file_->compressed();
+}
 
 bool scratch_needs_compression(uint64_t raw_bytes, const std::string& dir) {
   std::error_code ec;

@@ -114,7 +114,7 @@ std::string scratch_folder(const SceneBakeOptions& options) {
 // Refuses a bake whose level-0 stores (`store_bytes` of floats) go to scratch files in `dir`
 // and cannot fit its free space even compressed as well as any real atlas's levels: found
 // before the work, not when a write fails an hour into it. The transfer checks again from what
-// its stores take once written (TransferOptions::stores_in_memory).
+// its stores take once written (check_projected_scratch in transfer.cpp).
 Status check_scratch_space(uint64_t store_bytes, const std::string& dir) {
   auto gib = [](uint64_t b) { return std::to_string((b + (uint64_t(1) << 29)) >> 30); };
   return check_scratch_room(store_bytes / kScratchBestCompression, dir,
@@ -358,8 +358,8 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
     VT_RETURN_IF_ERROR(check_scratch_space(stores, to.scratch_dir).with_context("transfer"));
     // The build's scratch: the stores, converted in their own files, and a third more of
     // coarser levels; its levels are compressed as the stores are.
-    to.compress_scratch = options.build.compress_scratch ||
-                          scratch_needs_compression(stores / 3 * 4, to.scratch_dir);
+    to.compress_scratch =
+        options.build.compress_scratch || scratch_needs_compression(stores / 3 * 4, to.scratch_dir);
   }
   to.coverage_in_memory = !options.transfer_to_scratch && CoverageMask::fits_memory(W, H, limit);
   // The band cache costs a third of the transfer's time (zstd of every band) and 9-17 bytes of

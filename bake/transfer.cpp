@@ -50,11 +50,10 @@ Vec3d v3(const Vec3& a) {
   return {a[0], a[1], a[2]};
 }
 
-// Scratch stores are compressed, so what a bake's scratch takes shows only as they are written:
-// from a quarter of the rows on, every pass projects the level-0 stores' disk at the ratio so
-// far, plus a third for the build's coarser levels (VirtualCity at 32,760², raw: 32.2 bytes a
-// texel of scratch against 24 of stores), and refuses a bake whose rest does not fit, rather
-// than let a write fail later.
+// What compressed scratch stores take shows only as they are written: from a quarter of the rows
+// on, every pass projects the level-0 stores' disk at the ratio so far, plus a third for the
+// build's coarser levels (VirtualCity at 32,760², raw: 32.2 bytes a texel of scratch against 24
+// of stores), and refuses a bake whose rest does not fit, rather than let a write fail later.
 Status check_projected_scratch(const std::shared_ptr<LevelStore>* stores, int count,
                                uint32_t rows_done, uint32_t rows, const std::string& dir) {
   if (rows_done < rows / 4 || rows_done >= rows) return Status::Ok();
@@ -63,12 +62,12 @@ Status check_projected_scratch(const std::shared_ptr<LevelStore>* stores, int co
     if (stores[l]) written += stores[l]->disk_bytes();
   const double scratch = double(written) * rows / rows_done * 4 / 3;
   auto gib = [](double b) { return std::to_string(uint64_t(b / double(1 << 30) + 0.5)); };
-  return check_scratch_room(
-      uint64_t(std::max(0.0, scratch - double(written))), dir,
-      "at " + std::to_string(uint64_t(100.0 * rows_done / rows)) +
-          "% of the transfer the level-0 stores take " + gib(double(written)) +
-          " GiB compressed, projecting " + gib(scratch) +
-          " GiB of scratch with the coarser levels: the rest needs");
+  return check_scratch_room(uint64_t(std::max(0.0, scratch - double(written))), dir,
+                            "at " + std::to_string(uint64_t(100.0 * rows_done / rows)) +
+                                "% of the transfer the level-0 stores take " +
+                                gib(double(written)) + " GiB compressed, projecting " +
+                                gib(scratch) +
+                                " GiB of scratch with the coarser levels: the rest needs");
 }
 
 // Runs `body(band)` for every band on `threads` threads; the calling thread reports progress.
@@ -1288,9 +1287,8 @@ Expected<TransferResult> Transfer::run() {
   std::shared_ptr<LevelStore> stores[kSlots];
   for (int l = 0; l < kSlots; ++l) {
     if (!want_[l]) continue;
-    VT_ASSIGN_OR_RETURN(
-        stores[l], LevelStore::create(W, H, channels_[l], opt_.stores_in_memory,
-                                                   opt_.scratch_dir, opt_.compress_scratch));
+    VT_ASSIGN_OR_RETURN(stores[l], LevelStore::create(W, H, channels_[l], opt_.stores_in_memory,
+                                                      opt_.scratch_dir, opt_.compress_scratch));
   }
   VT_ASSIGN_OR_RETURN(std::shared_ptr<CoverageMask> coverage,
                       CoverageMask::create(W, H, opt_.coverage_in_memory, opt_.scratch_dir));

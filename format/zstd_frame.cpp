@@ -40,8 +40,7 @@ Status zstd_compress(std::span<const uint8_t> data, int level, std::vector<uint8
   ZSTD_CCtx* ctx = thread_cctx();
   if (!ctx) return Error(ErrorCode::kResourceLimit, "cannot create a zstd context");
   out.resize(ZSTD_compressBound(data.size()));
-  const size_t n =
-      ZSTD_compressCCtx(ctx, out.data(), out.size(), data.data(), data.size(), level);
+  const size_t n = ZSTD_compressCCtx(ctx, out.data(), out.size(), data.data(), data.size(), level);
   if (ZSTD_isError(n))
     return Error(ErrorCode::kInternal, std::string("zstd: ") + ZSTD_getErrorName(n));
   out.resize(n);

@@ -338,7 +338,7 @@ TEST(LevelStore, ScratchRowsAreCompressedChunksThatPartialWritesPatch) {
   EXPECT_EQ(store.disk_bytes(), 0u);
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> noise(0.0f, 1.0f);
-  const std::pair<uint32_t, uint32_t> pieces[] = {{60, 7}, {0, 3}, {130, 100}, {299, 1},
+  const std::pair<uint32_t, uint32_t> pieces[] = {{60, 7}, {0, 3},   {130, 100}, {299, 1},
                                                   {3, 57}, {67, 63}, {230, 69}};
   for (auto [y0, rows] : pieces) {
     for (size_t i = y0 * row; i < (y0 + rows) * row; ++i) want[i] = noise(rng);
