@@ -19,9 +19,9 @@ namespace vt {
 
 class ScratchFile;
 
-// Scratch levels are compressed (level_store.cpp), so their disk is known only once written. The
-// best ratio real working levels showed (VirtualCity at 4,200²: orm 5.4x, albedo 1.7x) rounded
-// up: scratch estimated from raw floats before any is written needs at least bytes / this.
+// What compressed scratch levels take is known only once written. The best ratio real working
+// levels showed (VirtualCity: orm 5.4-6.0x, albedo 1.7x) rounded up: scratch estimated from raw
+// floats before any is written needs at least bytes / this.
 inline constexpr uint64_t kScratchBestCompression = 8;
 
 // Refuses `needed` bytes of scratch files in `dir` ("" = the current folder) when its disk has
@@ -32,7 +32,7 @@ Status check_scratch_room(uint64_t needed, const std::string& dir, const std::st
 // Whether scratch levels of `raw_bytes` in all (floats) in `dir` are compressed: where they would
 // not fit 90% of the disk's free space raw. Elsewhere compressing costs more time than the disk
 // traffic it saves on this project's machines: VirtualCity's build at 16,440² (8.6 GB of raw
-// scratch, in the page cache) took 2.4x longer, at 32,760² (34.6 GB, past it) 1.5x.
+// scratch, in the page cache) took 1.4x longer, at 32,760² (34.6 GB, past it) 1.5x.
 bool scratch_needs_compression(uint64_t raw_bytes, const std::string& dir);
 
 class LevelStore final : public LevelSource {

@@ -92,7 +92,7 @@ void add_build_flags(CLI::App& app, BuildOptions& o) {
                  "Where levels larger than memory go (default: beside the output)");
   app.add_flag("--compress-scratch", o.compress_scratch,
                "Compress the levels in scratch files (zstd-1, lossless: the same output) even "
-               "where they fit the scratch disk raw: about 3x less disk for 1.5-2.4x the build "
+               "where they fit the scratch disk raw: about 3x less disk for 1.4-1.8x the build "
                "time (by default only when they would not fit)");
   app.add_flag("--update", o.update,
                "Update the output: copy every page of the existing file whose key (settings, "
