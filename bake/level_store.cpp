@@ -252,15 +252,18 @@ class ScratchFile {
   uint64_t uses_ = 0;
 };
 
+std::string gib_text(uint64_t bytes) {
+  return std::to_string((bytes + (uint64_t(1) << 29)) >> 30);
+}
+
 Status check_scratch_room(uint64_t needed, const std::string& dir, const std::string& what_needs) {
   const std::string folder = dir.empty() ? std::string(".") : dir;
   std::error_code ec;
   const std::filesystem::space_info space = std::filesystem::space(folder, ec);
   if (ec || space.available >= needed) return Status::Ok();
-  auto gib = [](uint64_t b) { return std::to_string((b + (uint64_t(1) << 29)) >> 30); };
   return Error(ErrorCode::kResourceLimit,
-               folder + ": " + what_needs + " " + gib(needed) +
-                   " GiB of scratch files here, and the disk has " + gib(space.available) +
+               folder + ": " + what_needs + " " + gib_text(needed) +
+                   " GiB of scratch files here, and the disk has " + gib_text(space.available) +
                    " GiB free; give --scratch-dir on a larger disk, or lower --size or "
                    "--texels-per-unit");
 }

@@ -28,6 +28,8 @@ inline constexpr uint64_t kScratchBestCompression = 8;
 // less free, naming the folder and both sizes after `what_needs` ("the atlas's level 0 needs at
 // least"); an unknown free space passes (the writes will tell).
 Status check_scratch_room(uint64_t needed, const std::string& dir, const std::string& what_needs);
+// Bytes as whole GiB, rounded: the unit of the scratch messages.
+std::string gib_text(uint64_t bytes);
 
 // Whether scratch levels of `raw_bytes` in all (floats) in `dir` are compressed: where they would
 // not fit 90% of the disk's free space raw. Elsewhere compressing costs more time than the disk

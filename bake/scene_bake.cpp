@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "bake/build_plan.h"
 #include "bake/build_summary_json.h"
 #include "bake/coverage_mask.h"
 #include "bake/level_source.h"
@@ -104,21 +105,13 @@ bool stores_in_memory(const SceneBakeOptions& options, uint64_t store_bytes) {
          level0_fits_memory(store_bytes, options.build.memory_limit);
 }
 
-// Where the bake's scratch files go: --scratch-dir, else beside the output.
-std::string scratch_folder(const SceneBakeOptions& options) {
-  return options.build.scratch_dir.empty()
-             ? std::filesystem::path(options.build.output).parent_path().string()
-             : options.build.scratch_dir;
-}
-
 // Refuses a bake whose level-0 stores (`store_bytes` of floats) go to scratch files in `dir`
 // and cannot fit its free space even compressed as well as any real atlas's levels: found
 // before the work, not when a write fails an hour into it. The transfer checks again from what
 // its stores take once written (check_projected_scratch in transfer.cpp).
 Status check_scratch_space(uint64_t store_bytes, const std::string& dir) {
-  auto gib = [](uint64_t b) { return std::to_string((b + (uint64_t(1) << 29)) >> 30); };
   return check_scratch_room(store_bytes / kScratchBestCompression, dir,
-                            "the atlas's level 0 (" + gib(store_bytes) + " GiB of floats, " +
+                            "the atlas's level 0 (" + gib_text(store_bytes) + " GiB of floats, " +
                                 std::to_string(kScratchBestCompression) +
                                 "x compressed at best) needs at least");
 }
@@ -288,7 +281,8 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
     const uint64_t stores =
         transfer_store_bytes(input, options.lighting.layer, uint32_t(side), uint32_t(side));
     if (!stores_in_memory(options, stores))
-      VT_RETURN_IF_ERROR(check_scratch_space(stores, scratch_folder(options)).with_context("bake"));
+      VT_RETURN_IF_ERROR(
+          check_scratch_space(stores, scratch_dir_for(options.build)).with_context("bake"));
   }
   uo.max_size_pages = std::max(
       1, std::min(uo.max_size_pages, unwrap::pages_within(texels_within(limit), uo.page_payload)));
@@ -346,7 +340,7 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
   to.threads = options.build.threads;
   to.color_config = options.build.color_config;
   to.lighting = options.lighting;
-  to.scratch_dir = scratch_folder(options);
+  to.scratch_dir = scratch_dir_for(options.build);
   to.progress = [&](double f) { report("transfer", f); };
   // Bands of rows straight to the layers' stores: in memory where the build holds level 0 so.
   to.band_rows = options.transfer_band_rows;

@@ -60,13 +60,11 @@ Status check_projected_scratch(const std::shared_ptr<LevelStore>* stores, int co
   uint64_t written = 0;
   for (int l = 0; l < count; ++l)
     if (stores[l]) written += stores[l]->disk_bytes();
-  const double scratch = double(written) * rows / rows_done * 4 / 3;
-  auto gib = [](double b) { return std::to_string(uint64_t(b / double(1 << 30) + 0.5)); };
-  return check_scratch_room(uint64_t(std::max(0.0, scratch - double(written))), dir,
+  const uint64_t scratch = uint64_t(double(written) * rows / rows_done * 4 / 3);
+  return check_scratch_room(scratch - std::min(scratch, written), dir,
                             "at " + std::to_string(uint64_t(100.0 * rows_done / rows)) +
-                                "% of the transfer the level-0 stores take " +
-                                gib(double(written)) + " GiB compressed, projecting " +
-                                gib(scratch) +
+                                "% of the transfer the level-0 stores take " + gib_text(written) +
+                                " GiB compressed, projecting " + gib_text(scratch) +
                                 " GiB of scratch with the coarser levels: the rest needs");
 }
 
