@@ -259,6 +259,7 @@ class HeldLevel0 final : public LevelSource {
   Status read(uint32_t y0, uint32_t y1, float* out) override { return store_->read(y0, y1, out); }
   const CoverageMask* coverage() const override { return store_->coverage(); }
   bool in_memory() const override { return store_->in_memory(); }
+  LevelStore* held_store() override { return store_.get(); }
   NonFiniteReport non_finite() const override { return report_; }
   ClipReport clipped() const override { return clipped_; }
 

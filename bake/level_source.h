@@ -14,6 +14,7 @@
 namespace vt {
 
 class CoverageMask;
+class LevelStore;
 struct LayerPlan;
 
 class LevelSource {
@@ -33,6 +34,9 @@ class LevelSource {
   virtual NonFiniteReport non_finite() const { return {}; }
   // Level 0 of an 8-bit layer: the values its storage clips (counted once per texel).
   virtual ClipReport clipped() const { return {}; }
+  // The store holding the level's texels whole, or nullptr (streamed): the farm's plan saves it
+  // rather than copying its rows (LevelStore::save).
+  virtual LevelStore* held_store() { return nullptr; }
 };
 
 // Level 0 of `input` as `plan` converts it. Without a coverage mask it streams: rows are read

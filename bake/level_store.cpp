@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <xxhash.h>
@@ -31,7 +32,7 @@ Status move_all(Io io, int fd, Byte* p, size_t left, off_t off, const std::strin
     ssize_t n = io(fd, p, left, off);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
-      return Error(ErrorCode::kIo, path + ": scratch " + verb + " failed: " + std::strerror(errno));
+      return Error(ErrorCode::kIo, path + ": " + verb + " failed: " + std::strerror(errno));
     }
     p += n, left -= size_t(n), off += n;
   }
@@ -68,17 +69,24 @@ class ScratchFile {
 
   static Expected<std::unique_ptr<ScratchFile>> create(const std::string& dir, uint32_t rows,
                                                        size_t row_bytes, bool compressed) {
-    std::string templ = (dir.empty() ? std::string(".") : dir) + "/.vtbake-level-XXXXXX";
-    std::vector<char> name(templ.begin(), templ.end());
-    name.push_back('\0');
-    const int fd = mkstemp(name.data());
-    if (fd < 0)
-      return Status(ErrorCode::kIo,
-                    templ + ": cannot create scratch file: " + std::strerror(errno));
-    unlink(name.data());  // the file lives as long as the descriptor
+    const std::string folder = dir.empty() ? std::string(".") : dir;
     std::unique_ptr<ScratchFile> f(new ScratchFile());
-    f->fd_ = fd;
-    f->path_ = name.data();
+    // Unnamed where the file system allows (save_as can then link it under a name); else named
+    // and unlinked at once. Either way the file lives as long as the descriptor.
+    f->fd_ = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+    f->linkable_ = f->fd_ >= 0;
+    f->path_ = folder + "/.vtbake-level (unnamed)";
+    if (f->fd_ < 0) {
+      std::string templ = folder + "/.vtbake-level-XXXXXX";
+      std::vector<char> name(templ.begin(), templ.end());
+      name.push_back('\0');
+      f->fd_ = mkstemp(name.data());
+      if (f->fd_ < 0)
+        return Status(ErrorCode::kIo,
+                      templ + ": cannot create scratch file: " + std::strerror(errno));
+      unlink(name.data());
+      f->path_ = name.data();
+    }
     f->rows_ = rows;
     f->compressed_ = compressed;
     if (!compressed) return f;
@@ -88,6 +96,98 @@ class ScratchFile {
     f->frame_bytes_.assign((uint64_t(rows) + f->chunk_rows_ - 1) / f->chunk_rows_, 0);
     return f;
   }
+
+  // A level file save_as wrote, `rows` of `row_bytes`, opened to read: raw rows, or compressed
+  // chunks whose table the file's footer holds. Every field of the footer is checked against
+  // what the caller expects, so a damaged or foreign file is refused, not misread.
+  static Expected<std::unique_ptr<ScratchFile>> open_saved(const std::string& path, uint32_t rows,
+                                                           size_t row_bytes, bool compressed) {
+    std::unique_ptr<ScratchFile> f(new ScratchFile());
+    f->fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (f->fd_ < 0) return Error(ErrorCode::kIo, path + ": cannot open: " + std::strerror(errno));
+    f->path_ = path;
+    f->rows_ = rows;
+    f->compressed_ = compressed;
+    f->saved_ = true;
+    struct stat st;
+    if (fstat(f->fd_, &st) != 0) return Error(ErrorCode::kIo, path + ": cannot stat");
+    const uint64_t size = uint64_t(st.st_size);
+    auto corrupt = [&](const std::string& what) {
+      return Error(ErrorCode::kCorrupt, path + ": " + what + " (a damaged work folder?)");
+    };
+    if (!compressed) {
+      if (size != uint64_t(rows) * row_bytes)
+        return corrupt("not the " + std::to_string(uint64_t(rows) * row_bytes) + " bytes expected");
+      f->disk_bytes_ = size;
+      return f;
+    }
+    Footer foot;
+    if (size < sizeof foot) return corrupt("too short for a compressed level");
+    VT_RETURN_IF_ERROR(move_all(::pread, f->fd_, reinterpret_cast<uint8_t*>(&foot), sizeof foot,
+                                off_t(size - sizeof foot), path, "read"));
+    const uint64_t chunks =
+        foot.chunk_rows ? (uint64_t(rows) + foot.chunk_rows - 1) / foot.chunk_rows : 0;
+    if (std::memcmp(foot.magic, kFooterMagic, sizeof foot.magic) != 0 || foot.rows != rows ||
+        foot.row_bytes != row_bytes || foot.chunk_rows == 0 || foot.chunks != chunks ||
+        foot.slot_bytes == 0 || foot.slot_bytes > (uint64_t(1) << 32) ||
+        size != chunks * foot.slot_bytes + chunks * sizeof(uint32_t) + sizeof foot)
+      return corrupt("not a compressed level of " + std::to_string(rows) + " rows of " +
+                     std::to_string(row_bytes) + " bytes");
+    f->chunk_rows_ = foot.chunk_rows;
+    f->slot_bytes_ = foot.slot_bytes;
+    f->frame_bytes_.resize(chunks);
+    VT_RETURN_IF_ERROR(move_all(::pread, f->fd_, reinterpret_cast<uint8_t*>(f->frame_bytes_.data()),
+                                chunks * sizeof(uint32_t), off_t(chunks * foot.slot_bytes), path,
+                                "read"));
+    for (uint32_t b : f->frame_bytes_) {
+      if (b > f->slot_bytes_) return corrupt("a chunk larger than its slot");
+      f->disk_bytes_ += b;
+    }
+    return f;
+  }
+
+  // Gives the file the new name `path`: linked there where it is unnamed and on the same file
+  // system (`allow_link`), else copied (a compressed file's frames only). A compressed file gets
+  // its chunk table as a footer first. Nothing may be written after.
+  Status save_as(const std::string& path, size_t row_bytes, bool allow_link) {
+    std::lock_guard lock(mutex_);
+    for (Decoded& d : decoded_) {
+      if (d.dirty) VT_RETURN_IF_ERROR(write_chunk(d.chunk, d.raw));
+      d.dirty = false;
+    }
+    saved_ = true;
+    const uint64_t end =
+        compressed_ ? frame_bytes_.size() * slot_bytes_ : uint64_t(rows_) * row_bytes;
+    if (compressed_) {
+      Footer foot;
+      std::memcpy(foot.magic, kFooterMagic, sizeof foot.magic);
+      foot.slot_bytes = slot_bytes_;
+      foot.row_bytes = row_bytes;
+      foot.rows = rows_;
+      foot.chunk_rows = chunk_rows_;
+      foot.chunks = uint32_t(frame_bytes_.size());
+      std::vector<uint8_t> tail(frame_bytes_.size() * sizeof(uint32_t) + sizeof foot);
+      std::memcpy(tail.data(), frame_bytes_.data(), frame_bytes_.size() * sizeof(uint32_t));
+      std::memcpy(tail.data() + frame_bytes_.size() * sizeof(uint32_t), &foot, sizeof foot);
+      VT_RETURN_IF_ERROR(
+          move_all(::pwrite, fd_, tail.data(), tail.size(), off_t(end), path_, "write"));
+    } else if (ftruncate(fd_, off_t(end)) != 0) {  // rows never written read as zeros
+      return Error(ErrorCode::kIo, path_ + ": scratch truncate failed: " + std::strerror(errno));
+    }
+    if (allow_link && linkable_) {
+      ::unlink(path.c_str());  // an empty staging file of that name
+      const std::string self = "/proc/self/fd/" + std::to_string(fd_);
+      if (::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, path.c_str(), AT_SYMLINK_FOLLOW) == 0)
+        return Status::Ok();
+    }
+    const int out = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+    if (out < 0) return Error(ErrorCode::kIo, path + ": cannot write: " + std::strerror(errno));
+    Status s = copy_to(out, path, end);
+    if (::close(out) != 0 && s.ok())
+      s = Error(ErrorCode::kIo, path + ": write failed: " + std::strerror(errno));
+    return s;
+  }
+
   ~ScratchFile() { close(fd_); }
 
   bool compressed() const { return compressed_; }
@@ -99,6 +199,7 @@ class ScratchFile {
   // Rows [y0, y0 + rows) of `row_bytes` each. The row size may shrink after the first writes
   // (LevelStore::keep_channels) as long as rows are rewritten top to bottom, each chunk whole.
   Status write(uint32_t y0, uint32_t rows, size_t row_bytes, const uint8_t* data) {
+    if (saved_) return Error(ErrorCode::kInternal, path_ + ": a saved level is read only");
     if (!compressed_) {
       const uint64_t end = (uint64_t(y0) + rows) * row_bytes;
       VT_RETURN_IF_ERROR(move_all(::pwrite, fd_, data, size_t(rows) * row_bytes,
@@ -157,6 +258,7 @@ class ScratchFile {
 
   // A raw file rewritten in a smaller row size (keep_channels) ends at `bytes`.
   Status truncate(uint64_t bytes) {
+    if (saved_) return Error(ErrorCode::kInternal, path_ + ": a saved level is read only");
     if (compressed_) return Status::Ok();
     if (ftruncate(fd_, off_t(bytes)) != 0)
       return Error(ErrorCode::kIo, path_ + ": scratch truncate failed: " + std::strerror(errno));
@@ -240,8 +342,40 @@ class ScratchFile {
     return Status::Ok();
   }
 
+  // Copies the file's bytes up to `end` and, compressed, its footer to `out` (at `path`), frame
+  // by frame: slots' unwritten tails stay holes there too.
+  Status copy_to(int out, const std::string& path, uint64_t end) {
+    std::vector<uint8_t> buffer;
+    auto copy = [&](uint64_t at, uint64_t bytes) -> Status {
+      for (uint64_t done = 0; done < bytes;) {
+        const size_t n = size_t(std::min<uint64_t>(bytes - done, uint64_t(4) << 20));
+        buffer.resize(n);
+        VT_RETURN_IF_ERROR(
+            move_all(::pread, fd_, buffer.data(), n, off_t(at + done), path_, "read"));
+        VT_RETURN_IF_ERROR(
+            move_all(::pwrite, out, buffer.data(), n, off_t(at + done), path, "write"));
+        done += n;
+      }
+      return Status::Ok();
+    };
+    if (!compressed_) return copy(0, end);
+    for (uint32_t c = 0; c < frame_bytes_.size(); ++c)
+      VT_RETURN_IF_ERROR(copy(slot(c), frame_bytes_[c]));
+    return copy(end, frame_bytes_.size() * sizeof(uint32_t) + sizeof(Footer));
+  }
+
+  // The end of a saved compressed level, after its table of frame sizes (uint32 per chunk).
+  static constexpr char kFooterMagic[8] = {'V', 'T', 'L', 'E', 'V', 'Z', '0', '1'};
+  struct Footer {
+    uint64_t slot_bytes = 0, row_bytes = 0;
+    uint32_t rows = 0, chunk_rows = 0, chunks = 0, reserved = 0;
+    char magic[8] = {};
+  };
+
   int fd_ = -1;
   std::string path_;
+  bool linkable_ = false;  // O_TMPFILE: save_as may link it
+  bool saved_ = false;     // save_as'd or open_saved: read only
   bool compressed_ = false;
   uint32_t rows_ = 0, chunk_rows_ = 1;
   uint64_t slot_bytes_ = 0;
@@ -317,6 +451,35 @@ Status LevelStore::set_coverage_and_dilate(std::shared_ptr<const CoverageMask> c
 }
 
 LevelStore::~LevelStore() = default;
+
+Expected<std::unique_ptr<LevelStore>> LevelStore::open_saved(const std::string& path,
+                                                             uint32_t width, uint32_t height,
+                                                             uint32_t channels, bool compressed) {
+  std::unique_ptr<LevelStore> s(new LevelStore());
+  s->width_ = width;
+  s->height_ = height;
+  s->channels_ = channels;
+  VT_ASSIGN_OR_RETURN(
+      s->file_, ScratchFile::open_saved(path, height, s->row_floats() * sizeof(float), compressed));
+  return s;
+}
+
+Expected<bool> LevelStore::save(const std::string& path, bool allow_link) {
+  if (file_) {
+    VT_RETURN_IF_ERROR(file_->save_as(path, row_floats() * sizeof(float), allow_link));
+    return file_->compressed();
+  }
+  if (!holds_texels())
+    return Error(ErrorCode::kInternal, path + ": level saved after its texels were handed over");
+  const int out = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+  if (out < 0) return Error(ErrorCode::kIo, path + ": cannot write: " + std::strerror(errno));
+  Status s = move_all(::pwrite, out, reinterpret_cast<const uint8_t*>(memory_.data()), bytes(), 0,
+                      path, "write");
+  if (::close(out) != 0 && s.ok())
+    s = Error(ErrorCode::kIo, path + ": write failed: " + std::strerror(errno));
+  VT_RETURN_IF_ERROR(std::move(s));
+  return false;
+}
 
 uint64_t LevelStore::disk_bytes() const {
   return file_ ? file_->disk_bytes() : 0;

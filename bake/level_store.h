@@ -45,6 +45,11 @@ class LevelStore final : public LevelSource {
                                                       uint32_t channels, bool in_memory,
                                                       const std::string& scratch_dir,
                                                       bool compressed = false);
+  // A level file save() wrote: width x height texels of `channels` floats, raw or `compressed`
+  // as save() said; read only. A file of another shape is refused (kCorrupt, naming it).
+  static Expected<std::unique_ptr<LevelStore>> open_saved(const std::string& path, uint32_t width,
+                                                          uint32_t height, uint32_t channels,
+                                                          bool compressed);
   // An in-memory level over texels the caller hands over (width * height * channels floats).
   static std::unique_ptr<LevelStore> adopt(uint32_t width, uint32_t height, uint32_t channels,
                                            std::vector<float> texels);
@@ -56,11 +61,18 @@ class LevelStore final : public LevelSource {
   uint32_t height() const override { return height_; }
   uint32_t channels() const override { return channels_; }
   bool in_memory() const override { return file_ == nullptr; }
+  LevelStore* held_store() override { return this; }
   uint64_t bytes() const { return uint64_t(width_) * height_ * channels_ * sizeof(float); }
   // A scratch file compressed in chunks (scratch_needs_compression).
   bool compressed() const;
   // What a scratch-file store holds on disk now; 0 in memory.
   uint64_t disk_bytes() const;
+
+  // Saves the texels as the new file `path` (the farm's work folder) and returns whether it is
+  // compressed (open_saved reads it). A scratch file is linked there where it is unnamed and on
+  // the same file system (`allow_link`), with no copy and its chunks as they are; otherwise
+  // copied. An in-memory level is written as raw rows. The store is read only afterwards.
+  Expected<bool> save(const std::string& path, bool allow_link = true);
 
   Status write_rows(uint32_t y0, uint32_t rows, const float* data);
   Status read(uint32_t y0, uint32_t y1, float* out) override;

@@ -21,6 +21,7 @@
 #include "bake/build_plan.h"
 #include "bake/build_tasks.h"
 #include "bake/level_source.h"
+#include "bake/level_store.h"
 #include "bake/unwrap/unwrap.h"
 #include "bake/update.h"
 #include "format/atomic_output.h"
@@ -39,6 +40,9 @@ double seconds_since(Clock::time_point t) {
 }
 
 constexpr const char* kPlanSchema = "vtbake-plan/1";
+// How a saved level stores its rows (plan.json "format"; LevelStore::save).
+constexpr const char* kRawLevel = "raw";
+constexpr const char* kCompressedLevel = "zstd-chunks";
 constexpr char kPartMagic[8] = {'V', 'T', 'P', 'A', 'R', 'T', '0', '1'};
 enum PartTag : uint8_t { kEnd = 0, kPage = 1, kTask = 2, kKey = 3 };
 
@@ -124,21 +128,20 @@ class PlannedSource final : public ImageSource {
   std::string what_;
 };
 
-// A level in its working form as the plan wrote it (converted, dilated), read by rows.
+// A level in its working form as the plan saved it (converted, dilated), read by rows, with
+// the mask the shard derives for it.
 class FileLevel final : public LevelSource {
  public:
-  FileLevel(std::shared_ptr<RawFileSource> file, std::shared_ptr<const CoverageMask> cov)
+  FileLevel(std::shared_ptr<LevelStore> file, std::shared_ptr<const CoverageMask> cov)
       : file_(std::move(file)), coverage_(std::move(cov)) {}
-  uint32_t width() const override { return file_->info().width; }
-  uint32_t height() const override { return file_->info().height; }
-  uint32_t channels() const override { return file_->info().channels; }
-  Status read(uint32_t y0, uint32_t y1, float* out) override {
-    return file_->read_rows(y0, y1, out);
-  }
+  uint32_t width() const override { return file_->width(); }
+  uint32_t height() const override { return file_->height(); }
+  uint32_t channels() const override { return file_->channels(); }
+  Status read(uint32_t y0, uint32_t y1, float* out) override { return file_->read(y0, y1, out); }
   const CoverageMask* coverage() const override { return coverage_.get(); }
 
  private:
-  std::shared_ptr<RawFileSource> file_;
+  std::shared_ptr<LevelStore> file_;
   std::shared_ptr<const CoverageMask> coverage_;
 };
 
@@ -225,10 +228,25 @@ Expected<uint64_t> write_source(ImageSource& source, const std::string& path) {
       [&](uint32_t y0, uint32_t y1, float* out) { return source.read_rows(y0, y1, out); });
 }
 
-Status write_level(LevelSource& level, const std::string& path) {
-  return write_rows(path, level.row_floats(), level.height(),
-                    [&](uint32_t y0, uint32_t y1, float* out) { return level.read(y0, y1, out); })
-      .status();
+// The file name of a level saved for the shards: raw floats, or a store's compressed chunks.
+std::string level_file_name(LevelSource& level, const std::string& stem) {
+  const LevelStore* store = level.held_store();
+  return stem + (store && store->compressed() ? ".f32.zc" : ".f32");
+}
+
+// A level for the shards at `path`: a level store saves itself (a scratch file is linked, not
+// copied, and stays compressed if it is); other levels are written as raw rows. Returns the
+// form, recorded in the plan beside the file's name.
+Expected<std::string> save_level(LevelSource& level, const std::string& path) {
+  if (LevelStore* store = level.held_store()) {
+    VT_ASSIGN_OR_RETURN(const bool compressed, store->save(path));
+    return std::string(compressed ? kCompressedLevel : kRawLevel);
+  }
+  VT_RETURN_IF_ERROR(
+      write_rows(path, level.row_floats(), level.height(),
+                 [&](uint32_t y0, uint32_t y1, float* out) { return level.read(y0, y1, out); })
+          .status());
+  return std::string(kRawLevel);
 }
 
 Expected<nlohmann::json> read_json(const std::string& path) {
@@ -455,9 +473,10 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
       }
       continue;
     }
-    const std::string file = "level0/" + plan.layers[i].spec.name + ".work.f32";
+    const std::string file =
+        level_file_name(level0, "level0/" + plan.layers[i].spec.name + ".work");
     VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/" + file));
-    VT_RETURN_IF_ERROR(write_level(level0, staged));
+    VT_ASSIGN_OR_RETURN(layers[i]["work_format"], save_level(level0, staged));
     layers[i]["work_file"] = file;
     layers[i]["work_channels"] = level0.channels();
   }
@@ -472,13 +491,13 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
     plan.options.level_done = [&](size_t li, uint32_t level, LevelSource& texels,
                                   float alpha_scale) -> Status {
       const auto t = Clock::now();
-      const std::string file =
-          "levels/" + plan.layers[li].spec.name + "." + std::to_string(level) + ".f32";
+      const std::string file = level_file_name(
+          texels, "levels/" + plan.layers[li].spec.name + "." + std::to_string(level));
       VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/" + file));
-      VT_RETURN_IF_ERROR(write_level(texels, staged));
+      VT_ASSIGN_OR_RETURN(const std::string format, save_level(texels, staged));
       nlohmann::json& l = layers[li];
       if (!l.contains("levels")) l["levels"] = nlohmann::json::array();
-      l["levels"].push_back({{"file", file}, {"alpha_scale", alpha_scale}});
+      l["levels"].push_back({{"file", file}, {"format", format}, {"alpha_scale", alpha_scale}});
       l["levels_coverage"] = texels.coverage() != nullptr;
       l["work_channels"] = texels.channels();
       t_levels += seconds_since(t);
@@ -709,19 +728,25 @@ Expected<std::function<Expected<BuildOptions::GivenLevel>(size_t, uint32_t)>> gi
   for (size_t i = 0; i < layers.size() && i < options.layers.size(); ++i) {
     const auto& l = layers[i];
     const uint32_t w0 = l.value("width", 0u), h0 = l.value("height", 0u);
-    ImageInfo info;
-    info.channels = l.value("work_channels", 0u);
-    auto open = [&](const std::string& file, uint32_t width, uint32_t height,
-                    std::shared_ptr<const CoverageMask> mask,
+    const uint32_t channels = l.value("work_channels", 0u);
+    auto open = [&](const std::string& file, const std::string& format, uint32_t width,
+                    uint32_t height, std::shared_ptr<const CoverageMask> mask,
                     float alpha_scale) -> Expected<BuildOptions::GivenLevel> {
-      info.width = width, info.height = height;
-      VT_ASSIGN_OR_RETURN(auto raw, RawFileSource::open(w.dir + "/" + file, info));
-      return BuildOptions::GivenLevel{std::make_shared<FileLevel>(std::move(raw), std::move(mask)),
-                                      alpha_scale};
+      const std::string path = w.dir + "/" + file;
+      if (format != kRawLevel && format != kCompressedLevel) {
+        return Error(ErrorCode::kCorrupt, work_plan_path(w.dir) + ": " + file +
+                                              " has the unknown form \"" + format + "\"");
+      }
+      VT_ASSIGN_OR_RETURN(
+          std::shared_ptr<LevelStore> texels,
+          LevelStore::open_saved(path, width, height, channels, format == kCompressedLevel));
+      return BuildOptions::GivenLevel{
+          std::make_shared<FileLevel>(std::move(texels), std::move(mask)), alpha_scale};
     };
     given[i].resize(1);
     if (const std::string file = l.value("work_file", ""); !file.empty()) {
-      VT_ASSIGN_OR_RETURN(given[i][0], open(file, w0, h0, options.layers[i].coverage, 1.0f));
+      VT_ASSIGN_OR_RETURN(given[i][0], open(file, l.value("work_format", kRawLevel), w0, h0,
+                                            options.layers[i].coverage, 1.0f));
     }
     const auto& levels = l.value("levels", nlohmann::json::array());
     const bool covered = l.value("levels_coverage", false) && options.layers[i].coverage;
@@ -738,9 +763,10 @@ Expected<std::function<Expected<BuildOptions::GivenLevel>(size_t, uint32_t)>> gi
         masks.push_back(std::move(half));
       }
       given[i].push_back({});
-      VT_ASSIGN_OR_RETURN(given[i].back(), open(levels[k].value("file", ""), width, height,
-                                                covered ? masks[k + 1] : nullptr,
-                                                levels[k].value("alpha_scale", 1.0f)));
+      VT_ASSIGN_OR_RETURN(
+          given[i].back(),
+          open(levels[k].value("file", ""), levels[k].value("format", kRawLevel), width, height,
+               covered ? masks[k + 1] : nullptr, levels[k].value("alpha_scale", 1.0f)));
     }
   }
   return std::function<Expected<BuildOptions::GivenLevel>(size_t, uint32_t)>(

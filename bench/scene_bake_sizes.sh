@@ -15,8 +15,9 @@ for n in $sizes; do
   json=$out/bake_$n.json
   /usr/bin/time -f '%M' -o "$out/rss_$n" "$vtbake" --json --threads 2 bake "$scene" --size "$n" \
     --memory-limit "$limit" --unwrapped - -o "$out/bake_$n.vtpf" "$@" > "$json" &
-  # Scratch bytes: the peak sum of the disk blocks of the bake's open scratch files (unlinked
-  # .vtbake-* files, read through /proc; sparse, so blocks, not sizes), sampled every half second.
+  # Scratch bytes: the peak sum of the disk blocks of the bake's open scratch files (unnamed
+  # O_TMPFILE files, "DIR/#INODE (deleted)", or unlinked .vtbake-* files, read through /proc;
+  # sparse, so blocks, not sizes), sampled every half second.
   python3 - "$!" > "$out/scratch_$n" <<'PY'
 import os, sys, time
 root = int(sys.argv[1]); peak = 0
@@ -36,7 +37,9 @@ while os.path.exists("/proc/%d" % root):
             for fd in os.listdir("/proc/%d/fd" % pid):
                 path = "/proc/%d/fd/%s" % (pid, fd)
                 try:
-                    if "/.vtbake-" in os.readlink(path): total += os.stat(path).st_blocks * 512
+                    link = os.readlink(path)
+                    if "/.vtbake-" in link or ("/#" in link and link.endswith(" (deleted)")):
+                        total += os.stat(path).st_blocks * 512
                 except OSError:
                     pass
         except OSError:

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <atomic>
 #include <filesystem>
+#include <fstream>
 #include <random>
 #include <set>
 #include <thread>
@@ -302,19 +303,23 @@ TEST(LevelStore, KeepChannelsDropsTheLastChannelsInPlace) {
     std::vector<float> back(want.size());
     ASSERT_TRUE((*store)->read(0, h, back.data()).ok());
     EXPECT_TRUE(back == want) << "kind " << kind;
-    if (kind == 1) EXPECT_EQ((*store)->disk_bytes(), (*store)->bytes());  // the file shrank
+    if (kind == 1) {
+      EXPECT_EQ((*store)->disk_bytes(), (*store)->bytes());  // the file shrank
+    }
     EXPECT_FALSE((*store)->read(h, h + 1, back.data()).ok());
   }
 }
 
-// Blocks the process's open scratch levels take on disk (unlinked .vtbake-level-* files).
+// Blocks the process's open scratch levels take on disk (unnamed O_TMPFILE files, "DIR/#INODE
+// (deleted)", or unlinked .vtbake-level-* files where the file system has no O_TMPFILE).
 uint64_t scratch_level_blocks_bytes() {
   uint64_t total = 0;
   for (const auto& fd : std::filesystem::directory_iterator("/proc/self/fd")) {
     std::error_code ec;
     const std::string target = std::filesystem::read_symlink(fd.path(), ec).string();
     struct stat st;
-    if (!ec && target.find("/.vtbake-level-") != std::string::npos &&
+    const bool unnamed = target.find("/#") != std::string::npos && target.ends_with(" (deleted)");
+    if (!ec && (unnamed || target.find("/.vtbake-level-") != std::string::npos) &&
         stat(fd.path().c_str(), &st) == 0)
       total += uint64_t(st.st_blocks) * 512;
   }
@@ -374,6 +379,76 @@ TEST(LevelStore, ScratchRowsAreCompressedChunksThatPartialWritesPatch) {
   EXPECT_TRUE(back == want);
   EXPECT_LT(store.disk_bytes(), noisy / 20);
   EXPECT_LT(scratch_level_blocks_bytes(), noisy / 10);  // the old frames' tails punched
+}
+
+// Open descriptors of this process on the file at `path` (a scratch file linked there).
+int descriptors_of(const std::string& path) {
+  struct stat want, st;
+  if (stat(path.c_str(), &want) != 0) return -1;
+  int n = 0;
+  for (const auto& fd : std::filesystem::directory_iterator("/proc/self/fd"))
+    n += stat(fd.path().c_str(), &st) == 0 && st.st_ino == want.st_ino && st.st_dev == want.st_dev;
+  return n;
+}
+
+// A level saved for the farm's shards (LevelStore::save) reads back as the same rows through
+// open_saved, from memory, raw scratch and compressed scratch, linked or copied: a compressed
+// level keeps its chunks (fewer bytes than raw on disk), rows never written read as zeros, a
+// part written last (still in the decoded chunks) is in the file, the store is read only after,
+// and a file of another shape, cut short or with a damaged footer is refused, naming it.
+TEST(LevelStore, SavedLevelsReadBackAsTheSameRows) {
+  const std::string dir = std::filesystem::temp_directory_path().string() + "/vt_saved_levels";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const uint32_t w = 3000, h = 97, ch = 3;  // compressed: 4 chunks of 29 rows
+  const size_t row = size_t(w) * ch;
+  for (int kind = 0; kind < 3; ++kind)
+    for (bool link : {true, false}) {
+      SCOPED_TRACE("kind " + std::to_string(kind) + (link ? " linked" : " copied"));
+      auto made = LevelStore::create(w, h, ch, kind == 0, dir, kind == 2);
+      ASSERT_TRUE(made.ok());
+      LevelStore& store = **made;
+      std::vector<float> want(row * h, 0.0f);
+      for (uint32_t y = 0; y < 60; ++y)  // rows 60-96 never written except 70-72
+        for (size_t i = 0; i < row; ++i) want[y * row + i] = float((y * 7 + i) % 13) * 0.125f;
+      ASSERT_TRUE(store.write_rows(0, 60, want.data()).ok());
+      for (size_t i = 70 * row; i < 73 * row; ++i) want[i] = 0.5f;
+      ASSERT_TRUE(store.write_rows(70, 3, want.data() + 70 * row).ok());
+      const std::string path = dir + "/level" + std::to_string(kind) + (link ? "l" : "c");
+      { std::ofstream(path) << "staged"; }  // an empty staging file is replaced
+      auto saved = store.save(path, link);
+      ASSERT_TRUE(saved.ok()) << saved.status().message();
+      EXPECT_EQ(*saved, kind == 2);
+      EXPECT_EQ(descriptors_of(path), kind != 0 && link ? 1 : 0);
+      if (kind != 0) {
+        EXPECT_FALSE(store.write_rows(0, 1, want.data()).ok());
+      }
+      struct stat st;
+      ASSERT_EQ(stat(path.c_str(), &st), 0);
+      if (kind == 2) {
+        EXPECT_LT(uint64_t(st.st_blocks) * 512, store.bytes() / 2);
+      }
+      made->reset();  // the store's file is gone; the saved one stays
+      auto back = LevelStore::open_saved(path, w, h, ch, *saved);
+      ASSERT_TRUE(back.ok()) << back.status().message();
+      std::vector<float> rows(row * h, -1.0f);
+      ASSERT_TRUE((*back)->read(0, h, rows.data()).ok());
+      EXPECT_TRUE(rows == want);
+      ASSERT_TRUE((*back)->read(65, 71, rows.data()).ok());
+      EXPECT_TRUE(std::equal(rows.begin(), rows.begin() + 6 * row, want.begin() + 65 * row));
+      EXPECT_FALSE((*back)->write_rows(0, 1, want.data()).ok());
+
+      auto other = LevelStore::open_saved(path, w, h + 1, ch, *saved);
+      ASSERT_FALSE(other.ok());
+      EXPECT_EQ(other.status().code(), ErrorCode::kCorrupt);
+      EXPECT_NE(other.status().message().find(path), std::string::npos);
+      if (kind == 2) {
+        std::filesystem::resize_file(path, std::filesystem::file_size(path) - 1);
+        EXPECT_EQ(LevelStore::open_saved(path, w, h, ch, true).status().code(),
+                  ErrorCode::kCorrupt);
+      }
+    }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(LevelStore, DilationFillsUncoveredTexelsFromCoveredOnes) {

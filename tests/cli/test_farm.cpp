@@ -4,6 +4,7 @@
 // running a shard again is safe; the merge refuses a part of another plan or a damaged one.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -31,7 +32,7 @@ class FarmCli : public ::testing::Test {
     if (!setup_error_.empty()) return;
     fs::create_directories(dir_ + "/local");
     for (const char* name : {"four", "tasks", "one", "kill", "a", "b", "alpha", "alpha_local",
-                             "opaque", "opaque_local", "last"})
+                             "opaque", "opaque_local", "last", "scratch", "scratch_local"})
       fs::create_directories(dir_ + "/" + name);
     RunResult b =
         run_vtbake("-q bake " + scene() + " -o " + dir_ + "/local/out.vtpf " + flags(), true);
@@ -260,15 +261,16 @@ TEST_F(FarmCli, ShardsTakeHashesAndAlphaDecisionsFromThePlan) {
   ASSERT_EQ(bake_opaque("opaque_local", "").exit_code, 0);
   const std::string w = work("opaque");
   ASSERT_EQ(bake_opaque("opaque", "--work " + w + " --plan " + w + "/plan.json").exit_code, 0);
-  for (const std::string& part : {"0/2", "1/2"})
+  for (const char* part : {"0/2", "1/2"})
     ASSERT_EQ(bake_opaque("opaque", "--work " + w + " --shard " + part).exit_code, 0);
   ASSERT_EQ(merge("opaque").exit_code, 0);
   EXPECT_TRUE(read_file(dir_ + "/opaque/out.vtpf") == read_file(dir_ + "/opaque_local/out.vtpf"))
       << "the merged page file differs from the one-process bake";
 
   for (const std::string& name : {std::string("opaque"), std::string("four")}) {
-    if (name == "four" && !fs::exists(work(name) + "/plan.json"))
+    if (name == "four" && !fs::exists(work(name) + "/plan.json")) {
       ASSERT_EQ(bake(name, "--plan " + work(name) + "/plan.json").exit_code, 0);
+    }
     auto plan = nlohmann::json::parse(read_file(work(name) + "/plan.json"));
     const auto& albedo = plan["layers"][0];
     ASSERT_EQ(albedo["name"], "albedo");
@@ -330,6 +332,48 @@ TEST_F(FarmCli, TheLastShardMergesOnce) {
   EXPECT_FALSE(fs::exists(work("last") + "/merged.json"));
   // --merge-last takes --shard, not --tasks.
   EXPECT_NE(bake("last", "--tasks 0 --merge-last").exit_code, 0);
+}
+
+// A plan whose level 0 is held in compressed scratch files (a memory limit under it) gives the
+// shards those files themselves, linked into the work folder with no copy and still compressed;
+// the shards read them and the merge equals the one-process bake. A damaged one fails the
+// shard, naming it.
+TEST_F(FarmCli, ShardsReadThePlansCompressedScratchLevels) {
+  const std::string size = " --size 12 --supersample 1 ";
+  auto bake12 = [&](const std::string& name, const std::string& args) {
+    return run_vtbake("-q bake " + scene() + " -o " + dir_ + "/" + name + "/out.vtpf" + size + args,
+                      true);
+  };
+  ASSERT_EQ(bake12("scratch_local", "").exit_code, 0);
+  const std::string scratch = " --memory-limit 150M --compress-scratch --work " + work("scratch");
+  RunResult p = bake12("scratch", scratch + " --plan " + work("scratch") + "/plan.json");
+  ASSERT_EQ(p.exit_code, 0) << p.out;
+  auto plan = nlohmann::json::parse(read_file(work("scratch") + "/plan.json"));
+  for (const auto& l : plan["layers"]) {
+    ASSERT_EQ(l["work_format"], "zstd-chunks") << l["name"];
+    const std::string file = work("scratch") + "/" + l["work_file"].get<std::string>();
+    const uint64_t raw = l["width"].get<uint64_t>() * l["height"].get<uint64_t>() *
+                         l["work_channels"].get<uint64_t>() * sizeof(float);
+    struct stat st;
+    ASSERT_EQ(stat(file.c_str(), &st), 0) << file;
+    EXPECT_LT(uint64_t(st.st_blocks) * 512, raw * 3 / 4) << file;
+  }
+  for (const char* shard : {"0/2", "1/2"}) {
+    RunResult r = bake12("scratch", scratch + " --shard " + shard);
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+  }
+  ASSERT_EQ(merge("scratch").exit_code, 0);
+  EXPECT_TRUE(read_file(dir_ + "/scratch/out.vtpf") == read_file(dir_ + "/scratch_local/out.vtpf"))
+      << "the merged page file differs from the one-process bake";
+
+  const std::string level0 =
+      work("scratch") + "/" + plan["layers"][1]["work_file"].get<std::string>();
+  fs::resize_file(level0, fs::file_size(level0) - 4);
+  fs::remove(work("scratch") + "/parts/shard-0-of-2.part");
+  RunResult cut = bake12("scratch", scratch + " --shard 0/2");
+  EXPECT_NE(cut.exit_code, 0);
+  EXPECT_NE(cut.out.find(level0), std::string::npos) << cut.out;
+  EXPECT_FALSE(fs::exists(work("scratch") + "/parts/shard-0-of-2.part"));
 }
 
 }  // namespace
