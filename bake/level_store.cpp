@@ -570,11 +570,16 @@ std::vector<float> StoredImageSource::release_texels() {
 
 Expected<uint64_t> StoredImageSource::content_hash() {
   if (released_hash_) return *released_hash_;
+  if (hash_) return *hash_;
   // An in-memory store handing out all its channels is hashed where it lies: the digest of the
   // rows streamed in bands (ImageSource::content_hash) is XXH3 of the same bytes in one piece,
   // without a band buffer to allocate and copy into.
-  if (const float* texels = texels_in_memory()) return XXH3_64bits(texels, store_->bytes());
-  return ImageSource::content_hash();
+  if (const float* texels = texels_in_memory()) {
+    hash_ = XXH3_64bits(texels, store_->bytes());
+  } else {
+    VT_ASSIGN_OR_RETURN(hash_, ImageSource::content_hash());
+  }
+  return *hash_;
 }
 
 }  // namespace vt

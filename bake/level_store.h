@@ -135,14 +135,15 @@ class StoredImageSource final : public ImageSource {
     return own ? store_ : nullptr;
   }
   void spent(uint64_t content_hash) { released_hash_ = content_hash; }
-  // The hash of the rows (kept once the texels are handed over).
+  // The hash of the rows, computed once (the store is not written after the transfer; the farm's
+  // plan asks before the build does) and kept once the texels are handed over.
   Expected<uint64_t> content_hash() override;
 
  private:
   ImageInfo info_;
   std::shared_ptr<LevelStore> store_;
   std::vector<float> rows_;
-  std::optional<uint64_t> released_hash_;
+  std::optional<uint64_t> released_hash_, hash_;
 };
 
 }  // namespace vt

@@ -5,6 +5,10 @@
 # with --json for what the farm's time is made of, and the per-core rates the 128K model uses
 # (bench/farm_model.py). Run as root, through `heavy`.
 #   bench/farm_bench.sh VTBAKE [SIZE_PAGES=16] [RUNS=3] [BAKE FLAGS...]   (e.g. --codec bc:high)
+# Environment: FARM_SCENE=PATH bakes that scene instead of the sample (e.g. VirtualCity for the
+# 64K figure, with --memory-limit 2G); FARM_BY_HAND=0 skips the steps by hand and the model;
+# FARM_TIME sets the Slurm jobs' time limit (default 1:00:00). After each farm round it prints
+# when the plan, each part and the merged file were written (seconds from the start).
 set -euo pipefail
 vtbake=$(readlink -f "$1")
 size="${2:-16}"
@@ -15,7 +19,11 @@ tmp=$(mktemp -d /tmp/vtbake-farm-bench.XXXXXX)
 source "$src/tests/farm/local_cluster.sh"
 trap 'stop_cluster; [[ -n "${VTBAKE_KEEP_BENCH:-}" ]] || rm -rf "$tmp"' EXIT
 echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
-"$vtbake" -q sample-scene "$tmp/scene"
+scene="${FARM_SCENE:-}"
+if [[ -z "$scene" ]]; then
+  "$vtbake" -q sample-scene "$tmp/scene"
+  scene="$tmp/scene/scene.gltf"
+fi
 flags=(--size "$size" "$@")
 now() { date +%s.%N; }
 median() { sort -g | awk '{a[NR] = $1} END {print a[int((NR + 1) / 2)]}'; }
@@ -27,24 +35,32 @@ start_cluster "$tmp/cluster"
 : >"$tmp/farm.times"
 for r in $(seq "$runs"); do
   t0=$(now)
-  "$vtbake" -q --threads 2 bake "$tmp/scene/scene.gltf" -o "$tmp/local/out.vtpf" "${flags[@]}" >/dev/null
+  "$vtbake" -q --threads 2 bake "$scene" -o "$tmp/local/out.vtpf" "${flags[@]}" >/dev/null
   echo "$(now) - $t0" | bc >>"$tmp/local.times"
   rm -rf "$tmp/farm"
   t0=$(now)
   PATH="$(dirname "$vtbake"):$PATH" "$src/scripts/farm.sh" --work "$tmp/farm/work" --shards 2 \
-    --cpus 1 --plan-cpus 2 --poll 0.2 --vtbake "$vtbake" \
-    -- "$tmp/scene/scene.gltf" -o "$tmp/farm/out.vtpf" "${flags[@]}" >/dev/null
+    --cpus 1 --plan-cpus 2 --poll 0.2 --time "${FARM_TIME:-1:00:00}" --vtbake "$vtbake" \
+    -- "$scene" -o "$tmp/farm/out.vtpf" "${flags[@]}" >/dev/null
   echo "$(now) - $t0" | bc >>"$tmp/farm.times"
   cmp "$tmp/local/out.vtpf" "$tmp/farm/out.vtpf"
+  for f in "$tmp/farm/work/plan.json" "$tmp"/farm/work/parts/*.part "$tmp/farm/out.vtpf"; do
+    echo "  round $r: $(basename "$f") written at +$(echo "$(stat -c %.3Y "$f") - $t0" | bc) s"
+  done
+  echo "  round $r: work folder $(du -sb "$tmp/farm/work" | cut -f1) bytes, $(du -sB1 "$tmp/farm/work" | cut -f1) on disk"
 done
 echo "one process (--threads 2): median $(median <"$tmp/local.times") s of $(paste -sd' ' "$tmp/local.times")"
 echo "Slurm, 2 shards x 1 CPU: median $(median <"$tmp/farm.times") s of $(paste -sd' ' "$tmp/farm.times") (merged file byte-identical)"
 stop_cluster
+if [[ "${FARM_BY_HAND:-1}" == 0 ]]; then
+  echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
+  exit 0
+fi
 
 # The steps by hand, with their stage times.
 w="$tmp/hand/work"
 mkdir -p "$tmp/hand"
-b=(bake "$tmp/scene/scene.gltf" -o "$tmp/hand/out.vtpf" "${flags[@]}" --work "$w")
+b=(bake "$scene" -o "$tmp/hand/out.vtpf" "${flags[@]}" --work "$w")
 t0=$(now)
 "$vtbake" --json --threads 2 "${b[@]}" --plan "$w/plan.json" >"$tmp/plan.json.out"
 t1=$(now)
@@ -59,7 +75,7 @@ echo "by hand: plan $(echo "$t1 - $t0" | bc) s, 2 shards at once $(echo "$t2 - $
 # Per-core rates: one shard of one (every page) and the plan's key pass, at 1 thread.
 "$vtbake" --json --threads 1 "${b[@]}" --shard 0/1 >"$tmp/shard_all.json"
 mkdir -p "$tmp/hand1"
-"$vtbake" --json --threads 1 bake "$tmp/scene/scene.gltf" -o "$tmp/hand1/out.vtpf" "${flags[@]}" \
+"$vtbake" --json --threads 1 bake "$scene" -o "$tmp/hand1/out.vtpf" "${flags[@]}" \
   --work "$tmp/hand1/work" --plan "$tmp/hand1/work/plan.json" >"$tmp/plan1.json.out"
 python3 "$src/bench/farm_model.py" --plan "$tmp/plan.json.out" --plan1 "$tmp/plan1.json.out" \
   --plan-graph "$w/plan.json" --shards "$tmp/shard0.json" "$tmp/shard1.json" \
