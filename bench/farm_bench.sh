@@ -29,24 +29,28 @@ now() { date +%s.%N; }
 median() { sort -g | awk '{a[NR] = $1} END {print a[int((NR + 1) / 2)]}'; }
 
 mkdir -p "$tmp/local"
+# The farm's steps log their --json reports (stage times) under the work folder's logs/.
+printf '#!/bin/sh\nexec %q --json "$@"\n' "$vtbake" >"$tmp/vtbake-json"
+chmod +x "$tmp/vtbake-json"
 start_cluster "$tmp/cluster"
 # Alternating rounds (one process, then the farm), so both see the same load.
 : >"$tmp/local.times"
 : >"$tmp/farm.times"
 for r in $(seq "$runs"); do
   t0=$(now)
-  "$vtbake" -q --threads 2 bake "$scene" -o "$tmp/local/out.vtpf" "${flags[@]}" >/dev/null
+  "$vtbake" --json --threads 2 bake "$scene" -o "$tmp/local/out.vtpf" "${flags[@]}" >"$tmp/local-$r.json"
   echo "$(now) - $t0" | bc >>"$tmp/local.times"
   rm -rf "$tmp/farm"
   t0=$(now)
   PATH="$(dirname "$vtbake"):$PATH" "$src/scripts/farm.sh" --work "$tmp/farm/work" --shards 2 \
-    --cpus 1 --plan-cpus 2 --poll 0.2 --time "${FARM_TIME:-1:00:00}" --vtbake "$vtbake" \
+    --cpus 1 --plan-cpus 2 --poll 0.2 --time "${FARM_TIME:-1:00:00}" --vtbake "$tmp/vtbake-json" \
     -- "$scene" -o "$tmp/farm/out.vtpf" "${flags[@]}" >/dev/null
   echo "$(now) - $t0" | bc >>"$tmp/farm.times"
   cmp "$tmp/local/out.vtpf" "$tmp/farm/out.vtpf"
   for f in "$tmp/farm/work/plan.json" "$tmp"/farm/work/parts/*.part "$tmp/farm/out.vtpf"; do
-    echo "  round $r: $(basename "$f") written at +$(echo "$(stat -c %.3Y "$f") - $t0" | bc) s"
+    echo "  round $r: $(basename "$f") written at +$(echo "$(date -r "$f" +%s.%N) - $t0" | bc) s"
   done
+  cp -r "$tmp/farm/work/logs" "$tmp/logs-$r"
   echo "  round $r: work folder $(du -sb "$tmp/farm/work" | cut -f1) bytes, $(du -sB1 "$tmp/farm/work" | cut -f1) on disk"
 done
 echo "one process (--threads 2): median $(median <"$tmp/local.times") s of $(paste -sd' ' "$tmp/local.times")"
