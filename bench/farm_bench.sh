@@ -7,7 +7,8 @@
 #   bench/farm_bench.sh VTBAKE [SIZE_PAGES=16] [RUNS=3] [BAKE FLAGS...]   (e.g. --codec bc:high)
 # Environment: FARM_SCENE=PATH bakes that scene instead of the sample (e.g. VirtualCity for the
 # 64K figure, with --memory-limit 2G); FARM_BY_HAND=0 skips the steps by hand and the model;
-# FARM_TIME sets the Slurm jobs' time limit (default 1:00:00). After each farm round it prints
+# FARM_TIME sets the Slurm jobs' time limit (default 1:00:00); FARM_WORK_RATIO is the model's
+# raw-floats-to-work-folder ratio (bench/farm_model.py --work-ratio). After each farm round it prints
 # when the plan, each part and the merged file were written (seconds from the start).
 set -euo pipefail
 vtbake=$(readlink -f "$1")
@@ -83,5 +84,5 @@ mkdir -p "$tmp/hand1"
   --work "$tmp/hand1/work" --plan "$tmp/hand1/work/plan.json" >"$tmp/plan1.json.out"
 python3 "$src/bench/farm_model.py" --plan "$tmp/plan.json.out" --plan1 "$tmp/plan1.json.out" \
   --plan-graph "$w/plan.json" --shards "$tmp/shard0.json" "$tmp/shard1.json" \
-  --shard-all "$tmp/shard_all.json" --merge "$tmp/merge.json"
+  --shard-all "$tmp/shard_all.json" --merge "$tmp/merge.json" --work-ratio "${FARM_WORK_RATIO:-1}"
 echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"

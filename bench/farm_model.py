@@ -31,6 +31,9 @@ def main():
     a.add_argument("--node-gbps", type=float, default=2.0, help="GB/s one node reads shared storage")
     a.add_argument("--storage-gbps", type=float, default=20.0, help="GB/s the storage gives in all")
     a.add_argument("--slurm-s", type=float, default=3.0, help="scheduling latency per chained job")
+    a.add_argument("--work-ratio", type=float, default=1.0,
+                   help="raw floats / work-folder bytes: the plan's levels saved compressed "
+                        "(scratch compressed: VirtualCity's 64K work folder measured it)")
     o = a.parse_args()
 
     plan, _ = stages(o.plan)
@@ -69,9 +72,11 @@ def main():
     T, P, L0 = texels * scale, pages * scale, level0_bytes * scale
     c = o.cores
     print("\nmodel: %d^2 atlas (%.3g texels, %.3g pages, level 0 %.0f GB as float), %d cores a "
-          "machine, %.1f GB/s a node, %.0f GB/s storage in all, %.0f s Slurm latency a step"
-          % (o.side, T, P, L0 / 1e9, c, o.node_gbps, o.storage_gbps, o.slurm_s))
-    levels = L0 * 4 / 3  # every level in working form, written once by the plan
+          "machine, %.1f GB/s a node, %.0f GB/s storage in all, %.0f s Slurm latency a step, "
+          "work files %.2fx smaller than raw floats"
+          % (o.side, T, P, L0 / 1e9, c, o.node_gbps, o.storage_gbps, o.slurm_s, o.work_ratio))
+    # Every level in working form, written once by the plan (bytes on shared storage).
+    levels = L0 * 4 / 3 / o.work_ratio
     pyramid = keys_s_per_texel * T / c
     plan_s = transfer_s_per_texel * T / c + pyramid + tables_s + levels / (o.node_gbps * 1e9)
     merge_s = merge_s_per_page * P
@@ -100,10 +105,10 @@ def main():
     print("| machines | transfer shards | gather (serial) | encode shards | merge | total | "
           "speed-up |")
     print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
-    gather = L0 / (o.node_gbps * 1e9) + pyramid + levels / (o.node_gbps * 1e9)
+    gather = L0 / o.work_ratio / (o.node_gbps * 1e9) + pyramid + levels / (o.node_gbps * 1e9)
     for m in (8, 64, 512):
         bw = min(o.node_gbps * m, o.storage_gbps) * 1e9
-        transfer = transfer_s_per_texel * T / (m * c) + L0 / bw
+        transfer = transfer_s_per_texel * T / (m * c) + L0 / o.work_ratio / bw
         encode = encode_s_per_page * P / (m * c) + levels / bw
         total = transfer + gather + encode + merge_s + 4 * o.slurm_s
         print("| %d | %.0f s | %.0f s | %.0f s | %.0f s | %.0f s (%.1f h) | %.1f |"
