@@ -466,7 +466,6 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
   // thread of its own while the key pass below runs (which only reads level 0): a level held in
   // memory is copied out (2.9 s at 5,760², where the key pass leaves part of a core idle); one
   // in a scratch file is linked at once.
-  t0 = Clock::now();
   std::vector<std::pair<size_t, std::string>> working;  // layer, staged path
   for (size_t i = 0; i < plan.layers.size() && !dir.empty(); ++i) {
     LevelSource& level0 = *plan.layers[i].level0;
