@@ -50,6 +50,17 @@ void advise_huge_pages(void* data, size_t bytes) {
   if (end > begin) (void)madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
 }
 
+// Creates (or empties) `path` and fills it through write(fd); a failed close fails too.
+template <class Write>
+Status write_new_file(const std::string& path, Write&& write) {
+  const int out = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+  if (out < 0) return Error(ErrorCode::kIo, path + ": cannot write: " + std::strerror(errno));
+  Status s = write(out);
+  if (::close(out) != 0 && s.ok())
+    s = Error(ErrorCode::kIo, path + ": write failed: " + std::strerror(errno));
+  return s;
+}
+
 constexpr uint64_t kBlock = 4096;
 uint64_t whole_blocks(uint64_t bytes) {
   return (bytes + kBlock - 1) / kBlock * kBlock;
@@ -151,10 +162,7 @@ class ScratchFile {
   // its chunk table as a footer first. Nothing may be written after.
   Status save_as(const std::string& path, size_t row_bytes, bool allow_link) {
     std::lock_guard lock(mutex_);
-    for (Decoded& d : decoded_) {
-      if (d.dirty) VT_RETURN_IF_ERROR(write_chunk(d.chunk, d.raw));
-      d.dirty = false;
-    }
+    for (Decoded& d : decoded_) VT_RETURN_IF_ERROR(write_back(d));
     saved_ = true;
     const uint64_t end =
         compressed_ ? frame_bytes_.size() * slot_bytes_ : uint64_t(rows_) * row_bytes;
@@ -180,12 +188,7 @@ class ScratchFile {
       if (::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, path.c_str(), AT_SYMLINK_FOLLOW) == 0)
         return Status::Ok();
     }
-    const int out = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
-    if (out < 0) return Error(ErrorCode::kIo, path + ": cannot write: " + std::strerror(errno));
-    Status s = copy_to(out, path, end);
-    if (::close(out) != 0 && s.ok())
-      s = Error(ErrorCode::kIo, path + ": write failed: " + std::strerror(errno));
-    return s;
+    return write_new_file(path, [&](int out) { return copy_to(out, path, end); });
   }
 
   ~ScratchFile() { close(fd_); }
@@ -304,12 +307,19 @@ class ScratchFile {
     }
     d->used = ++uses_;
     if (d->chunk == c && d->raw.size() == chunk_bytes) return d;
-    if (d->dirty) VT_RETURN_IF_ERROR(write_chunk(d->chunk, d->raw));
-    d->chunk = kNone, d->dirty = false;
+    VT_RETURN_IF_ERROR(write_back(*d));
+    d->chunk = kNone;
     d->raw.resize(chunk_bytes);
     VT_RETURN_IF_ERROR(read_chunk(c, d->raw));
     d->chunk = c;
     return d;
+  }
+
+  // A decoded chunk's changes to disk (nothing if it has none).
+  Status write_back(Decoded& d) {
+    if (d.dirty) VT_RETURN_IF_ERROR(write_chunk(d.chunk, d.raw));
+    d.dirty = false;
+    return Status::Ok();
   }
 
   Status read_chunk(uint32_t c, std::span<uint8_t> raw) const {
@@ -464,21 +474,14 @@ Expected<std::unique_ptr<LevelStore>> LevelStore::open_saved(const std::string& 
   return s;
 }
 
-Expected<bool> LevelStore::save(const std::string& path, bool allow_link) {
-  if (file_) {
-    VT_RETURN_IF_ERROR(file_->save_as(path, row_floats() * sizeof(float), allow_link));
-    return file_->compressed();
-  }
+Status LevelStore::save(const std::string& path, bool allow_link) {
+  if (file_) return file_->save_as(path, row_floats() * sizeof(float), allow_link);
   if (!holds_texels())
     return Error(ErrorCode::kInternal, path + ": level saved after its texels were handed over");
-  const int out = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
-  if (out < 0) return Error(ErrorCode::kIo, path + ": cannot write: " + std::strerror(errno));
-  Status s = move_all(::pwrite, out, reinterpret_cast<const uint8_t*>(memory_.data()), bytes(), 0,
-                      path, "write");
-  if (::close(out) != 0 && s.ok())
-    s = Error(ErrorCode::kIo, path + ": write failed: " + std::strerror(errno));
-  VT_RETURN_IF_ERROR(std::move(s));
-  return false;
+  return write_new_file(path, [&](int out) {
+    return move_all(::pwrite, out, reinterpret_cast<const uint8_t*>(memory_.data()), bytes(), 0,
+                    path, "write");
+  });
 }
 
 uint64_t LevelStore::disk_bytes() const {

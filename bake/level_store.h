@@ -68,11 +68,11 @@ class LevelStore final : public LevelSource {
   // What a scratch-file store holds on disk now; 0 in memory.
   uint64_t disk_bytes() const;
 
-  // Saves the texels as the new file `path` (the farm's work folder) and returns whether it is
-  // compressed (open_saved reads it). A scratch file is linked there where it is unnamed and on
-  // the same file system (`allow_link`), with no copy and its chunks as they are; otherwise
-  // copied. An in-memory level is written as raw rows. The store is read only afterwards.
-  Expected<bool> save(const std::string& path, bool allow_link = true);
+  // Saves the texels as the new file `path` (the farm's work folder), compressed as the store is
+  // (open_saved reads it so). A scratch file is linked there where it is unnamed and on the same
+  // file system (`allow_link`), with no copy and its chunks as they are; otherwise copied. An
+  // in-memory level is written as raw rows. The store is read only afterwards.
+  Status save(const std::string& path, bool allow_link = true);
 
   Status write_rows(uint32_t y0, uint32_t rows, const float* data);
   Status read(uint32_t y0, uint32_t y1, float* out) override;

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
+#include <string_view>
 
 #include "bake/build_plan.h"
 #include "bake/build_tasks.h"
@@ -61,22 +62,17 @@ Status io_error(const std::string& path, const std::string& what) {
   return Error(ErrorCode::kIo, path + ": " + what + ": " + std::strerror(errno));
 }
 
-// Level 0 of a layer as the plan wrote it: raw little-endian floats, row-major.
+// Level 0 of a layer as the plan wrote it: raw little-endian floats, row-major, read as a saved
+// level (LevelStore::open_saved checks its size).
 class RawFileSource final : public ImageSource {
  public:
   static Expected<std::shared_ptr<RawFileSource>> open(const std::string& path, ImageInfo info) {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) return io_error(path, "cannot open");
-    auto s = std::shared_ptr<RawFileSource>(new RawFileSource(fd, path, std::move(info)));
-    const uint64_t want = uint64_t(s->info_.width) * s->info_.height * s->info_.channels * 4;
-    std::error_code ec;
-    if (fs::file_size(path, ec) != want) {
-      return Error(ErrorCode::kCorrupt, path + ": not the " + std::to_string(want) +
-                                            " bytes the plan says (a damaged work folder?)");
-    }
-    return s;
+    VT_ASSIGN_OR_RETURN(
+        std::shared_ptr<LevelStore> file,
+        LevelStore::open_saved(path, info.width, info.height, info.channels, false));
+    return std::shared_ptr<RawFileSource>(
+        new RawFileSource(std::move(file), path, std::move(info)));
   }
-  ~RawFileSource() override { ::close(fd_); }
   const ImageInfo& info() const override { return info_; }
   // The plan wrote the file with the hash of its bytes, which is the default content hash
   // (XXH3 of the rows in order): taken from the plan instead of reading the whole level again.
@@ -86,24 +82,14 @@ class RawFileSource final : public ImageSource {
     return ImageSource::content_hash();
   }
   Status read_rows(uint32_t y0, uint32_t y1, float* out) override {
-    if (y0 > y1 || y1 > info_.height) return Error(ErrorCode::kInvalidArgument, path_ + ": rows");
-    const size_t row = size_t(info_.width) * info_.channels * sizeof(float);
-    size_t left = row * (y1 - y0);
-    off_t at = off_t(row * y0);
-    auto* p = reinterpret_cast<char*>(out);
-    while (left > 0) {
-      const ssize_t n = ::pread(fd_, p, left, at);
-      if (n <= 0) return io_error(path_, "read failed");
-      p += n, at += n, left -= size_t(n);
-    }
-    return Status::Ok();
+    return file_->read(y0, y1, out);
   }
   std::string origin() const override { return path_; }
 
  private:
-  RawFileSource(int fd, std::string path, ImageInfo info)
-      : fd_(fd), path_(std::move(path)), info_(std::move(info)) {}
-  int fd_;
+  RawFileSource(std::shared_ptr<LevelStore> file, std::string path, ImageInfo info)
+      : file_(std::move(file)), path_(std::move(path)), info_(std::move(info)) {}
+  std::shared_ptr<LevelStore> file_;
   std::string path_;
   ImageInfo info_;
   std::optional<uint64_t> hash_;
@@ -229,25 +215,23 @@ Expected<uint64_t> write_source(ImageSource& source, const std::string& path) {
       [&](uint32_t y0, uint32_t y1, float* out) { return source.read_rows(y0, y1, out); });
 }
 
-// The file name of a level saved for the shards: raw floats, or a store's compressed chunks.
-std::string level_file_name(LevelSource& level, const std::string& stem) {
+// How a level is saved for the shards (plan.json "format"): a store's compressed scratch file
+// as its chunks, anything else as raw floats.
+const char* level_format(LevelSource& level) {
   const LevelStore* store = level.held_store();
-  return stem + (store && store->compressed() ? ".f32.zc" : ".f32");
+  return store && store->compressed() ? kCompressedLevel : kRawLevel;
+}
+std::string level_file_name(const char* format, const std::string& stem) {
+  return stem + (std::string_view(format) == kCompressedLevel ? ".f32.zc" : ".f32");
 }
 
-// A level for the shards at `path`: a level store saves itself (a scratch file is linked, not
-// copied, and stays compressed if it is); other levels are written as raw rows. Returns the
-// form, recorded in the plan beside the file's name.
-Expected<std::string> save_level(LevelSource& level, const std::string& path) {
-  if (LevelStore* store = level.held_store()) {
-    VT_ASSIGN_OR_RETURN(const bool compressed, store->save(path));
-    return std::string(compressed ? kCompressedLevel : kRawLevel);
-  }
-  VT_RETURN_IF_ERROR(
-      write_rows(path, level.row_floats(), level.height(),
-                 [&](uint32_t y0, uint32_t y1, float* out) { return level.read(y0, y1, out); })
-          .status());
-  return std::string(kRawLevel);
+// A level for the shards at `path`, in level_format's form: a level store saves itself (a
+// scratch file is linked, not copied); other levels are written as raw rows.
+Status save_level(LevelSource& level, const std::string& path) {
+  if (LevelStore* store = level.held_store()) return store->save(path);
+  return write_rows(path, level.row_floats(), level.height(),
+                    [&](uint32_t y0, uint32_t y1, float* out) { return level.read(y0, y1, out); })
+      .status();
 }
 
 Expected<nlohmann::json> read_json(const std::string& path) {
@@ -477,21 +461,20 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
       }
       continue;
     }
+    const char* format = level_format(level0);
     const std::string file =
-        level_file_name(level0, "level0/" + plan.layers[i].spec.name + ".work");
+        level_file_name(format, "level0/" + plan.layers[i].spec.name + ".work");
     VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/" + file));
     working.emplace_back(i, std::move(staged));
     layers[i]["work_file"] = file;
+    layers[i]["work_format"] = format;
     layers[i]["work_channels"] = level0.channels();
   }
-  std::vector<std::string> working_formats(working.size());
   double t_working = 0;
   std::future<Status> saving = std::async(std::launch::async, [&]() -> Status {
     const auto t = Clock::now();
-    for (size_t k = 0; k < working.size(); ++k) {
-      VT_ASSIGN_OR_RETURN(working_formats[k],
-                          save_level(*plan.layers[working[k].first].level0, working[k].second));
-    }
+    for (const auto& [layer, staged] : working)
+      VT_RETURN_IF_ERROR(save_level(*plan.layers[layer].level0, staged));
     t_working = seconds_since(t);
     return Status::Ok();
   });
@@ -505,10 +488,11 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
     plan.options.level_done = [&](size_t li, uint32_t level, LevelSource& texels,
                                   float alpha_scale) -> Status {
       const auto t = Clock::now();
+      const char* format = level_format(texels);
       const std::string file = level_file_name(
-          texels, "levels/" + plan.layers[li].spec.name + "." + std::to_string(level));
+          format, "levels/" + plan.layers[li].spec.name + "." + std::to_string(level));
       VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/" + file));
-      VT_ASSIGN_OR_RETURN(const std::string format, save_level(texels, staged));
+      VT_RETURN_IF_ERROR(save_level(texels, staged));
       nlohmann::json& l = layers[li];
       if (!l.contains("levels")) l["levels"] = nlohmann::json::array();
       l["levels"].push_back({{"file", file}, {"format", format}, {"alpha_scale", alpha_scale}});
@@ -523,8 +507,6 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
   const double t_keys = seconds_since(t0) - t_levels;
   VT_RETURN_IF_ERROR(saving.get());  // joined before anything it uses goes out of scope
   VT_ASSIGN_OR_RETURN(BuildSummary keys, std::move(keyed));
-  for (size_t k = 0; k < working.size(); ++k)
-    layers[working[k].first]["work_format"] = working_formats[k];
   sum.stages.push_back({"write working level 0", t_working});  // alongside the keys
   sum.stages.push_back({"keys", t_keys});
   sum.stages.push_back({"write levels", t_levels});
