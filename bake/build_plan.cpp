@@ -241,6 +241,12 @@ uint64_t working_set(const BuildPlan& plan, const LayerPlan& layer, uint32_t wid
   return level_working_set(plan, layer, width) + kLevelChoiceAllowance;
 }
 
+// A level of a layer in its working form (floats), in bytes.
+uint64_t working_level_bytes(const PageGeometry& g, const LayerPlan& layer, uint32_t level) {
+  return uint64_t(g.level_width(level)) * g.level_height(level) * layer.work_channels *
+         sizeof(float);
+}
+
 // Which levels live in memory: level l + 1 does if it and level l fit in what the working set
 // leaves. Level 0 streams, or with coverage is held where open_level0 put it (pull-push runs in
 // bands over scratch files too).
@@ -253,9 +259,7 @@ std::vector<bool> choose_level_memory(const BuildPlan& plan, const LayerPlan& la
     const uint64_t masks = CoverageMask::pyramid_memory_bytes(g.width, g.height, limit);
     limit -= std::min(limit, masks + dilation_budget(plan.options));
   }
-  auto level_bytes = [&](uint32_t l) {
-    return uint64_t(g.level_width(l)) * g.level_height(l) * layer.work_channels * sizeof(float);
-  };
+  auto level_bytes = [&](uint32_t l) { return working_level_bytes(g, layer, l); };
   std::vector<bool> in_memory(g.level_count());
   in_memory[0] = layer.level0->in_memory();
   for (uint32_t l = 0; l + 1 < g.level_count(); ++l) {
@@ -272,9 +276,7 @@ uint64_t scratch_level_bytes(const BuildPlan& plan) {
   uint64_t bytes = 0;
   for (const LayerPlan& layer : plan.layers)
     for (uint32_t l = 1; l < layer.level_in_memory.size(); ++l)
-      if (!layer.level_in_memory[l])
-        bytes +=
-            uint64_t(g.level_width(l)) * g.level_height(l) * layer.work_channels * sizeof(float);
+      if (!layer.level_in_memory[l]) bytes += working_level_bytes(g, layer, l);
   return bytes;
 }
 
