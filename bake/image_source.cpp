@@ -1,4 +1,5 @@
 #include "bake/image_source.h"
+#include "scene/image_load.h"
 
 #include <OpenImageIO/imageio.h>
 #define XXH_STATIC_LINKING_ONLY  // XXH3_state_t on the stack
@@ -115,10 +116,9 @@ class FileImageSource final : public ImageSource {
 
 Expected<std::unique_ptr<ImageSource>> open_image_file(const std::string& path) {
   VT_RETURN_IF_ERROR(check_png_chunks(path));  // before libpng can print its own line
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) {
-    return Status(ErrorCode::kNotFound, path + ": cannot open image: " + OIIO::geterror());
-  }
+  std::string error;
+  auto in = scene::open_image_input(path, error);
+  if (!in) return Status(ErrorCode::kNotFound, path + ": cannot open image: " + error);
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) {
     return Status(ErrorCode::kCorrupt, path + ": image has no texels");

@@ -11,6 +11,7 @@
 #include "bake/unwrap/atlas_raster.h"
 #include "common/parallel.h"
 #include "common/vec.h"
+#include "scene/image_load.h"
 #include "scene/material_rules.h"
 #include "scene/tangent_frame.h"
 
@@ -542,14 +543,8 @@ Status Transfer::setup_images(const std::vector<bool>* wanted) {
     slot.tried = path;
     bool untiled = false;
     {
-      auto in = OIIO::ImageInput::open(path);
-      if (!in) {
-        // Reported per material slot by check_missing_textures.
-        slot.error = OIIO::geterror();
-        slot.error = slot.error.substr(0, slot.error.find('\n'));  // further lines repeat it
-        if (slot.error.empty()) slot.error = "OpenImageIO cannot read it";
-        continue;
-      }
+      auto in = scene::open_image_input(path, slot.error);
+      if (!in) continue;  // reported per material slot by check_missing_textures
       const OIIO::ImageSpec& spec = in->spec();
       untiled = spec.tile_width == 0;
       if (used_as_colour(scene_, i)) {

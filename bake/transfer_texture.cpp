@@ -1,6 +1,7 @@
 // Source textures for the transfer (see transfer_texture.h).
 #include "bake/transfer_texture.h"
 #include "bake/color.h"
+#include "scene/image_load.h"
 #include "scene/material_rules.h"
 
 #include <OpenImageIO/imageio.h>
@@ -33,8 +34,9 @@ inline double finite_or_zero(double x) {
 Expected<TransferTexture> TransferTexture::load(const std::string& path,
                                                 const ColorConverter* to_linear,
                                                 const ColorConverter* from_linear) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) return Error(ErrorCode::kNotFound, first_line(OIIO::geterror()));
+  std::string error;
+  auto in = scene::open_image_input(path, error);
+  if (!in) return Error(ErrorCode::kNotFound, error);
   TransferTexture tex;
   tex.channels_ = std::clamp(in->spec().nchannels, 1, 4);
   const int channels = tex.channels_;

@@ -3,18 +3,40 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <filesystem>
 #include <memory>
 
 namespace vt::scene {
+
+std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path, std::string& error) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    error = "Could not open file \"" + path + "\"";
+    return nullptr;
+  }
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) {
+    error = OIIO::geterror();
+    error = error.substr(0, error.find('\n'));  // further lines repeat it
+    if (error.empty()) error = "OpenImageIO cannot read it";
+  } else if (std::string(in->format_name()) == "null") {
+    error = "not an image file";
+    return nullptr;
+  }
+  return in;
+}
 
 Expected<FloatImage> load_float_image(const scene::Image& image) {
   OIIO::Filesystem::IOMemReader mem(image.bytes.data(), image.bytes.size());
   const std::string name =
       image.embedded() ? std::string("embedded") + image.embedded_extension() : image.path;
-  std::unique_ptr<OIIO::ImageInput> in =
-      image.embedded() ? OIIO::ImageInput::open(name, nullptr, &mem) : OIIO::ImageInput::open(name);
+  std::string error;
+  std::unique_ptr<OIIO::ImageInput> in = image.embedded()
+                                             ? OIIO::ImageInput::open(name, nullptr, &mem)
+                                             : open_image_input(name, error);
   if (!in) {
-    return Error(ErrorCode::kNotFound, "cannot open image '" + name + "': " + OIIO::geterror());
+    return Error(ErrorCode::kNotFound, "cannot open image '" + name +
+                                           "': " + (image.embedded() ? OIIO::geterror() : error));
   }
   const OIIO::ImageSpec& spec = in->spec();
   const int ch = spec.nchannels;

@@ -4,7 +4,11 @@
 // lighting baker's alpha-masked shadows (bake/lighting.cpp) build on it.
 #pragma once
 
+#include <OpenImageIO/imageio.h>
+
 #include <cstdint>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "common/status.h"
@@ -19,6 +23,11 @@ struct FloatImage {
   std::vector<float> rgba;
   const float* at(uint32_t x, uint32_t y) const { return &rgba[(size_t(y) * width + x) * 4]; }
 };
+
+// OpenImageIO's reader of the image file at `path`, or null with `error` saying why (its first
+// line). Only a file of a real format: OpenImageIO's "null" plugin makes up an image for any name
+// ending in .nul, file or not, which would bake as if the texture were there.
+std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path, std::string& error);
 
 // Errors name the image: kNotFound when it cannot be opened, kCorrupt when it cannot be read or
 // has a size of 0 or over 65536 per side.

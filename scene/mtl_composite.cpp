@@ -6,6 +6,7 @@
 
 #include <algorithm>
 
+#include "scene/image_load.h"
 #include "scene/obj_mtl.h"
 
 namespace vt::scene::detail {
@@ -37,11 +38,21 @@ Expected<Image> composite_image(const std::vector<ChannelSource>& channels,
   bool wide = false;  // a source with more than 8 bits: the result is 16-bit
   for (size_t c = 0; c < channels.size(); ++c) {
     if (channels[c].path.empty()) continue;
+    std::string error;
+    if (!open_image_input(channels[c].path, error))
+      return Error(ErrorCode::kNotFound,
+                   channels[c].path + ": cannot read the image (" + error + ")");
     images[c] = OIIO::ImageBuf(channels[c].path);
     if (!images[c].read(0, 0, true, OIIO::TypeDesc::FLOAT))
       return Error(ErrorCode::kNotFound,
                    channels[c].path + ": cannot read the image (" + images[c].geterror() + ")");
     const OIIO::ImageSpec& spec = images[c].spec();
+    if (spec.nchannels < 1 || spec.width < 1 || spec.height < 1 ||
+        spec.channelnames.size() != size_t(spec.nchannels))
+      return Error(ErrorCode::kCorrupt, channels[c].path + ": no usable pixels (" +
+                                            std::to_string(spec.width) + "x" +
+                                            std::to_string(spec.height) + ", " +
+                                            std::to_string(spec.nchannels) + " channels)");
     w = std::max(w, spec.width), h = std::max(h, spec.height);
     wide |= spec.format.size() > 1;
   }

@@ -19,6 +19,7 @@
 #include <cstdlib>
 #include <memory>
 
+#include "scene/image_load.h"
 #include "scene/obj_mtl.h"
 #include "scene/scene_io_util.h"
 
@@ -111,7 +112,8 @@ MapStatement parse_map(const std::string& rest) {
 // A bump map that holds heights rather than normals (see the rules at the top).
 bool is_height_map(const std::string& path, char imfchan) {
   if (imfchan == 'l' || imfchan == 'z') return true;
-  auto in = OIIO::ImageInput::open(path);
+  std::string error;
+  auto in = open_image_input(path, error);
   if (!in) return false;  // unreadable here: the transfer reports it, as a normal map
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.nchannels < 3) return true;

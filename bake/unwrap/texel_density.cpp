@@ -1,5 +1,6 @@
 // Source texel density and the density side file (see texel_density.h).
 #include "bake/unwrap/texel_density.h"
+#include "scene/image_load.h"
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
@@ -126,13 +127,15 @@ double triangle_source_density(double width, double height, double uv_area, doub
 
 Expected<std::array<int, 2>> image_size(const scene::Image& image) {
   std::unique_ptr<OIIO::ImageInput> in;
+  std::string err;
   OIIO::Filesystem::IOMemReader proxy(image.bytes.data(), image.bytes.size());
-  if (image.embedded())
+  if (image.embedded()) {
     in = OIIO::ImageInput::open(embedded_name(image), nullptr, &proxy);
-  else
-    in = OIIO::ImageInput::open(image.path);
+    if (!in) err = OIIO::geterror();
+  } else {
+    in = scene::open_image_input(image.path, err);
+  }
   if (!in) {
-    std::string err = OIIO::geterror();
     return Error(ErrorCode::kNotFound,
                  "cannot read the image header" + (err.empty() ? std::string() : " (" + err + ")"));
   }

@@ -16,14 +16,14 @@ namespace {
 using namespace vt::testing;
 
 // A textured quad whose map_Kd file does not exist; returns the .obj path.
-std::string quad_with_missing_texture() {
+std::string quad_with_missing_texture(const std::string& map_kd = "textures/brick.png") {
   const std::string obj = temp_path("quad.obj");
   const std::string dir = obj.substr(0, obj.rfind('/'));
   std::ofstream(obj) << "mtllib quad.mtl\n"
                         "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
                         "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
                         "usemtl Brick\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
-  std::ofstream(dir + "/quad.mtl") << "newmtl Brick\nKd 0.5 0.25 1.0\nmap_Kd textures/brick.png\n";
+  std::ofstream(dir + "/quad.mtl") << "newmtl Brick\nKd 0.5 0.25 1.0\nmap_Kd " << map_kd << "\n";
   return obj;
 }
 
@@ -36,6 +36,25 @@ TEST(CliBake, MissingTextureIsAnErrorNamingMaterialSlotAndPath) {
       << r.out;
   EXPECT_NE(r.out.find("(tried " + dir + "/textures/brick.png)"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(dir + "/q.vtpf"));
+}
+
+// OpenImageIO's "null" plugin makes up a 1024x1024 image for any name ending in .nul, there or not:
+// such a texture baked silently from nothing, and an MTL map_d packed from it crashed the loader.
+TEST(CliBake, ATextureNamedForOpenImageIOsNullPluginIsNotAnImage) {
+  for (const bool present : {false, true}) {
+    const std::string obj = quad_with_missing_texture("brick.nul");
+    const std::string dir = obj.substr(0, obj.rfind('/'));
+    if (present) std::ofstream(dir + "/brick.nul") << "not an image";
+    if (present) std::ofstream(dir + "/alpha.nul") << "not an image";
+    std::ofstream(dir + "/quad.mtl", std::ios::app) << "map_d alpha.nul\n";  // packed into map_Kd
+    RunResult r = run_vtbake("bake " + obj + " -o " + dir + "/q.vtpf --size 1 --unwrapped -", true);
+    EXPECT_EQ(r.exit_code, 2) << r.out;
+    EXPECT_NE(r.out.find("material 'Brick' baseColorTexture: cannot read image"), std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find(present ? "not an image file" : "Could not open file"), std::string::npos)
+        << r.out;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/q.vtpf"));
+  }
 }
 
 TEST(CliBake, MissingTextureWarnBakesAndReports) {
