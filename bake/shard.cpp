@@ -404,13 +404,12 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
     const bool raw = !coverage || in.coverage != bo.layers[0].coverage;
     const std::string file = raw ? "level0/" + name + ".f32" : "";
     if (!dir.empty()) {
+      // A layer kept only in working form is hashed after plan_build, which hashes the rows as
+      // it converts them (at 64K, asking first read a 51 GB level 0 once more: 86.5 s).
       uint64_t hash = 0;
       if (raw) {
         VT_ASSIGN_OR_RETURN(std::string staged, outputs.stage(dir + "/" + file));
         VT_ASSIGN_OR_RETURN(hash, write_source(*in.source, staged));
-      } else {
-        // Before plan_build: a source that hands its texels over to level 0 hashes them first.
-        VT_ASSIGN_OR_RETURN(hash, in.source->content_hash());
       }
       layer_hashes.push_back(hash);
     }
@@ -440,7 +439,11 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
   for (size_t i = 0; i < plan.layers.size(); ++i) {
     layers[i]["input_key"] = hex(plan.layers[i].input_key);  // for the merged update record
     // What a shard would otherwise read the whole of level 0 for: its hash and the alpha scan.
+    // The hash is of the source before drop_opaque_alpha (each shard drops it again).
     if (i < layer_hashes.size()) {
+      if (!raw_written[i]) {
+        VT_ASSIGN_OR_RETURN(layer_hashes[i], prepared->build.layers[i].source->content_hash());
+      }
       layers[i]["content_hash"] = hex(layer_hashes[i]);
       layers[i]["alpha_dropped"] = bo.layers[i].alpha_dropped;
     }
