@@ -3,7 +3,11 @@
 #define XXH_STATIC_LINKING_ONLY  // XXH3_state_t on the stack
 #include <xxhash.h>
 #include <algorithm>
+#include <bit>
 #include <cstring>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "bake/level_store.h"
 #include "bake/pyramid.h"
@@ -11,14 +15,46 @@
 namespace vt {
 namespace {
 
-// Rows of packed words <-> one byte per texel.
+// Rows of packed words <-> one byte per texel, a word (or a byte of one) at a time: a 64K atlas's
+// mask is 4.3 G texels, packed once and unpacked several times by every bake and shard (bit by
+// bit that was ~0.8 ns a texel, 3.5 s a pass).
 void pack_row(const uint8_t* texels, uint32_t width, uint32_t* words) {
-  std::fill(words, words + (width + 31) / 32, 0u);
-  for (uint32_t x = 0; x < width; ++x)
-    if (texels[x]) words[x / 32] |= 1u << (x % 32);
+  uint32_t x = 0;
+#if defined(__SSE2__)
+  const __m128i zero = _mm_setzero_si128();
+  for (; x + 32 <= width; x += 32) {
+    const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(texels + x));
+    const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(texels + x + 16));
+    const uint32_t zero_a = uint32_t(_mm_movemask_epi8(_mm_cmpeq_epi8(a, zero)));
+    const uint32_t zero_b = uint32_t(_mm_movemask_epi8(_mm_cmpeq_epi8(b, zero)));
+    words[x / 32] = ~(zero_a | zero_b << 16);
+  }
+#endif
+  for (; x < width; x += 32) {
+    uint32_t word = 0;
+    for (uint32_t i = 0; i < 32 && x + i < width; ++i) word |= uint32_t(texels[x + i] != 0) << i;
+    words[x / 32] = word;
+  }
 }
+
+// Byte b's 8 bits as 8 bytes of 0 or 1 (little-endian: bit i in byte i).
+struct SpreadBits {
+  uint64_t bytes[256];
+  constexpr SpreadBits() : bytes() {
+    for (int b = 0; b < 256; ++b)
+      for (int i = 0; i < 8; ++i) bytes[b] |= uint64_t((b >> i) & 1) << (8 * i);
+  }
+};
+constexpr SpreadBits kSpreadBits;
+
 void unpack_row(const uint32_t* words, uint32_t width, uint8_t* texels) {
-  for (uint32_t x = 0; x < width; ++x) texels[x] = uint8_t((words[x / 32] >> (x % 32)) & 1u);
+  uint32_t x = 0;
+  for (; x + 8 <= width; x += 8) {
+    uint64_t spread = kSpreadBits.bytes[(words[x / 32] >> (x % 32)) & 0xffu];
+    if constexpr (std::endian::native == std::endian::big) spread = __builtin_bswap64(spread);
+    std::memcpy(texels + x, &spread, 8);
+  }
+  for (; x < width; ++x) texels[x] = uint8_t((words[x / 32] >> (x % 32)) & 1u);
 }
 
 }  // namespace
@@ -67,6 +103,7 @@ uint32_t CoverageMask::band_rows() const {
 }
 
 Status CoverageMask::write_rows(uint32_t y0, uint32_t rows, const uint8_t* texels) {
+  hash_.reset();
   std::vector<uint32_t> packed(size_t(words()) * rows);
   for (uint32_t r = 0; r < rows; ++r)
     pack_row(texels + size_t(r) * width_, width_, packed.data() + size_t(r) * words());
@@ -109,6 +146,7 @@ Expected<std::vector<uint8_t>> CoverageMask::to_bytes() const {
 }
 
 Expected<uint64_t> CoverageMask::content_hash() const {
+  if (hash_) return *hash_;
   XXH3_state_t state;
   XXH3_64bits_reset(&state);
   std::vector<uint8_t> rows;
@@ -116,7 +154,8 @@ Expected<uint64_t> CoverageMask::content_hash() const {
     VT_RETURN_IF_ERROR(read_rows(y, std::min(height_, y + band_rows()), rows));
     XXH3_64bits_update(&state, rows.data(), rows.size());
   }
-  return uint64_t(XXH3_64bits_digest(&state));
+  hash_ = XXH3_64bits_digest(&state);
+  return *hash_;
 }
 
 Expected<std::shared_ptr<CoverageMask>> CoverageMask::downsample(

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -57,7 +58,8 @@ class CoverageMask {
   // Rows moved at a time by the mask's own loops (about 4 MiB as bytes); callers that stream a
   // mask to or from a file use it too.
   uint32_t band_rows() const;
-  // XXH3 of to_bytes(), computed in bands (the plan hash's, as when masks were bytes).
+  // XXH3 of to_bytes(), computed in bands (the plan hash's, as when masks were bytes) once
+  // until the next write: every layer of a scene bake shares level 0's mask.
   Expected<uint64_t> content_hash() const;
   // The half-size level's mask: a texel is covered when any of its 2x2 footprint is (the
   // footprint clamped at odd sizes; downsample_coverage's rule), derived in bands.
@@ -69,6 +71,7 @@ class CoverageMask {
   uint32_t words() const { return (width_ + 31) / 32; }
   uint32_t width_ = 0, height_ = 0;
   std::unique_ptr<LevelStore> store_;  // words() 32-bit words a row (moved as floats' bytes)
+  mutable std::optional<uint64_t> hash_;
 };
 
 }  // namespace vt

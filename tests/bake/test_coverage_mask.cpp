@@ -104,7 +104,11 @@ TEST(CoverageMask, PresentPagesAndHashAreThoseOfTheBytes) {
   }
   EXPECT_GT(present, 0u);
   EXPECT_LT(present, g.pages_x(0) * g.pages_y(0));
-  const std::vector<uint8_t> b01 = as_01(bytes);
+  std::vector<uint8_t> b01 = as_01(bytes);
+  EXPECT_EQ(*(*mask)->content_hash(), XXH3_64bits(b01.data(), b01.size()));
+  // The hash is kept between writes, not past one.
+  b01[size_t(g.height / 2) * g.width + 5] ^= 1;
+  ASSERT_TRUE((*mask)->write_rows(g.height / 2, 1, &b01[size_t(g.height / 2) * g.width]).ok());
   EXPECT_EQ(*(*mask)->content_hash(), XXH3_64bits(b01.data(), b01.size()));
 }
 
