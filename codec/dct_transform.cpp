@@ -112,13 +112,6 @@ void idct_block_scalar(const int16_t* f, int nv, int nu, int16_t* out, int strid
   }
 }
 
-void idct_dc_block_scalar(int dc, int16_t* out, int stride) {
-  const int t = std::clamp((kIdctBasis[0][0] * dc + 256) >> 9, -32768, 32767);
-  const int16_t v = int16_t(std::clamp((t * kIdctBasis[0][0] + 2048) >> 12, -4095, 4095));
-  for (int y = 0; y < 8; y++)
-    for (int x = 0; x < 8; x++) out[y * stride + x] = v;
-}
-
 void ycocg420_to_rgb_scalar(const int16_t* yp, int ystride, const int16_t* co, const int16_t* cg,
                             int cstride, int width, int height, int ch, uint8_t* texels) {
   const int cw = width / 2, chh = height / 2;
@@ -298,17 +291,8 @@ VT_INLINE void idct_block_dispatch(const int16_t* f, int nv, int nu, int16_t* ou
   }
 }
 
-VT_INLINE void idct_dc_x86(int dc, int16_t* out, int stride) {
-  const int t = std::clamp((1448 * dc + 256) >> 9, -32768, 32767);
-  const __m128i v = _mm_set1_epi16(int16_t(std::clamp((t * 1448 + 2048) >> 12, -4095, 4095)));
-  for (int y = 0; y < 8; y++) _mm_storeu_si128(reinterpret_cast<__m128i*>(out + y * stride), v);
-}
-
 void idct_block_sse2(const int16_t* f, int nv, int nu, int16_t* out, int stride) {
   idct_block_dispatch(f, nv, nu, out, stride);
-}
-void idct_dc_block_sse2(int dc, int16_t* out, int stride) {
-  idct_dc_x86(dc, out, stride);
 }
 
 // SSE2 colour conversion: 16 texels per step. Without pshufb, RGB is packed from RGB0 dwords
@@ -611,9 +595,6 @@ VT_AVX2 void idct_block_avx2(const int16_t* f, int nv, int nu, int16_t* out, int
       return idct_block_avx2_n<8, 8>(f, out, stride);
   }
 }
-VT_AVX2 void idct_dc_block_avx2(int dc, int16_t* out, int stride) {
-  idct_dc_x86(dc, out, stride);
-}
 
 // pshufb masks spreading 16 R, G or B bytes over 48 RGB bytes: kRgbShuffle[k][c] gives channel
 // c's bytes of output bytes 16k..16k+15 (both 128-bit lanes alike).
@@ -839,19 +820,13 @@ bool host_has_avx2() {
 
 namespace {
 
-constexpr TransformImpl kScalar = {"scalar",
-                                   idct_block_scalar,
-                                   idct_dc_block_scalar,
-                                   ycocg420_to_rgb_scalar,
-                                   ycocg_to_rgb_scalar,
-                                   plane_to_channel_scalar};
+constexpr TransformImpl kScalar = {"scalar", idct_block_scalar, ycocg420_to_rgb_scalar,
+                                   ycocg_to_rgb_scalar, plane_to_channel_scalar};
 
 #if VT_TRANSFORM_X86
 constexpr TransformImpl kImpls[] = {
-    {"avx2", idct_block_avx2, idct_dc_block_avx2, ycocg420_to_rgb_avx2, ycocg_to_rgb_avx2,
-     plane_to_channel_avx2},
-    {"sse2", idct_block_sse2, idct_dc_block_sse2, ycocg420_to_rgb_sse2, ycocg_to_rgb_sse2,
-     plane_to_channel_sse2},
+    {"avx2", idct_block_avx2, ycocg420_to_rgb_avx2, ycocg_to_rgb_avx2, plane_to_channel_avx2},
+    {"sse2", idct_block_sse2, ycocg420_to_rgb_sse2, ycocg_to_rgb_sse2, plane_to_channel_sse2},
     kScalar,
 };
 #else
@@ -882,10 +857,6 @@ const TransformImpl& scalar_transform() {
 
 void idct_block(const int16_t* f, int nv, int nu, int16_t* out, int stride) {
   best().idct_block(f, nv, nu, out, stride);
-}
-
-void idct_dc_block(int dc, int16_t* out, int stride) {
-  best().idct_dc_block(dc, out, stride);
 }
 
 void ycocg420_to_rgb(const int16_t* y, int ystride, const int16_t* co, const int16_t* cg,

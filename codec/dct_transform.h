@@ -25,6 +25,7 @@
 // width and height are multiples of 8, at most 4096; 4:2:0 chroma planes are width/2 x height/2.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 
@@ -48,8 +49,15 @@ inline constexpr int16_t kIdctBasis[8][8] = {
 // of the full transform. out: 8x8 samples in 1/8 texel units, rows `stride` apart.
 void idct_block(const int16_t* f, int nv, int nu, int16_t* out, int stride);
 
-// DC-only block: fills 8x8 with the value idct_block gives for f[0] = dc (|dc| <= 2047), rest 0.
-void idct_dc_block(int dc, int16_t* out, int stride);
+// DC-only block: fills 8x8 with the value idct_block gives for f[0] = dc (|dc| <= 2047), rest 0:
+// pass 1 then pass 2 on the DC basis entry. Inline, since most blocks of smooth pages are
+// DC-only and a call per block through the ISA dispatch cost more than the fill.
+inline void idct_dc_block(int dc, int16_t* out, int stride) {
+  const int t = std::clamp((kIdctBasis[0][0] * dc + 256) >> 9, -32768, 32767);
+  const int16_t v = int16_t(std::clamp((t * kIdctBasis[0][0] + 2048) >> 12, -4095, 4095));
+  for (int y = 0; y < 8; y++)
+    for (int x = 0; x < 8; x++) out[y * stride + x] = v;
+}
 
 // YCoCg planes to interleaved texels with `ch` channels (3 or 4; channel 3 untouched).
 // 4:2:0: co, cg are width/2 x height/2, `cstride` apart, upsampled with the 9-3-3-1 filter.
@@ -67,7 +75,6 @@ void plane_to_channel(const int16_t* src, int stride, int width, int height, int
 // Plain scalar reference implementations: the definition of the arithmetic, used on hosts
 // without SIMD and by the tests.
 void idct_block_scalar(const int16_t* f, int nv, int nu, int16_t* out, int stride);
-void idct_dc_block_scalar(int dc, int16_t* out, int stride);
 void ycocg420_to_rgb_scalar(const int16_t* y, int ystride, const int16_t* co, const int16_t* cg,
                             int cstride, int width, int height, int ch, uint8_t* texels);
 void ycocg_to_rgb_scalar(const int16_t* y, int ystride, const int16_t* co, const int16_t* cg,
@@ -81,7 +88,6 @@ void plane_to_channel_scalar(const int16_t* src, int stride, int width, int heig
 struct TransformImpl {
   const char* name;  // "avx2", "sse2", "scalar"
   void (*idct_block)(const int16_t* f, int nv, int nu, int16_t* out, int stride);
-  void (*idct_dc_block)(int dc, int16_t* out, int stride);
   void (*ycocg420_to_rgb)(const int16_t* y, int ystride, const int16_t* co, const int16_t* cg,
                           int cstride, int width, int height, int ch, uint8_t* texels);
   void (*ycocg_to_rgb)(const int16_t* y, int ystride, const int16_t* co, const int16_t* cg,

@@ -6,8 +6,8 @@
 //   dct_bench --runtime [KODAK_DIR]                 DCT decode + BC1 real-time, pages/s
 //   dct_bench --transcode [ROUNDS [BASIS_BC1_DIR [SET]]]  issue 22: decode vs JPEG and DCT + BC1
 //                                       on Kodak and PBR maps, interleaved (SET: a name's part)
-//   dct_bench --profile [PASSES]            Kodak fold 0's DCT + BC1 transcode alone, PASSES
-//                                           times (a loop for perf)
+//   dct_bench --profile [PASSES [SET [decode]]]  one set's DCT + BC1 transcode (or decode)
+//                                           alone, PASSES times (a loop for perf)
 //   dct_bench [google benchmark flags]             per-page decode / encode timings
 //
 // Report: bits per texel, PSNR (RGB, per page), single-thread encode / decode Mtexel/s (median
@@ -542,35 +542,48 @@ double basis_bc1_psnr(const std::vector<Page>& pages, const std::vector<std::str
 // (kodimNN_unpacked_rgb_BC1_RGB_PPPP.png from `basisu -unpack`) also Basis's PSNR after BC1 on
 // the same Kodak pages. SET (part of a set's name) runs that set alone: see the note on
 // libjpeg-turbo's speed below.
-int transcode(int rounds, const std::string& basis_dir, const std::string& only) {
+// The page sets of --transcode and --profile (Kodak fold 0; PBR colour maps; PBR normal and ORM
+// maps read as RGB), each coded with tables trained on its other fold; `only` (part of a set's
+// name) keeps that set alone. With `basis_dir`, the Basis BC1 files of Kodak fold 0's pages.
+std::vector<TranscodeSet> load_transcode_sets(const std::string& only, const std::string& basis_dir,
+                                              std::vector<std::string>* basis_files) {
+  auto wanted = [&](const char* name) {
+    return only.empty() || std::strstr(name, only.c_str()) != nullptr;
+  };
   std::vector<Page> folds[2];
-  const auto files = list_pngs(g_kodak_dir);
-  std::vector<std::string> basis_files;
+  const auto files = wanted("Kodak fold 0") ? list_pngs(g_kodak_dir) : std::vector<std::string>{};
   for (size_t i = 0; i < files.size(); i++) {
     auto pages = load_pages(files[i], 3);
     for (size_t p = 0; p < pages.size() && i % 2 == 0 && !basis_dir.empty(); p++) {
       char name[64];
       std::snprintf(name, sizeof name, "_unpacked_rgb_BC1_RGB_%04zu.png", p);
-      basis_files.push_back(basis_dir + "/" + std::filesystem::path(files[i]).stem().string() +
-                            name);
+      basis_files->push_back(basis_dir + "/" + std::filesystem::path(files[i]).stem().string() +
+                             name);
     }
     for (Page& p : pages) folds[i % 2].push_back(std::move(p));
   }
   // Game textures: colour maps, and the other maps (normal, ORM) read as RGB pages too.
   std::vector<Page> tex[2], other[2];
-  for (const auto& f : list_pngs(g_texture_dir)) {
+  const bool textures = wanted("PBR baseColor maps") || wanted("PBR normal + ORM maps");
+  for (const auto& f : textures ? list_pngs(g_texture_dir) : std::vector<std::string>{}) {
     auto pages = load_pages(f, 3);
     auto& to = f.find("baseColor") != std::string::npos ? tex : other;
     for (size_t i = 0; i < pages.size(); i++) to[i % 2].push_back(std::move(pages[i]));
   }
   std::vector<TranscodeSet> sets;
   auto add = [&](const char* name, std::vector<Page>(&f)[2]) {
-    if (!f[0].empty() && (only.empty() || std::strstr(name, only.c_str())))
+    if (!f[0].empty() && wanted(name))
       sets.push_back(make_transcode_set(name, std::move(f[0]), f[1]));
   };
   add("Kodak fold 0", folds);
   add("PBR baseColor maps", tex);
   add("PBR normal + ORM maps", other);
+  return sets;
+}
+
+int transcode(int rounds, const std::string& basis_dir, const std::string& only) {
+  std::vector<std::string> basis_files;
+  const std::vector<TranscodeSet> sets = load_transcode_sets(only, basis_dir, &basis_files);
   if (sets.empty()) return 1;
   const bool with_basis = !basis_files.empty() && sets[0].name == "Kodak fold 0";
   const double basis_psnr = with_basis ? basis_bc1_psnr(sets[0].pages, basis_files) : 0;
@@ -667,15 +680,14 @@ int transcode(int rounds, const std::string& basis_dir, const std::string& only)
   return 0;
 }
 
-// `dct_bench --profile PASSES`: the transcode loop of --transcode's Kodak row and nothing else
-// timed, so that a profiler's shares are the runtime path's.
-int profile(int passes) {
-  std::vector<Page> folds[2];
-  const auto files = list_pngs(g_kodak_dir);
-  for (size_t i = 0; i < files.size(); i++)
-    for (Page& p : load_pages(files[i], 3)) folds[i % 2].push_back(std::move(p));
-  if (folds[0].empty()) return 1;
-  const TranscodeSet set = make_transcode_set("Kodak fold 0", std::move(folds[0]), folds[1]);
+// `dct_bench --profile PASSES [SET [decode]]`: the transcode loop of --transcode's row for SET
+// (default Kodak) and nothing else timed, so that a profiler's shares are the runtime path's;
+// with "decode", the passes decode only.
+int profile(int passes, const std::string& only, bool decode_only) {
+  const std::vector<TranscodeSet> sets =
+      load_transcode_sets(only.empty() ? "Kodak" : only, "", nullptr);
+  if (sets.empty()) return 1;
+  const TranscodeSet& set = sets[0];
   Page out(set.pages[0].size());
   std::vector<uint8_t> bc(bc_image_bytes(BcFormat::kBc1, kPage, kPage));
   // FNV-1a over every decoded page and its BC1 bytes: builds that must not change an output
@@ -695,16 +707,17 @@ int profile(int passes) {
     const double t0 = now_s();
     for (const auto& c : set.dct) (void)dct_decode_page(*set.tables, c, kPage, kPage, out.data());
     const double t1 = now_s();
-    for (const auto& c : set.dct) {
-      (void)dct_decode_page(*set.tables, c, kPage, kPage, out.data());
+    for (size_t i = 0; i < set.dct.size() && !decode_only; i++) {
+      (void)dct_decode_page(*set.tables, set.dct[i], kPage, kPage, out.data());
       (void)bc_encode_image(BcFormat::kBc1, BcQuality::kRealtime, out.data(), kPage, kPage, 3,
                             bc.data());
     }
     decode += t1 - t0, both += now_s() - t1;
   }
   const double n = double(set.pages.size()) * passes;
-  std::printf("decode %.0f pages/s, decode + BC1 %.0f pages/s, output digest %016llx\n", n / decode,
-              n / both, (unsigned long long)digest);
+  std::printf("%s: decode %.0f pages/s, decode + BC1 %.0f pages/s, output digest %016llx\n",
+              set.name.c_str(), n / decode, decode_only ? 0.0 : n / both,
+              (unsigned long long)digest);
   return 0;
 }
 
@@ -806,7 +819,8 @@ int main(int argc, char** argv) {
                      argc > 4 ? argv[4] : "");
   }
   if (argc > 1 && std::strcmp(argv[1], "--profile") == 0)
-    return profile(argc > 2 ? std::atoi(argv[2]) : 100);
+    return profile(argc > 2 ? std::atoi(argv[2]) : 100, argc > 3 ? argv[3] : "",
+                   argc > 4 && std::strcmp(argv[4], "decode") == 0);
   if (argc > 1 && std::strcmp(argv[1], "--speed") == 0) {
     if (argc > 2) g_kodak_dir = argv[2];
     return speed(7);

@@ -22,6 +22,7 @@
 namespace {
 
 using vt::Lcg64;
+using vt::dct_detail::idct_dc_block;
 using vt::dct_detail::TransformImpl;
 
 constexpr int kPage = 128;
@@ -79,7 +80,7 @@ void idct_page(const TransformImpl& impl, PagePlanes& out) {
     const int stride = b.plane == 0 ? kPage : kPage / 2;
     int16_t* o = out.plane(b.plane) + size_t(b.by) * 8 * stride + b.bx * 8;
     if (b.nv == 0) {
-      impl.idct_dc_block(b.f[0], o, stride);
+      idct_dc_block(b.f[0], o, stride);
     } else {
       impl.idct_block(b.f, b.nv, b.nu, o, stride);
     }
