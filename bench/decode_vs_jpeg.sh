@@ -11,6 +11,9 @@
 #
 #   bench/decode_vs_jpeg.sh [ROUNDS] [BINARY...]     (default: build/release/bench/dct_bench)
 #
+# With DCT_BENCH_GAME_TEXTURES=DIR (e.g. supertuxkart-data unpacked with dpkg -x, its
+# share/games/supertuxkart/data/textures), a fourth set: the game data under DIR.
+#
 # Several binaries (e.g. a copy of an older build's dct_bench first) run side by side, setting
 # by setting. Each run is pinned to one core (taskset -c 1); keep the machine otherwise quiet.
 set -euo pipefail
@@ -34,7 +37,7 @@ for setting in "${SETTINGS[@]}"; do
       [ "$aslr" = off ] && wrap=(setarch "$(uname -m)" -R taskset -c 1)
       GLIBC_TUNABLES=$setting "${wrap[@]}" "$bin" --transcode "$ROUNDS" |
         awk -F'|' -v b="$bin" -v s="$setting aslr=$aslr" \
-          '/^\| (Kodak fold 0|PBR [^|]*maps) \|/ { gsub(/^ +| +$/, "", $2);
+          '/^\| (Kodak fold 0|PBR [^|]*maps|game textures) \|/ { gsub(/^ +| +$/, "", $2);
              printf "%s\t%s\t%s\t%s\t%s\t%s\n", b, s, $2, $8 + 0, $9 + 0, $10 + 0 }' >>"$OUT"
     done
   done

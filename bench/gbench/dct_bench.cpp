@@ -5,7 +5,9 @@
 //   dct_bench --speed [KODAK_DIR]                   decode speed against JPEG, interleaved
 //   dct_bench --runtime [KODAK_DIR]                 DCT decode + BC1 real-time, pages/s
 //   dct_bench --transcode [ROUNDS [BASIS_BC1_DIR [SET]]]  issue 22: decode vs JPEG and DCT + BC1
-//                                       on Kodak and PBR maps, interleaved (SET: a name's part)
+//                                       on Kodak, PBR maps (and game textures: env
+//                                       DCT_BENCH_GAME_TEXTURES=DIR), interleaved (SET: a
+//                                       name's part)
 //   dct_bench --profile [PASSES [SET [decode]]]  one set's DCT + BC1 transcode (or decode)
 //                                           alone, PASSES times (a loop for perf)
 //   dct_bench [google benchmark flags]             per-page decode / encode timings
@@ -16,9 +18,11 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
@@ -534,17 +538,10 @@ double basis_bc1_psnr(const std::vector<Page>& pages, const std::vector<std::str
   return psnr_from(se, double(pages.size()) * kPage * kPage * 3);
 }
 
-// `dct_bench --transcode ROUNDS [BASIS_BC1_DIR [SET]]`: per page set (Kodak fold 0, 288 pages:
-// the pages bench/transcode_vs_basis.sh gives Basis; the PBR colour maps; the PBR normal and ORM
-// maps, read as RGB), DCT decode, JPEG decode and DCT decode + BC1 real-time, passes alternating,
-// medians of thread CPU time over ROUNDS. Both codecs code the same RGB pages at about equal
-// PSNR: DCT q50 4:2:0 (tables trained on the other fold), JPEG q75 4:2:0. With BASIS_BC1_DIR
-// (kodimNN_unpacked_rgb_BC1_RGB_PPPP.png from `basisu -unpack`) also Basis's PSNR after BC1 on
-// the same Kodak pages. SET (part of a set's name) runs that set alone: see the note on
-// libjpeg-turbo's speed below.
 // The page sets of --transcode and --profile (Kodak fold 0; PBR colour maps; PBR normal and ORM
-// maps read as RGB), each coded with tables trained on its other fold; `only` (part of a set's
-// name) keeps that set alone. With `basis_dir`, the Basis BC1 files of Kodak fold 0's pages.
+// maps read as RGB; game textures when DCT_BENCH_GAME_TEXTURES names a folder), each coded with
+// tables trained on its other fold; `only` (part of a set's name) keeps that set alone. With
+// `basis_dir`, the Basis BC1 files of Kodak fold 0's pages.
 std::vector<TranscodeSet> load_transcode_sets(const std::string& only, const std::string& basis_dir,
                                               std::vector<std::string>* basis_files) {
   auto wanted = [&](const char* name) {
@@ -570,6 +567,23 @@ std::vector<TranscodeSet> load_transcode_sets(const std::string& only, const std
     auto& to = f.find("baseColor") != std::string::npos ? tex : other;
     for (size_t i = 0; i < pages.size(); i++) to[i % 2].push_back(std::move(pages[i]));
   }
+  // Game data (DCT_BENCH_GAME_TEXTURES: a folder, e.g. supertuxkart-data's unpacked
+  // share/games/supertuxkart/data): every PNG and JPEG under it, its first four pages each.
+  std::vector<Page> game[2];
+  const char* game_dir = std::getenv("DCT_BENCH_GAME_TEXTURES");
+  if (game_dir != nullptr && wanted("game textures") && std::filesystem::is_directory(game_dir)) {
+    std::vector<std::string> images;
+    for (const auto& e : std::filesystem::recursive_directory_iterator(game_dir)) {
+      std::string ext = e.path().extension().string();
+      for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+      if (e.is_regular_file() && (ext == ".png" || ext == ".jpg" || ext == ".jpeg"))
+        images.push_back(e.path().string());
+    }
+    std::sort(images.begin(), images.end());
+    size_t n = 0;
+    for (const auto& f : images)
+      for (Page& p : load_pages(f, 3, 4)) game[n++ % 2].push_back(std::move(p));
+  }
   std::vector<TranscodeSet> sets;
   auto add = [&](const char* name, std::vector<Page>(&f)[2]) {
     if (!f[0].empty() && wanted(name))
@@ -578,9 +592,18 @@ std::vector<TranscodeSet> load_transcode_sets(const std::string& only, const std
   add("Kodak fold 0", folds);
   add("PBR baseColor maps", tex);
   add("PBR normal + ORM maps", other);
+  add("game textures", game);
   return sets;
 }
 
+// `dct_bench --transcode ROUNDS [BASIS_BC1_DIR [SET]]`: per page set (Kodak fold 0, 288 pages:
+// the pages bench/transcode_vs_basis.sh gives Basis; the PBR colour maps; the PBR normal and ORM
+// maps, read as RGB), DCT decode, JPEG decode and DCT decode + BC1 real-time, passes alternating,
+// medians of thread CPU time over ROUNDS. Both codecs code the same RGB pages at about equal
+// PSNR: DCT q50 4:2:0 (tables trained on the other fold), JPEG q75 4:2:0. With BASIS_BC1_DIR
+// (kodimNN_unpacked_rgb_BC1_RGB_PPPP.png from `basisu -unpack`) also Basis's PSNR after BC1 on
+// the same Kodak pages. SET (part of a set's name) runs that set alone: see the note on
+// libjpeg-turbo's speed below.
 int transcode(int rounds, const std::string& basis_dir, const std::string& only) {
   std::vector<std::string> basis_files;
   const std::vector<TranscodeSet> sets = load_transcode_sets(only, basis_dir, &basis_files);
