@@ -675,18 +675,20 @@ VT_AVX2 VT_INLINE __m256i clamp_chroma_avx2(__m256i v) {
   return _mm256_min_epi16(_mm256_max_epi16(v, _mm256_set1_epi16(-2047)), _mm256_set1_epi16(2047));
 }
 
-// v[i] = 3 * clamp(a[i]) + clamp(b[i]) for i < n (n >= 16), |v| <= 8188.
+VT_AVX2 VT_INLINE void blend16_avx2(const int16_t* a, const int16_t* b, int16_t* v) {
+  const __m256i x = clamp_chroma_avx2(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(a)));
+  const __m256i y = clamp_chroma_avx2(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(b)));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(v),
+                      _mm256_add_epi16(_mm256_add_epi16(x, _mm256_add_epi16(x, x)), y));
+}
+
+// v[i] = 3 * clamp(a[i]) + clamp(b[i]) for i < n (n >= 16), |v| <= 8188. Whole steps, then
+// one ending at n that overlaps the one before (the same values again): a plain counted loop
+// keeps the addressing to pointer increments (pages are 128 wide: no overlap step).
 VT_AVX2 VT_INLINE void blend_rows_avx2(const int16_t* a, const int16_t* b, int n, int16_t* v) {
-  for (int i = 0;; i += 16) {
-    if (i > n - 16) i = n - 16;  // the last step may overlap the one before
-    const __m256i x =
-        clamp_chroma_avx2(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(a + i)));
-    const __m256i y =
-        clamp_chroma_avx2(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(b + i)));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(v + i),
-                        _mm256_add_epi16(_mm256_add_epi16(x, _mm256_add_epi16(x, x)), y));
-    if (i == n - 16) break;
-  }
+  int i = 0;
+  for (; i + 16 <= n; i += 16) blend16_avx2(a + i, b + i, v + i);
+  if (i < n) blend16_avx2(a + n - 16, b + n - 16, v + n - 16);
 }
 
 // Horizontal 3:1 step of the 4:2:0 filter for 16 chroma samples at v (v[-1], v[16] valid):
@@ -701,6 +703,17 @@ VT_AVX2 VT_INLINE void upsample16_avx2(const int16_t* v, __m256i* A, __m256i* B)
   const __m256i odd = _mm256_srai_epi16(_mm256_add_epi16(c3, r), 4);
   *A = _mm256_unpacklo_epi16(even, odd);  // texels 0-7 | 16-23
   *B = _mm256_unpackhi_epi16(even, odd);  // texels 8-15 | 24-31
+}
+
+// Texels [2 * cx, 2 * cx + 32) of an output row from the blended chroma at vco, vcg (chroma
+// sample cx; one sample each side valid).
+template <int CH>
+VT_AVX2 VT_INLINE void ycocg420_step_avx2(const int16_t* vco, const int16_t* vcg, const int16_t* yr,
+                                          uint8_t* o, int cx) {
+  __m256i coA, coB, cgA, cgB;
+  upsample16_avx2(vco, &coA, &coB);
+  upsample16_avx2(vcg, &cgA, &cgB);
+  put32_avx2<CH>(yr + 2 * cx, coA, coB, cgA, cgB, o + size_t(2 * cx) * CH);
 }
 
 template <int CH>
@@ -718,14 +731,10 @@ VT_AVX2 void ycocg420_avx2(const int16_t* yp, int ystride, const int16_t* co, co
     vcg[0] = vcg[1], vcg[cw + 1] = vcg[cw];
     const int16_t* yr = yp + size_t(y) * ystride;
     uint8_t* o = texels + size_t(y) * width * CH;
-    for (int cx = 0;; cx += 16) {
-      if (cx > cw - 16) cx = cw - 16;  // the last step may overlap (same bytes again)
-      __m256i coA, coB, cgA, cgB;
-      upsample16_avx2(vco + 1 + cx, &coA, &coB);
-      upsample16_avx2(vcg + 1 + cx, &cgA, &cgB);
-      put32_avx2<CH>(yr + 2 * cx, coA, coB, cgA, cgB, o + size_t(2 * cx) * CH);
-      if (cx == cw - 16) break;
-    }
+    // Whole steps, then one ending at cw that overlaps the one before (the same bytes again).
+    int cx = 0;
+    for (; cx + 16 <= cw; cx += 16) ycocg420_step_avx2<CH>(vco + 1 + cx, vcg + 1 + cx, yr, o, cx);
+    if (cx < cw) ycocg420_step_avx2<CH>(vco + 1 + cw - 16, vcg + 1 + cw - 16, yr, o, cw - 16);
   }
 }
 
