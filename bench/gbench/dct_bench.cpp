@@ -598,12 +598,12 @@ std::vector<TranscodeSet> load_transcode_sets(const std::string& only, const std
 
 // `dct_bench --transcode ROUNDS [BASIS_BC1_DIR [SET]]`: per page set (Kodak fold 0, 288 pages:
 // the pages bench/transcode_vs_basis.sh gives Basis; the PBR colour maps; the PBR normal and ORM
-// maps, read as RGB), DCT decode, JPEG decode and DCT decode + BC1 real-time, passes alternating,
-// medians of thread CPU time over ROUNDS. Both codecs code the same RGB pages at about equal
-// PSNR: DCT q50 4:2:0 (tables trained on the other fold), JPEG q75 4:2:0. With BASIS_BC1_DIR
-// (kodimNN_unpacked_rgb_BC1_RGB_PPPP.png from `basisu -unpack`) also Basis's PSNR after BC1 on
-// the same Kodak pages. SET (part of a set's name) runs that set alone: see the note on
-// libjpeg-turbo's speed below.
+// maps, read as RGB; game textures, see load_transcode_sets), DCT decode, JPEG decode and DCT
+// decode + BC1 real-time, passes alternating, medians of thread CPU time over ROUNDS. Both codecs
+// code the same RGB pages at about equal PSNR: DCT q50 4:2:0 (tables trained on the other fold),
+// JPEG q75 4:2:0. With BASIS_BC1_DIR (kodimNN_unpacked_rgb_BC1_RGB_PPPP.png from `basisu -unpack`)
+// also Basis's PSNR after BC1 on the same Kodak pages. SET (part of a set's name) runs that set
+// alone: see the note on libjpeg-turbo's speed below.
 int transcode(int rounds, const std::string& basis_dir, const std::string& only) {
   std::vector<std::string> basis_files;
   const std::vector<TranscodeSet> sets = load_transcode_sets(only, basis_dir, &basis_files);
