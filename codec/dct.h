@@ -77,9 +77,9 @@ using DctTablesPtr = std::unique_ptr<DctTables, DctTablesDeleter>;
 // Builds tables for the settings. `training_pages` (optional, each width*height*channels
 // bytes) fits static token models to the content: pages decode fastest and smallest with them
 // (on photographs about 10% smaller than untrained tables, whose models adapt while a page is
-// decoded, at about 1.2x the entropy decoding time). The texels decoded are the same either
-// way. Width and height: multiples of 8 up to 4096; the YCoCg layouts need 3 or 4 channels.
-// Bad settings give kInvalidArgument.
+// decoded, at about 1.2x the entropy decoding time). The texels decoded differ only where the
+// encoder's rate estimates, taken from the models, tip a level. Width and height: multiples of 8 up
+// to 4096; the YCoCg layouts need 3 or 4 channels. Bad settings give kInvalidArgument.
 Expected<DctTablesPtr> dct_make_tables(
     const DctSettings& settings, int width, int height,
     std::span<const std::span<const uint8_t>> training_pages = {});
@@ -95,14 +95,19 @@ DctTablesShape dct_tables_shape(const DctTables& tables);
 
 // Encodes one page of width*height texels, `channels` interleaved 8-bit channels, row-major, in
 // page mode `mode` (which must apply: dct_mode_applies). Replaces the contents of `out`.
-// Deterministic: the same texels, tables and mode give the same bytes.
+// Below quality 100 the levels of ones are chosen by rate and distortion (fewer bytes and fewer
+// tokens to decode at equal error; about 1.3x the encoding time). Deterministic: the same texels,
+// tables and mode give the same bytes.
 Status dct_encode_page(const DctTables& tables, const uint8_t* texels, int width, int height,
                        std::vector<uint8_t>& out, DctPageMode mode = {});
 // Whether the tables code pages in `mode` (full chroma needs 4:2:0 tables).
 bool dct_mode_applies(const DctTables& tables, DctPageMode mode);
-// The luma DC quantiser step of mode {}: the scale of the tables' distortion, for rate-distortion
-// decisions.
+// The luma DC quantiser step of mode {}.
 int dct_base_step(const DctTables& tables);
+// What a bit is worth at the tables' quantiser (mode {}), in texel SSE summed over channels: the
+// slope of the layer's rate-distortion curve, for the encoder's decisions (the levels of each
+// page, format/dct_page_modes.h's choice of mode).
+double dct_layer_slope(const DctTables& tables);
 // The tables' version (3 or 4): version 3 tables code only mode {} and no lossless pages.
 int dct_tables_version(const DctTables& tables);
 // Decodes one page into `texels`, which must be exactly width * height * channels bytes for the

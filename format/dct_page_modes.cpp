@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <numbers>
 
 #include "format/zstd_frame.h"
 
@@ -11,18 +12,14 @@ namespace vt {
 namespace {
 
 // The distortion-rate slope at the page's own operating point: D(R) ~ 2^(-2R) at high rate, so
-// dSSE/dbit = 2 ln 2 * MSE of the default mode. Bounded below by the slope a uniform quantiser
-// of the tables' step would have (2 ln 2 * step^2 / 12), for pages the default mode codes
-// exactly. (The step alone underestimates it several times where 4:2:0 chroma dominates the
-// error: on photographs at quality 90 it chose lossless pages 5.7x larger.)
-constexpr double kTwoLn2 = 2.0 * 0.6931471805599453;
-// ... and bounded below by the layer's slope, the same for every page: a page's own MSE is small
-// where the page is smooth or mostly padding (the edge pages and coarse levels of an image), and
-// a lambda that small bought lossless or finer forms for them at a worse rate-distortion trade
-// than the rest of the layer (whole Kodak pyramids: +1.5% bytes at equal PSNR, q50-q95). The
-// default mode's curve on photographs (Kodak, all levels, chords between q50/75/90/95) has slopes
-// of about 62, 31, 7.8 and 3.5 SSE per bit at luma DC steps 12, 6, 2 and 1: about 5 * step.
-constexpr double kLayerSlopePerStep = 5.0;
+// dSSE/dbit = 2 ln 2 * MSE of the default mode; bounded below by the layer's slope, the same for
+// every page (dct_layer_slope). A page's own MSE is small where the page is smooth or mostly
+// padding (the edge pages and coarse levels of an image), and a lambda that small bought lossless
+// or finer forms for them at a worse rate-distortion trade than the rest of the layer (whole
+// Kodak pyramids: +1.5% bytes at equal PSNR, q50-q95); the step's uniform-quantiser slope alone
+// underestimates it several times where 4:2:0 chroma dominates the error (on photographs at
+// quality 90 it chose lossless pages 5.7x larger).
+constexpr double kTwoLn2 = 2.0 * std::numbers::ln2;
 // Only pages whose lossless form is within this factor of their default DCT form (content that is
 // not a photograph) or that miss the floor try the other DCT modes: photographs keep their
 // encoding time and bytes.
@@ -71,9 +68,8 @@ Expected<uint8_t> dct_encode_page_modes(const DctTables& tables, const uint8_t* 
     if (decoded) std::memcpy(decoded, best.decoded.data(), n);
     return uint8_t(0);
   }
-  const double step = dct_base_step(tables);
-  const double lambda = std::max(
-      {kTwoLn2 * step * step / 12.0, kLayerSlopePerStep * step, kTwoLn2 * best.sse / double(n)});
+  const int step = dct_base_step(tables);
+  const double lambda = std::max(dct_layer_slope(tables), kTwoLn2 * best.sse / double(n));
   auto cost = [&](const Candidate& c) { return c.sse + lambda * 8.0 * double(c.bytes.size()); };
   auto meets_floor = [&](const Candidate& c) {
     return settings.min_psnr <= 0 || psnr_of(c.sse, n) >= settings.min_psnr;
@@ -87,7 +83,7 @@ Expected<uint8_t> dct_encode_page_modes(const DctTables& tables, const uint8_t* 
   if (!base_ok || double(best.bytes.size()) * kHardContentRatio >= double(lossless_size)) {
     for (int finer = 0; finer <= kDctMaxFiner; ++finer) {
       // A finer step than 1 is the same quantiser again.
-      if (finer > 0 && (int(step) >> (finer - 1)) <= 1) break;
+      if (finer > 0 && (step >> (finer - 1)) <= 1) break;
       for (int full = 0; full < 2; ++full) {
         const DctPageMode mode{full == 1, uint8_t(finer)};
         if ((finer == 0 && !full) || !dct_mode_applies(tables, mode)) continue;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <numbers>
 #include <vector>
 
 #include "codec/dct.h"
@@ -149,10 +150,10 @@ struct Bound {
   double chroma420_db;
 };
 const Bound kBounds[] = {
-    {Pattern::kGradient, 25, 38.0, 37.5}, {Pattern::kGradient, 75, 48.5, 48.0},
-    {Pattern::kGradient, 95, 54.5, 54.0}, {Pattern::kNoise, 25, 20.5, 17.3},
+    {Pattern::kGradient, 25, 36.7, 36.8}, {Pattern::kGradient, 75, 48.5, 48.0},
+    {Pattern::kGradient, 95, 54.5, 54.0}, {Pattern::kNoise, 25, 19.8, 17.2},
     {Pattern::kNoise, 75, 32.0, 18.5},    {Pattern::kNoise, 95, 45.5, 18.6},
-    {Pattern::kEdges, 25, 29.5, 20.3},    {Pattern::kEdges, 75, 40.5, 20.7},
+    {Pattern::kEdges, 25, 28.4, 20.3},    {Pattern::kEdges, 75, 40.5, 20.7},
     {Pattern::kEdges, 95, 55.0, 20.7},    {Pattern::kText, 25, 24.9, 24.8},
     {Pattern::kText, 75, 35.4, 32.8},     {Pattern::kText, 95, 47.8, 35.4},
     {Pattern::kMixed, 25, 29.1, 24.5},    {Pattern::kMixed, 75, 37.5, 25.9},
@@ -307,15 +308,40 @@ TEST(Dct, DecodedTexelsArePinned) {
   // check the decoded PSNR is sane and update both numbers.
   uint64_t hc = 1469598103934665603ull;
   for (uint8_t v : data) hc = (hc ^ v) * 1099511628211ull;
-  EXPECT_EQ(hc, 1008099265690154706ull);
+  EXPECT_EQ(hc, 15488033857020092065ull);
   EXPECT_GT(dct_test::psnr(page, decoded), 25.0);  // 4:2:0 on colour noise: ~27.3 dB
   uint64_t h = 1469598103934665603ull;
   for (uint8_t v : decoded) h = (h ^ v) * 1099511628211ull;
-  EXPECT_EQ(h, 12700418807988317610ull);
+  EXPECT_EQ(h, 17576140493363672463ull);
   // The pinned output must exercise real arithmetic, not only clamping.
   std::vector<int> histogram(256, 0);
   for (uint8_t v : decoded) histogram[v]++;
   EXPECT_GT(std::count_if(histogram.begin(), histogram.end(), [](int c) { return c > 0; }), 100);
+}
+
+// The encoder chooses each block's levels by rate and distortion: a lone small coefficient at the
+// end of a block costs a pair token for every pair up to it, more than its error is worth, and is
+// dropped although the deadzone quantiser alone would keep it.
+TEST(Dct, RateDistortionLevelsDropALoneCostlyCoefficient) {
+  auto t = tables_for(50, {1, DctPlaneLayout::kPlanes}, 64, 64);
+  // The step of the (7, 7) coefficient, the last in zigzag order, from the serialised tables:
+  // plane 0's steps (natural order) follow the 13-byte header.
+  const int step = dct_serialize_tables(*t)[13 + 63];
+  // A flat page with, in one block, the (7, 7) basis function at 0.75 steps: the deadzone
+  // rounding (+0.36) makes it a level of 1.
+  std::vector<uint8_t> page(64 * 64, 128);
+  for (int y = 0; y < 8; y++) {
+    for (int x = 0; x < 8; x++) {
+      const double b = 0.25 * std::cos((2 * x + 1) * 7 * std::numbers::pi / 16) *
+                       std::cos((2 * y + 1) * 7 * std::numbers::pi / 16);
+      page[size_t(16 + y) * 64 + 24 + x] = uint8_t(std::lround(128 + 0.75 * step * b));
+    }
+  }
+  std::vector<uint8_t> coded, decoded(page.size());
+  ASSERT_TRUE(dct_encode_page(*t, page.data(), 64, 64, coded).ok());
+  ASSERT_TRUE(dct_decode_page(*t, coded, 64, 64, decoded.data()).ok());
+  EXPECT_NE(page, std::vector<uint8_t>(page.size(), 128));
+  EXPECT_EQ(decoded, std::vector<uint8_t>(page.size(), 128)) << "the lone level is dropped";
 }
 
 TEST(Dct, TrainedTablesCodeSimilarPagesSmaller) {
@@ -331,7 +357,9 @@ TEST(Dct, TrainedTablesCodeSimilarPagesSmaller) {
   const RoundTrip a = round_trip(*trained, page, 128, 128);
   const RoundTrip b = round_trip(*plain, page, 128, 128);
   EXPECT_LT(a.bytes, b.bytes);
-  EXPECT_DOUBLE_EQ(a.psnr, b.psnr);  // training changes the entropy coding only
+  // Training changes the entropy coding, and the levels only through the rate estimates the
+  // encoder's rate-distortion pass takes from the models.
+  EXPECT_NEAR(a.psnr, b.psnr, 0.05);
 }
 
 TEST(Dct, AdaptiveModelsOnTrainedTablesChangeOnlyTheBytes) {
