@@ -688,14 +688,14 @@ void rdo_plane(const float* bits, double lambda, const uint8_t* quant, int bw, i
         uint16_t pair_ctx[kPairs], esc_ctx[kPairs];
         for (int j = 0; j < pairs; j += 4)
           pair_contexts(n.left, n.up, j, 1, pair_ctx + j, esc_ctx + j);
-        // Per pair: its token and nonzeros; the offset of its models in pair_bits.
-        uint8_t token[kPairs], pair_nz[kPairs];
+        // Per pair: its nonzeros, and its token's offset in pair_bits under its neighbour
+        // contexts (the nonzeros-left term is added as a walk goes).
+        uint8_t pair_nz[kPairs];
         uint16_t offset[kPairs];
         for (int j = 0, k = 1; j < pairs; j++, k += 2) {
           const int v1 = k < 63 ? z[k + 1] : 0;
-          token[j] = uint8_t(pair_class(z[k]) + 4 * pair_class(v1));
           pair_nz[j] = uint8_t((z[k] != 0) + (v1 != 0));
-          offset[j] = uint16_t(pair_ctx[j] * kTokens + token[j]);
+          offset[j] = uint16_t(pair_ctx[j] * kTokens + pair_class(z[k]) + 4 * pair_class(v1));
         }
         const float* pb = pair_bits.data();
         const float* nz_bits = bits + (kNzHist + n.nz_ctx) * kTokens;
@@ -711,12 +711,12 @@ void rdo_plane(const float* bits, double lambda, const uint8_t* quant, int bw, i
           }
           return lam * total;
         };
-        // Position k's one becomes zero in the pair tables.
-        auto drop = [&](int k) {
-          const int j = (k - 1) >> 1, d = k & 1 ? 1 : 4;
-          token[j] = uint8_t(token[j] - d);
-          offset[j] = uint16_t(offset[j] - d);
-          pair_nz[j]--;
+        // Position k's one becomes zero (dir -1) or comes back (+1) in the pair tables: its
+        // class is bit 0 of the token for the pair's first position, bit 2 for its second.
+        auto toggle = [&](int k, int dir) {
+          const int j = (k - 1) >> 1;
+          offset[j] = uint16_t(offset[j] + dir * (k & 1 ? 1 : 4));
+          pair_nz[j] = uint8_t(pair_nz[j] + dir);
         };
         // SSE added by a one becoming zero: s^2 (|x|^2 - (|x| - 1)^2) = s^2 (2 |x| - 1).
         auto added = [&](int k) {
@@ -741,7 +741,7 @@ void rdo_plane(const float* bits, double lambda, const uint8_t* quant, int bw, i
         }
         for (uint64_t gone = nonzero & ~best_nonzero; gone != 0; gone &= gone - 1) {
           const int k = std::countr_zero(gone);
-          drop(k);
+          toggle(k, -1);
           z[k] = 0;
         }
         nonzero = best_nonzero;
@@ -754,17 +754,14 @@ void rdo_plane(const float* bits, double lambda, const uint8_t* quant, int bw, i
           const float cost = added(k);
           if (cost >= lam * kRdoMaxSavedBits) continue;
           const uint64_t trial = nonzero & ~(uint64_t(1) << k);
-          drop(k);
+          toggle(k, -1);
           const float r = rate(trial);
           if (cost + r < current) {
             current = r;
             nonzero = trial;
             z[k] = 0;
           } else {
-            const int j = (k - 1) >> 1, d = k & 1 ? 1 : 4;  // undo drop(k)
-            token[j] = uint8_t(token[j] + d);
-            offset[j] = uint16_t(offset[j] + d);
-            pair_nz[j]++;
+            toggle(k, +1);
           }
         }
       }
@@ -798,10 +795,21 @@ double rdo_lambda(const DctSettings& s, int step, int p) {
   return kRdoSlopeScale * 2.0 * std::numbers::ln2 * step * step / 12.0 * luma_weight / weight;
 }
 
-// Quality 100 keeps every level the deadzone quantiser gives: the pass would trade error for
-// bytes (on smooth content up to 4.5 dB for half the bytes), and q100 asks for the least error.
-bool uses_rdo(const DctSettings& s) {
-  return s.quality < 100;
+// Plane p's levels as the encoder codes them, zigzag order: quantised, then, with `bits` (the
+// plane's token costs) and below quality 100, through the rate-distortion pass. Quality 100 keeps
+// every level the deadzone quantiser gives: the pass would trade error for bytes (on smooth
+// content up to 4.5 dB for half the bytes), and q100 asks for the least error.
+void plane_levels(const DctSettings& s, const FloatPlane& fp, int p, int luma_step,
+                  const uint8_t* quant, const float* bits, int16_t* coefs, BlockInfo* info) {
+  if (!bits || s.quality == 100) {
+    quantize_plane(fp, quant, coefs);
+    return;
+  }
+  thread_local std::vector<float> scaled;  // per thread: no allocation per page
+  scaled.resize(size_t(fp.dims.bw) * fp.dims.bh * 64);
+  quantize_plane(fp, quant, coefs, scaled.data());
+  rdo_plane(bits, rdo_lambda(s, luma_step, p), quant, fp.dims.bw, fp.dims.bh, scaled.data(), coefs,
+            info);
 }
 
 // ---- tables: static token frequencies ----
@@ -949,20 +957,14 @@ void count_tokens(const DctSettings& s, const uint8_t* const quant[4], const uin
   FloatPlane planes[4];
   build_planes(s, texels, width, height, planes);
   std::vector<int16_t> coefs;
-  std::vector<float> scaled;
   std::vector<BlockInfo> info;
   for (int p = 0; p < plane_count(s); p++) {
     const PlaneDims& d = planes[p].dims;
     coefs.assign(size_t(d.bw) * d.bh * 64, 0);
     info.assign(size_t(d.bw) * d.bh, BlockInfo{});
-    if (bits && uses_rdo(s)) {
-      scaled.resize(coefs.size());
-      quantize_plane(planes[p], quant[p], coefs.data(), scaled.data());
-      rdo_plane(bits + size_t(p) * kHistPerPlane * kTokens, rdo_lambda(s, quant[0][0], p), quant[p],
-                d.bw, d.bh, scaled.data(), coefs.data(), info.data());
-    } else {
-      quantize_plane(planes[p], quant[p], coefs.data());
-    }
+    plane_levels(s, planes[p], p, quant[0][0], quant[p],
+                 bits ? bits + size_t(p) * kHistPerPlane * kTokens : nullptr, coefs.data(),
+                 info.data());
     TokenCounter counter(counts.data() + size_t(p) * kHistPerPlane);
     code_plane(counter, nullptr, d.bw, d.bh, coefs.data(), info.data());
   }
@@ -1236,19 +1238,12 @@ void encode_tokens(const DctTables& t, const FloatPlane* planes, std::vector<uin
   thread_local std::vector<TokenModel> models;
   thread_local std::vector<int16_t> coefs;   // every element written by quantize_plane
   thread_local std::vector<BlockInfo> info;  // and by code_plane before it is read
-  thread_local std::vector<float> scaled;
   for (int p = 0; p < plane_count(t.settings); p++) {
     const PlaneDims& d = planes[p].dims;
     coefs.resize(size_t(d.bw) * d.bh * 64);
     info.resize(size_t(d.bw) * d.bh);
-    if (uses_rdo(t.settings)) {
-      scaled.resize(coefs.size());
-      quantize_plane(planes[p], t.quant[p], coefs.data(), scaled.data());
-      rdo_plane(t.token_bits[p].data(), rdo_lambda(t.settings, t.quant[0][0], p), t.quant[p], d.bw,
-                d.bh, scaled.data(), coefs.data(), info.data());
-    } else {
-      quantize_plane(planes[p], t.quant[p], coefs.data());
-    }
+    plane_levels(t.settings, planes[p], p, t.quant[0][0], t.quant[p], t.token_bits[p].data(),
+                 coefs.data(), info.data());
     code_plane(enc, plane_models<kAdaptive>(t, p, models), d.bw, d.bh, coefs.data(), info.data());
   }
   std::vector<uint8_t> rans;
