@@ -596,8 +596,29 @@ void quantize_plane(const FloatPlane& fp, const uint8_t* quant, int16_t* coefs,
 
 // ---- rate-distortion optimised quantisation ----
 
-// Bits a token costs in each model, -log2 of its probability: the encoder's rate estimate (exact
-// for static models, the starting point for adaptive ones).
+// The price of a token in bits, beside its own: the decoder's time goes by tokens, so the pass
+// also ends blocks earlier where that costs little. And the pass's lambda over the uniform
+// quantiser's slope (rdo_lambda). Chosen at equal PSNR on photographs (Kodak q50, trained tables,
+// docs/BENCHMARKS.md "Rate-distortion optimised levels"): 1.4% fewer bytes and 7% fewer decode
+// instructions a page than the deadzone levels alone; with no token price, 2% and 6%.
+constexpr float kRdoTokenBits = 2.0f;
+constexpr double kRdoSlopeScale = 1.25;
+
+// The rate-distortion pass's costs of one plane's tokens (kHistPerPlane * kTokens, from each
+// token's -log2 probability), pair tokens with their sign bits and the price of their tokens
+// (kRdoTokenBits each, escapes included) added, so that the pass prices a pair with one lookup.
+void price_pair_tokens(float* bits) {
+  for (int i = kPairHist; i < kEscHist; i++) {
+    for (int t = 0; t < kTokens; t++) {
+      const PairToken& e = kBuckets.pair_token[t];
+      bits[size_t(i) * kTokens + size_t(t)] +=
+          float(e.nonzeros) + kRdoTokenBits * float(1 + std::popcount(unsigned(e.escapes)));
+    }
+  }
+}
+
+// The pass's token costs from a plane's models: exact for static models, the starting point for
+// adaptive ones.
 std::vector<float> token_bits(const std::vector<TokenModel>& models) {
   std::vector<float> bits(models.size() * kTokens);
   for (size_t i = 0; i < models.size(); i++) {
@@ -606,6 +627,7 @@ std::vector<float> token_bits(const std::vector<TokenModel>& models) {
       bits[i * kTokens + size_t(t)] = float(dct_detail::kFreqBits - std::log2(double(f)));
     }
   }
+  price_pair_tokens(bits.data());
   return bits;
 }
 
@@ -641,14 +663,6 @@ inline uint64_t ac_masks(const int16_t* z, uint64_t* ones) {
   return nonzero & ~uint64_t(1);
 }
 
-// The price of a token in bits, beside its own: the decoder's time goes by tokens, so the pass
-// also ends blocks earlier where that costs little. And the pass's lambda over the uniform
-// quantiser's slope (rdo_lambda). Chosen at equal PSNR on photographs (Kodak q50, trained tables,
-// docs/BENCHMARKS.md "Rate-distortion optimised levels"): 1.4% fewer bytes and 7% fewer decode
-// instructions a page than the deadzone levels alone; with no token price, 2% and 6%.
-constexpr float kRdoTokenBits = 2.0f;
-constexpr double kRdoSlopeScale = 1.25;
-
 // Bits a one in the middle of a block can save at most: its sign bit and a change of its pair
 // token's class. Ones whose added error is dearer are not tried.
 constexpr float kRdoMaxSavedBits = 6.0f;
@@ -660,20 +674,11 @@ constexpr float kRdoMaxSavedBits = 6.0f;
 // pair up to them), then each remaining one, last first, where that lowers J. DC levels are kept.
 // The rate is code_plane's: the count token, and each pair token with its sign bits under its
 // contexts (nonzeros left included); escapes are left out, as dropping a one never changes them.
-// `scaled`: the coefficients over their steps (quantize_plane); `lambda`: coefficient SSE per bit.
+// `bits`: the plane's token costs (token_bits); `scaled`: the coefficients over their steps
+// (quantize_plane); `lambda`: coefficient SSE per bit.
 void rdo_plane(const float* bits, double lambda, const uint8_t* quant, int bw, int bh,
                const float* scaled, int16_t* coefs, BlockInfo* info) {
   const float lam = float(lambda);
-  // Pair token bits with the sign bits and the price of its tokens added: one lookup a pair.
-  thread_local std::vector<float> pair_bits;
-  pair_bits.assign(bits, bits + kHistPerPlane * kTokens);
-  for (int i = kPairHist; i < kEscHist; i++) {
-    for (int t = 0; t < kTokens; t++) {
-      const PairToken& e = kBuckets.pair_token[t];
-      pair_bits[size_t(i) * kTokens + size_t(t)] +=
-          float(e.nonzeros) + kRdoTokenBits * float(1 + std::popcount(unsigned(e.escapes)));
-    }
-  }
   for (int by = 0; by < bh; by++) {
     for (int bx = 0; bx < bw; bx++) {
       const int index = by * bw + bx;
@@ -688,7 +693,7 @@ void rdo_plane(const float* bits, double lambda, const uint8_t* quant, int bw, i
         uint16_t pair_ctx[kPairs], esc_ctx[kPairs];
         for (int j = 0; j < pairs; j += 4)
           pair_contexts(n.left, n.up, j, 1, pair_ctx + j, esc_ctx + j);
-        // Per pair: its nonzeros, and its token's offset in pair_bits under its neighbour
+        // Per pair: its nonzeros, and its token's offset in `bits` under its neighbour
         // contexts (the nonzeros-left term is added as a walk goes).
         uint8_t pair_nz[kPairs];
         uint16_t offset[kPairs];
@@ -697,7 +702,6 @@ void rdo_plane(const float* bits, double lambda, const uint8_t* quant, int bw, i
           pair_nz[j] = uint8_t((z[k] != 0) + (v1 != 0));
           offset[j] = uint16_t(pair_ctx[j] * kTokens + pair_class(z[k]) + 4 * pair_class(v1));
         }
-        const float* pb = pair_bits.data();
         const float* nz_bits = bits + (kNzHist + n.nz_ctx) * kTokens;
         auto rate = [&](uint64_t nonzeros) {
           const int count = std::popcount(nonzeros);
@@ -705,7 +709,7 @@ void rdo_plane(const float* bits, double lambda, const uint8_t* quant, int bw, i
           const int t = uint_token(unsigned(count));
           float total = nz_bits[t] + float(kUintExtra[t]);
           for (int j = 0, rem1 = count, rem2 = count; j < end; j++) {
-            total += pb[offset[j] + kBuckets.rem[rem2] * kTokens];
+            total += bits[offset[j] + kBuckets.rem[rem2] * kTokens];
             rem2 = rem1;
             rem1 -= pair_nz[j];
           }
@@ -771,12 +775,17 @@ void rdo_plane(const float* bits, double lambda, const uint8_t* quant, int bw, i
   }
 }
 
+// The distortion-rate slope of a uniform quantiser of step `step`, SSE per bit: 2 ln 2 step^2 / 12.
+double uniform_quantiser_slope(int step) {
+  return 2.0 * std::numbers::ln2 * step * step / 12.0;
+}
+
 // The layer's rate-distortion slope, texel SSE (summed over channels) per bit, at luma DC step
 // `step`: the default mode's curve on photographs (Kodak, all levels, chords between q50/75/90/95)
 // has slopes of about 62, 31, 7.8 and 3.5 SSE per bit at steps 12, 6, 2 and 1, about 5 * step;
 // bounded below by the slope of a uniform quantiser of that step, 2 ln 2 * step^2 / 12.
 double layer_slope(int step) {
-  return std::max(2.0 * std::numbers::ln2 * step * step / 12.0, 5.0 * step);
+  return std::max(uniform_quantiser_slope(step), 5.0 * step);
 }
 
 // The rate-distortion pass's lambda for plane p, coefficient SSE per bit: a uniform quantiser's
@@ -792,7 +801,7 @@ double rdo_lambda(const DctSettings& s, int step, int p) {
     weight = p == 1 ? 2 : 3;
     if (plane_is_half(s, p)) weight *= 4;
   }
-  return kRdoSlopeScale * 2.0 * std::numbers::ln2 * step * step / 12.0 * luma_weight / weight;
+  return kRdoSlopeScale * uniform_quantiser_slope(step) * luma_weight / weight;
 }
 
 // Plane p's levels as the encoder codes them, zigzag order: quantised, then, with `bits` (the
@@ -1324,6 +1333,8 @@ Expected<DctTablesPtr> dct_make_tables(const DctSettings& settings, int width, i
   for (size_t i = 0; i < prior.size(); i++)
     for (int tk = 0; tk < kTokens; tk++)
       prior_bits[i * kTokens + size_t(tk)] = float(-std::log2(prior[i][size_t(tk)]));
+  for (int p = 0; p < n; p++)
+    price_pair_tokens(prior_bits.data() + size_t(p) * kHistPerPlane * kTokens);
   bool trained = false;
   for (size_t i = 0; i < training_pages.size(); i++) {
     if (training_pages[i].size() != page_bytes) {

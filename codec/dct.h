@@ -96,8 +96,8 @@ DctTablesShape dct_tables_shape(const DctTables& tables);
 // Encodes one page of width*height texels, `channels` interleaved 8-bit channels, row-major, in
 // page mode `mode` (which must apply: dct_mode_applies). Replaces the contents of `out`.
 // Below quality 100 the levels of ones are chosen by rate and distortion (fewer bytes and fewer
-// tokens to decode at equal error; about 1.5x a page's encoding time). Deterministic: the same texels,
-// tables and mode give the same bytes.
+// tokens to decode at equal error; about 1.5x a page's encoding time). Deterministic: the same
+// texels, tables and mode give the same bytes.
 Status dct_encode_page(const DctTables& tables, const uint8_t* texels, int width, int height,
                        std::vector<uint8_t>& out, DctPageMode mode = {});
 // Whether the tables code pages in `mode` (full chroma needs 4:2:0 tables).
