@@ -404,6 +404,8 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
       {"unwrap_method", options.unwrap.method == unwrap::Method::kArap ? "arap" : "lscm"},
       {"padding", options.unwrap.padding},
   };
+  // Slots baked from their factor alone: the validator's reference draws them so too.
+  if (!summary.missing_textures.empty()) meta["missing_textures"] = "warn";
   // Only a lit bake says how it was lit: the metadata of light-less bakes stays as it was.
   if (scene_has_lights(input)) {
     meta["lighting"] = {{"lights", input.placed_lights().size()},

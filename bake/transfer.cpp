@@ -39,6 +39,7 @@ namespace {
 constexpr uint32_t kBandRows = 16;
 constexpr float kOpaque = 1.0f - 0.5f / 255.0f;  // alpha at or above this is stored as opaque
 
+using scene::material_label;
 using scene::Vec2;
 using scene::Vec3;
 using scene::Vec4;
@@ -311,18 +312,6 @@ bool material_has_orm(const scene::Material& m) {
 bool material_has_emissive(const scene::Material& m) {
   return m.emissive_strength > 0 && (m.emissive_texture.valid() || m.emissive_factor[0] > 0 ||
                                      m.emissive_factor[1] > 0 || m.emissive_factor[2] > 0);
-}
-
-std::string material_label(const std::string& name, int64_t index) {
-  if (!name.empty()) return "material '" + name + "'";
-  if (index < 0) return "the default material";
-  return "material " + std::to_string(index) + " (unnamed)";
-}
-std::string material_label(const scene::Scene& scene, const scene::Material& m) {
-  const scene::Material* first = scene.materials.data();
-  const bool listed =
-      !std::less<>()(&m, first) && std::less<>()(&m, first + scene.materials.size());
-  return material_label(m.name, listed ? &m - first : -1);
 }
 
 // The materials that primitives with triangles use, in scene order.
@@ -616,8 +605,10 @@ Status Transfer::check_missing_textures() {
       if (img.embedded()) miss.image += " (embedded)";
       miss.path = images_[r.image].tried;
       miss.reason = images_[r.image].error;
-      if (opt_.missing_textures == MissingTextures::kError)
-        return Error(ErrorCode::kNotFound, miss.message());
+      if (opt_.missing_textures == MissingTextures::kError) {
+        return Error(ErrorCode::kNotFound,
+                     miss.message() + " (--missing-textures warn bakes the slot from its factor)");
+      }
       missing_.push_back(std::move(miss));
     }
   }

@@ -35,6 +35,7 @@ struct BakeSettings {
   int supersample = 1;
   MipFilter filter = MipFilter::kKaiser;
   LightingOptions lighting;  // a lit bake's AO (the lights are the original scene's)
+  MissingTextures missing_textures = MissingTextures::kError;
 };
 
 Expected<BakeSettings> bake_settings(const PageFileReader& reader) {
@@ -49,10 +50,17 @@ Expected<BakeSettings> bake_settings(const PageFileReader& reader) {
   const std::string filter = build.is_object() ? build.value("filter", "kaiser") : "kaiser";
   VT_ASSIGN_OR_RETURN(s.filter, parse_mip_filter(filter.c_str()));
   s.lighting = baked_lighting_options(reader);
+  s.missing_textures = baked_missing_textures(reader);
   return s;
 }
 
 }  // namespace
+
+MissingTextures baked_missing_textures(const PageFileReader& reader) {
+  const nlohmann::json meta = nlohmann::json::parse(reader.metadata_json(), nullptr, false);
+  return meta.is_object() && meta.value("missing_textures", "") == "warn" ? MissingTextures::kWarn
+                                                                          : MissingTextures::kError;
+}
 
 LightingOptions baked_lighting_options(const PageFileReader& reader) {
   LightingOptions o;
@@ -604,6 +612,7 @@ Expected<AtlasCheckReport> check_atlas_pages(std::shared_ptr<const PageFileReade
   to.lighting = settings.lighting;
   to.threads = o.threads;
   to.scratch_dir = o.scratch_dir;
+  to.missing_textures = settings.missing_textures;
   auto transfer = transfer_materials(scene, to);
   if (!transfer.ok()) return transfer.status().with_context("atlas check: transfer");
   report.transfer_seconds = seconds_since(t0);

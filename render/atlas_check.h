@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "bake/lighting.h"
+#include "bake/transfer.h"
 #include "common/status.h"
 #include "format/page_file.h"
 #include "scene/scene.h"
@@ -121,6 +122,9 @@ Status uploaded_texels(const PageSource& source, const LayerSpec& spec, const Pa
 // shadows on, whatever the bake used: the references always cast them). Defaults for a file
 // without.
 LightingOptions baked_lighting_options(const PageFileReader& reader);
+// kWarn when the bake drew some texture slot from its factor alone (`--missing-textures warn`
+// and an image it could not read), so that the references do the same; else kError.
+MissingTextures baked_missing_textures(const PageFileReader& reader);
 
 // The report as report.json's "atlas" object (docs/JSON.md).
 nlohmann::json to_json(const AtlasCheckReport& report);

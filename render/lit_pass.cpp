@@ -46,23 +46,29 @@ ReferenceTexture constant_texture(uint8_t r, uint8_t g, uint8_t b) {
   return make_texture({r, g, b, 255}, 1, 1, nullptr, 1);
 }
 
-// Loads each image once, on first use.
+// Loads each image once, on first use. An image that cannot be read is an error, or with
+// `missing_as_factor` no image (the slot's factor alone), its error kept in `missing`.
 class ImageCache {
  public:
-  explicit ImageCache(const scene::Scene& s) : scene_(s), images_(s.images.size()) {}
+  ImageCache(const scene::Scene& s, bool missing_as_factor)
+      : scene_(s), images_(s.images.size()), missing_as_factor_(missing_as_factor) {}
   // Null for a texture reference without an image.
   Expected<const scene::FloatImage*> get(const scene::TextureRef& t) {
     if (!t.valid() || size_t(t.image) >= images_.size()) return nullptr;
     if (!images_[t.image]) {
-      VT_ASSIGN_OR_RETURN(scene::FloatImage img, scene::load_float_image(scene_.images[t.image]));
-      images_[t.image] = std::move(img);
+      auto img = scene::load_float_image(scene_.images[t.image]);
+      if (!img.ok() && !missing_as_factor_) return img.status();
+      if (!img.ok()) missing.push_back(img.status().message());
+      images_[t.image] = img.ok() ? std::move(*img) : scene::FloatImage{};
     }
-    return &*images_[t.image];
+    return images_[t.image]->rgba.empty() ? nullptr : &*images_[t.image];
   }
+  std::vector<std::string> missing;  // errors of the images read as missing, in order
 
  private:
   const scene::Scene& scene_;
   std::vector<std::optional<scene::FloatImage>> images_;
+  bool missing_as_factor_;
 };
 
 // ORM as the bake's transfer computes it, each factor applied per texel (filtering commutes with
@@ -214,19 +220,22 @@ LitFrameOptions lit_frame_for(const Camera& camera, uint32_t inputs) {
   return o;
 }
 
-Expected<std::vector<LitMaterial>> lit_materials(const scene::Scene& s, uint32_t max_side) {
-  ImageCache images(s);
+Expected<std::vector<LitMaterial>> lit_materials(const scene::Scene& s,
+                                                 const ReferenceDrawOptions& options,
+                                                 std::vector<std::string>* missing) {
+  ImageCache images(s, options.missing_as_factor);
   std::vector<LitMaterial> out;
   for (size_t mi = 0; mi <= s.materials.size(); ++mi) {
     const scene::Material m = mi < s.materials.size() ? s.materials[mi] : scene::Material{};
-    auto lm = lit_material(m, images, max_side);
+    auto lm = lit_material(m, images, options.max_texture_side);
     if (!lm.ok()) {
       return lm.status().with_context(
           s.source_path + ": " +
-          (m.name.empty() ? "material " + std::to_string(mi) : "material '" + m.name + "'"));
+          scene::material_label(m.name, mi < s.materials.size() ? int64_t(mi) : -1));
     }
     out.push_back(std::move(*lm));
   }
+  if (missing) *missing = std::move(images.missing);
   return out;
 }
 

@@ -47,10 +47,12 @@ Expected<LitLayers> find_lit_layers(std::span<const LayerSpec> layers,
 LitFrameOptions lit_frame_for(const Camera& camera, uint32_t inputs);
 
 // One LitMaterial per material and one for the default material (last), in the order of
-// reference_scene_draws' textures. Textures larger than `max_texture_side` are box-reduced.
-// Errors name the image that cannot be read.
+// reference_scene_draws' textures, under the same options (texture size; an image that cannot be
+// read is an error naming the material and the image, or the slot's factor alone, listed in
+// `missing`).
 Expected<std::vector<LitMaterial>> lit_materials(const scene::Scene& scene,
-                                                 uint32_t max_texture_side = 4096);
+                                                 const ReferenceDrawOptions& options = {},
+                                                 std::vector<std::string>* missing = nullptr);
 
 // Fills the vertex normals and tangents of `draws` (made by reference_scene_draws or
 // virtual_scene_draws from `scene`, same order) in world space: the primitive's own, else

@@ -147,7 +147,8 @@ void apply_base_color(const scene::Material& m, std::vector<uint8_t>& texels) {
 
 }  // namespace
 
-Expected<SceneDraws> reference_scene_draws(const scene::Scene& s, uint32_t max_side) {
+Expected<SceneDraws> reference_scene_draws(const scene::Scene& s,
+                                           const ReferenceDrawOptions& options) {
   VT_ASSIGN_OR_RETURN(
       SceneDraws out,
       draws(
@@ -165,22 +166,34 @@ Expected<SceneDraws> reference_scene_draws(const scene::Scene& s, uint32_t max_s
             return UvSource{uvs, &t};
           },
           true));
-  // One texture per material plus the default material's.
+  // One texture per material plus the default material's; only the drawn ones read an image.
+  std::vector<bool> drawn(s.materials.size() + 1, false);
+  for (const MeshData& mesh : out.meshes) drawn[mesh.reference_texture] = true;
   for (size_t mi = 0; mi <= s.materials.size(); ++mi) {
     ReferenceTexture tex;
     std::vector<uint8_t> texels = {255, 255, 255, 255};
     tex.width = tex.height = 1;
     const scene::Material m = mi < s.materials.size() ? s.materials[mi] : scene::Material{};
     const scene::TextureRef& t = m.base_color_texture;
-    if (t.valid() && size_t(t.image) < s.images.size()) {
-      VT_ASSIGN_OR_RETURN(texels, load_rgba8(s.images[t.image], &tex.width, &tex.height));
-      tex.sampler = TextureSampler{t.wrap_s, t.wrap_t, t.mag_filter};
+    if (drawn[mi] && t.valid() && size_t(t.image) < s.images.size()) {
+      uint32_t width = 0, height = 0;
+      auto image = load_rgba8(s.images[t.image], &width, &height);
+      if (image.ok()) {
+        texels = std::move(*image);
+        tex.width = width, tex.height = height;
+        tex.sampler = TextureSampler{t.wrap_s, t.wrap_t, t.mag_filter};
+      } else {
+        const std::string what = scene::material_label(s.materials[mi].name, int64_t(mi)) +
+                                 " baseColorTexture: " + image.status().message();
+        if (!options.missing_as_factor) return Error(image.status().code(), what);
+        out.missing_textures.push_back(what + " (drawn from its factor, as the bake did)");
+      }
     }
     apply_base_color(m, texels);
     tex.levels = box_mip_chain(texels.data(), tex.width, tex.height);
     // Too large for the device or memory: drop the finest levels.
     uint32_t drop = 0;
-    while (std::max(tex.width >> drop, tex.height >> drop) > max_side) ++drop;
+    while (std::max(tex.width >> drop, tex.height >> drop) > options.max_texture_side) ++drop;
     if (drop > 0) {
       tex.levels.erase(tex.levels.begin(), tex.levels.begin() + drop);
       tex.width = std::max(1u, tex.width >> drop);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "common/status.h"
@@ -17,6 +18,16 @@ struct SceneDraws {
   std::vector<MeshData> meshes;
   std::vector<ReferenceTexture> textures;  // reference draws only
   Vec3f bounds_min, bounds_max;            // world space; min > max when there is no geometry
+  // Reference draws: base colour images that could not be read, drawn from their material's
+  // factor (ReferenceDrawOptions::missing_as_factor), one line each.
+  std::vector<std::string> missing_textures;
+};
+
+struct ReferenceDrawOptions {
+  uint32_t max_texture_side = 4096;  // larger images are box-reduced to fit
+  // A base colour image that cannot be read: the material's factor alone, as `vtbake bake
+  // --missing-textures warn` baked it, listed in SceneDraws::missing_textures; false: an error.
+  bool missing_as_factor = false;
 };
 
 // The unwrapped scene for the virtual-texture pass: every primitive with its UV set `uv_set`
@@ -29,10 +40,11 @@ Expected<SceneDraws> virtual_scene_draws(const scene::Scene& scene, int uv_set =
 // (OpenImageIO; float images are taken as linear, others as sRGB) multiplied by
 // base_color_factor in linear light and stored as sRGB 8-bit, with a full mip chain and the
 // texture's sampler (wrap per axis, magFilter); a material without an image gets a 1 x 1 texture
-// of its factor. Images larger than `max_texture_side` are box-reduced to fit. Each vertex's UV
+// of its factor, and one no drawn primitive uses is not read. An image that cannot be read is
+// an error naming the material and the slot (or see `options`). Each vertex's UV
 // is the slot's texCoord set through its KHR_texture_transform (exact: the transform is affine)
 // and its colour the primitive's COLOR_0 (alpha 1 for OPAQUE materials); MASK keeps its cutoff.
 Expected<SceneDraws> reference_scene_draws(const scene::Scene& scene,
-                                           uint32_t max_texture_side = 4096);
+                                           const ReferenceDrawOptions& options = {});
 
 }  // namespace vt::render

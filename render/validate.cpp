@@ -428,6 +428,7 @@ struct BakeInputs {
   scene::Scene original, baked;  // for the atlas check
   std::string unwrapped;         // the baked scene's path
   SceneDraws reference, virt;
+  ReferenceDrawOptions reference_options;  // as the bake read the textures (its metadata)
   uint32_t layer = 0;
 };
 
@@ -470,7 +471,9 @@ Expected<BakeInputs> read_bake_inputs(const BakeValidationOptions& o) {
   // The bake's own output: its image uris point back at the original scene's files (checked
   // above), from wherever the bake was written.
   VT_ASSIGN_OR_RETURN(in.baked, scene::load_scene(in.unwrapped, {.allow_outside_paths = true}));
-  VT_ASSIGN_OR_RETURN(in.reference, reference_scene_draws(in.original));
+  in.reference_options.missing_as_factor =
+      baked_missing_textures(*in.reader) == MissingTextures::kWarn;
+  VT_ASSIGN_OR_RETURN(in.reference, reference_scene_draws(in.original, in.reference_options));
   VT_ASSIGN_OR_RETURN(in.virt, virtual_scene_draws(in.baked));
   if (in.reference.meshes.empty() || in.virt.meshes.empty()) {
     return Error(ErrorCode::kInvalidArgument, o.scene + ": nothing to draw");
@@ -495,6 +498,8 @@ Status finish_report(const BakeInputs& in, const BakeValidationOptions& o, doubl
                      std::chrono::steady_clock::time_point start, ValidationReport& report) {
   add_scene_warnings(in.original, o.scene, report.warnings);
   add_scene_warnings(in.baked, in.unwrapped, report.warnings);
+  for (const std::string& m : in.reference.missing_textures)
+    report.warnings.push_back(o.scene + ": " + m);
   for (const AtlasLayerReport& l : report.atlas.layers) {
     if (!l.note.empty()) report.warnings.push_back("atlas check: layer " + l.name + ": " + l.note);
   }
@@ -514,6 +519,17 @@ Status finish_report(const BakeInputs& in, const BakeValidationOptions& o, doubl
 }
 
 // The lit check's layers and materials; the draws get their shading frames when it runs.
+// The original scene's lit materials, their images read as the bake read them; the images read
+// as missing join the reference's list.
+Expected<std::vector<LitMaterial>> reference_lit_materials(BakeInputs& in) {
+  std::vector<std::string> missing;
+  VT_ASSIGN_OR_RETURN(std::vector<LitMaterial> materials,
+                      lit_materials(in.original, in.reference_options, &missing));
+  for (const std::string& m : missing)
+    in.reference.missing_textures.push_back(m + " (drawn from its factor, as the bake did)");
+  return materials;
+}
+
 struct LitInputs {
   LitLayers layers;
   std::vector<LitMaterial> materials;
@@ -530,7 +546,7 @@ Expected<LitInputs> lit_inputs_for(const PageSource& source, BakeInputs& in,
   if (!lit.layers.any()) return lit;
   VT_RETURN_IF_ERROR(add_shading_frames(in.original, in.reference, true));
   VT_RETURN_IF_ERROR(add_shading_frames(in.baked, in.virt, false));
-  VT_ASSIGN_OR_RETURN(lit.materials, lit_materials(in.original));
+  VT_ASSIGN_OR_RETURN(lit.materials, reference_lit_materials(in));
   return lit;
 }
 
@@ -550,7 +566,7 @@ Status check_lighting_views(Renderer& renderer, const std::shared_ptr<const Page
   const double texel_size = texels_per_unit > 0 ? 1.0 / texels_per_unit : 0.0;
   if (!lit.layers.any()) {
     VT_RETURN_IF_ERROR(add_shading_frames(in.original, in.reference, true));
-    VT_ASSIGN_OR_RETURN(lit.materials, lit_materials(in.original));
+    VT_ASSIGN_OR_RETURN(lit.materials, reference_lit_materials(in));
   }
   VT_ASSIGN_OR_RETURN(
       std::unique_ptr<LightingReference> reference,

@@ -304,6 +304,9 @@ Expected<Scene> load_assimp(const std::string& path) {
   // Points and lines are dropped by SortByPType; normals are made only where a mesh has none.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                               aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  // FindInvalidData would drop a UV set whose coordinates are all equal (a Quake 3 MD3 flare or
+  // muzzle flash samples one texel of its texture): the material still reads it, so keep it.
+  importer.SetPropertyBool(AI_CONFIG_PP_FID_IGNORE_TEXTURECOORDS, true);
   const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                          aiProcess_SortByPType | aiProcess_GenSmoothNormals |
                          aiProcess_ValidateDataStructure | aiProcess_FindInvalidData;

@@ -2,8 +2,22 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 namespace vt::scene {
+
+std::string material_label(const std::string& name, int64_t index) {
+  if (!name.empty()) return "material '" + name + "'";
+  if (index < 0) return "the default material";
+  return "material " + std::to_string(index) + " (unnamed)";
+}
+
+std::string material_label(const Scene& scene, const Material& m) {
+  const Material* first = scene.materials.data();
+  const bool listed =
+      !std::less<>()(&m, first) && std::less<>()(&m, first + scene.materials.size());
+  return material_label(m.name, listed ? &m - first : -1);
+}
 
 const std::vector<Vec2>* texture_uv_set(const Primitive& p, const TextureRef& ref) {
   if (ref.texcoord < 0 || size_t(ref.texcoord) >= p.uvs.size()) return nullptr;

@@ -6,11 +6,17 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "scene/scene.h"
 
 namespace vt::scene {
+
+// How messages name a material: "material 'NAME'", "material INDEX (unnamed)", or "the default
+// material" (index < 0: a primitive without one). The second form finds `m` in `scene`.
+std::string material_label(const std::string& name, int64_t index);
+std::string material_label(const Scene& scene, const Material& m);
 
 // The UV set a texture slot reads (TEXCOORD_n after KHR_texture_transform's texCoord override),
 // or nullptr when the primitive lacks it or the set is shorter than the positions.

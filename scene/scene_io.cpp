@@ -5,6 +5,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -135,8 +136,9 @@ bool exists(const std::string& path) {
 }
 
 // `relative` ('/'-separated) below `folder`, matching each component case-insensitively where
-// the exact name is absent. Empty when some component has no match.
-std::string find_ignoring_case(const std::string& folder, const std::string& relative) {
+// the exact name is absent (a trailing '/' keeps one on the result). Empty when some component
+// has no match.
+std::string match_ignoring_case(const std::string& folder, const std::string& relative) {
   std::string at = folder;
   size_t start = 0;
   while (start <= relative.size()) {
@@ -158,7 +160,41 @@ std::string find_ignoring_case(const std::string& folder, const std::string& rel
     }
     if (start <= relative.size()) at += '/';
   }
-  return exists(at) ? at : "";
+  return at;
+}
+
+// The file `relative` below `folder` as match_ignoring_case finds it; empty when it is not there.
+std::string find_ignoring_case(const std::string& folder, const std::string& relative) {
+  const std::string at = match_ignoring_case(folder, relative);
+  return !at.empty() && exists(at) ? at : "";
+}
+
+// An image in `folder` with the stem of `name` ('/'-separated, below `folder`) and another
+// image extension, letter case ignored: Quake 3 models name a texture by a shader name without
+// one (or as .tga where the file is a .jpg), and the engine tries its loaders' extensions in
+// turn. Their order decides between several. Empty when none is there.
+std::string find_other_extension(const std::string& folder, const std::string& name) {
+  static const char* const kImageExtensions[] = {".tga", ".jpg",  ".jpeg", ".png", ".bmp", ".dds",
+                                                 ".tif", ".tiff", ".exr",  ".hdr", ".webp"};
+  const std::filesystem::path written(name);
+  const std::string dir = written.has_parent_path()
+                              ? match_ignoring_case(folder, written.parent_path().string() + "/")
+                              : folder;
+  if (dir.empty() && written.has_parent_path()) return "";
+  const std::string stem = lower(written.stem().string());
+  // The best (extension rank, file name): the name decides between letter cases, whatever
+  // order the folder lists them in.
+  std::pair<ptrdiff_t, std::string> best{std::size(kImageExtensions), ""};
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.empty() ? "." : dir, ec)) {
+    const std::filesystem::path& p = entry.path();
+    if (lower(p.stem().string()) != stem || !exists(p.string())) continue;
+    const ptrdiff_t rank = std::find(std::begin(kImageExtensions), std::end(kImageExtensions),
+                                     lower(p.extension().string())) -
+                           std::begin(kImageExtensions);
+    best = std::min(best, {rank, p.filename().string()});
+  }
+  return best.second.empty() ? "" : dir + best.second;
 }
 
 }  // namespace
@@ -194,6 +230,12 @@ std::string resolve_written_path(const std::string& folder, const std::string& w
       *note = "'" + written + "' not found; using '" + beside + "' (same name, next to it)";
       return beside;
     }
+  }
+  std::string other = absolute ? "" : find_other_extension(folder, s);
+  if (other.empty() && base != s && !base.empty()) other = find_other_extension(folder, base);
+  if (!other.empty()) {
+    *note = "'" + written + "' not found; using '" + other + "' (same name, another extension)";
+    return other;
   }
   return windows_absolute ? folder + base : as_written;
 }

@@ -3,6 +3,9 @@
 // factor alone, the miss printed as a warning and listed in --json.
 #include <gtest/gtest.h>
 
+#include <OpenImageIO/imageio.h>
+
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -35,6 +38,9 @@ TEST(CliBake, MissingTextureIsAnErrorNamingMaterialSlotAndPath) {
   EXPECT_NE(r.out.find("material 'Brick' baseColorTexture: cannot read image"), std::string::npos)
       << r.out;
   EXPECT_NE(r.out.find("(tried " + dir + "/textures/brick.png)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(--missing-textures warn bakes the slot from its factor)"),
+            std::string::npos)
+      << r.out;
   EXPECT_FALSE(std::filesystem::exists(dir + "/q.vtpf"));
 }
 
@@ -79,6 +85,42 @@ TEST(CliBake, MissingTextureWarnBakesAndReports) {
   ASSERT_EQ(j["warnings"].size(), 1u);
 
   EXPECT_EQ(run_vtbake(args + "x", false).exit_code, 2);  // an unknown policy is bad usage
+}
+
+// `vtbake validate` repeats what the bake did: a slot baked from its factor (the bake's metadata
+// says so) is drawn from its factor, with a warning; the texture back in place, the bake no longer
+// matches the scene and fails. A bake that read the texture, validated after the texture is gone,
+// is an error naming the material and slot. --atlas-only: the references without Vulkan.
+TEST(CliBake, ValidateDrawsASlotBakedFromItsFactorTheSameWay) {
+  const std::string obj = quad_with_missing_texture();
+  const std::string dir = obj.substr(0, obj.rfind('/'));
+  const std::string bake = "-q bake " + obj + " -o " + dir + "/q.vtpf --size 1";
+  const std::string validate = "validate " + obj + " " + dir + "/q.vtpf --atlas-only";
+  ASSERT_EQ(run_vtbake(bake + " --missing-textures warn", true).exit_code, 0);
+  RunResult r = run_vtbake(validate, true);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("material 'Brick' baseColorTexture: cannot open image"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("(drawn from its factor, as the bake did)"), std::string::npos) << r.out;
+
+  // A 2 x 2 checker of red and blue: far from the factor the bake used.
+  std::filesystem::create_directories(dir + "/textures");
+  const uint8_t texels[] = {255, 0, 0, 0, 0, 255, 0, 0, 255, 255, 0, 0};
+  auto out = OIIO::ImageOutput::create(dir + "/textures/brick.png");
+  ASSERT_TRUE(out);
+  ASSERT_TRUE(
+      out->open(dir + "/textures/brick.png", OIIO::ImageSpec(2, 2, 3, OIIO::TypeDesc::UINT8)));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, texels));
+  out->close();
+  r = run_vtbake(validate, true);
+  EXPECT_EQ(r.exit_code, 1) << r.out;  // the scene changed since the bake
+
+  ASSERT_EQ(run_vtbake(bake, true).exit_code, 0);
+  std::filesystem::remove(dir + "/textures/brick.png");
+  r = run_vtbake(validate, true);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("material 'Brick' baseColorTexture: cannot open image"), std::string::npos)
+      << r.out;
 }
 
 }  // namespace

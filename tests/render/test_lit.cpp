@@ -109,6 +109,14 @@ TEST(LitMaterials, FactorsAndDefaultsAsTheBakeAppliesThem) {
   auto err = lit_materials(missing);
   ASSERT_FALSE(err.ok());
   EXPECT_NE(err.status().message().find("gone.png"), std::string::npos);
+  // As a bake with --missing-textures warn: the slot's factor alone (a flat normal), listed.
+  std::vector<std::string> listed;
+  auto factor = lit_materials(missing, {.missing_as_factor = true}, &listed);
+  ASSERT_TRUE(factor.ok()) << factor.status().message();
+  EXPECT_FALSE((*factor)[0].has_normal_map);
+  EXPECT_EQ((*factor)[0].normal.levels[0], (std::vector<uint8_t>{128, 128, 255, 255}));
+  ASSERT_EQ(listed.size(), 1u);
+  EXPECT_NE(listed[0].find("gone.png"), std::string::npos) << listed[0];
 }
 
 TEST(LitShadingFrames, NormalsTangentsAndUvsInWorldSpace) {

@@ -171,6 +171,39 @@ scene::Material textured(scene::WrapMode s, scene::WrapMode t) {
   return m;
 }
 
+// Only drawn materials read their image; one that cannot be read names the material and slot,
+// or (a bake with --missing-textures warn) is drawn from the factor alone and listed. No Vulkan.
+TEST(ReferenceRules, ImagesThatCannotBeReadNameTheMaterialOrDrawTheFactor) {
+  const std::string png = cell_png("missing_ref");
+  ASSERT_FALSE(png.empty());
+  scene::Material m = textured(scene::WrapMode::kRepeat, scene::WrapMode::kRepeat);
+  m.base_color_factor = {0.5f, 0.5f, 0.5f, 1};
+  scene::Scene sc = one_primitive_scene(screen_quad(0, 0, 1), m, png);
+  scene::Material unused = m;
+  unused.name = "unused";
+  unused.base_color_texture.image = 1;
+  sc.materials.push_back(unused);
+  sc.images.push_back(sc.images[0]);
+  sc.images[1].path = png + ".gone.png";
+  auto draws = reference_scene_draws(sc);
+  ASSERT_TRUE(draws.ok()) << draws.status().message();
+  EXPECT_EQ(draws->textures[0].width, uint32_t(kTexels));
+  EXPECT_TRUE(draws->missing_textures.empty());
+
+  sc.materials[0].base_color_texture.image = 1;
+  draws = reference_scene_draws(sc);
+  ASSERT_FALSE(draws.ok());
+  EXPECT_EQ(draws.status().message().rfind("material 'm' baseColorTexture: cannot open image", 0),
+            0u)
+      << draws.status().message();
+  draws = reference_scene_draws(sc, {.missing_as_factor = true});
+  ASSERT_TRUE(draws.ok()) << draws.status().message();
+  ASSERT_EQ(draws->missing_textures.size(), 1u);
+  EXPECT_NE(draws->missing_textures[0].find("drawn from its factor"), std::string::npos);
+  EXPECT_EQ(draws->textures[0].width, 1u);  // the factor: 0.5 linear, 188 in sRGB
+  EXPECT_EQ(draws->textures[0].levels[0], (std::vector<uint8_t>{188, 188, 188, 255}));
+}
+
 TEST(ReferenceRules, MirroredRepeatAndClampPerAxis) {
   REQUIRE_VULKAN();
   const std::string png = cell_png("mirror_ref");

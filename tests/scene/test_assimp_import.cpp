@@ -25,9 +25,9 @@ void write_text(const fs::path& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
 }
 
-// A COLLADA quad (two triangles) with UVs, vertex colours and a diffuse texture `image`, a
-// node translated by (5, 0, 0).
-std::string collada_quad(const std::string& image) {
+// A COLLADA quad (two triangles) with UVs (`uvs`: four S T pairs), vertex colours and a diffuse
+// texture `image`, a node translated by (5, 0, 0).
+std::string collada_quad(const std::string& image, const std::string& uvs = "0 0 1 0 1 1 0 1") {
   return R"(<?xml version="1.0" encoding="utf-8"?>
 <COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
   <asset><unit name="meter" meter="1"/><up_axis>Y_UP</up_axis></asset>
@@ -46,7 +46,8 @@ std::string collada_quad(const std::string& image) {
       <technique_common><accessor source="#pos-a" count="4" stride="3">
         <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
       </accessor></technique_common></source>
-    <source id="uv"><float_array id="uv-a" count="8">0 0 1 0 1 1 0 1</float_array>
+    <source id="uv"><float_array id="uv-a" count="8">)" +
+         uvs + R"(</float_array>
       <technique_common><accessor source="#uv-a" count="4" stride="2">
         <param name="S" type="float"/><param name="T" type="float"/>
       </accessor></technique_common></source>
@@ -135,6 +136,38 @@ TEST(AssimpImport, TexturePathsFromOtherMachinesAreFoundWithAWarning) {
             folder + "sub/../floor.jpg");
   // Nothing anywhere: the plain resolution, so the error names what the file asked for.
   EXPECT_EQ(resolve("gone/none.png"), folder + "gone/none.png");
+  // The same name with another image extension (Quake 3 shader names have none, and name .tga
+  // files shipped as .jpg), in the folder as written (its letter case ignored), else beside.
+  write_text(d / "Tex" / "bullet.jpg", "x");
+  EXPECT_EQ(resolve("tex/bullet.tga"), (d / "Tex" / "bullet.jpg").string());
+  EXPECT_NE(note.find("another extension"), std::string::npos) << note;
+  write_text(d / "gauntlet.TGA", "x");
+  EXPECT_EQ(resolve("models/weapons/Gauntlet"), (d / "gauntlet.TGA").string());
+  // Several: the engine's order (.tga before .jpg before .png), not the folder's listing order.
+  write_text(d / "both.png", "x");
+  write_text(d / "both.jpg", "x");
+  write_text(d / "both.tga", "x");
+  EXPECT_EQ(resolve("both"), (d / "both.tga").string());
+  // Only images stand in: a model of that name does not.
+  write_text(d / "orb.md3", "x");
+  EXPECT_EQ(resolve("orb.png"), folder + "orb.png");
+}
+
+TEST(AssimpImport, UvSetWithOneCoordinateEverywhereIsKept) {
+  // A Quake 3 flare samples a single texel: every UV equal. assimp's FindInvalidData would drop
+  // the set, and the material's texture would then read a UV set the primitive lacks.
+  fs::path d = fresh_dir("one_uv");
+  write_text(d / "flare.dae", collada_quad("flare.png", "0.25 0.75 0.25 0.75 0.25 0.75 0.25 0.75"));
+  auto s = scene::load_scene((d / "flare.dae").string());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  ASSERT_EQ(s->meshes.size(), 1u);
+  const scene::Primitive& prim = s->meshes[0].primitives.at(0);
+  ASSERT_EQ(prim.uvs.size(), 1u);
+  ASSERT_EQ(prim.uvs[0].size(), prim.positions.size());
+  for (const auto& uv : prim.uvs[0]) {
+    EXPECT_FLOAT_EQ(uv[0], 0.25f);
+    EXPECT_FLOAT_EQ(uv[1], 0.25f);  // v flipped to glTF's orientation
+  }
 }
 
 TEST(AssimpImport, AsciiStlAndUnreadableFiles) {
