@@ -32,6 +32,7 @@ struct BakeArgs {
   // Batches: one output per scene under out_dir, scenes also from a list file.
   std::string out_dir, list;
   bool keep_going = false;
+  bool keep_folders = false;  // outputs at the scenes' relative paths under out_dir
   vt::SceneBakeOptions options;
   // Sharding over a build farm (bake/shard.h, docs/FARM.md).
   std::string plan, work, shard;
@@ -171,10 +172,16 @@ void print_summary(const vt::SceneBakeSummary& s) {
   std::printf(" peak resident set at the end of each stage\n");
 }
 
+// A scene of a batch: its path, and the path as the command line or the list gave it.
+struct BatchScene {
+  std::string path, as_given;
+};
+
 // The scenes of a batch: the positionals, then --list FILE's lines (blank lines and lines
 // starting with '#' skipped; relative paths from the list file's folder).
-vt::Expected<std::vector<std::string>> batch_scenes(const BakeArgs& a) {
-  std::vector<std::string> scenes = a.scenes;
+vt::Expected<std::vector<BatchScene>> batch_scenes(const BakeArgs& a) {
+  std::vector<BatchScene> scenes;
+  for (const std::string& s : a.scenes) scenes.push_back({s, s});
   if (!a.list.empty()) {
     if (vt::Status s = vt::check_input_file(a.list); !s.ok()) return s.with_context("--list");
     std::ifstream in(a.list);
@@ -184,10 +191,25 @@ vt::Expected<std::vector<std::string>> batch_scenes(const BakeArgs& a) {
       const size_t start = line.find_first_not_of(' ');
       if (start == std::string::npos || line[start] == '#') continue;
       std::filesystem::path p(line.substr(start));
-      scenes.push_back(p.is_absolute() || base.empty() ? p.string() : (base / p).string());
+      scenes.push_back(
+          {p.is_absolute() || base.empty() ? p.string() : (base / p).string(), p.string()});
     }
   }
   return scenes;
+}
+
+// A batch scene's page file: DIR/STEM.vtpf, or with --keep-folders DIR/PATH.vtpf for the path as
+// given (relative, without '..': a game's models/*/head.md3 each get their own).
+vt::Expected<std::string> batch_output(const BakeArgs& a, const BatchScene& scene) {
+  const std::filesystem::path dir(a.out_dir);
+  if (!a.keep_folders) return (dir / std::filesystem::path(scene.path).stem()).string() + ".vtpf";
+  const std::filesystem::path relative = std::filesystem::path(scene.as_given).lexically_normal();
+  if (relative.is_absolute() || !relative.has_filename() || *relative.begin() == "..") {
+    return vt::Error(vt::ErrorCode::kInvalidArgument,
+                     scene.path + ": --keep-folders needs a relative path below the list's " +
+                         "folder (or the current one), not '" + scene.as_given + "'");
+  }
+  return (dir / relative).replace_extension(".vtpf").string();
 }
 
 // `vtbake bake A B ... --out-dir D` / `--list FILE`: every argument and input checked first,
@@ -211,15 +233,17 @@ int run_batch(BakeArgs& a, const vt::cli::GlobalOptions& global) {
   std::vector<Item> items;
   std::map<std::string, std::string> outputs;  // output -> scene: two scenes on one refused
   bool bad_input = false;
-  for (const std::string& scene : *scenes) {
+  for (const BatchScene& scene : *scenes) {
     Item it;
-    it.scene = scene;
-    it.output =
-        (std::filesystem::path(a.out_dir) / std::filesystem::path(scene).stem()).string() + ".vtpf";
-    it.status = vt::check_input_file(scene);
-    if (auto [at, fresh] = outputs.emplace(it.output, scene); !fresh && it.status.ok()) {
-      it.status = vt::Error(vt::ErrorCode::kInvalidArgument,
-                            scene + ": would write " + it.output + " as " + at->second + " does");
+    it.scene = scene.path;
+    auto output = batch_output(a, scene);
+    it.output = output.ok() ? *output : "";
+    it.status = output.ok() ? vt::check_input_file(scene.path) : output.status();
+    if (auto [at, fresh] = outputs.emplace(it.output, scene.path); !fresh && it.status.ok()) {
+      it.status =
+          vt::Error(vt::ErrorCode::kInvalidArgument,
+                    scene.path + ": would write " + it.output + " as " + at->second + " does" +
+                        (a.keep_folders ? "" : " (--keep-folders keeps them apart)"));
     }
     if (!it.status.ok()) {
       std::fprintf(stderr, "vtbake bake: %s\n", it.status.message().c_str());
@@ -241,11 +265,15 @@ int run_batch(BakeArgs& a, const vt::cli::GlobalOptions& global) {
     }
     return vt::cli::kExitBadInput;
   }
-  std::error_code ec;
-  std::filesystem::create_directories(a.out_dir, ec);
-  if (ec) {
-    return vt::cli::report_error(
-        "bake", vt::Error(vt::ErrorCode::kIo, a.out_dir + ": cannot create: " + ec.message()));
+  for (const Item& it : items) {
+    if (!it.status.ok()) continue;
+    const std::string folder = std::filesystem::path(it.output).parent_path().string();
+    std::error_code ec;
+    std::filesystem::create_directories(folder, ec);
+    if (ec) {
+      return vt::cli::report_error(
+          "bake", vt::Error(vt::ErrorCode::kIo, folder + ": cannot create: " + ec.message()));
+    }
   }
   size_t failed = 0, baked = 0;
   for (size_t i = 0; i < items.size(); ++i) {
@@ -304,15 +332,22 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
   auto args = std::make_shared<BakeArgs>();
   vt::SceneBakeOptions& o = args->options;
   app.add_option("scene", args->scenes,
-                 "Scene(s) to bake (.gltf, .glb, .obj, .ply, .drc); several = a batch (--out-dir)");
-  app.add_option("--out-dir", args->out_dir,
-                 "Batch: write each scene's page file (and .glb) as DIR/STEM.vtpf; parent folders "
-                 "are created");
+                 "Scene(s) to bake (.gltf, .glb, .obj, .ply, .drc, or what assimp reads: .fbx, "
+                 ".dae, .3ds, .md3, ...); several = a batch (--out-dir)");
+  CLI::Option* out_dir = app.add_option(
+      "--out-dir", args->out_dir,
+      "Batch: write each scene's page file (and .glb) as DIR/STEM.vtpf; parent folders "
+      "are created");
   app.add_option("--list", args->list,
                  "Batch: also bake the scenes listed in FILE, one path a line (relative to FILE's "
                  "folder; '#' lines skipped)");
   app.add_flag("--keep-going", args->keep_going,
                "Batch: bake the other scenes when one fails (exit 1 if any failed)");
+  app.add_flag("--keep-folders", args->keep_folders,
+               "Batch: write DIR/PATH.vtpf for each scene's path as given (relative to the list's "
+               "folder or the current one, no '..') instead of DIR/STEM.vtpf, so scenes of one "
+               "name in different folders stay apart")
+      ->needs(out_dir);
   app.add_option("--unwrapped", o.unwrapped,
                  "Where to write the unwrapped scene (.glb; default OUT.glb; '-' = not written)");
   app.add_option("--cache", o.cache,

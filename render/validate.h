@@ -215,7 +215,7 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
 
 // A bake against the scene it came from, as `vtbake validate` runs it.
 struct BakeValidationOptions {
-  std::string scene;      // the original scene (.gltf, .glb, .obj, .ply, .drc)
+  std::string scene;      // the original scene (any format scene::load_scene reads)
   std::string page_file;  // the bake (.vtpf)
   std::string unwrapped;  // the unwrapped scene the bake wrote; "" = page_file with .glb
   std::string out_dir;    // PNGs and report.json; "" = page_file with .validate

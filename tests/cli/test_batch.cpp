@@ -113,5 +113,34 @@ TEST_F(BatchCli, InputsAreCheckedBeforeAnyWork) {
       2);
 }
 
+TEST_F(BatchCli, KeepFoldersKeepsScenesOfOneNameApart) {
+  // A game's models/*/head.md3: one stem in many folders.
+  ASSERT_EQ(write_sample_scene(dir_ + "/scenes/sub"), "");
+  const std::string list = dir_ + "/scenes/folders.txt";
+  std::ofstream(list) << "scene.gltf\nsub/scene.gltf\n";
+  RunResult stems =
+      run_vtbake("-q bake --list " + list + " --out-dir " + dir_ + "/kf0" + flags(), true);
+  EXPECT_EQ(stems.exit_code, 2) << stems.out;
+  EXPECT_NE(stems.out.find("(--keep-folders keeps them apart)"), std::string::npos) << stems.out;
+  RunResult r = run_vtbake(
+      "-q bake --list " + list + " --keep-folders --out-dir " + dir_ + "/kf" + flags(), true);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  for (const char* out : {"/kf/scene.vtpf", "/kf/sub/scene.vtpf", "/kf/sub/scene.glb"})
+    EXPECT_TRUE(fs::exists(dir_ + out)) << out;
+  // A path that leaves the list's folder has no place under DIR: refused before any work.
+  std::ofstream(list, std::ios::app) << "../scenes/a.gltf\n";
+  r = run_vtbake("-q bake --list " + list + " --keep-folders --out-dir " + dir_ + "/kf2" + flags(),
+                 true);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("--keep-folders needs a relative path"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir_ + "/kf2/scene.vtpf"));
+  // Without a batch it means nothing: bad usage.
+  EXPECT_EQ(
+      run_vtbake("-q bake " + scene("a.gltf") + " -o " + dir_ + "/x.vtpf --keep-folders" + flags(),
+                 true)
+          .exit_code,
+      2);
+}
+
 }  // namespace
 }  // namespace vt
