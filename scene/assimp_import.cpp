@@ -313,7 +313,10 @@ Expected<Scene> load_assimp(const std::string& path) {
   const aiScene* ai = importer.ReadFile(path, flags);
   if (!ai || !ai->mRootNode) {
     std::string why = importer.GetErrorString();
-    return Error(ErrorCode::kCorrupt, path + ": " + (why.empty() ? "assimp cannot read it" : why));
+    // assimp's own words ("Validation failed: ...", "Invalid md3 file: ...") say little of whose
+    // check failed without its name.
+    return Error(ErrorCode::kCorrupt,
+                 path + ": " + (why.empty() ? "assimp cannot read it" : "assimp: " + why));
   }
   if (ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE)
     return Error(ErrorCode::kCorrupt, path + ": assimp read an incomplete scene (no meshes?)");

@@ -343,6 +343,15 @@ Expected<Scene> load_by_extension(const std::string& path, const SceneLoadOption
   if (ext == "obj") return detail::load_obj(path, options);
   if (ext == "ply") return detail::load_ply(path);
   if (ext == "drc") return detail::load_drc(path);
+  if (ext == "pk3" || ext == "bsp") {
+    // assimp 5.2's Q3BSP importer fails on real maps (its own test map too, assimp issue 2862;
+    // OpenArena's maps alike) and overflows its heap on crafted lump sizes (issue 6711, fixed
+    // after 5.2): nothing to gain from handing it a file.
+    return Error(ErrorCode::kUnsupported,
+                 path +
+                     ": Quake 3 BSP maps are not supported (assimp's importer fails on real "
+                     "maps and is unsafe on crafted ones); bake the map's models (.md3) instead");
+  }
   if (detail::assimp_reads(ext)) return detail::load_assimp(path);
   return Error(ErrorCode::kUnsupported,
                path +
