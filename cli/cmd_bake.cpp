@@ -292,7 +292,9 @@ int run_batch(BakeArgs& a, const vt::cli::GlobalOptions& global) {
         it.summary = std::move(s).value();
         ++baked;
         for (const std::string& w : it.summary.warnings)
-          std::fprintf(stderr, "warning: %s: %s\n", it.scene.c_str(), w.c_str());
+          // Most warnings name the scene already (the importers'); the others get its name.
+          std::fprintf(stderr, "warning: %s%s\n",
+                       w.rfind(it.scene, 0) == 0 ? "" : (it.scene + ": ").c_str(), w.c_str());
       } else {
         it.status = s.status();
         std::fprintf(stderr, "vtbake bake: %s\n", it.status.message().c_str());

@@ -164,13 +164,18 @@ class AssimpScene {
         m.Get(AI_MATKEY_COLOR_DIFFUSE, c) == AI_SUCCESS)
       mat.base_color_factor = {c.r, c.g, c.b, c.a};
     float opacity = 1;
-    // Opacity 0 hides the whole material: that is 3ds Max's COLLADA exporter writing
-    // <transparency> inverted (Collada/earthCylindrical.DAE), not a surface meant to be unseen.
     if (m.Get(AI_MATKEY_OPACITY, opacity) == AI_SUCCESS && opacity <= 0) {
-      warn("material '" + mat.name +
-           "': opacity 0 (the material would be invisible) read as opaque; the exporter "
-           "likely wrote transparency inverted");
-      opacity = 1;
+      // In COLLADA that is 3ds Max's exporter writing <transparency> inverted
+      // (Collada/earthCylindrical.DAE), not a surface meant to be unseen. Elsewhere it is what
+      // the author wrote (AC3D's "trans 1": FlightGear's light halos and pick boxes).
+      if (lower_extension(path_) == "dae") {
+        warn("material '" + mat.name +
+             "': opacity 0 (the material would be invisible) read as opaque; the exporter "
+             "likely wrote transparency inverted");
+        opacity = 1;
+      } else {
+        warn("material '" + mat.name + "': opacity 0: its surfaces bake fully transparent");
+      }
     }
     if (opacity < 1) {
       mat.base_color_factor[3] *= opacity;

@@ -248,5 +248,28 @@ TEST(AssimpImport, ColladaOpacityZeroIsReadAsOpaque) {
   EXPECT_TRUE(warned);
 }
 
+TEST(AssimpImport, OpacityZeroOutsideColladaIsTransparent) {
+  // AC3D's "trans 1" (FlightGear's light halos): the author's word, not an exporter's inversion.
+  fs::path d = fresh_dir("ac_opacity");
+  write_text(d / "halo.ac",
+             "AC3Db\n"
+             "MATERIAL \"halo\" rgb 1 1 1  amb 0.2 0.2 0.2  emis 0 0 0  spec 0.5 0.5 0.5  shi 10  "
+             "trans 1\n"
+             "OBJECT world\nkids 1\nOBJECT poly\nname \"quad\"\nnumvert 4\n"
+             "0 0 0\n1 0 0\n1 1 0\n0 1 0\nnumsurf 1\nSURF 0x10\nmat 0\nrefs 4\n"
+             "0 0 0\n1 1 0\n2 1 1\n3 0 1\nkids 0\n");
+  auto s = scene::load_scene((d / "halo.ac").string());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  ASSERT_GE(s->materials.size(), 1u);
+  const scene::Material& m = s->materials[0];
+  EXPECT_EQ(m.name, "halo");
+  EXPECT_EQ(m.alpha_mode, scene::AlphaMode::kBlend);
+  EXPECT_FLOAT_EQ(m.base_color_factor[3], 0.0f);
+  bool warned = false;
+  for (const std::string& w : s->warnings)
+    warned |= w.find("bake fully transparent") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
 }  // namespace
 }  // namespace vt::test
