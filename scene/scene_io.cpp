@@ -197,6 +197,22 @@ std::string find_other_extension(const std::string& folder, const std::string& n
   return best.second.empty() ? "" : dir + best.second;
 }
 
+// The folders beside a scene where tools keep its images (FlightGear's Models/*/Textures/, an
+// exporter's textures/), letter case ignored, in name order.
+std::vector<std::string> texture_folders(const std::string& folder) {
+  static const char* const kNames[] = {"images", "maps", "tex", "texture", "textures"};
+  std::vector<std::string> out;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(folder.empty() ? "." : folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_directory(ec) &&
+        std::find(std::begin(kNames), std::end(kNames), lower(name)) != std::end(kNames))
+      out.push_back(folder + name + "/");
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 }  // namespace
 
 std::string resolve_written_path(const std::string& folder, const std::string& written,
@@ -231,8 +247,19 @@ std::string resolve_written_path(const std::string& folder, const std::string& w
       return beside;
     }
   }
+  const std::vector<std::string> texture_dirs =
+      base.empty() ? std::vector<std::string>{} : texture_folders(folder);
+  for (const std::string& dir : texture_dirs) {
+    const std::string found = find_ignoring_case(dir, base);
+    if (!found.empty()) {
+      *note = "'" + written + "' not found; using '" + found + "' (same name, textures folder)";
+      return found;
+    }
+  }
   std::string other = absolute ? "" : find_other_extension(folder, s);
   if (other.empty() && base != s && !base.empty()) other = find_other_extension(folder, base);
+  for (size_t i = 0; other.empty() && i < texture_dirs.size(); ++i)
+    other = find_other_extension(texture_dirs[i], base);
   if (!other.empty()) {
     *note = "'" + written + "' not found; using '" + other + "' (same name, another extension)";
     return other;

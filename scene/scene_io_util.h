@@ -25,8 +25,10 @@ std::string percent_decode(const std::string& uri);
 // The file an exporter meant by `written` (relative to `folder`, "" or ending in '/'):
 // backslashes read as '/', a leading "./" dropped; when that file does not exist, a
 // case-insensitive match in the same folders, then the base name next to `folder` (an absolute
-// or Windows path from the exporter's machine), then either with another image extension (a
-// Quake 3 shader name, a .tga converted to .jpg). `note` receives what was substituted (empty
+// or Windows path from the exporter's machine), then in a textures folder beside the scene
+// (textures/, tex/, images/, maps/, letter case ignored: FlightGear's Textures/), then any of
+// these with another image extension (a Quake 3 shader name, a .tga converted to .jpg). `note`
+// receives what was substituted (empty
 // when the file was found as written). When nothing matches, the path as written resolved
 // against `folder` is returned (the caller reports it missing).
 std::string resolve_written_path(const std::string& folder, const std::string& written,

@@ -148,6 +148,14 @@ TEST(AssimpImport, TexturePathsFromOtherMachinesAreFoundWithAWarning) {
   write_text(d / "both.jpg", "x");
   write_text(d / "both.tga", "x");
   EXPECT_EQ(resolve("both"), (d / "both.tga").string());
+  // A textures folder beside the scene (FlightGear keeps Models/X/Textures/), with the name as
+  // written, then with another extension.
+  fs::create_directories(d / "Textures");
+  write_text(d / "Textures" / "horloge.rgb", "x");
+  EXPECT_EQ(resolve("horloge.rgb"), (d / "Textures" / "horloge.rgb").string());
+  EXPECT_NE(note.find("textures folder"), std::string::npos) << note;
+  write_text(d / "Textures" / "deck.png", "x");
+  EXPECT_EQ(resolve("C:\\work\\deck.tga"), (d / "Textures" / "deck.png").string());
   // Only images stand in: a model of that name does not.
   write_text(d / "orb.md3", "x");
   EXPECT_EQ(resolve("orb.png"), folder + "orb.png");
