@@ -38,6 +38,10 @@ struct BakeSettings {
   MissingTextures missing_textures = MissingTextures::kError;
 };
 
+LightingOptions lighting_options_from(const nlohmann::json& meta);
+MissingTextures missing_textures_from(const nlohmann::json& meta);
+
+// One parse of the metadata: a 64K bake's holds megabytes of page keys.
 Expected<BakeSettings> bake_settings(const PageFileReader& reader) {
   const nlohmann::json meta = nlohmann::json::parse(reader.metadata_json(), nullptr, false);
   if (!meta.is_object() || meta.value("tool", "") != "vtbake bake") {
@@ -49,22 +53,18 @@ Expected<BakeSettings> bake_settings(const PageFileReader& reader) {
   const nlohmann::json build = meta.value("build", nlohmann::json::object());
   const std::string filter = build.is_object() ? build.value("filter", "kaiser") : "kaiser";
   VT_ASSIGN_OR_RETURN(s.filter, parse_mip_filter(filter.c_str()));
-  s.lighting = baked_lighting_options(reader);
-  s.missing_textures = baked_missing_textures(reader);
+  s.lighting = lighting_options_from(meta);
+  s.missing_textures = missing_textures_from(meta);
   return s;
 }
 
-}  // namespace
-
-MissingTextures baked_missing_textures(const PageFileReader& reader) {
-  const nlohmann::json meta = nlohmann::json::parse(reader.metadata_json(), nullptr, false);
+MissingTextures missing_textures_from(const nlohmann::json& meta) {
   return meta.is_object() && meta.value("missing_textures", "") == "warn" ? MissingTextures::kWarn
                                                                           : MissingTextures::kError;
 }
 
-LightingOptions baked_lighting_options(const PageFileReader& reader) {
+LightingOptions lighting_options_from(const nlohmann::json& meta) {
   LightingOptions o;
-  const nlohmann::json meta = nlohmann::json::parse(reader.metadata_json(), nullptr, false);
   const nlohmann::json lit =
       meta.is_object() ? meta.value("lighting", nlohmann::json::object()) : nlohmann::json();
   if (lit.is_object()) {
@@ -80,6 +80,16 @@ LightingOptions baked_lighting_options(const PageFileReader& reader) {
                                                            : LightingLayer::kSeparate;
   }
   return o;
+}
+
+}  // namespace
+
+MissingTextures baked_missing_textures(const PageFileReader& reader) {
+  return missing_textures_from(nlohmann::json::parse(reader.metadata_json(), nullptr, false));
+}
+
+LightingOptions baked_lighting_options(const PageFileReader& reader) {
+  return lighting_options_from(nlohmann::json::parse(reader.metadata_json(), nullptr, false));
 }
 
 namespace {

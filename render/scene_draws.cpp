@@ -183,10 +183,10 @@ Expected<SceneDraws> reference_scene_draws(const scene::Scene& s,
         tex.width = width, tex.height = height;
         tex.sampler = TextureSampler{t.wrap_s, t.wrap_t, t.mag_filter};
       } else {
-        const std::string what = scene::material_label(s.materials[mi].name, int64_t(mi)) +
+        const std::string what = scene::material_label(m.name, int64_t(mi)) +
                                  " baseColorTexture: " + image.status().message();
         if (!options.missing_as_factor) return Error(image.status().code(), what);
-        out.missing_textures.push_back(what + " (drawn from its factor, as the bake did)");
+        out.missing_textures.push_back(what + kDrawnFromFactor);
       }
     }
     apply_base_color(m, texels);

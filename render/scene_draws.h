@@ -23,6 +23,9 @@ struct SceneDraws {
   std::vector<std::string> missing_textures;
 };
 
+// Ends each line of SceneDraws::missing_textures.
+inline constexpr char kDrawnFromFactor[] = " (drawn from its factor, as the bake did)";
+
 struct ReferenceDrawOptions {
   uint32_t max_texture_side = 4096;  // larger images are box-reduced to fit
   // A base colour image that cannot be read: the material's factor alone, as `vtbake bake

@@ -518,7 +518,6 @@ Status finish_report(const BakeInputs& in, const BakeValidationOptions& o, doubl
   return write_report_json(report.out_dir + "/report.json", report);
 }
 
-// The lit check's layers and materials; the draws get their shading frames when it runs.
 // The original scene's lit materials, their images read as the bake read them; the images read
 // as missing join the reference's list.
 Expected<std::vector<LitMaterial>> reference_lit_materials(BakeInputs& in) {
@@ -526,10 +525,11 @@ Expected<std::vector<LitMaterial>> reference_lit_materials(BakeInputs& in) {
   VT_ASSIGN_OR_RETURN(std::vector<LitMaterial> materials,
                       lit_materials(in.original, in.reference_options, &missing));
   for (const std::string& m : missing)
-    in.reference.missing_textures.push_back(m + " (drawn from its factor, as the bake did)");
+    in.reference.missing_textures.push_back(m + kDrawnFromFactor);
   return materials;
 }
 
+// The lit check's layers and materials; the draws get their shading frames when it runs.
 struct LitInputs {
   LitLayers layers;
   std::vector<LitMaterial> materials;
