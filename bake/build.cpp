@@ -334,7 +334,7 @@ class LayerRun {
         reused[x] = 1;
         return;
       }
-      const bool clipped = layer_.store_page(page.data(), page_texels, alpha_.scale, bytes.data(),
+      const bool clipped = layer_.store_page(page.data(), S, alpha_.scale, bytes.data(),
                                              reference.empty() ? nullptr : reference.data());
       const bool measure = type == TexelType::kF16 || (clipped && !reference.empty());
       errors[x] =

@@ -14,6 +14,7 @@
 #include "bake/level_source.h"
 #include "bake/level_store.h"
 #include "bake/paging.h"
+#include "bake/pyramid.h"
 #include "bake/row_window.h"
 #include "common/half.h"
 #include "common/parallel.h"
@@ -198,7 +199,7 @@ Expected<std::vector<std::vector<uint8_t>>> training_sample(
       cut_page(g, chosen[i + k], plan.options.address, band, texels.data());
       if (keys) row_keys[k] = page_task_key(seed, chosen[i + k], 1.0f, texels);
       row[k].resize(layer.encoder->page_bytes());
-      layer.store_page(texels.data(), page_texels, 1.0f, row[k].data());
+      layer.store_page(texels.data(), S, 1.0f, row[k].data());
     });
     for (size_t k = 0; k < row.size(); ++k) {
       if (layer.encoder->is_constant(row[k].data())) continue;
@@ -549,16 +550,15 @@ Status plan_tables(BuildPlan& plan, const LayerInput& in, LayerPlan& layer,
 
 }  // namespace
 
-bool LayerPlan::store_page(float* texels, size_t count, float alpha_scale, uint8_t* out,
+bool LayerPlan::store_page(float* texels, uint32_t side, float alpha_scale, uint8_t* out,
                            float* reference) const {
   const uint32_t wc = work_channels;
+  const size_t count = size_t(side) * side;
   if (alpha >= 0) {
-    for (size_t i = 0; i < count; ++i) {
-      float* t = texels + i * wc;
-      float a = t[alpha];
-      for (int c = 0; c < 3; ++c) t[c] = a > 0 ? std::min(t[c] / a, kFloatMax) : 0.0f;
-      if (alpha_scale != 1.0f) t[alpha] = std::min(1.0f, a * alpha_scale);
-    }
+    unpremultiply_page(texels, side, wc, alpha);
+    if (alpha_scale != 1.0f)
+      for (size_t i = 0; i < count; ++i)
+        texels[i * wc + alpha] = std::min(1.0f, texels[i * wc + alpha] * alpha_scale);
   }
   if (spec.texel_type == TexelType::kF32) {
     if (to_storage) to_storage->apply(texels, count, int(wc));

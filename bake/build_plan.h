@@ -57,14 +57,15 @@ struct LayerPlan {
   bool copy_previous = false;
   int previous_layer = -1;
 
-  // Linear working texels of a page (modified) to the layer's stored bytes. Returns true when
-  // the storage clipped some value (8 bits: outside [0, 1]; half: beyond +-kHalfMax); for 8-bit
-  // layers `reference`, when not null, then receives
-  // what the stored bytes would be unclipped (count * spec.channels values in 8-bit code units,
-  // unrounded): the values the page's error is measured against. Half layers always fill it
-  // (when not null) with the float values before rounding to half (count * spec.channels): half
-  // storage is not lossless, and its error is measured against them.
-  bool store_page(float* texels, size_t count, float alpha_scale, uint8_t* out,
+  // Linear working texels of a side x side page (modified) to the layer's stored bytes: colour
+  // unpremultiplied, and under zero alpha bled from the texels around. Returns true when the
+  // storage clipped some value (8 bits: outside [0, 1]; half: beyond +-kHalfMax); for 8-bit
+  // layers `reference`, when not null, then receives what the stored bytes would be unclipped
+  // (side * side * spec.channels values in 8-bit code units, unrounded): the values the page's
+  // error is measured against. Half layers always fill it (when not null) with the float values
+  // before rounding to half (side * side * spec.channels): half storage is not lossless, and its
+  // error is measured against them.
+  bool store_page(float* texels, uint32_t side, float alpha_scale, uint8_t* out,
                   float* reference = nullptr) const;
 };
 

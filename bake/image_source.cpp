@@ -86,6 +86,7 @@ class FileImageSource final : public ImageSource {
       bool ok = in_->read_scanlines(0, 0, spec.y + int(y0), spec.y + int(y1), spec.z, 0,
                                     int(info_.channels), OIIO::TypeDesc::FLOAT, out);
       if (!ok) return decode_error(path_, in_->geterror());
+      straighten(out, size_t(y1 - y0) * info_.width);
       return Status::Ok();
     }
     // Tiled: read whole tile rows covering [y0, y1) and copy the rows asked for.
@@ -100,10 +101,17 @@ class FileImageSource final : public ImageSource {
     if (!ok) return decode_error(path_, in_->geterror());
     std::memcpy(out, tile_buf_.data() + size_t(y0 - ty0) * row_floats,
                 size_t(y1 - y0) * row_floats * sizeof(float));
+    straighten(out, size_t(y1 - y0) * info_.width);
     return Status::Ok();
   }
 
  private:
+  // A file of premultiplied colour (OpenEXR) reads as straight colour, as every other does.
+  void straighten(float* texels, size_t count) const {
+    const int a = scene::associated_alpha_channel(in_->spec(), int(info_.channels));
+    if (a >= 0) scene::unassociate_alpha(texels, count, int(info_.channels), a);
+  }
+
   std::string path_;
   std::unique_ptr<OIIO::ImageInput> in_;
   ImageInfo info_;
@@ -186,6 +194,10 @@ Status write_image_file(ImageSource& source, const std::string& path, uint32_t t
   OIIO::ImageSpec spec(int(info.width), int(info.height), int(info.channels), type);
   spec.alpha_channel = info.alpha_channel;
   if (!info.color_space.empty()) spec.attribute("oiio:ColorSpace", info.color_space);
+  // The source's colour is straight, as PNG and most formats store it (OpenImageIO would divide
+  // it by alpha again); OpenEXR stores colour premultiplied.
+  spec.attribute("oiio:UnassociatedAlpha", 1);
+  const bool premultiply = info.alpha_channel >= 0 && std::string(out->format_name()) == "openexr";
   bool tiled = tile > 0 && out->supports("tiles");
   if (tiled) {
     spec.tile_width = spec.tile_height = int(tile);
@@ -198,6 +210,11 @@ Status write_image_file(ImageSource& source, const std::string& path, uint32_t t
     for (uint32_t y = 0; y < info.height; y += band) {
       uint32_t y1 = std::min(info.height, y + band);
       VT_RETURN_IF_ERROR(source.read_rows(y, y1, rows.data()));
+      for (size_t i = 0; premultiply && i < size_t(y1 - y) * info.width; ++i) {
+        float* t = &rows[i * info.channels];
+        for (uint32_t c = 0; c < info.channels; ++c)
+          if (int(c) != info.alpha_channel) t[c] *= t[info.alpha_channel];
+      }
       bool ok = tiled
                     ? out->write_tiles(0, int(info.width), int(y), int(y1), 0, 1,
                                        OIIO::TypeDesc::FLOAT, rows.data())

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <numbers>
 
 namespace vt {
@@ -370,6 +371,22 @@ uint64_t pull_push(float* texels, const uint8_t* coverage, uint32_t width, uint3
     }
   }
   return uncovered;
+}
+
+void unpremultiply_page(float* texels, uint32_t side, uint32_t channels, int alpha) {
+  const size_t count = size_t(side) * side;
+  thread_local std::vector<uint8_t> has_alpha;
+  has_alpha.resize(count);
+  for (size_t i = 0; i < count; ++i) has_alpha[i] = texels[i * channels + alpha] > 0;
+  const bool bled = pull_push(texels, has_alpha.data(), side, side, channels) > 0;
+  constexpr float kFloatMax = std::numeric_limits<float>::max();
+  for (size_t i = 0; i < count; ++i) {
+    float* t = texels + i * channels;
+    // A bled texel divides by its pulled alpha: the weighted mean of its neighbours' colour.
+    const float a = t[alpha];
+    for (int c = 0; c < 3; ++c) t[c] = a > 0 ? std::min(t[c] / a, kFloatMax) : 0.0f;
+    if (bled && !has_alpha[i]) t[alpha] = 0.0f;
+  }
 }
 
 }  // namespace vt

@@ -96,4 +96,11 @@ std::vector<uint8_t> downsample_coverage(const uint8_t* coverage, uint32_t width
 uint64_t pull_push(float* texels, const uint8_t* coverage, uint32_t width, uint32_t height,
                    uint32_t channels);
 
+// A side x side page of premultiplied colour (alpha channel `alpha`) to straight colour, as
+// pages are stored. Colour under zero alpha, lost in premultiplied form, takes the
+// alpha-weighted colour of the nearest texels with alpha (pull-push over the page) rather than
+// black: the run time filters straight colour, and black there would fringe every alpha edge.
+// A page's border holds every texel a filter reads beside its payload, so the page alone decides.
+void unpremultiply_page(float* texels, uint32_t side, uint32_t channels, int alpha);
+
 }  // namespace vt

@@ -181,14 +181,10 @@ Expected<ReferenceLayer> make_reference_layer(uint32_t index, const LayerSpec& s
 
 // A page of working texels (modified) to the layer's stored texels, as the build stores them
 // (LayerPlan::store_page): 8-bit texels, or floats for float layers.
-void store_reference(const ReferenceLayer& r, float* t, size_t n, uint8_t* out) {
+void store_reference(const ReferenceLayer& r, float* t, uint32_t side, uint8_t* out) {
   const uint32_t wc = r.work_channels;
-  if (is_colour(r.spec.semantic) && wc == 4) {
-    for (size_t i = 0; i < n; ++i) {
-      const float a = t[i * wc + 3];
-      for (int c = 0; c < 3; ++c) t[i * wc + c] = a > 0 ? t[i * wc + c] / a : 0.0f;
-    }
-  }
+  const size_t n = size_t(side) * side;
+  if (is_colour(r.spec.semantic) && wc == 4) unpremultiply_page(t, side, wc, 3);
   if (r.spec.texel_type == TexelType::kF16) {
     if (r.to_storage) r.to_storage->apply(t, n, int(wc));
     for (size_t i = 0; i < n * wc; ++i) {
@@ -409,7 +405,7 @@ Status check_level(const PageSource& source, const PageFileReader& reader, uint3
     ref.resize(bytes);
     test.resize(bytes);
     cut_page_from_level(g, id, r.spec.address_mode, r.level.data(), r.work_channels, work.data());
-    store_reference(r, work.data(), n, ref.data());
+    store_reference(r, work.data(), ps, ref.data());
     status[k] = o.stored_texels ? reader.read_texels(id, r.index, test)
                                 : uploaded_texels(source, r.spec, id, r.index, upload, test.data());
     if (status[k].ok()) status[k] = measure_page(r, ref.data(), test.data(), int(ps), e);

@@ -37,11 +37,15 @@ struct Vertex {
 };
 enum LitTextureUv : uint32_t { kLitNormalUv, kLitOcclusionUv, kLitMetalRoughUv, kLitEmissiveUv };
 
+// MeshData::alpha_cutoff of a blended material: both renders write its colour premultiplied
+// by alpha, as it composites (shaders/common.glsl).
+inline constexpr float kAlphaBlended = -2.0f;
+
 struct MeshData {
   std::vector<Vertex> vertices;
   std::vector<uint32_t> indices;   // triangle list
   uint32_t reference_texture = 0;  // index into the reference textures
-  float alpha_cutoff = -1.0f;      // < 0: no alpha test
+  float alpha_cutoff = -1.0f;      // < 0: no alpha test; kAlphaBlended: blended
 };
 
 // A material texture's own sampler (glTF): addressing per axis and the magnification filter.

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "format/atomic_output.h"
+#include "scene/image_load.h"
 
 namespace vt::render {
 
@@ -77,8 +78,9 @@ Status write_png(const std::string& path, const Rgba8Image& image) {
 }
 
 Expected<Rgba8Image> read_png(const std::string& path) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) return Error(ErrorCode::kIo, path + ": cannot read image: " + OIIO::geterror());
+  std::string error;
+  auto in = scene::open_image_input(path, error);
+  if (!in) return Error(ErrorCode::kIo, path + ": cannot read image: " + error);
   const OIIO::ImageSpec& spec = in->spec();
   const int channels = spec.nchannels;
   if (spec.width <= 0 || spec.height <= 0 || channels <= 0 || spec.width > 65536 ||

@@ -87,7 +87,10 @@ Expected<SceneDraws> draws(const scene::Scene& s, UvOf uv_of, bool reference) {
         b.add(o.x, o.y, o.z);
       }
       m.indices = p.indices;
-      m.alpha_cutoff = mat ? scene::alpha_test_cutoff(*mat) : -1.0f;
+      m.alpha_cutoff = !mat ? -1.0f
+                       : mat->alpha_mode == scene::AlphaMode::kBlend
+                           ? kAlphaBlended
+                           : scene::alpha_test_cutoff(*mat);
       // Reference texture index = material index; the default material is the last texture.
       m.reference_texture = reference ? uint32_t(mat ? p.material : int(s.materials.size())) : 0;
       out.meshes.push_back(std::move(m));

@@ -8,13 +8,25 @@
 
 namespace vt::scene {
 
-std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path, std::string& error) {
+std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path, std::string& error,
+                                                   OIIO::Filesystem::IOProxy* proxy) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
+  if (!proxy && !std::filesystem::is_regular_file(path, ec)) {
     error = "Could not open file \"" + path + "\"";
     return nullptr;
   }
-  auto in = OIIO::ImageInput::open(path);
+  static const OIIO::ImageSpec straight_colour = [] {
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    return config;
+  }();
+  // OpenImageIO 2.4 drops the proxy argument when a config is given: it goes in the config.
+  OIIO::ImageSpec with_proxy;
+  if (proxy) {
+    with_proxy = straight_colour;
+    with_proxy.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+  }
+  auto in = OIIO::ImageInput::open(path, proxy ? &with_proxy : &straight_colour, proxy);
   if (!in) {
     error = OIIO::geterror();
     error = error.substr(0, error.find('\n'));  // further lines repeat it
@@ -26,18 +38,30 @@ std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path, std:
   return in;
 }
 
+int associated_alpha_channel(const OIIO::ImageSpec& spec, int channels) {
+  // open_image_input asks for straight colour: the formats that store it say so.
+  const bool associated = spec.get_int_attribute("oiio:UnassociatedAlpha", 0) == 0;
+  return associated && spec.alpha_channel >= 0 && spec.alpha_channel < channels ? spec.alpha_channel
+                                                                                : -1;
+}
+
+void unassociate_alpha(float* texels, size_t count, int channels, int alpha) {
+  for (size_t i = 0; i < count; ++i) {
+    float* t = texels + i * size_t(channels);
+    if (!(t[alpha] > 0)) continue;
+    for (int c = 0; c < channels; ++c)
+      if (c != alpha) t[c] /= t[alpha];
+  }
+}
+
 Expected<FloatImage> load_float_image(const scene::Image& image) {
   OIIO::Filesystem::IOMemReader mem(image.bytes.data(), image.bytes.size());
   const std::string name =
       image.embedded() ? std::string("embedded") + image.embedded_extension() : image.path;
   std::string error;
-  std::unique_ptr<OIIO::ImageInput> in = image.embedded()
-                                             ? OIIO::ImageInput::open(name, nullptr, &mem)
-                                             : open_image_input(name, error);
-  if (!in) {
-    return Error(ErrorCode::kNotFound, "cannot open image '" + name +
-                                           "': " + (image.embedded() ? OIIO::geterror() : error));
-  }
+  std::unique_ptr<OIIO::ImageInput> in =
+      open_image_input(name, error, image.embedded() ? &mem : nullptr);
+  if (!in) return Error(ErrorCode::kNotFound, "cannot open image '" + name + "': " + error);
   const OIIO::ImageSpec& spec = in->spec();
   const int ch = spec.nchannels;
   if (spec.width <= 0 || spec.height <= 0 || ch <= 0 || spec.width > 65536 || spec.height > 65536) {
@@ -47,6 +71,8 @@ Expected<FloatImage> load_float_image(const scene::Image& image) {
   if (!in->read_image(0, 0, 0, ch, OIIO::TypeDesc::FLOAT, px.data())) {
     return Error(ErrorCode::kCorrupt, "cannot read image '" + name + "': " + in->geterror());
   }
+  if (const int a = associated_alpha_channel(spec, ch); a >= 0)
+    unassociate_alpha(px.data(), px.size() / size_t(ch), ch, a);
   FloatImage out;
   out.width = uint32_t(spec.width);
   out.height = uint32_t(spec.height);

@@ -26,8 +26,20 @@ struct FloatImage {
 
 // OpenImageIO's reader of the image file at `path`, or null with `error` saying why (its first
 // line). Only a file of a real format: OpenImageIO's "null" plugin makes up an image for any name
-// ending in .nul, file or not, which would bake as if the texture were there.
-std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path, std::string& error);
+// ending in .nul, file or not, which would bake as if the texture were there. Colour comes as
+// the file stores it: by default OpenImageIO premultiplies straight alpha (PNG, TGA, TIFF, ...)
+// as it reads, and every reader here takes straight colour (the bake premultiplies it once, in
+// linear light). With `proxy` (embedded bytes) `path` only names the format.
+std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path, std::string& error,
+                                                   OIIO::Filesystem::IOProxy* proxy = nullptr);
+
+// The channel of `spec` whose alpha the file's colour is premultiplied by (OpenEXR's convention, a
+// TIFF of associated alpha), when it is one of the first `channels` read; -1 when colour is
+// straight. Readers divide it out (unassociate_alpha) so that every image reads straight.
+int associated_alpha_channel(const OIIO::ImageSpec& spec, int channels);
+// Colour (every channel but `alpha`) divided by alpha in `count` texels of `channels` floats;
+// where alpha is 0 colour is left as stored.
+void unassociate_alpha(float* texels, size_t count, int channels, int alpha);
 
 // Errors name the image: kNotFound when it cannot be opened, kCorrupt when it cannot be read or
 // has a size of 0 or over 65536 per side.

@@ -126,15 +126,11 @@ double triangle_source_density(double width, double height, double uv_area, doub
 }
 
 Expected<std::array<int, 2>> image_size(const scene::Image& image) {
-  std::unique_ptr<OIIO::ImageInput> in;
   std::string err;
   OIIO::Filesystem::IOMemReader proxy(image.bytes.data(), image.bytes.size());
-  if (image.embedded()) {
-    in = OIIO::ImageInput::open(embedded_name(image), nullptr, &proxy);
-    if (!in) err = OIIO::geterror();
-  } else {
-    in = scene::open_image_input(image.path, err);
-  }
+  const std::unique_ptr<OIIO::ImageInput> in =
+      image.embedded() ? scene::open_image_input(embedded_name(image), err, &proxy)
+                       : scene::open_image_input(image.path, err);
   if (!in) {
     return Error(ErrorCode::kNotFound,
                  "cannot read the image header" + (err.empty() ? std::string() : " (" + err + ")"));

@@ -6,7 +6,8 @@ layout(push_constant) uniform Push {
   mat4 mvp;
   // xy: level-0 texel size of the texture; z: derivative scale (render size over pass size:
   // the feedback pass runs at reduced resolution but must pick the full-resolution LOD);
-  // w: alpha cutoff, negative when the material has no alpha test.
+  // w: alpha cutoff, negative when the material has no alpha test: kAlphaBlended (-2) for a
+  // blended material, -1 for an opaque one.
   vec4 tex;
   // x: level count, y: page payload, z: page border, w: page size (payload + 2 * border).
   ivec4 vt;
@@ -29,6 +30,12 @@ const int kMaxTaps = 16;
 // the same texels (BC decoding and filtering rounding): the passes flag such fragments so the
 // exact check can tell a flipped alpha test from a wrong texel.
 const float kAlphaEdge = 4.5 / 255.0;
+
+// A blended material's colour is written as it composites, premultiplied by its alpha, in both
+// renders: colour under zero alpha is never seen and must not count (the bake bleeds colour
+// there, the source keeps whatever its artist left).
+const float kAlphaBlended = -2.0;
+bool alpha_blended() { return pc.tex.w <= kAlphaBlended; }
 
 // Anisotropic footprint: `taps` taps (the anisotropy ratio, rounded up, 1..kMaxTaps) along the
 // major axis of the pixel's footprint; the LOD comes from the larger of the minor axis and the

@@ -77,6 +77,6 @@ void main() {
                vec3(intBitsToFloat(pc.vt.x), intBitsToFloat(pc.vt.y), intBitsToFloat(pc.vt.z));
   }
   vec3 c = shade(v_world, shading, srgb_to_linear3(albedo.rgb) * v_color.rgb, orm, emissive);
-  out_color = vec4(linear_to_srgb3(c), 1.0);
+  out_color = vec4(linear_to_srgb3(alpha_blended() ? c * albedo.a : c), 1.0);
   out_covered = 1u;
 }

@@ -92,6 +92,6 @@ void main() {
   vec3 emissive =
       (pc.misc.w & kLitEmissive) != 0 ? srgb_to_linear3(c.emissive.rgb / float(f.taps)) : vec3(0.0);
   vec3 lin = shade(v_world, shading, srgb_to_linear3(albedo.rgb), orm, emissive);
-  out_color = vec4(linear_to_srgb3(lin), 1.0);
+  out_color = vec4(linear_to_srgb3(alpha_blended() ? lin * albedo.a : lin), 1.0);
   out_status = 0x80000000u | uint(l0) | (uint(sampled) << 8);
 }

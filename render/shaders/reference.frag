@@ -31,6 +31,7 @@ void main() {
   }
   c.a *= v_color.a;
   if (pc.tex.w >= 0.0 && c.a < pc.tex.w) discard;
+  if (alpha_blended()) c.rgb *= c.a;
   out_color = c;
   // Bit 1: alpha-tested with alpha within kAlphaEdge of the cutoff (virtual.frag's bit 30).
   out_covered = pc.tex.w >= 0.0 && c.a < pc.tex.w + kAlphaEdge ? 3u : 1u;

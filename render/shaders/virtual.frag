@@ -24,6 +24,7 @@ void main() {
   if (tested && c.a < pc.tex.w) discard;
   bool edge = tested && c.a < pc.tex.w + kAlphaEdge;
   if (pc.misc.w == 1) c.rgb = max(c.rgb, vec3(0.0)) / (1.0 + max(c.rgb, vec3(0.0)));
+  else if (alpha_blended()) c.rgb *= c.a;
   out_color = c;
   // The status bits: VirtualFrame::kStatus* (render/renderer.h).
   out_status = 0x80000000u | (edge ? 0x40000000u : 0u) |

@@ -397,6 +397,75 @@ TEST(Build, OpaqueAlphaDropped) {
   fs::remove_all(dir);
 }
 
+// Colour under zero alpha is lost in the premultiplied working form; stored black, the run
+// time's straight-colour filtering would darken every alpha edge. A half-transparent image whose
+// transparent half is black stores the opaque half's colour there, at every level, alpha 0 kept.
+TEST(Build, ColourUnderZeroAlphaIsTheEdgeColourNotBlack) {
+  const uint32_t w = 40, h = 30, opaque_w = 26;  // every level-0 page (payload 24) has alpha
+  const uint8_t colour[3] = {200, 120, 40};
+  std::vector<float> t(size_t(w) * h * 4, 0.0f);
+  for (uint32_t y = 0; y < h; ++y)
+    for (uint32_t x = 0; x < opaque_w; ++x) {
+      for (int c = 0; c < 3; ++c) t[(size_t(y) * w + x) * 4 + c] = colour[c] / 255.0f;
+      t[(size_t(y) * w + x) * 4 + 3] = 1.0f;
+    }
+  ImageInfo info;
+  info.width = w, info.height = h, info.channels = 4, info.alpha_channel = 3;
+  info.color_space = "sRGB";
+  BuildOptions o;
+  o.layers.push_back(
+      test::layer_input(LayerSemantic::kAlbedo, std::make_shared<MemoryImageSource>(info, t)));
+  o.payload = 24;
+  o.codec.codec = CodecKind::kRaw;
+  o.filter = MipFilter::kBox;  // Kaiser's overshoot at the alpha edge moves level 1 by a code
+  auto built = test::build_in_memory(o);
+  ASSERT_TRUE(built);
+  auto enc = test::encoder_for(*built, 0, o);
+  const PageGeometry& g = built->desc.geometry;
+  for (uint32_t l = 0; l < 2; ++l) {
+    std::vector<uint8_t> present;
+    auto level = test::reassemble_level(*built, 0, l, enc, &present);
+    size_t transparent = 0;
+    for (size_t i = 0; i < size_t(g.level_width(l)) * g.level_height(l); ++i) {
+      ASSERT_TRUE(present[i]) << "level " << l << " texel " << i;
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(level[i * 4 + c], colour[c]) << l << " " << i;
+      transparent += level[i * 4 + 3] == 0;
+    }
+    EXPECT_GT(transparent, 0u) << "level " << l;  // alpha 0 stays 0 where it was
+  }
+}
+
+// PNG stores straight colour: a translucent texel's colour is baked as stored, not as
+// OpenImageIO's default read gives it (premultiplied, so a second premultiply darkened it).
+TEST(Build, TranslucentPngTexelsKeepTheirColour) {
+  fs::path dir = temp_dir();
+  const uint32_t w = 8, h = 8;
+  const uint8_t texel[4] = {100, 40, 190, 40};
+  std::vector<float> t(size_t(w) * h * 4);
+  for (size_t i = 0; i < size_t(w) * h; ++i)
+    for (int c = 0; c < 4; ++c) t[i * 4 + c] = (i % 2 ? 255 : texel[c]) / 255.0f;
+  ImageInfo info;
+  info.width = w, info.height = h, info.channels = 4, info.alpha_channel = 3;
+  info.color_space = "sRGB";
+  MemoryImageSource mem(info, t);
+  const std::string png = (dir / "translucent.png").string();
+  ASSERT_TRUE(write_image_file(mem, png).ok());
+  auto src = open_image_file(png);
+  ASSERT_TRUE(src.ok()) << src.status().message();
+  BuildOptions o;
+  o.layers.push_back(test::layer_input(LayerSemantic::kAlbedo,
+                                       std::shared_ptr<ImageSource>(std::move(src).value())));
+  o.payload = 24;
+  o.codec.codec = CodecKind::kRaw;
+  auto built = test::build_in_memory(o);
+  ASSERT_TRUE(built);
+  auto level = test::reassemble_level(*built, 0, 0, test::encoder_for(*built, 0, o));
+  for (size_t i = 0; i < size_t(w) * h; ++i)
+    for (int c = 0; c < 4; ++c)
+      ASSERT_EQ(level[i * 4 + c], i % 2 ? 255 : texel[c]) << i << " " << c;
+  fs::remove_all(dir);
+}
+
 TEST(Build, MissingFileIsAClearError) {
   auto src = open_image_file("/nonexistent/dir/missing.exr");
   ASSERT_FALSE(src.ok());

@@ -259,5 +259,29 @@ TEST(PullPush, NothingOrEverythingCoveredIsLeftAlone) {
   EXPECT_EQ(img, (std::vector<float>{1, 2, 3, 4}));
 }
 
+// Straight colour back from premultiplied: under zero alpha, the alpha-weighted colour of the
+// texels around (not a plain mean: a texel at alpha 0.75 outweighs one at 0.25), alpha kept 0;
+// a page without alpha anywhere stays black.
+TEST(UnpremultiplyPage, ColourUnderZeroAlphaIsBledFromTheTexelsAround) {
+  std::vector<float> page(4 * 4 * 4, 0.0f);
+  const float red_a = 0.75f, green_a = 0.25f;
+  page[0 * 4 + 0] = 1.0f * red_a, page[0 * 4 + 3] = red_a;      // texel (0, 0): red
+  page[1 * 4 + 1] = 0.5f * green_a, page[1 * 4 + 3] = green_a;  // texel (1, 0): half green
+  unpremultiply_page(page.data(), 4, 4, 3);
+  EXPECT_FLOAT_EQ(page[0], 1.0f);
+  EXPECT_FLOAT_EQ(page[3], red_a);
+  EXPECT_FLOAT_EQ(page[4 + 1], 0.5f);
+  EXPECT_FLOAT_EQ(page[4 + 3], green_a);
+  for (size_t i = 2; i < 16; ++i) {
+    EXPECT_FLOAT_EQ(page[i * 4 + 0], 0.75f) << i;  // (0.75 * 1 + 0.25 * 0) / (0.75 + 0.25)
+    EXPECT_FLOAT_EQ(page[i * 4 + 1], 0.125f) << i;
+    EXPECT_EQ(page[i * 4 + 2], 0.0f) << i;
+    EXPECT_EQ(page[i * 4 + 3], 0.0f) << i;
+  }
+  std::vector<float> empty(4 * 4 * 4, 0.0f);
+  unpremultiply_page(empty.data(), 4, 4, 3);
+  EXPECT_EQ(empty, std::vector<float>(4 * 4 * 4, 0.0f));
+}
+
 }  // namespace
 }  // namespace vt

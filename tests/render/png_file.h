@@ -13,7 +13,8 @@ namespace vt::render {
 inline bool write_png_file(const std::string& path, int width, int height, int channels,
                            const std::vector<uint8_t>& texels) {
   auto out = OIIO::ImageOutput::create(path);
-  const OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::UINT8);
+  OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::UINT8);
+  spec.attribute("oiio:UnassociatedAlpha", 1);  // texels as given: straight colour
   return out && out->open(path, spec) && out->write_image(OIIO::TypeDesc::UINT8, texels.data()) &&
          out->close();
 }

@@ -314,6 +314,30 @@ TEST(ReferenceRules, AlphaMaskDiscardsBelowTheCutoff) {
   EXPECT_GT(empty, 100);
 }
 
+// A blended material is written as it composites: colour premultiplied by alpha (the cells at
+// alpha 40 read 40/255 of their colour), alpha as sampled.
+TEST(ReferenceRules, AlphaBlendWritesColourPremultiplied) {
+  REQUIRE_VULKAN();
+  const std::string png = cell_png("blend_ref", true);
+  ASSERT_FALSE(png.empty());
+  scene::Material m = textured(scene::WrapMode::kRepeat, scene::WrapMode::kRepeat);
+  m.alpha_mode = scene::AlphaMode::kBlend;
+  auto f = render_reference_of(one_primitive_scene(screen_quad(0, 0, 1), m, png));
+  ASSERT_TRUE(f.ok()) << f.status().message();
+  int translucent = 0;
+  const int n = compare_pixels(
+      *f, m.base_color_texture, 0, 0, 1, near_cell_centre,
+      [&](auto pos) -> std::optional<Texel> {
+        Texel t = cell_at(pos, true);
+        translucent += t[3] < 255;
+        for (int c = 0; c < 3; ++c) t[c] = uint8_t(std::lround(t[c] * (t[3] / 255.0)));
+        return t;
+      },
+      2);
+  EXPECT_GT(n, 200);
+  EXPECT_GT(translucent, 100);
+}
+
 // A UV-sphere pole seen from above (earthCylindrical.DAE's cap): one pole vertex at u = 0.5
 // shared by a fan of kPoleFan triangles whose ring vertices run u = 0 .. 1 at t = 1, so each
 // triangle but the middle ones shears up to half the texture across its height. The texture is
@@ -542,6 +566,20 @@ TEST(ReferenceRulesBake, AlphaMaskValidates) {
   m.alpha_mode = scene::AlphaMode::kMask;
   m.alpha_cutoff = 0.5f;
   bake_and_validate("mask", box(false, 0, 1), m);
+}
+
+// A blended face whose colour under zero alpha (column 0: blue 255, where the rest is 96) is
+// not what the bake keeps there (colour bled from the texels with alpha): invisible, so both
+// renders write colour premultiplied and it does not count.
+TEST(ReferenceRulesBake, BlendedColourUnderZeroAlphaValidates) {
+  REQUIRE_VULKAN();
+  scene::Material m = textured(scene::WrapMode::kMirroredRepeat, scene::WrapMode::kMirroredRepeat);
+  m.alpha_mode = scene::AlphaMode::kBlend;
+  bake_and_validate("blend", box(false, 0, 1), m, {}, [](int x, int y) {
+    Texel t = ramp_texel(x, y);
+    if (x == 0) t[2] = 255;
+    return t;
+  });
 }
 
 // A closed box with holes: the faces seen through them stream the levels they want only when the
