@@ -1,5 +1,6 @@
 // The build pipeline end to end: non-finite policies, coverage and absent pages, determinism
 // across thread counts, the out-of-core path, codecs, and a file written and read back.
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -463,6 +464,34 @@ TEST(Build, TranslucentPngTexelsKeepTheirColour) {
   for (size_t i = 0; i < size_t(w) * h; ++i)
     for (int c = 0; c < 4; ++c)
       ASSERT_EQ(level[i * 4 + c], i % 2 ? 255 : texel[c]) << i << " " << c;
+  fs::remove_all(dir);
+}
+
+// OpenEXR stores colour premultiplied: written so, and divided out again when read, so that an
+// EXR reads as straight colour like every other file.
+TEST(Build, ExrColourIsPremultipliedInTheFileAndStraightWhenRead) {
+  fs::path dir = temp_dir();
+  const std::vector<float> t = {0.8f, 0.4f, 0.2f, 0.25f, 2.0f, 1.0f, 0.5f, 1.0f};  // 2 x 1
+  ImageInfo info;
+  info.width = 2, info.height = 1, info.channels = 4, info.alpha_channel = 3;
+  info.is_float = true;
+  info.color_space = "linear";
+  MemoryImageSource mem(info, t);
+  const std::string exr = (dir / "translucent.exr").string();
+  ASSERT_TRUE(write_image_file(mem, exr).ok());
+  {
+    auto raw = OIIO::ImageInput::open(exr);
+    ASSERT_TRUE(raw);
+    std::vector<float> stored(8);
+    ASSERT_TRUE(raw->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, stored.data()));
+    EXPECT_NEAR(stored[0], 0.8f * 0.25f, 1e-3f);  // half floats
+    EXPECT_NEAR(stored[4], 2.0f, 1e-3f);
+  }
+  auto src = open_image_file(exr);
+  ASSERT_TRUE(src.ok()) << src.status().message();
+  std::vector<float> back(8);
+  ASSERT_TRUE((*src)->read_rows(0, 1, back.data()).ok());
+  for (size_t i = 0; i < t.size(); ++i) EXPECT_NEAR(back[i], t[i], t[i] / 1024) << i;
   fs::remove_all(dir);
 }
 
