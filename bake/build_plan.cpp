@@ -89,7 +89,7 @@ Expected<LayerPlan> plan_layer(const LayerInput& in, const BuildOptions& options
     p.to_storage = std::move(to_store).value();
     p.spec.color_space = want_float ? ColorSpace::kLinear : ColorSpace::kSrgb;
     for (uint32_t c = 0; c < p.work_channels; ++c) p.rules.min_value[c] = 0;
-    if (p.alpha >= 0) p.rules.max_value[p.alpha] = 1;
+    if (p.alpha >= 0) p.rules.max_value[p.alpha] = 1, p.rules.premultiplied_alpha = p.alpha;
   } else {
     // ORM and custom layers are data: no colour conversion.
     p.work_channels = info.channels;

@@ -224,6 +224,10 @@ void downsample_rows(const DownsampleKernel& kernel, const DownsampleRules& rule
             a[0] = 0, a[1] = 0, a[2] = 1;
           }
         }
+        if (const int pa = rules.premultiplied_alpha; pa >= 0 && a[pa] > rules.max_value[pa]) {
+          const double scale = rules.max_value[pa] / a[pa];
+          for (uint32_t c = 0; c < ch; ++c) a[c] *= scale;
+        }
         for (uint32_t c = 0; c < ch; ++c) {
           double v = std::clamp(a[c], double(rules.min_value[c]), double(rules.max_value[c]));
           o[size_t(i) * ch + c] = float(v);

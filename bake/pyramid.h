@@ -59,6 +59,10 @@ struct DownsampleRules {
   bool renormalize_xyz = false;               // channels 0-2 are a normal: rescale to unit length
   float min_value[4] = {-3.4028235e38f, -3.4028235e38f, -3.4028235e38f, -3.4028235e38f};
   float max_value[4] = {3.4028235e38f, 3.4028235e38f, 3.4028235e38f, 3.4028235e38f};
+  // The alpha channel colour is premultiplied by, or -1: where a filter's overshoot takes alpha
+  // past its max_value, colour is scaled down with it (clamping alpha alone brightened the
+  // straight colour at alpha edges by the overshoot, up to a few percent with Kaiser).
+  int premultiplied_alpha = -1;
 };
 
 // Computes rows [y0, y1) of the half-size level (width (src.width + 1) / 2) into `out`. `src`

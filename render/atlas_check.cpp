@@ -166,7 +166,8 @@ Expected<ReferenceLayer> make_reference_layer(uint32_t index, const LayerSpec& s
       if (u8 || is_colour(spec.semantic)) r.rules.min_value[c] = 0;
       if (u8 && !is_colour(spec.semantic)) r.rules.max_value[c] = 1;
     }
-    if (is_colour(spec.semantic) && r.work_channels == 4) r.rules.max_value[3] = 1;
+    if (is_colour(spec.semantic) && r.work_channels == 4)
+      r.rules.max_value[3] = 1, r.rules.premultiplied_alpha = 3;
   }
   r.rules.address = spec.address_mode;
   if (is_colour(spec.semantic)) {
