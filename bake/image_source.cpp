@@ -108,7 +108,7 @@ class FileImageSource final : public ImageSource {
  private:
   // A file of premultiplied colour (OpenEXR) reads as straight colour, as every other does.
   void straighten(float* texels, size_t count) const {
-    const int a = scene::associated_alpha_channel(in_->spec(), int(info_.channels));
+    const int a = scene::associated_alpha_channel(*in_, int(info_.channels));
     if (a >= 0) scene::unassociate_alpha(texels, count, int(info_.channels), a);
   }
 

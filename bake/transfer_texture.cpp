@@ -52,7 +52,7 @@ Expected<TransferTexture> TransferTexture::load(const std::string& path,
     if (!in->read_image(0, m, 0, channels, OIIO::TypeDesc::FLOAT, texels)) {
       return Error(ErrorCode::kIo, "cannot read its texels (" + first_line(in->geterror()) + ")");
     }
-    if (const int a = scene::associated_alpha_channel(spec, channels); a >= 0)
+    if (const int a = scene::associated_alpha_channel(*in, channels); a >= 0)
       scene::unassociate_alpha(texels, count, channels, a);
     tex.levels_.push_back(level);
   }

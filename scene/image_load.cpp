@@ -38,9 +38,15 @@ std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path, std:
   return in;
 }
 
-int associated_alpha_channel(const OIIO::ImageSpec& spec, int channels) {
-  // open_image_input asks for straight colour: the formats that store it say so.
-  const bool associated = spec.get_int_attribute("oiio:UnassociatedAlpha", 0) == 0;
+int associated_alpha_channel(const OIIO::ImageInput& in, int channels) {
+  // A TIFF says which it stores (OpenImageIO marks the unassociated kind, which open_image_input
+  // asks to keep as stored); OpenEXR is premultiplied by definition. Formats that know no such
+  // thing (SGI, BMP, DDS, ...) store straight colour.
+  const OIIO::ImageSpec& spec = in.spec();
+  const std::string format = in.format_name();
+  const bool associated =
+      format == "openexr" ||
+      (format == "tiff" && spec.get_int_attribute("oiio:UnassociatedAlpha", 0) == 0);
   return associated && spec.alpha_channel >= 0 && spec.alpha_channel < channels ? spec.alpha_channel
                                                                                 : -1;
 }
@@ -71,7 +77,7 @@ Expected<FloatImage> load_float_image(const scene::Image& image) {
   if (!in->read_image(0, 0, 0, ch, OIIO::TypeDesc::FLOAT, px.data())) {
     return Error(ErrorCode::kCorrupt, "cannot read image '" + name + "': " + in->geterror());
   }
-  if (const int a = associated_alpha_channel(spec, ch); a >= 0)
+  if (const int a = associated_alpha_channel(*in, ch); a >= 0)
     unassociate_alpha(px.data(), px.size() / size_t(ch), ch, a);
   FloatImage out;
   out.width = uint32_t(spec.width);

@@ -33,10 +33,11 @@ struct FloatImage {
 std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path, std::string& error,
                                                    OIIO::Filesystem::IOProxy* proxy = nullptr);
 
-// The channel of `spec` whose alpha the file's colour is premultiplied by (OpenEXR's convention, a
-// TIFF of associated alpha), when it is one of the first `channels` read; -1 when colour is
-// straight. Readers divide it out (unassociate_alpha) so that every image reads straight.
-int associated_alpha_channel(const OIIO::ImageSpec& spec, int channels);
+// The channel whose alpha the colour `in` reads is premultiplied by (OpenEXR's convention, a TIFF
+// of associated alpha), when it is one of the first `channels` read; -1 when colour is straight
+// (every other format: PNG, TGA, SGI, DDS, ...). Readers divide it out (unassociate_alpha) so
+// that every image reads straight.
+int associated_alpha_channel(const OIIO::ImageInput& in, int channels);
 // Colour (every channel but `alpha`) divided by alpha in `count` texels of `channels` floats;
 // where alpha is 0 colour is left as stored.
 void unassociate_alpha(float* texels, size_t count, int channels, int alpha);

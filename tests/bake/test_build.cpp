@@ -435,9 +435,10 @@ TEST(Build, ColourUnderZeroAlphaIsTheEdgeColourNotBlack) {
   }
 }
 
-// PNG stores straight colour: a translucent texel's colour is baked as stored, not as
-// OpenImageIO's default read gives it (premultiplied, so a second premultiply darkened it).
-TEST(Build, TranslucentPngTexelsKeepTheirColour) {
+// PNG, TGA and SGI store straight colour: a translucent texel's colour is baked as stored, not
+// as OpenImageIO's default read gives PNG and TGA (premultiplied, so a second premultiply
+// darkened them), nor divided by alpha where a format has no word on it (SGI).
+TEST(Build, TranslucentTexelsKeepTheirColour) {
   fs::path dir = temp_dir();
   const uint32_t w = 8, h = 8;
   const uint8_t texel[4] = {100, 40, 190, 40};
@@ -448,21 +449,23 @@ TEST(Build, TranslucentPngTexelsKeepTheirColour) {
   info.width = w, info.height = h, info.channels = 4, info.alpha_channel = 3;
   info.color_space = "sRGB";
   MemoryImageSource mem(info, t);
-  const std::string png = (dir / "translucent.png").string();
-  ASSERT_TRUE(write_image_file(mem, png).ok());
-  auto src = open_image_file(png);
-  ASSERT_TRUE(src.ok()) << src.status().message();
-  BuildOptions o;
-  o.layers.push_back(test::layer_input(LayerSemantic::kAlbedo,
-                                       std::shared_ptr<ImageSource>(std::move(src).value())));
-  o.payload = 24;
-  o.codec.codec = CodecKind::kRaw;
-  auto built = test::build_in_memory(o);
-  ASSERT_TRUE(built);
-  auto level = test::reassemble_level(*built, 0, 0, test::encoder_for(*built, 0, o));
-  for (size_t i = 0; i < size_t(w) * h; ++i)
-    for (int c = 0; c < 4; ++c)
-      ASSERT_EQ(level[i * 4 + c], i % 2 ? 255 : texel[c]) << i << " " << c;
+  for (const char* name : {"translucent.png", "translucent.tga", "translucent.sgi"}) {
+    const std::string path = (dir / name).string();
+    ASSERT_TRUE(write_image_file(mem, path).ok()) << name;
+    auto src = open_image_file(path);
+    ASSERT_TRUE(src.ok()) << src.status().message();
+    BuildOptions o;
+    o.layers.push_back(test::layer_input(LayerSemantic::kAlbedo,
+                                         std::shared_ptr<ImageSource>(std::move(src).value())));
+    o.payload = 24;
+    o.codec.codec = CodecKind::kRaw;
+    auto built = test::build_in_memory(o);
+    ASSERT_TRUE(built);
+    auto level = test::reassemble_level(*built, 0, 0, test::encoder_for(*built, 0, o));
+    for (size_t i = 0; i < size_t(w) * h; ++i)
+      for (int c = 0; c < 4; ++c)
+        ASSERT_EQ(level[i * 4 + c], i % 2 ? 255 : texel[c]) << name << " " << i << " " << c;
+  }
   fs::remove_all(dir);
 }
 
