@@ -3,6 +3,7 @@
 // ancestor, upsampled nearest (docs/FORMAT.md, "Extracting a level"). The texels are written
 // as stored: a colour layer's alpha is unassociated (PNG's convention), and a 2- or 4-channel
 // data layer (normal XY, custom) has no alpha at all, so nothing is divided by a last channel.
+// OpenEXR alone stores colour premultiplied: a colour layer with alpha goes in multiplied.
 #include <cstdio>
 #include <filesystem>
 

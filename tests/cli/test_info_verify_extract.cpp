@@ -196,6 +196,41 @@ TEST(CliExtract, RoundTripsEveryLevelExactly) {
   EXPECT_EQ(run("extract " + t.path + " -o " + png).exit_code, 2);  // --level is required
 }
 
+// OpenEXR stores colour premultiplied by alpha: an RGBA colour layer goes in multiplied (and
+// vtbake's reader divides it out again); alpha as stored.
+TEST(CliExtract, AlphaColourLayerToExrIsPremultiplied) {
+  PageFileDesc desc;
+  desc.geometry = {20, 12, 8, 2};
+  desc.layers = {layer("albedo", 4, TexelType::kU8, PageCodec::kRawZstd)};
+  const PageGeometry& g = desc.geometry;
+  auto levels = random_levels(g, 4, 11);
+  const std::string path = temp_path("rgba.vtpf");
+  {
+    auto w = PageFileWriter::create(path, desc);
+    ASSERT_TRUE(w.ok());
+    for (uint32_t y = 0; y < g.pages_y(0); ++y)
+      for (uint32_t x = 0; x < g.pages_x(0); ++x) {
+        auto p = cut_page(levels[0], g.level_width(0), g.level_height(0), 4, g, {0, x, y});
+        std::vector<uint8_t> z;
+        ASSERT_TRUE(zstd_compress(p, 1, z).ok());
+        ASSERT_TRUE((*w)->add_page({0, x, y}, 0, z).ok());
+      }
+    ASSERT_TRUE((*w)->finish().ok());
+  }
+  const std::string exr = temp_path("rgba.exr");
+  ASSERT_EQ(run("-q extract " + path + " --level 0 -o " + exr).exit_code, 0);
+  auto in = OIIO::ImageInput::open(exr);
+  ASSERT_TRUE(in);
+  ASSERT_EQ(in->spec().nchannels, 4);
+  std::vector<float> f(levels[0].size());
+  ASSERT_TRUE(in->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, f.data()));
+  for (size_t i = 0; i < f.size(); i += 4) {
+    const float a = levels[0][i + 3] / 255.0f;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(f[i + c], levels[0][i + c] / 255.0f * a, 1e-3f) << i;
+    EXPECT_NEAR(f[i + 3], a, 1e-3f) << i;
+  }
+}
+
 TEST(CliExtract, HalfFloatLayerToExrIsExact) {
   PageFileDesc desc;
   desc.geometry = {20, 12, 8, 2};
