@@ -67,6 +67,7 @@ class FileImageSource final : public ImageSource {
     const OIIO::ImageSpec& spec = in_->spec();
     tile_w_ = uint32_t(std::max(spec.tile_width, 0));
     tile_h_ = uint32_t(std::max(spec.tile_height, 0));
+    associated_alpha_ = scene::associated_alpha_channel(*in_, int(info_.channels));
   }
 
   const ImageInfo& info() const override { return info_; }
@@ -108,8 +109,8 @@ class FileImageSource final : public ImageSource {
  private:
   // A file of premultiplied colour (OpenEXR) reads as straight colour, as every other does.
   void straighten(float* texels, size_t count) const {
-    const int a = scene::associated_alpha_channel(*in_, int(info_.channels));
-    if (a >= 0) scene::unassociate_alpha(texels, count, int(info_.channels), a);
+    if (associated_alpha_ >= 0)
+      scene::unassociate_alpha(texels, count, int(info_.channels), associated_alpha_);
   }
 
   std::string path_;
@@ -117,6 +118,7 @@ class FileImageSource final : public ImageSource {
   ImageInfo info_;
   uint32_t file_channels_ = 0;
   uint32_t tile_w_ = 0, tile_h_ = 0;
+  int associated_alpha_ = -1;  // scene::associated_alpha_channel, once
   std::vector<float> tile_buf_;
 };
 
@@ -210,11 +212,9 @@ Status write_image_file(ImageSource& source, const std::string& path, uint32_t t
     for (uint32_t y = 0; y < info.height; y += band) {
       uint32_t y1 = std::min(info.height, y + band);
       VT_RETURN_IF_ERROR(source.read_rows(y, y1, rows.data()));
-      for (size_t i = 0; premultiply && i < size_t(y1 - y) * info.width; ++i) {
-        float* t = &rows[i * info.channels];
-        for (uint32_t c = 0; c < info.channels; ++c)
-          if (int(c) != info.alpha_channel) t[c] *= t[info.alpha_channel];
-      }
+      if (premultiply)
+        scene::associate_alpha(rows.data(), size_t(y1 - y) * info.width, int(info.channels),
+                               info.alpha_channel);
       bool ok = tiled
                     ? out->write_tiles(0, int(info.width), int(y), int(y1), 0, 1,
                                        OIIO::TypeDesc::FLOAT, rows.data())

@@ -2,13 +2,12 @@
 // EXR, TIFF, 16-bit and float images); the light executable writes 8-bit PNG itself.
 #include <OpenImageIO/imageio.h>
 
-#include <cstring>
 #include <string>
 #include <vector>
 
 #include "cli/command.h"
-#include "common/half.h"
 #include "format/atomic_output.h"
+#include "scene/image_load.h"
 
 namespace {
 
@@ -52,24 +51,12 @@ vt::Status write_image_oiio(const std::string& path, const vt::LevelImage& image
   // the layer's straight colour goes in multiplied, as floats, so that it reads back as stored.
   std::vector<float> premultiplied;
   if (spec.alpha_channel >= 0 && std::string(out->format_name()) == "openexr") {
-    const size_t n = size_t(image.width) * image.height * image.channels;
-    premultiplied.resize(n);
-    const uint8_t* t = image.texels.data();
-    for (size_t i = 0; i < n; ++i) {
-      if (image.texel_type == vt::TexelType::kU8) {
-        premultiplied[i] = t[i] / 255.0f;
-      } else if (image.texel_type == vt::TexelType::kF16) {
-        uint16_t h;
-        std::memcpy(&h, t + 2 * i, 2);
-        premultiplied[i] = vt::half_to_float(h);
-      } else {
-        std::memcpy(&premultiplied[i], t + 4 * i, 4);
-      }
-    }
-    const uint32_t ch = image.channels, a = uint32_t(spec.alpha_channel);
-    for (size_t i = 0; i < n; i += ch)
-      for (uint32_t c = 0; c < ch; ++c)
-        if (c != a) premultiplied[i + c] *= premultiplied[i + a];
+    const size_t count = size_t(image.width) * image.height;
+    premultiplied.resize(count * image.channels);
+    OIIO::convert_pixel_values(type, image.texels.data(), OIIO::TypeDesc::FLOAT,
+                               premultiplied.data(), int(premultiplied.size()));
+    vt::scene::associate_alpha(premultiplied.data(), count, int(image.channels),
+                               spec.alpha_channel);
     texels = premultiplied.data();
     type = OIIO::TypeDesc::FLOAT;
   }

@@ -60,6 +60,14 @@ void unassociate_alpha(float* texels, size_t count, int channels, int alpha) {
   }
 }
 
+void associate_alpha(float* texels, size_t count, int channels, int alpha) {
+  for (size_t i = 0; i < count; ++i) {
+    float* t = texels + i * size_t(channels);
+    for (int c = 0; c < channels; ++c)
+      if (c != alpha) t[c] *= t[alpha];
+  }
+}
+
 Expected<FloatImage> load_float_image(const scene::Image& image) {
   OIIO::Filesystem::IOMemReader mem(image.bytes.data(), image.bytes.size());
   const std::string name =

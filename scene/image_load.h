@@ -41,6 +41,8 @@ int associated_alpha_channel(const OIIO::ImageInput& in, int channels);
 // Colour (every channel but `alpha`) divided by alpha in `count` texels of `channels` floats;
 // where alpha is 0 colour is left as stored.
 void unassociate_alpha(float* texels, size_t count, int channels, int alpha);
+// Its inverse, for writers of OpenEXR: colour multiplied by alpha.
+void associate_alpha(float* texels, size_t count, int channels, int alpha);
 
 // Errors name the image: kNotFound when it cannot be opened, kCorrupt when it cannot be read or
 // has a size of 0 or over 65536 per side.
