@@ -531,11 +531,13 @@ Status Transfer::setup_images(const std::vector<bool>* wanted) {
     }
     slot.tried = path;
     bool untiled = false;
+    int channels = 0;  // decided on the file itself: made MIP levels would carry a padding alpha
     {
       auto in = scene::open_image_input(path, slot.error);
       if (!in) continue;  // reported per material slot by check_missing_textures
       const OIIO::ImageSpec& spec = in->spec();
       untiled = spec.tile_width == 0;
+      channels = scene::data_channels(*in);
       if (used_as_colour(scene_, i)) {
         VT_RETURN_IF_ERROR(set_colour_space(slot, img.embedded() ? "" : img.path, spec));
       }
@@ -564,7 +566,8 @@ Status Transfer::setup_images(const std::vector<bool>* wanted) {
         std::filesystem::remove(tx, ec);
       }
     }
-    auto texture = TransferTexture::load(source, slot.to_working.get(), slot.from_working.get());
+    auto texture =
+        TransferTexture::load(source, slot.to_working.get(), slot.from_working.get(), channels);
     if (!texture.ok()) {
       if (texture.status().code() != ErrorCode::kNotFound)
         return texture.status().with_context(slot.name);
@@ -581,7 +584,7 @@ Status Transfer::setup_images(const std::vector<bool>* wanted) {
     };
     VT_ASSIGN_OR_RETURN(slot.texture, keep(*texture));
     if (slot.to_working && used_as_data(scene_, i)) {
-      auto data = TransferTexture::load(source);
+      auto data = TransferTexture::load(source, nullptr, nullptr, channels);
       if (!data.ok()) return data.status().with_context(slot.name);
       VT_ASSIGN_OR_RETURN(slot.data_texture, keep(*data));
     }

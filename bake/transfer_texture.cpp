@@ -33,13 +33,13 @@ inline double finite_or_zero(double x) {
 
 Expected<TransferTexture> TransferTexture::load(const std::string& path,
                                                 const ColorConverter* to_linear,
-                                                const ColorConverter* from_linear) {
+                                                const ColorConverter* from_linear, int channels) {
   std::string error;
   auto in = scene::open_image_input(path, error);
   if (!in) return Error(ErrorCode::kNotFound, error);
   TransferTexture tex;
-  tex.channels_ = std::clamp(in->spec().nchannels, 1, 4);
-  const int channels = tex.channels_;
+  tex.channels_ = std::clamp(channels > 0 ? channels : scene::data_channels(*in), 1, 4);
+  channels = tex.channels_;
   for (int m = 0; in->seek_subimage(0, m); ++m) {
     const OIIO::ImageSpec& spec = in->spec();
     if (spec.width <= 0 || spec.height <= 0 || spec.nchannels < channels) break;

@@ -41,13 +41,15 @@ class TransferTexture {
  public:
   // Reads `path` whole: its own MIP levels when the file has them (a tiled .tx/.exr), else
   // level 0 and box-filtered levels made here (each level half the size, rounded down, at least
-  // 1). At most 4 channels are kept. With `to_linear` and `from_linear` (a colour texture: its
-  // space to linear and back) the made levels average decoded colour channels and store them
-  // re-encoded; null = data, averaged as stored. Errors name the file and give OpenImageIO's
-  // reason; kNotFound when the file cannot be opened, kIo when its texels cannot be read.
+  // 1). The first `channels` are kept (0: the file's data channels, scene::data_channels), at
+  // most 4. With `to_linear` and `from_linear` (a colour texture: its space to linear and back)
+  // the made levels average decoded colour channels and store them re-encoded; null = data,
+  // averaged as stored. Errors name the file and give OpenImageIO's reason; kNotFound when the
+  // file cannot be opened, kIo when its texels cannot be read.
   static Expected<TransferTexture> load(const std::string& path,
                                         const ColorConverter* to_linear = nullptr,
-                                        const ColorConverter* from_linear = nullptr);
+                                        const ColorConverter* from_linear = nullptr,
+                                        int channels = 0);
 
   int channels() const { return channels_; }
   uint32_t width() const { return levels_.empty() ? 0 : levels_[0].width; }

@@ -3,6 +3,7 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 
@@ -36,6 +37,29 @@ std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path, std:
     return nullptr;
   }
   return in;
+}
+
+int data_channels(OIIO::ImageInput& in) {
+  const OIIO::ImageSpec& spec = in.spec();
+  const int alpha = spec.alpha_channel;
+  const std::string format = in.format_name();
+  if ((format != "bmp" && format != "targa") || alpha < 0 || alpha != spec.nchannels - 1 ||
+      spec.width <= 0 || spec.height <= 0)
+    return spec.nchannels;
+  const int band = std::max(1, (1 << 20) / spec.width);
+  std::vector<uint8_t> a(size_t(spec.width) * size_t(std::min(band, spec.height)));
+  for (int y = 0; y < spec.height; y += band) {
+    const int y1 = std::min(spec.height, y + band);
+    if (!in.read_scanlines(0, 0, spec.y + y, spec.y + y1, 0, alpha, alpha + 1,
+                           OIIO::TypeDesc::UINT8, a.data())) {
+      (void)in.geterror();  // the texels' read reports it
+      return spec.nchannels;
+    }
+    const size_t n = size_t(spec.width) * size_t(y1 - y);
+    if (std::any_of(a.begin(), a.begin() + std::ptrdiff_t(n), [](uint8_t v) { return v != 0; }))
+      return spec.nchannels;
+  }
+  return alpha;
 }
 
 int associated_alpha_channel(const OIIO::ImageInput& in, int channels) {
@@ -77,7 +101,7 @@ Expected<FloatImage> load_float_image(const scene::Image& image) {
       open_image_input(name, error, image.embedded() ? &mem : nullptr);
   if (!in) return Error(ErrorCode::kNotFound, "cannot open image '" + name + "': " + error);
   const OIIO::ImageSpec& spec = in->spec();
-  const int ch = spec.nchannels;
+  const int ch = data_channels(*in);
   if (spec.width <= 0 || spec.height <= 0 || ch <= 0 || spec.width > 65536 || spec.height > 65536) {
     return Error(ErrorCode::kCorrupt, "image '" + name + "' has a bad size");
   }

@@ -13,6 +13,7 @@
 #include "format/page_file_inspect.h"
 #include "samples/procedural.h"
 #include "tests/bake/bake_test_util.h"
+#include "tests/scene/bmp_tga_files.h"
 
 namespace vt {
 namespace {
@@ -466,6 +467,51 @@ TEST(Build, TranslucentTexelsKeepTheirColour) {
       for (int c = 0; c < 4; ++c)
         ASSERT_EQ(level[i * 4 + c], i % 2 ? 255 : texel[c]) << name << " " << i << " " << c;
   }
+  fs::remove_all(dir);
+}
+
+// A BMP or TGA whose fourth byte is 0 everywhere holds no alpha (BI_RGB padding, a TGA header with
+// no alpha bits): read as RGB, not as a fully transparent image. Alpha that is not 0 everywhere,
+// and a zero alpha in formats that only store real alpha (PNG), stay.
+TEST(Build, PaddingAlphaOfBmpAndTgaReadsOpaque) {
+  fs::path dir = temp_dir();
+  const uint32_t w = 5, h = 3;
+  std::vector<uint8_t> rgba(size_t(w) * h * 4);
+  for (size_t i = 0; i < size_t(w) * h; ++i)
+    for (int c = 0; c < 3; ++c) rgba[i * 4 + c] = uint8_t(17 * i + 80 * c);
+  auto check = [&](const std::string& path, uint32_t channels) {
+    auto src = open_image_file(path);
+    ASSERT_TRUE(src.ok()) << src.status().message();
+    const ImageInfo& info = (*src)->info();
+    ASSERT_EQ(info.channels, channels) << path;
+    EXPECT_EQ(info.alpha_channel, channels == 4 ? 3 : -1) << path;
+    std::vector<float> texels(size_t(w) * h * channels);
+    ASSERT_TRUE((*src)->read_rows(0, h, texels.data()).ok());
+    for (size_t i = 0; i < size_t(w) * h; ++i)
+      for (uint32_t c = 0; c < channels; ++c)
+        ASSERT_EQ(std::lround(texels[i * channels + c] * 255), rgba[i * 4 + c]) << path << " " << i;
+  };
+  const std::string bmp = (dir / "padding.bmp").string(), tga = (dir / "padding.tga").string();
+  ASSERT_TRUE(test::write_bmp32(bmp, w, h, rgba));
+  check(bmp, 3);
+  for (uint8_t bits : {0, 8}) {
+    ASSERT_TRUE(test::write_tga32(tga, w, h, rgba, bits));
+    check(tga, 3);
+  }
+  rgba[7 * 4 + 3] = 1;  // one texel with alpha: the channel is alpha
+  ASSERT_TRUE(test::write_bmp32(bmp, w, h, rgba));
+  check(bmp, 4);
+  ASSERT_TRUE(test::write_tga32(tga, w, h, rgba, 0));
+  check(tga, 4);
+  rgba[7 * 4 + 3] = 0;
+  std::vector<float> zero_alpha(rgba.begin(), rgba.end());
+  for (float& v : zero_alpha) v /= 255;
+  ImageInfo info;
+  info.width = w, info.height = h, info.channels = 4, info.alpha_channel = 3;
+  MemoryImageSource mem(info, zero_alpha);
+  const std::string png = (dir / "transparent.png").string();
+  ASSERT_TRUE(write_image_file(mem, png).ok());
+  check(png, 4);
   fs::remove_all(dir);
 }
 

@@ -11,6 +11,8 @@
 
 #include "bake/color.h"
 #include "bake/transfer_texture.h"
+#include "scene/image_load.h"
+#include "tests/scene/bmp_tga_files.h"
 #include "tests/transfer/scratch_dir.h"
 
 namespace vt {
@@ -175,6 +177,31 @@ TEST(TransferTexture, UnreadableFileIsNotFound) {
   ASSERT_FALSE(t.ok());
   EXPECT_EQ(t.status().code(), ErrorCode::kNotFound);
   EXPECT_FALSE(t.status().message().empty());
+}
+
+// A 32-bit BMP's padding byte (0 in every texel) is no alpha for the transfer's texture or the
+// validator's reference image: both read the colour, opaque.
+TEST(TransferTexture, BmpPaddingByteIsNotAlpha) {
+  test::ScratchDir dir;
+  const std::string p = dir.file("padding.bmp");
+  const std::vector<uint8_t> rgba = {200, 100, 50, 0, 10, 20, 30, 0};  // 2 x 1
+  ASSERT_TRUE(test::write_bmp32(p, 2, 1, rgba));
+  auto t = TransferTexture::load(p, nullptr);
+  ASSERT_TRUE(t.ok()) << t.status().message();
+  EXPECT_EQ(t->channels(), 3);
+  TextureLookup q;
+  q.s = 0.25, q.t = 0.5, q.nearest = true;
+  float v[4] = {0, 0, 0, 0};
+  t->sample(q, v);
+  EXPECT_NEAR(v[0], 200 / 255.0f, 1e-6f);
+  EXPECT_NEAR(v[2], 50 / 255.0f, 1e-6f);
+  scene::Image image;
+  image.path = p;
+  auto img = scene::load_float_image(image);
+  ASSERT_TRUE(img.ok()) << img.status().message();
+  EXPECT_EQ(img->channels, 3u);
+  EXPECT_EQ(img->at(1, 0)[3], 1.0f);
+  EXPECT_NEAR(img->at(1, 0)[2], 30 / 255.0f, 1e-6f);
 }
 
 }  // namespace
