@@ -472,8 +472,11 @@ Status Transfer::set_colour_space(ImageSlot& slot, const std::string& path,
   const bool is_float = spec.format.basetype == OIIO::TypeDesc::FLOAT ||
                         spec.format.basetype == OIIO::TypeDesc::HALF ||
                         spec.format.basetype == OIIO::TypeDesc::DOUBLE;
-  const std::string space =
-      colours.texture_space(path, spec.get_string_attribute("oiio:ColorSpace"), is_float);
+  // A scene's 8/16-bit colour texture is sRGB by its slot whatever its file says (a PNG gAMA, a
+  // TGA gamma): glTF requires it, other tools read them so, and so does the validator's
+  // reference. Float files keep their metadata (their space), and the config's file rules win.
+  const std::string space = colours.texture_space(
+      path, is_float ? std::string(spec.get_string_attribute("oiio:ColorSpace")) : "", is_float);
   auto converter = colours.converter(space, colours.working_space());
   if (!converter.ok()) return converter.status().with_context(slot.name);
   if ((*converter)->is_identity()) return Status::Ok();

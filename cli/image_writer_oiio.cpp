@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "cli/command.h"
+#include "common/srgb.h"
 #include "format/atomic_output.h"
 #include "scene/image_load.h"
 
@@ -45,19 +46,31 @@ vt::Status write_image_oiio(const std::string& path, const vt::LevelImage& image
     return vt::Error(vt::ErrorCode::kInvalidArgument,
                      path + ": cannot write this kind of image: " + OIIO::geterror());
   OIIO::TypeDesc type = oiio_type(image.texel_type);
-  const OIIO::ImageSpec spec = output_spec(image, layer);
+  OIIO::ImageSpec spec = output_spec(image, layer);
   const void* texels = image.texels.data();
-  // OpenEXR's colour is premultiplied by its alpha (readers, vtbake's included, divide it out):
-  // the layer's straight colour goes in multiplied, as floats, so that it reads back as stored.
-  std::vector<float> premultiplied;
-  if (spec.alpha_channel >= 0 && std::string(out->format_name()) == "openexr") {
+  // OpenEXR and Radiance HDR hold linear light (readers, vtbake's included, take them so): an
+  // sRGB layer's colour goes in decoded. OpenEXR's colour is also premultiplied by its alpha:
+  // the layer's straight colour goes in multiplied. Both as floats, so that they read back as
+  // stored. Other formats get the stored values, tagged with the layer's encoding.
+  const std::string format = out->format_name();
+  const bool srgb = layer.color_space == vt::ColorSpace::kSrgb;
+  const bool decode = srgb && (format == "openexr" || format == "hdr");
+  const bool premultiply = spec.alpha_channel >= 0 && format == "openexr";
+  spec.attribute("oiio:ColorSpace", srgb && !decode ? "sRGB" : "Linear");
+  std::vector<float> converted;
+  if (decode || premultiply) {
     const size_t count = size_t(image.width) * image.height;
-    premultiplied.resize(count * image.channels);
-    OIIO::convert_pixel_values(type, image.texels.data(), OIIO::TypeDesc::FLOAT,
-                               premultiplied.data(), int(premultiplied.size()));
-    vt::scene::associate_alpha(premultiplied.data(), count, int(image.channels),
-                               spec.alpha_channel);
-    texels = premultiplied.data();
+    converted.resize(count * image.channels);
+    OIIO::convert_pixel_values(type, image.texels.data(), OIIO::TypeDesc::FLOAT, converted.data(),
+                               int(converted.size()));
+    if (decode) {
+      for (size_t i = 0; i < converted.size(); ++i)
+        if (int(i % image.channels) != spec.alpha_channel)
+          converted[i] = vt::srgb_to_linear(converted[i]);
+    }
+    if (premultiply)
+      vt::scene::associate_alpha(converted.data(), count, int(image.channels), spec.alpha_channel);
+    texels = converted.data();
     type = OIIO::TypeDesc::FLOAT;
   }
   return vt::write_output(path, [&](const std::string& temp) -> vt::Status {

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "common/srgb.h"
 #include "format/page_file.h"
 #include "tests/cli/cli_test_util.h"
 #include "tests/format/page_file_test_util.h"
@@ -196,6 +197,22 @@ TEST(CliExtract, RoundTripsEveryLevelExactly) {
   EXPECT_EQ(run("extract " + t.path + " -o " + png).exit_code, 2);  // --level is required
 }
 
+// A one-layer file at `path` whose level 0 pages are cut from `level` (texel_bytes each).
+void write_level0(const std::string& path, const PageFileDesc& desc,
+                  const std::vector<uint8_t>& level, uint32_t texel_bytes) {
+  const PageGeometry& g = desc.geometry;
+  auto w = PageFileWriter::create(path, desc);
+  ASSERT_TRUE(w.ok());
+  for (uint32_t y = 0; y < g.pages_y(0); ++y)
+    for (uint32_t x = 0; x < g.pages_x(0); ++x) {
+      auto p = cut_page(level, g.level_width(0), g.level_height(0), texel_bytes, g, {0, x, y});
+      std::vector<uint8_t> z;
+      ASSERT_TRUE(zstd_compress(p, 1, z).ok());
+      ASSERT_TRUE((*w)->add_page({0, x, y}, 0, z).ok());
+    }
+  ASSERT_TRUE((*w)->finish().ok());
+}
+
 // OpenEXR stores colour premultiplied by alpha: an RGBA colour layer goes in multiplied (and
 // vtbake's reader divides it out again); alpha as stored.
 TEST(CliExtract, AlphaColourLayerToExrIsPremultiplied) {
@@ -205,18 +222,7 @@ TEST(CliExtract, AlphaColourLayerToExrIsPremultiplied) {
   const PageGeometry& g = desc.geometry;
   auto levels = random_levels(g, 4, 11);
   const std::string path = temp_path("rgba.vtpf");
-  {
-    auto w = PageFileWriter::create(path, desc);
-    ASSERT_TRUE(w.ok());
-    for (uint32_t y = 0; y < g.pages_y(0); ++y)
-      for (uint32_t x = 0; x < g.pages_x(0); ++x) {
-        auto p = cut_page(levels[0], g.level_width(0), g.level_height(0), 4, g, {0, x, y});
-        std::vector<uint8_t> z;
-        ASSERT_TRUE(zstd_compress(p, 1, z).ok());
-        ASSERT_TRUE((*w)->add_page({0, x, y}, 0, z).ok());
-      }
-    ASSERT_TRUE((*w)->finish().ok());
-  }
+  write_level0(path, desc, levels[0], 4);
   const std::string exr = temp_path("rgba.exr");
   ASSERT_EQ(run("-q extract " + path + " --level 0 -o " + exr).exit_code, 0);
   auto in = OIIO::ImageInput::open(exr);
@@ -231,6 +237,41 @@ TEST(CliExtract, AlphaColourLayerToExrIsPremultiplied) {
   }
 }
 
+// OpenEXR holds linear light: an sRGB layer's colour goes in decoded (then premultiplied), so
+// that readers (vtbake's build among them) take it as the colour it is. Other formats get the
+// stored values, tagged sRGB.
+TEST(CliExtract, SrgbColourLayerToExrIsLinearLight) {
+  PageFileDesc desc;
+  desc.geometry = {20, 12, 8, 2};
+  desc.layers = {layer("albedo", 4, TexelType::kU8, PageCodec::kRawZstd)};
+  desc.layers[0].color_space = ColorSpace::kSrgb;
+  auto levels = random_levels(desc.geometry, 4, 13);
+  const std::string path = temp_path("srgb.vtpf");
+  write_level0(path, desc, levels[0], 4);
+  const std::string exr = temp_path("srgb.exr"), tif = temp_path("srgb.tif");
+  ASSERT_EQ(run("-q extract " + path + " --level 0 -o " + exr).exit_code, 0);
+  ASSERT_EQ(run("-q extract " + path + " --level 0 -o " + tif).exit_code, 0);
+  auto in = OIIO::ImageInput::open(exr);
+  ASSERT_TRUE(in);
+  EXPECT_EQ(in->spec().get_string_attribute("oiio:ColorSpace"), "Linear");
+  std::vector<float> f(levels[0].size());
+  ASSERT_TRUE(in->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, f.data()));
+  for (size_t i = 0; i < f.size(); i += 4) {
+    const float a = levels[0][i + 3] / 255.0f;
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(f[i + c], srgb_to_linear(levels[0][i + c] / 255.0f) * a, 1e-3f) << i;
+    EXPECT_NEAR(f[i + 3], a, 1e-3f) << i;
+  }
+  OIIO::ImageSpec straight;
+  straight.attribute("oiio:UnassociatedAlpha", 1);
+  auto tin = OIIO::ImageInput::open(tif, &straight);
+  ASSERT_TRUE(tin);
+  EXPECT_EQ(tin->spec().get_string_attribute("oiio:ColorSpace"), "sRGB");
+  std::vector<uint8_t> stored(levels[0].size());
+  ASSERT_TRUE(tin->read_image(0, 0, 0, 4, OIIO::TypeDesc::UINT8, stored.data()));
+  EXPECT_EQ(stored, levels[0]);
+}
+
 TEST(CliExtract, HalfFloatLayerToExrIsExact) {
   PageFileDesc desc;
   desc.geometry = {20, 12, 8, 2};
@@ -240,18 +281,7 @@ TEST(CliExtract, HalfFloatLayerToExrIsExact) {
   for (auto& level : levels)
     for (size_t i = 1; i < level.size(); i += 2) level[i] &= 0xBB;  // finite halves only
   const std::string path = temp_path("half.vtpf");
-  {
-    auto w = PageFileWriter::create(path, desc);
-    ASSERT_TRUE(w.ok());
-    for (uint32_t y = 0; y < g.pages_y(0); ++y)
-      for (uint32_t x = 0; x < g.pages_x(0); ++x) {
-        auto p = cut_page(levels[0], g.level_width(0), g.level_height(0), 6, g, {0, x, y});
-        std::vector<uint8_t> z;
-        ASSERT_TRUE(zstd_compress(p, 1, z).ok());
-        ASSERT_TRUE((*w)->add_page({0, x, y}, 0, z).ok());
-      }
-    ASSERT_TRUE((*w)->finish().ok());
-  }
+  write_level0(path, desc, levels[0], 6);
   const std::string exr = temp_path("half.exr");
   ASSERT_EQ(run("-q extract " + path + " --level 0 -o " + exr).exit_code, 0);
   auto in = OIIO::ImageInput::open(exr);

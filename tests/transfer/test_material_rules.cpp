@@ -116,6 +116,32 @@ TEST(TransferRules, TextureTransformMovesTheLookup) {
   EXPECT_GT(err_untransformed / n, 0.05);  // the transform really moved the lookup
 }
 
+// A PNG's gAMA chunk (OpenImageIO reads "Gamma2.2") does not decide how a scene's colour texture
+// decodes: glTF says such metadata MUST be ignored, and the slot makes it sRGB.
+TEST(TransferRules, PngGammaTagDoesNotChangeASceneTexture) {
+  test::ScratchDir dir;
+  const std::string png = dir.file("tagged.png");
+  const std::vector<uint8_t> texels(4 * 4 * 3, 30);
+  {
+    auto out = OIIO::ImageOutput::create(png);
+    ASSERT_TRUE(out);
+    OIIO::ImageSpec spec(4, 4, 3, OIIO::TypeDesc::UINT8);
+    spec.attribute("oiio:ColorSpace", "Gamma2.2");
+    spec.attribute("oiio:Gamma", 2.2f);
+    ASSERT_TRUE(out->open(png, spec) && out->write_image(OIIO::TypeDesc::UINT8, texels.data()) &&
+                out->close());
+  }
+  ASSERT_EQ(OIIO::ImageInput::open(png)->spec().get_string_attribute("oiio:ColorSpace"),
+            "Gamma2.2");
+  scene::Scene s = test::textured_scene(atlas_quad(), png);
+  auto r = transfer_materials(s, atlas_options());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  const TransferLayer* albedo = find(*r, LayerSemantic::kAlbedo);
+  ASSERT_NE(albedo, nullptr);
+  // sRGB 30 is 0.0137 in linear light; as a 2.2 power it would be 0.0090.
+  for (float v : albedo->texels) ASSERT_NEAR(v, srgb_to_linear(30 / 255.0f), 2e-4f);
+}
+
 TEST(TransferRules, NearestMagFilterTakesWholeTexels) {
   test::ScratchDir dir;
   auto img = write_rgb(dir.file("cells.png"), 4, 4, [](int i, int j, uint8_t* t) {
