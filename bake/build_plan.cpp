@@ -66,8 +66,6 @@ Expected<LayerPlan> plan_layer(const LayerInput& in, const BuildOptions& options
     p.work_channels = 3;
     p.spec.channels = 2;
     p.spec.texel_type = TexelType::kU8;
-    p.rules.renormalize_xyz = true;
-    for (int c = 0; c < 3; ++c) p.rules.min_value[c] = -1, p.rules.max_value[c] = 1;
   } else if (is_colour(in.semantic)) {
     const bool has_alpha = info.channels == 2 || info.channels == 4;
     p.colour = true;
@@ -88,19 +86,13 @@ Expected<LayerPlan> plan_layer(const LayerInput& in, const BuildOptions& options
     if (!to_store.ok()) return to_store.status().with_context(p.spec.name);
     p.to_storage = std::move(to_store).value();
     p.spec.color_space = want_float ? ColorSpace::kLinear : ColorSpace::kSrgb;
-    for (uint32_t c = 0; c < p.work_channels; ++c) p.rules.min_value[c] = 0;
-    if (p.alpha >= 0) p.rules.max_value[p.alpha] = 1, p.rules.premultiplied_alpha = p.alpha;
   } else {
     // ORM and custom layers are data: no colour conversion.
     p.work_channels = info.channels;
     p.spec.channels = uint8_t(info.channels);
     p.spec.texel_type = float_type;
-    if (!want_float) {
-      for (uint32_t c = 0; c < p.work_channels; ++c)
-        p.rules.min_value[c] = 0, p.rules.max_value[c] = 1;
-    }
   }
-  p.rules.address = options.address;
+  p.rules = downsample_rules_for(p.spec, p.work_channels);
   return p;
 }
 

@@ -168,6 +168,23 @@ DownsampleKernel make_downsample_kernel(MipFilter filter) {
   return k;
 }
 
+DownsampleRules downsample_rules_for(const LayerSpec& spec, uint32_t work_channels) {
+  DownsampleRules rules;
+  rules.address = spec.address_mode;
+  if (spec.semantic == LayerSemantic::kNormal) {
+    rules.renormalize_xyz = true;
+    for (int c = 0; c < 3; ++c) rules.min_value[c] = -1, rules.max_value[c] = 1;
+    return rules;
+  }
+  const bool u8 = spec.texel_type == TexelType::kU8, colour = is_colour(spec.semantic);
+  for (uint32_t c = 0; c < work_channels && c < 4; ++c) {
+    if (u8 || colour) rules.min_value[c] = 0;
+    if (u8 && !colour) rules.max_value[c] = 1;
+  }
+  if (colour && work_channels == 4) rules.max_value[3] = 1, rules.premultiplied_alpha = 3;
+  return rules;
+}
+
 void downsample_rows(const DownsampleKernel& kernel, const DownsampleRules& rules,
                      const RowBand& src, uint32_t y0, uint32_t y1, float* out,
                      const CoverageBand* coverage) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "common/status.h"
+#include "format/page_file.h"
 #include "format/page_geometry.h"
 
 namespace vt {
@@ -64,6 +65,12 @@ struct DownsampleRules {
   // straight colour at alpha edges by the overshoot, up to a few percent with Kaiser).
   int premultiplied_alpha = -1;
 };
+
+// The rules of a layer's levels from its spec and working channels (3 for a normal map, 4 for
+// colour with alpha): normals renormalised in [-1, 1], colour non-negative with alpha at most 1
+// (colour scaled with its overshoot), 8-bit data in [0, 1], float data as filtered. The build's
+// plan and the validator's reference pyramid both take them from here.
+DownsampleRules downsample_rules_for(const LayerSpec& spec, uint32_t work_channels);
 
 // Computes rows [y0, y1) of the half-size level (width (src.width + 1) / 2) into `out`. `src`
 // must hold rows 2*y0 + first .. 2*(y1-1) + first + taps - 1. Each output row depends only on

@@ -155,21 +155,8 @@ Expected<ReferenceLayer> make_reference_layer(uint32_t index, const LayerSpec& s
   for (const TransferLayer& l : transfer.layers)
     if (l.semantic == spec.semantic) t = &l;
   if (!t) return Error(ErrorCode::kNotFound, "the scene's materials give no such layer");
-  if (spec.semantic == LayerSemantic::kNormal) {
-    r.work_channels = 3;
-    r.rules.renormalize_xyz = true;
-    for (int c = 0; c < 3; ++c) r.rules.min_value[c] = -1, r.rules.max_value[c] = 1;
-  } else {
-    r.work_channels = spec.channels;
-    const bool u8 = spec.texel_type == TexelType::kU8;
-    for (uint32_t c = 0; c < r.work_channels; ++c) {
-      if (u8 || is_colour(spec.semantic)) r.rules.min_value[c] = 0;
-      if (u8 && !is_colour(spec.semantic)) r.rules.max_value[c] = 1;
-    }
-    if (is_colour(spec.semantic) && r.work_channels == 4)
-      r.rules.max_value[3] = 1, r.rules.premultiplied_alpha = 3;
-  }
-  r.rules.address = spec.address_mode;
+  r.work_channels = spec.semantic == LayerSemantic::kNormal ? 3 : spec.channels;
+  r.rules = downsample_rules_for(spec, r.work_channels);
   if (is_colour(spec.semantic)) {
     const bool srgb = spec.color_space == ColorSpace::kSrgb;
     VT_ASSIGN_OR_RETURN(r.to_storage, ColorConverter::create("linear", srgb ? "sRGB" : "linear"));
