@@ -30,43 +30,9 @@ double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-// The settings of the bake the reference must repeat, from the file's metadata.
-struct BakeSettings {
-  int supersample = 1;
-  MipFilter filter = MipFilter::kKaiser;
-  LightingOptions lighting;  // a lit bake's AO (the lights are the original scene's)
-  MissingTextures missing_textures = MissingTextures::kError;
-};
-
-LightingOptions lighting_options_from(const nlohmann::json& meta);
-MissingTextures missing_textures_from(const nlohmann::json& meta);
-
-// One parse of the metadata: a 64K bake's holds megabytes of page keys.
-Expected<BakeSettings> bake_settings(const PageFileReader& reader) {
-  const nlohmann::json meta = nlohmann::json::parse(reader.metadata_json(), nullptr, false);
-  if (!meta.is_object() || meta.value("tool", "") != "vtbake bake") {
-    return Error(ErrorCode::kInvalidArgument,
-                 reader.path() + ": not a scene bake (metadata has no \"tool\": \"vtbake bake\")");
-  }
-  BakeSettings s;
-  s.supersample = meta.value("supersample", 1);
-  const nlohmann::json build = meta.value("build", nlohmann::json::object());
-  const std::string filter = build.is_object() ? build.value("filter", "kaiser") : "kaiser";
-  VT_ASSIGN_OR_RETURN(s.filter, parse_mip_filter(filter.c_str()));
-  s.lighting = lighting_options_from(meta);
-  s.missing_textures = missing_textures_from(meta);
-  return s;
-}
-
-MissingTextures missing_textures_from(const nlohmann::json& meta) {
-  return meta.is_object() && meta.value("missing_textures", "") == "warn" ? MissingTextures::kWarn
-                                                                          : MissingTextures::kError;
-}
-
 LightingOptions lighting_options_from(const nlohmann::json& meta) {
   LightingOptions o;
-  const nlohmann::json lit =
-      meta.is_object() ? meta.value("lighting", nlohmann::json::object()) : nlohmann::json();
+  const nlohmann::json lit = meta.value("lighting", nlohmann::json::object());
   if (lit.is_object()) {
     // Shadows are what the scene's lights cast: the reference always casts them, so a bake
     // made with --no-shadows (a speed knob) fails where a shadow falls. AO is asked for: the
@@ -84,12 +50,20 @@ LightingOptions lighting_options_from(const nlohmann::json& meta) {
 
 }  // namespace
 
-MissingTextures baked_missing_textures(const PageFileReader& reader) {
-  return missing_textures_from(nlohmann::json::parse(reader.metadata_json(), nullptr, false));
-}
-
-LightingOptions baked_lighting_options(const PageFileReader& reader) {
-  return lighting_options_from(nlohmann::json::parse(reader.metadata_json(), nullptr, false));
+Expected<BakeSettings> baked_settings(const PageFileReader& reader) {
+  const nlohmann::json meta = nlohmann::json::parse(reader.metadata_json(), nullptr, false);
+  BakeSettings s;
+  if (!meta.is_object()) return s;
+  s.scene_bake = meta.value("tool", "") == "vtbake bake";
+  s.supersample = meta.value("supersample", 1);
+  const nlohmann::json build = meta.value("build", nlohmann::json::object());
+  const std::string filter = build.is_object() ? build.value("filter", "kaiser") : "kaiser";
+  VT_ASSIGN_OR_RETURN(s.filter, parse_mip_filter(filter.c_str()));
+  s.lighting = lighting_options_from(meta);
+  s.missing_textures = meta.value("missing_textures", "") == "warn" ? MissingTextures::kWarn
+                                                                    : MissingTextures::kError;
+  s.texels_per_unit = meta.value("texels_per_unit", 0.0);
+  return s;
 }
 
 namespace {
@@ -570,6 +544,15 @@ Expected<AtlasCheckReport> check_atlas_pages(std::shared_ptr<const PageFileReade
                                              const scene::Scene& original,
                                              const scene::Scene& unwrapped,
                                              const AtlasCheckOptions& o) {
+  VT_ASSIGN_OR_RETURN(const BakeSettings settings, baked_settings(*reader));
+  return check_atlas_pages(std::move(reader), settings, original, unwrapped, o);
+}
+
+Expected<AtlasCheckReport> check_atlas_pages(std::shared_ptr<const PageFileReader> reader,
+                                             const BakeSettings& settings,
+                                             const scene::Scene& original,
+                                             const scene::Scene& unwrapped,
+                                             const AtlasCheckOptions& o) {
   AtlasCheckReport report;
   if (!o.enabled) {
     report.note = "disabled";
@@ -577,7 +560,10 @@ Expected<AtlasCheckReport> check_atlas_pages(std::shared_ptr<const PageFileReade
   }
   const auto t0 = Clock::now();
   const PageGeometry& g = reader->geometry();
-  VT_ASSIGN_OR_RETURN(BakeSettings settings, bake_settings(*reader));
+  if (!settings.scene_bake) {
+    return Error(ErrorCode::kInvalidArgument,
+                 reader->path() + ": not a scene bake (metadata has no \"tool\": \"vtbake bake\")");
+  }
   if (original.materials.size() != unwrapped.materials.size()) {
     return Error(ErrorCode::kInvalidArgument,
                  "the unwrapped scene has " + std::to_string(unwrapped.materials.size()) +

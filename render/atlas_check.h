@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "bake/lighting.h"
+#include "bake/pyramid.h"
 #include "bake/transfer.h"
 #include "common/status.h"
 #include "format/page_file.h"
@@ -103,11 +104,34 @@ struct AtlasCheckReport {
   bool passed() const { return failures.empty(); }
 };
 
+// What a scene bake recorded in its metadata that the references repeat. One parse: a 64K bake's
+// metadata holds megabytes of page keys.
+struct BakeSettings {
+  bool scene_bake = false;  // "tool": "vtbake bake"
+  int supersample = 1;
+  MipFilter filter = MipFilter::kKaiser;
+  // AO samples and distance, bounces; shadows on, whatever the bake used: the references always
+  // cast them. Defaults for a file without.
+  LightingOptions lighting;
+  // kWarn when the bake drew some texture slot from its factor alone (`--missing-textures warn`
+  // and an image it could not read), so that the references do the same.
+  MissingTextures missing_textures = MissingTextures::kError;
+  double texels_per_unit = 0;  // 0: not recorded
+};
+// Errors only for a mip filter this build does not know.
+Expected<BakeSettings> baked_settings(const PageFileReader& reader);
+
 // Checks `reader`'s pages against `unwrapped` (the scene the bake wrote, for its atlas UVs) with
 // the materials and images of `original` (the scene it was baked from; they must have as many
 // materials). A failing page is a report that has not passed(), not an error; errors are bad
 // input (kInvalidArgument: the file is not a scene bake of this scene) or a failed write (kIo).
 Expected<AtlasCheckReport> check_atlas_pages(std::shared_ptr<const PageFileReader> reader,
+                                             const scene::Scene& original,
+                                             const scene::Scene& unwrapped,
+                                             const AtlasCheckOptions& options);
+// The same with the file's settings already read (baked_settings).
+Expected<AtlasCheckReport> check_atlas_pages(std::shared_ptr<const PageFileReader> reader,
+                                             const BakeSettings& settings,
                                              const scene::Scene& original,
                                              const scene::Scene& unwrapped,
                                              const AtlasCheckOptions& options);
@@ -117,14 +141,6 @@ Expected<AtlasCheckReport> check_atlas_pages(std::shared_ptr<const PageFileReade
 // are. `upload` is scratch; `out` takes page_size^2 texels of spec.texel_bytes().
 Status uploaded_texels(const PageSource& source, const LayerSpec& spec, const PageId& id,
                        uint32_t layer, std::vector<uint8_t>& upload, uint8_t* out);
-
-// The lighting settings a scene bake recorded in its metadata (AO samples and distance, bounces;
-// shadows on, whatever the bake used: the references always cast them). Defaults for a file
-// without.
-LightingOptions baked_lighting_options(const PageFileReader& reader);
-// kWarn when the bake drew some texture slot from its factor alone (`--missing-textures warn`
-// and an image it could not read), so that the references do the same; else kError.
-MissingTextures baked_missing_textures(const PageFileReader& reader);
 
 // The report as report.json's "atlas" object (docs/JSON.md).
 nlohmann::json to_json(const AtlasCheckReport& report);

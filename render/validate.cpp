@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <nlohmann/json.hpp>
 
 #include "codec/metrics.h"
 #include "format/page_file.h"
@@ -428,6 +427,7 @@ struct BakeInputs {
   scene::Scene original, baked;  // for the atlas check
   std::string unwrapped;         // the baked scene's path
   SceneDraws reference, virt;
+  BakeSettings settings;                   // the bake's metadata, read once
   ReferenceDrawOptions reference_options;  // as the bake read the textures (its metadata)
   uint32_t layer = 0;
 };
@@ -471,8 +471,8 @@ Expected<BakeInputs> read_bake_inputs(const BakeValidationOptions& o) {
   // The bake's own output: its image uris point back at the original scene's files (checked
   // above), from wherever the bake was written.
   VT_ASSIGN_OR_RETURN(in.baked, scene::load_scene(in.unwrapped, {.allow_outside_paths = true}));
-  in.reference_options.missing_as_factor =
-      baked_missing_textures(*in.reader) == MissingTextures::kWarn;
+  VT_ASSIGN_OR_RETURN(in.settings, baked_settings(*in.reader));
+  in.reference_options.missing_as_factor = in.settings.missing_textures == MissingTextures::kWarn;
   VT_ASSIGN_OR_RETURN(in.reference, reference_scene_draws(in.original, in.reference_options));
   VT_ASSIGN_OR_RETURN(in.virt, virtual_scene_draws(in.baked));
   if (in.reference.meshes.empty() || in.virt.meshes.empty()) {
@@ -561,17 +561,15 @@ Status check_lighting_views(Renderer& renderer, const std::shared_ptr<const Page
   for (uint32_t l = 0; l < specs.size() && !layer; ++l)
     if (is_light(specs[l].semantic)) layer = l;
   if (!layer) return Status::Ok();
-  const nlohmann::json meta = nlohmann::json::parse(in.reader->metadata_json(), nullptr, false);
-  const double texels_per_unit = meta.is_object() ? meta.value("texels_per_unit", 0.0) : 0.0;
-  const double texel_size = texels_per_unit > 0 ? 1.0 / texels_per_unit : 0.0;
+  const double tpu = in.settings.texels_per_unit;
+  const double texel_size = tpu > 0 ? 1.0 / tpu : 0.0;
   if (!lit.layers.any()) {
     VT_RETURN_IF_ERROR(add_shading_frames(in.original, in.reference, true));
     VT_ASSIGN_OR_RETURN(lit.materials, reference_lit_materials(in));
   }
-  VT_ASSIGN_OR_RETURN(
-      std::unique_ptr<LightingReference> reference,
-      LightingReference::create(in.original, in.reference, lit.materials,
-                                baked_lighting_options(*in.reader), texel_size, o.atlas.threads));
+  VT_ASSIGN_OR_RETURN(std::unique_ptr<LightingReference> reference,
+                      LightingReference::create(in.original, in.reference, lit.materials,
+                                                in.settings.lighting, texel_size, o.atlas.threads));
   LightingViewOptions lo;
   lo.layer = *layer;
   lo.address_mode = specs[*layer].address_mode;
@@ -627,7 +625,7 @@ Expected<ValidationReport> validate_bake(const BakeValidationOptions& o) {
   AtlasCheckOptions ao = o.atlas;
   ao.out_dir = out_dir;
   VT_ASSIGN_OR_RETURN(AtlasCheckReport atlas,
-                      check_atlas_pages(in.reader, in.original, in.baked, ao));
+                      check_atlas_pages(in.reader, in.settings, in.original, in.baked, ao));
   if (!o.render_views) {
     ValidationReport report;
     report.page_file = o.page_file;
