@@ -53,7 +53,9 @@ std::string mime_from_hint(const char* hint) {
 
 class AssimpScene {
  public:
-  AssimpScene(const std::string& path, const aiScene& ai) : path_(path), ai_(ai) {
+  // `animations`: how many the file had (dropped before assimp's validation).
+  AssimpScene(const std::string& path, const aiScene& ai, unsigned animations)
+      : path_(path), ai_(ai), animations_(animations) {
     scene_.source_path = path;
     folder_ = parent_folder(path);
   }
@@ -66,8 +68,8 @@ class AssimpScene {
     fit_uv_sets();
     if (skipped_faces_ > 0)
       warn(std::to_string(skipped_faces_) + " point and line primitives skipped (no surface)");
-    if (ai_.mNumAnimations > 0)
-      warn(std::to_string(ai_.mNumAnimations) + " animations ignored (baked in the rest pose)");
+    if (animations_ > 0)
+      warn(std::to_string(animations_) + " animations ignored (baked in the rest pose)");
     if (boned_meshes_ > 0)
       warn(std::to_string(boned_meshes_) + " skinned meshes baked in their bind pose");
     if (ai_.mNumLights > 0)
@@ -286,6 +288,7 @@ class AssimpScene {
 
   std::string path_, folder_;
   const aiScene& ai_;
+  unsigned animations_ = 0;
   Scene scene_;
   std::map<std::string, int> images_;
   std::map<std::vector<unsigned>, int> meshes_;
@@ -315,7 +318,19 @@ Expected<Scene> load_assimp(const std::string& path) {
   const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                          aiProcess_SortByPType | aiProcess_GenSmoothNormals |
                          aiProcess_ValidateDataStructure | aiProcess_FindInvalidData;
-  const aiScene* ai = importer.ReadFile(path, flags);
+  // Read, drop the animations, then post-process: the bake takes the rest pose, and assimp's
+  // validation refuses a whole model over an animation's key past its end (Minetest's B3D
+  // characters: key 221 of a 220-frame animation).
+  const aiScene* ai = importer.ReadFile(path, 0);
+  const unsigned animations = ai ? ai->mNumAnimations : 0;
+  if (ai && animations > 0) {
+    aiScene* owned = const_cast<aiScene*>(ai);  // the importer's own scene, changed in place
+    for (unsigned i = 0; i < animations; ++i) delete owned->mAnimations[i];
+    delete[] owned->mAnimations;
+    owned->mAnimations = nullptr;
+    owned->mNumAnimations = 0;
+  }
+  if (ai) ai = importer.ApplyPostProcessing(flags);
   if (!ai || !ai->mRootNode) {
     std::string why = importer.GetErrorString();
     // assimp's own words ("Validation failed: ...", "Invalid md3 file: ...") say little of whose
@@ -325,7 +340,7 @@ Expected<Scene> load_assimp(const std::string& path) {
   }
   if (ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE)
     return Error(ErrorCode::kCorrupt, path + ": assimp read an incomplete scene (no meshes?)");
-  return AssimpScene(path, *ai).convert();
+  return AssimpScene(path, *ai, animations).convert();
 }
 
 }  // namespace vt::scene::detail

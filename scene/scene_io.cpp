@@ -197,19 +197,24 @@ std::string find_other_extension(const std::string& folder, const std::string& n
   return best.second.empty() ? "" : dir + best.second;
 }
 
-// The folders beside a scene where tools keep its images (FlightGear's Models/*/Textures/, an
-// exporter's textures/), letter case ignored, in name order.
+// The folders where tools keep a scene's images: beside it (FlightGear's Models/*/Textures/, an
+// exporter's textures/), then beside its folder (a game's models/ and textures/, as Minetest's
+// mods keep them); letter case ignored, each group in name order.
 std::vector<std::string> texture_folders(const std::string& folder) {
   static const char* const kNames[] = {"images", "maps", "tex", "texture", "textures"};
   std::vector<std::string> out;
-  std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator(folder.empty() ? "." : folder, ec)) {
-    const std::string name = entry.path().filename().string();
-    if (entry.is_directory(ec) &&
-        std::find(std::begin(kNames), std::end(kNames), lower(name)) != std::end(kNames))
-      out.push_back(folder + name + "/");
+  for (const std::string& base : {folder, folder + "../"}) {
+    std::vector<std::string> found;
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(base.empty() ? "." : base, ec)) {
+      const std::string name = entry.path().filename().string();
+      if (entry.is_directory(ec) &&
+          std::find(std::begin(kNames), std::end(kNames), lower(name)) != std::end(kNames))
+        found.push_back(base + name + "/");
+    }
+    std::sort(found.begin(), found.end());
+    out.insert(out.end(), found.begin(), found.end());
   }
-  std::sort(out.begin(), out.end());
   return out;
 }
 

@@ -159,6 +159,52 @@ TEST(AssimpImport, TexturePathsFromOtherMachinesAreFoundWithAWarning) {
   // Only images stand in: a model of that name does not.
   write_text(d / "orb.md3", "x");
   EXPECT_EQ(resolve("orb.png"), folder + "orb.png");
+  // A textures folder beside the scene's own (a game's models/ and textures/): after those
+  // beside the scene.
+  fs::create_directories(d / "models");
+  fs::create_directories(d / "TEXTURES");
+  write_text(d / "TEXTURES" / "cart.png", "x");
+  EXPECT_EQ(scene::detail::resolve_written_path(folder + "models/", "cart.png", &note),
+            folder + "models/../TEXTURES/cart.png");
+  EXPECT_NE(note.find("textures folder"), std::string::npos) << note;
+  fs::create_directories(d / "models" / "textures");
+  write_text(d / "models" / "textures" / "cart.png", "x");
+  EXPECT_EQ(scene::detail::resolve_written_path(folder + "models/", "cart.png", &note),
+            folder + "models/textures/cart.png");
+}
+
+// A Blitz3D model whose animation has a key past the animation's end (Minetest's characters:
+// key 221 of 220 frames). The bake takes the rest pose, so the animation is dropped, not the
+// model (assimp's validation refused the whole file).
+TEST(AssimpImport, AnimationKeysPastTheEndDoNotRefuseTheModel) {
+  auto chunk = [](const char* tag, const std::string& body) {
+    const int32_t n = int32_t(body.size());
+    return std::string(tag, 4) + std::string(reinterpret_cast<const char*>(&n), 4) + body;
+  };
+  auto raw = [](std::initializer_list<float> f, std::initializer_list<int32_t> i = {}) {
+    std::string out;
+    for (int32_t v : i) out.append(reinterpret_cast<const char*>(&v), 4);
+    for (float v : f) out.append(reinterpret_cast<const char*>(&v), 4);
+    return out;
+  };
+  // One triangle with a UV set; an animation of 1 frame at 60 fps whose position keys are at
+  // frames 1 and 3 (little-endian hosts, as B3D is).
+  const std::string vrts = raw({0, 0, 0, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, {0, 1, 2});
+  const std::string mesh =
+      chunk("MESH", raw({}, {-1}) + chunk("VRTS", vrts) + chunk("TRIS", raw({}, {-1, 0, 1, 2})));
+  const std::string keys = chunk("KEYS", raw({}, {1}) + raw({0, 0, 0}, {1}) + raw({1, 0, 0}, {3}));
+  const std::string anim = chunk("ANIM", raw({60}, {0, 1}));
+  const std::string node = chunk(
+      "NODE", std::string("tri", 4) + raw({0, 0, 0, 1, 1, 1, 1, 0, 0, 0}) + mesh + keys + anim);
+  fs::path d = fresh_dir("b3d_anim");
+  write_text(d / "anim.b3d", chunk("BB3D", raw({}, {1}) + node));
+  auto s = scene::load_scene((d / "anim.b3d").string());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  ASSERT_EQ(s->meshes.size(), 1u);
+  EXPECT_EQ(s->meshes[0].primitives.at(0).positions.size(), 3u);
+  bool warned = false;
+  for (const std::string& w : s->warnings) warned |= w.find("1 animations ignored") != w.npos;
+  EXPECT_TRUE(warned);
 }
 
 TEST(AssimpImport, UvSetWithOneCoordinateEverywhereIsKept) {
