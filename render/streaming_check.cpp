@@ -139,7 +139,7 @@ StreamingBounds default_streaming_bounds(RuntimeFormat) {
   // 3DS/FBX/COLLADA/glTF boards): every pixel beyond 4 steps read a border, up to 18 steps and
   // 0.23% of border pixels; interior pixels within 2 steps (hence max_abs 8, was 16, when border
   // pixels were counted with them). Zeroed borders: up to 168 steps.
-  b.border_max_abs = 40;
+  b.border_max_abs = 40;  // also the alpha-test band of the passes (kAlphaEdge, common.glsl)
   b.border_max_share_beyond = 0.02;
   return b;
 }

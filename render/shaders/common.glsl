@@ -27,9 +27,14 @@ pc;
 const int kMaxTaps = 16;
 
 // Alpha within this much of a material's cutoff may flip the alpha test between two renders of
-// the same texels (BC decoding and filtering rounding): the passes flag such fragments so the
-// exact check can tell a flipped alpha test from a wrong texel.
-const float kAlphaEdge = 4.5 / 255.0;
+// the same texels: the passes flag such fragments so the exact check can tell a flipped alpha
+// test from a wrong texel. Inside a page the two alphas agree to a rounding, but a tap on a
+// page's border reads that page's own encoding of its neighbour's texels, which the check lets
+// differ by up to its border bound (render/streaming_check.cpp, border_max_abs: 40 steps); a
+// masked edge across a seam then flips where the alphas lie that far apart. At 4.5 / 255 the
+// sample scene baked at its default density (a 12480² atlas) failed its exact check on 12 leaf
+// edge pixels off by up to 126 steps, each a flipped test on a seam.
+const float kAlphaEdge = 40.0 / 255.0;
 
 // A blended material's colour is written as it composites, premultiplied by its alpha, in both
 // renders: colour under zero alpha is never seen and must not count (the bake bleeds colour
