@@ -137,7 +137,9 @@ Expected<std::unique_ptr<ImageSource>> open_image_file(const std::string& path) 
   ImageInfo info;
   info.width = uint32_t(spec.width);
   info.height = uint32_t(spec.height);
-  info.channels = uint32_t(std::min(scene::data_channels(*in), 4));
+  const Expected<int> channels = scene::data_channels(*in);
+  if (!channels.ok()) return decode_error(path, channels.status().message());
+  info.channels = uint32_t(std::min(*channels, 4));
   info.is_float = spec.format.basetype == OIIO::TypeDesc::HALF ||
                   spec.format.basetype == OIIO::TypeDesc::FLOAT ||
                   spec.format.basetype == OIIO::TypeDesc::DOUBLE;

@@ -540,7 +540,9 @@ Status Transfer::setup_images(const std::vector<bool>* wanted) {
       if (!in) continue;  // reported per material slot by check_missing_textures
       const OIIO::ImageSpec& spec = in->spec();
       untiled = spec.tile_width == 0;
-      channels = scene::data_channels(*in);
+      // Unreadable: 0, and the texture's load below reports it.
+      const Expected<int> data = scene::data_channels(*in);
+      channels = data.ok() ? *data : 0;
       if (used_as_colour(scene_, i)) {
         VT_RETURN_IF_ERROR(set_colour_space(slot, img.embedded() ? "" : img.path, spec));
       }

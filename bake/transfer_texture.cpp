@@ -38,7 +38,13 @@ Expected<TransferTexture> TransferTexture::load(const std::string& path,
   auto in = scene::open_image_input(path, error);
   if (!in) return Error(ErrorCode::kNotFound, error);
   TransferTexture tex;
-  tex.channels_ = std::clamp(channels > 0 ? channels : scene::data_channels(*in), 1, 4);
+  if (channels <= 0) {
+    const Expected<int> data = scene::data_channels(*in);
+    if (!data.ok())
+      return Error(ErrorCode::kIo, "cannot read its texels (" + data.status().message() + ")");
+    channels = *data;
+  }
+  tex.channels_ = std::clamp(channels, 1, 4);
   channels = tex.channels_;
   for (int m = 0; in->seek_subimage(0, m); ++m) {
     const OIIO::ImageSpec& spec = in->spec();

@@ -39,7 +39,7 @@ std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path, std:
   return in;
 }
 
-int data_channels(OIIO::ImageInput& in) {
+Expected<int> data_channels(OIIO::ImageInput& in) {
   const OIIO::ImageSpec& spec = in.spec();
   const int alpha = spec.alpha_channel;
   const std::string format = in.format_name();
@@ -52,8 +52,9 @@ int data_channels(OIIO::ImageInput& in) {
     const int y1 = std::min(spec.height, y + band);
     if (!in.read_scanlines(0, 0, spec.y + y, spec.y + y1, 0, alpha, alpha + 1,
                            OIIO::TypeDesc::UINT8, a.data())) {
-      (void)in.geterror();  // the texels' read reports it
-      return spec.nchannels;
+      std::string why = in.geterror();
+      why = why.substr(0, why.find('\n'));
+      return Error(ErrorCode::kCorrupt, why.empty() ? "OpenImageIO cannot read it" : why);
     }
     const size_t n = size_t(spec.width) * size_t(y1 - y);
     if (std::any_of(a.begin(), a.begin() + std::ptrdiff_t(n), [](uint8_t v) { return v != 0; }))
@@ -101,7 +102,11 @@ Expected<FloatImage> load_float_image(const scene::Image& image) {
       open_image_input(name, error, image.embedded() ? &mem : nullptr);
   if (!in) return Error(ErrorCode::kNotFound, "cannot open image '" + name + "': " + error);
   const OIIO::ImageSpec& spec = in->spec();
-  const int ch = data_channels(*in);
+  const Expected<int> data = data_channels(*in);
+  if (!data.ok())
+    return Error(ErrorCode::kCorrupt,
+                 "cannot read image '" + name + "': " + data.status().message());
+  const int ch = *data;
   if (spec.width <= 0 || spec.height <= 0 || ch <= 0 || spec.width > 65536 || spec.height > 65536) {
     return Error(ErrorCode::kCorrupt, "image '" + name + "' has a bad size");
   }

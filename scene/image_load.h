@@ -36,8 +36,10 @@ std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path, std:
 // How many of the file's channels carry data: all, except in a BMP or TGA whose alpha is 0 in
 // every texel, where the channels before it. There the fourth byte is padding (a 32-bit BMP's
 // BI_RGB rows, a TGA whose header gives no alpha bits) that viewers show opaque; read as alpha it
-// would bake the image fully transparent. Reads those formats' alpha channel to tell.
-int data_channels(OIIO::ImageInput& in);
+// would bake the image fully transparent. Reads those formats' alpha channel to tell; kCorrupt
+// (OpenImageIO's first line) when it cannot: OpenImageIO's TGA reader answers later reads from
+// what it decoded before the error, so the error must not be lost here.
+Expected<int> data_channels(OIIO::ImageInput& in);
 
 // The channel whose alpha the colour `in` reads is premultiplied by (OpenEXR's convention, a TIFF
 // of associated alpha), when it is one of the first `channels` read; -1 when colour is straight

@@ -503,6 +503,15 @@ TEST(Build, PaddingAlphaOfBmpAndTgaReadsOpaque) {
   check(bmp, 4);
   ASSERT_TRUE(test::write_tga32(tga, w, h, rgba, 0));
   check(tga, 4);
+  // Cut short: the alpha read fails, and the error is the file's (OpenImageIO's TGA reader would
+  // answer the texels' reads from what it decoded before the end).
+  ASSERT_TRUE(test::write_tga32(tga, w, h, rgba, 0));
+  fs::resize_file(tga, 18 + 4 * w);
+  auto cut = open_image_file(tga);
+  ASSERT_FALSE(cut.ok());
+  EXPECT_EQ(cut.status().code(), ErrorCode::kCorrupt);
+  EXPECT_NE(cut.status().message().find("padding.tga"), std::string::npos)
+      << cut.status().message();
   rgba[7 * 4 + 3] = 0;
   std::vector<float> zero_alpha(rgba.begin(), rgba.end());
   for (float& v : zero_alpha) v /= 255;
