@@ -41,7 +41,7 @@ Expected<TransferTexture> TransferTexture::load(const std::string& path,
   if (channels <= 0) {
     const Expected<int> data = scene::data_channels(*in);
     if (!data.ok())
-      return Error(ErrorCode::kIo, "cannot read its texels (" + data.status().message() + ")");
+      return Error(ErrorCode::kCorrupt, "cannot read its texels (" + data.status().message() + ")");
     channels = *data;
   }
   tex.channels_ = std::clamp(channels, 1, 4);
@@ -56,14 +56,15 @@ Expected<TransferTexture> TransferTexture::load(const std::string& path,
     tex.texels_.resize(level.offset + count * channels);
     float* texels = tex.texels_.data() + level.offset;
     if (!in->read_image(0, m, 0, channels, OIIO::TypeDesc::FLOAT, texels)) {
-      return Error(ErrorCode::kIo, "cannot read its texels (" + first_line(in->geterror()) + ")");
+      return Error(ErrorCode::kCorrupt,
+                   "cannot read its texels (" + first_line(in->geterror()) + ")");
     }
     if (const int a = scene::associated_alpha_channel(*in, channels); a >= 0)
       scene::unassociate_alpha(texels, count, channels, a);
     tex.levels_.push_back(level);
   }
   (void)OIIO::geterror();  // seek_subimage past the last level leaves a message
-  if (tex.levels_.empty()) return Error(ErrorCode::kIo, "no texels in the file");
+  if (tex.levels_.empty()) return Error(ErrorCode::kCorrupt, "no texels in the file");
   if (tex.levels_.size() == 1) tex.make_box_levels(to_linear, from_linear);
   tex.data_ = tex.texels_.data(), tex.floats_ = tex.texels_.size();
   return tex;

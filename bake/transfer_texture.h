@@ -45,7 +45,8 @@ class TransferTexture {
   // most 4. With `to_linear` and `from_linear` (a colour texture: its space to linear and back)
   // the made levels average decoded colour channels and store them re-encoded; null = data,
   // averaged as stored. Errors name the file and give OpenImageIO's reason; kNotFound when the
-  // file cannot be opened, kIo when its texels cannot be read.
+  // file cannot be opened, kCorrupt when its texels cannot be decoded (damaged or cut short: bad
+  // input, exit 2, as the build says of its images).
   static Expected<TransferTexture> load(const std::string& path,
                                         const ColorConverter* to_linear = nullptr,
                                         const ColorConverter* from_linear = nullptr,

@@ -6,6 +6,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cmath>
+#include <filesystem>
 #include <functional>
 #include <vector>
 
@@ -202,6 +203,19 @@ TEST(TransferTexture, BmpPaddingByteIsNotAlpha) {
   EXPECT_EQ(img->channels, 3u);
   EXPECT_EQ(img->at(1, 0)[3], 1.0f);
   EXPECT_NEAR(img->at(1, 0)[2], 30 / 255.0f, 1e-6f);
+}
+
+// A texture cut short is bad input (kCorrupt: exit 2, as the build says of its images), not a
+// failed write or read of the machine (kIo: exit 1).
+TEST(TransferTexture, CutShortFileIsCorrupt) {
+  test::ScratchDir dir;
+  const std::string p = dir.file("cut.tga");
+  const std::vector<uint8_t> rgba(64 * 64 * 4, 200);
+  ASSERT_TRUE(test::write_tga32(p, 64, 64, rgba, 8));
+  std::filesystem::resize_file(p, 18 + 64 * 4 * 3);
+  auto t = TransferTexture::load(p, nullptr);
+  ASSERT_FALSE(t.ok());
+  EXPECT_EQ(t.status().code(), ErrorCode::kCorrupt) << t.status().message();
 }
 
 }  // namespace
