@@ -19,11 +19,6 @@ namespace {
 
 constexpr int kMaxTaps = 16;  // anisotropy: taps along the footprint's major axis
 
-std::string first_line(std::string s) {
-  s = s.substr(0, s.find('\n'));  // further lines repeat it
-  return s.empty() ? "OpenImageIO cannot read it" : s;
-}
-
 // Coordinates past this are sampled at 0 (the wrap of such a float has no fraction left).
 inline double finite_or_zero(double x) {
   return std::fabs(x) < 1e15 ? x : 0.0;
@@ -57,7 +52,7 @@ Expected<TransferTexture> TransferTexture::load(const std::string& path,
     float* texels = tex.texels_.data() + level.offset;
     if (!in->read_image(0, m, 0, channels, OIIO::TypeDesc::FLOAT, texels)) {
       return Error(ErrorCode::kCorrupt,
-                   "cannot read its texels (" + first_line(in->geterror()) + ")");
+                   "cannot read its texels (" + scene::oiio_first_line(in->geterror()) + ")");
     }
     if (const int a = scene::associated_alpha_channel(*in, channels); a >= 0)
       scene::unassociate_alpha(texels, count, channels, a);

@@ -9,6 +9,11 @@
 
 namespace vt::scene {
 
+std::string oiio_first_line(std::string message) {
+  message = message.substr(0, message.find('\n'));
+  return message.empty() ? "OpenImageIO cannot read it" : message;
+}
+
 std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path, std::string& error,
                                                    OIIO::Filesystem::IOProxy* proxy) {
   std::error_code ec;
@@ -29,9 +34,7 @@ std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path, std:
   }
   auto in = OIIO::ImageInput::open(path, proxy ? &with_proxy : &straight_colour, proxy);
   if (!in) {
-    error = OIIO::geterror();
-    error = error.substr(0, error.find('\n'));  // further lines repeat it
-    if (error.empty()) error = "OpenImageIO cannot read it";
+    error = oiio_first_line(OIIO::geterror());
   } else if (std::string(in->format_name()) == "null") {
     error = "not an image file";
     return nullptr;
@@ -51,11 +54,8 @@ Expected<int> data_channels(OIIO::ImageInput& in) {
   for (int y = 0; y < spec.height; y += band) {
     const int y1 = std::min(spec.height, y + band);
     if (!in.read_scanlines(0, 0, spec.y + y, spec.y + y1, 0, alpha, alpha + 1,
-                           OIIO::TypeDesc::UINT8, a.data())) {
-      std::string why = in.geterror();
-      why = why.substr(0, why.find('\n'));
-      return Error(ErrorCode::kCorrupt, why.empty() ? "OpenImageIO cannot read it" : why);
-    }
+                           OIIO::TypeDesc::UINT8, a.data()))
+      return Error(ErrorCode::kCorrupt, oiio_first_line(in.geterror()));
     const size_t n = size_t(spec.width) * size_t(y1 - y);
     if (std::any_of(a.begin(), a.begin() + std::ptrdiff_t(n), [](uint8_t v) { return v != 0; }))
       return spec.nchannels;

@@ -33,6 +33,10 @@ struct FloatImage {
 std::unique_ptr<OIIO::ImageInput> open_image_input(const std::string& path, std::string& error,
                                                    OIIO::Filesystem::IOProxy* proxy = nullptr);
 
+// The first line of an OpenImageIO error message (further lines repeat it), or "OpenImageIO
+// cannot read it" when there is none.
+std::string oiio_first_line(std::string message);
+
 // How many of the file's channels carry data: all, except in a BMP or TGA whose alpha is 0 in
 // every texel, where the channels before it. There the fourth byte is padding (a 32-bit BMP's
 // BI_RGB rows, a TGA whose header gives no alpha bits) that viewers show opaque; read as alpha it

@@ -33,6 +33,16 @@ std::shared_ptr<ImageSource> memory_image(uint32_t w, uint32_t h, uint32_t ch,
   return std::make_shared<MemoryImageSource>(info, std::move(texels));
 }
 
+// A build of one albedo layer from the image file at `path`: 24-texel payloads, `codec`.
+Expected<BuildOptions> albedo_file_build(const std::string& path, CodecKind codec) {
+  VT_ASSIGN_OR_RETURN(std::unique_ptr<ImageSource> src, open_image_file(path));
+  BuildOptions o;
+  o.layers.push_back(test::layer_input(LayerSemantic::kAlbedo, std::move(src)));
+  o.payload = 24;
+  o.codec.codec = codec;
+  return o;
+}
+
 fs::path temp_dir() {
   fs::path d =
       fs::temp_directory_path() / ("vt_bake_tests_" + std::to_string(getpid()) + "_" +
@@ -297,13 +307,9 @@ TEST(Build, FileWrittenAndReadBack) {
   ASSERT_TRUE(write_image_file(exr_mem, (dir / "in.exr").string(), 32).ok());
 
   for (const char* name : {"in.png", "in.exr"}) {
-    auto src = open_image_file((dir / name).string());
-    ASSERT_TRUE(src.ok()) << src.status().message();
-    BuildOptions o;
-    o.layers.push_back(test::layer_input(LayerSemantic::kAlbedo,
-                                         std::shared_ptr<ImageSource>(std::move(src).value())));
-    o.payload = 24;
-    o.codec.codec = CodecKind::kRaw;
+    auto options = albedo_file_build((dir / name).string(), CodecKind::kRaw);
+    ASSERT_TRUE(options.ok()) << options.status().message();
+    BuildOptions o = *options;
     o.output = (dir / (std::string(name) + ".vtpf")).string();
     auto sum = build_page_file(o);
     ASSERT_TRUE(sum.ok()) << sum.status().message();
@@ -373,13 +379,9 @@ TEST(Build, OpaqueAlphaDropped) {
     std::string png = (dir / (translucent ? "t.png" : "o.png")).string();
     ASSERT_TRUE(write_image_file(mem, png).ok());
     for (CodecKind codec : {CodecKind::kRaw, CodecKind::kBc}) {
-      auto src = open_image_file(png);
-      ASSERT_TRUE(src.ok()) << src.status().message();
-      BuildOptions o;
-      o.layers.push_back(test::layer_input(LayerSemantic::kAlbedo,
-                                           std::shared_ptr<ImageSource>(std::move(src).value())));
-      o.payload = 24;
-      o.codec.codec = codec;
+      auto options = albedo_file_build(png, codec);
+      ASSERT_TRUE(options.ok()) << options.status().message();
+      BuildOptions o = *options;
       o.output = png + ".vtpf";
       auto sum = build_page_file(o);
       ASSERT_TRUE(sum.ok()) << sum.status().message();
@@ -453,13 +455,9 @@ TEST(Build, TranslucentTexelsKeepTheirColour) {
   for (const char* name : {"translucent.png", "translucent.tga", "translucent.sgi"}) {
     const std::string path = (dir / name).string();
     ASSERT_TRUE(write_image_file(mem, path).ok()) << name;
-    auto src = open_image_file(path);
-    ASSERT_TRUE(src.ok()) << src.status().message();
-    BuildOptions o;
-    o.layers.push_back(test::layer_input(LayerSemantic::kAlbedo,
-                                         std::shared_ptr<ImageSource>(std::move(src).value())));
-    o.payload = 24;
-    o.codec.codec = CodecKind::kRaw;
+    auto options = albedo_file_build(path, CodecKind::kRaw);
+    ASSERT_TRUE(options.ok()) << options.status().message();
+    const BuildOptions& o = *options;
     auto built = test::build_in_memory(o);
     ASSERT_TRUE(built);
     auto level = test::reassemble_level(*built, 0, 0, test::encoder_for(*built, 0, o));
