@@ -1035,7 +1035,9 @@ template <bool kAdaptive>
       bits.refill();  // enough for both values and the sign
       const int nz = std::min(decode_uint<kAdaptive>(rans, bits, models[kNzHist + n.nz_ctx]), 63);
       int res = decode_uint<kAdaptive>(rans, bits, models[kDcHist + n.dc_ctx]);
-      if (res != 0 && bits.take(1, 1)) res = -res;
+      // Signs without a branch: they are coin flips to a predictor.
+      const int dc_negative = -int(bits.take(res != 0, res != 0));
+      res = (res ^ dc_negative) - dc_negative;
       z[0] = int16_t(std::clamp(n.dc_pred + res, -kMaxQuantized, kMaxQuantized));
       // Models for the first eight pairs up front: most blocks end within them, and a
       // data-dependent "next four pairs?" branch would mispredict. Pair j's model is its
@@ -1080,7 +1082,8 @@ template <bool kAdaptive>
         const int k = __builtin_ctzll(escapes) + 1;
         bits.refill();
         const int v = decode_uint<kAdaptive>(rans, bits, models[esc_ctx[(k - 1) >> 1]]);
-        z[k] = int16_t(z[k] < 0 ? z[k] - v : z[k] + v);
+        const int negative = z[k] >> 15;  // the +-3 written by the pair loop
+        z[k] = int16_t(z[k] + ((v ^ negative) - negative));
       }
       // A valid block's last pair holds its last nonzero.
       info[index] = {z[0], uint8_t(nz), uint8_t(std::min(2 * j, 63))};
