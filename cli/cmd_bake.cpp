@@ -177,11 +177,22 @@ struct BatchScene {
   std::string path, as_given;
 };
 
+// An absolute path below `folder` as given relative to it (what --keep-folders keeps: a list
+// made with `find "$PWD" ...` names its scenes absolutely); any other path unchanged.
+std::string relative_if_below(const std::filesystem::path& p, const std::filesystem::path& folder) {
+  if (!p.is_absolute()) return p.string();
+  std::error_code error;
+  const std::filesystem::path base = std::filesystem::absolute(folder, error).lexically_normal();
+  if (error) return p.string();
+  const std::filesystem::path relative = p.lexically_normal().lexically_relative(base);
+  return relative.empty() || *relative.begin() == ".." ? p.string() : relative.string();
+}
+
 // The scenes of a batch: the positionals, then --list FILE's lines (blank lines and lines
 // starting with '#' skipped; relative paths from the list file's folder).
 vt::Expected<std::vector<BatchScene>> batch_scenes(const BakeArgs& a) {
   std::vector<BatchScene> scenes;
-  for (const std::string& s : a.scenes) scenes.push_back({s, s});
+  for (const std::string& s : a.scenes) scenes.push_back({s, relative_if_below(s, ".")});
   if (!a.list.empty()) {
     if (vt::Status s = vt::check_input_file(a.list); !s.ok()) return s.with_context("--list");
     std::ifstream in(a.list);
@@ -191,23 +202,24 @@ vt::Expected<std::vector<BatchScene>> batch_scenes(const BakeArgs& a) {
       const size_t start = line.find_first_not_of(' ');
       if (start == std::string::npos || line[start] == '#') continue;
       std::filesystem::path p(line.substr(start));
-      scenes.push_back(
-          {p.is_absolute() || base.empty() ? p.string() : (base / p).string(), p.string()});
+      scenes.push_back({p.is_absolute() || base.empty() ? p.string() : (base / p).string(),
+                        relative_if_below(p, base.empty() ? "." : base)});
     }
   }
   return scenes;
 }
 
 // A batch scene's page file: DIR/STEM.vtpf, or with --keep-folders DIR/PATH.vtpf for the path as
-// given (relative, without '..': a game's models/*/head.md3 each get their own).
+// given (relative, or absolute below the list's or the current folder; without '..': a game's
+// models/*/head.md3 each get their own).
 vt::Expected<std::string> batch_output(const BakeArgs& a, const BatchScene& scene) {
   const std::filesystem::path dir(a.out_dir);
   if (!a.keep_folders) return (dir / std::filesystem::path(scene.path).stem()).string() + ".vtpf";
   const std::filesystem::path relative = std::filesystem::path(scene.as_given).lexically_normal();
   if (relative.is_absolute() || !relative.has_filename() || *relative.begin() == "..") {
     return vt::Error(vt::ErrorCode::kInvalidArgument,
-                     scene.path + ": --keep-folders needs a relative path below the list's " +
-                         "folder (or the current one), not '" + scene.as_given + "'");
+                     scene.path + ": --keep-folders needs a path below the list's folder (or " +
+                         "the current one), not '" + scene.as_given + "'");
   }
   return (dir / relative).replace_extension(".vtpf").string();
 }
@@ -346,9 +358,9 @@ vt::cli::CommandRunner make_bake(CLI::App& app) {
   app.add_flag("--keep-going", args->keep_going,
                "Batch: bake the other scenes when one fails (exit 1 if any failed)");
   app.add_flag("--keep-folders", args->keep_folders,
-               "Batch: write DIR/PATH.vtpf for each scene's path as given (relative to the list's "
-               "folder or the current one, no '..') instead of DIR/STEM.vtpf, so scenes of one "
-               "name in different folders stay apart")
+               "Batch: write DIR/PATH.vtpf for each scene's path below the list's folder or the "
+               "current one (as given, or the part below when given absolute; no '..') instead "
+               "of DIR/STEM.vtpf, so scenes of one name in different folders stay apart")
       ->needs(out_dir);
   app.add_option("--unwrapped", o.unwrapped,
                  "Where to write the unwrapped scene (.glb; default OUT.glb; '-' = not written)");

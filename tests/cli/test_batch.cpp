@@ -127,13 +127,27 @@ TEST_F(BatchCli, KeepFoldersKeepsScenesOfOneNameApart) {
   ASSERT_EQ(r.exit_code, 0) << r.out;
   for (const char* out : {"/kf/scene.vtpf", "/kf/sub/scene.vtpf", "/kf/sub/scene.glb"})
     EXPECT_TRUE(fs::exists(dir_ + out)) << out;
-  // A path that leaves the list's folder has no place under DIR: refused before any work.
-  std::ofstream(list, std::ios::app) << "../scenes/a.gltf\n";
-  r = run_vtbake("-q bake --list " + list + " --keep-folders --out-dir " + dir_ + "/kf2" + flags(),
-                 true);
-  EXPECT_EQ(r.exit_code, 2) << r.out;
-  EXPECT_NE(r.out.find("--keep-folders needs a relative path"), std::string::npos) << r.out;
-  EXPECT_FALSE(fs::exists(dir_ + "/kf2/scene.vtpf"));
+  // A list made with `find "$PWD"` names them absolutely: the part below the list's folder.
+  const std::string scenes = fs::absolute(dir_ + "/scenes").lexically_normal().string();
+  const std::string absolute_list = dir_ + "/scenes/absolute.txt";
+  std::ofstream(absolute_list) << scenes << "/scene.gltf\n" << scenes << "/sub/./scene.gltf\n";
+  r = run_vtbake(
+      "-q bake --list " + absolute_list + " --keep-folders --out-dir " + dir_ + "/kf3" + flags(),
+      true);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  for (const char* out : {"/kf3/scene.vtpf", "/kf3/sub/scene.vtpf"})
+    EXPECT_TRUE(fs::exists(dir_ + out)) << out;
+  // A path that leaves the list's folder has no place under DIR, given relative or absolute:
+  // refused before any work.
+  const std::string beside = fs::absolute(dir_ + "/other/a.gltf").lexically_normal().string();
+  for (const std::string& outside : {std::string("../scenes/a.gltf"), beside}) {
+    std::ofstream(list) << "scene.gltf\n" << outside << "\n";
+    r = run_vtbake(
+        "-q bake --list " + list + " --keep-folders --out-dir " + dir_ + "/kf2" + flags(), true);
+    EXPECT_EQ(r.exit_code, 2) << outside << r.out;
+    EXPECT_NE(r.out.find("--keep-folders needs a path below"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(dir_ + "/kf2/scene.vtpf"));
+  }
   // Without a batch it means nothing: bad usage.
   EXPECT_EQ(
       run_vtbake("-q bake " + scene("a.gltf") + " -o " + dir_ + "/x.vtpf --keep-folders" + flags(),
