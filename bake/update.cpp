@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "common/utf8.h"
+
 namespace vt {
 namespace {
 
@@ -179,9 +181,11 @@ std::string path_for_metadata(const std::string& path, const std::string& output
   std::error_code ec;
   const fs::path file = fs::weakly_canonical(fs::absolute(path, ec), ec);
   const fs::path dir = fs::weakly_canonical(fs::absolute(output, ec), ec).parent_path();
-  if (ec) return fs::path(path).lexically_normal().generic_string();
+  // JSON holds UTF-8: a file name in another encoding is recorded as its Latin-1 reading (the
+  // record is for people; nothing opens it).
+  if (ec) return as_utf8(fs::path(path).lexically_normal().generic_string());
   const fs::path rel = file.lexically_relative(dir);
-  return rel.empty() ? file.generic_string() : rel.generic_string();
+  return as_utf8(rel.empty() ? file.generic_string() : rel.generic_string());
 }
 
 uint64_t count_dropped(const PreviousBuild& previous, int layer, const PageGeometry& g,

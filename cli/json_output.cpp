@@ -19,7 +19,10 @@ void print_json(const char* command, int exit_code, const nlohmann::json& body) 
   nlohmann::ordered_json j = {
       {"schema", kJsonSchema}, {"command", command}, {"ok", exit_code == 0}, {"exit", exit_code}};
   for (const auto& [key, value] : body.items()) j[key] = value;
-  std::printf("%s\n", j.dump().c_str());
+  // Messages quote paths as the disk spells them, which need not be UTF-8: such bytes become
+  // U+FFFD rather than an exception that loses the report.
+  std::printf("%s\n",
+              j.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace).c_str());
   std::fflush(stdout);
 }
 

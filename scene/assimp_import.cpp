@@ -66,6 +66,7 @@ class AssimpScene {
     VT_RETURN_IF_ERROR(add_node(*ai_.mRootNode, -1));
     scene_.roots.push_back(0);
     fit_uv_sets();
+    untexture_surfaces_without_uvs(&scene_);
     if (skipped_faces_ > 0)
       warn(std::to_string(skipped_faces_) + " point and line primitives skipped (no surface)");
     if (animations_ > 0)
@@ -139,6 +140,14 @@ class AssimpScene {
     aiTextureMapMode modes[2] = {aiTextureMapMode_Wrap, aiTextureMapMode_Wrap};
     if (m.GetTexture(type, 0, &file, &mapping, &uv_index, nullptr, nullptr, modes) != AI_SUCCESS)
       return ref;
+    // assimp's IQM importer turns a mesh's material string into a texture path, empty when the
+    // game assigns skins in its own config (Sauerbraten's iqm.cfg).
+    if (file.length == 0) {
+      const std::string name = m.GetName().C_Str();
+      warn((name.empty() ? std::string("an unnamed material") : "material '" + name + "'") +
+           ": a texture with no file name is ignored");
+      return ref;
+    }
     if (mapping != aiTextureMapping_UV) {
       warn("material '" + std::string(m.GetName().C_Str()) +
            "': a texture with non-UV (projected) mapping is ignored");
@@ -323,6 +332,15 @@ Expected<Scene> load_assimp(const std::string& path) {
   // characters: key 221 of a 220-frame animation).
   const aiScene* ai = importer.ReadFile(path, 0);
   const unsigned animations = ai ? ai->mNumAnimations : 0;
+  // An animation-only file (Sauerbraten's and Quake's IQM/MD5 animation files beside the
+  // model) fails assimp's validation with "aiScene::mNumMeshes is 0".
+  if (ai && ai->mNumMeshes == 0) {
+    return Error(ErrorCode::kInvalidArgument,
+                 path + ": no meshes: nothing to bake" +
+                     (animations > 0 ? " (the file holds " + std::to_string(animations) +
+                                           " animations only: bake the model they animate)"
+                                     : std::string()));
+  }
   if (ai && animations > 0) {
     aiScene* owned = const_cast<aiScene*>(ai);  // the importer's own scene, changed in place
     for (unsigned i = 0; i < animations; ++i) delete owned->mAnimations[i];

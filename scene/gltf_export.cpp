@@ -120,7 +120,7 @@ class DocumentBuilder {
         std::error_code ec;
         auto base = std::filesystem::absolute(out_folder_.empty() ? "." : out_folder_, ec);
         auto rel = std::filesystem::relative(std::filesystem::absolute(im.path, ec), base, ec);
-        j["uri"] = ec || rel.empty() ? im.path : rel.generic_string();
+        j["uri"] = detail::percent_encode_path(ec || rel.empty() ? im.path : rel.generic_string());
         if (!im.mime_type.empty()) j["mimeType"] = im.mime_type;
       }
       doc_["images"].push_back(j);

@@ -248,6 +248,7 @@ Scene ObjReader::finish() && {
   node.mesh = 0;
   scene_.nodes.push_back(node);
   scene_.roots.push_back(0);
+  untexture_surfaces_without_uvs(&scene_);
   return std::move(scene_);
 }
 

@@ -4,28 +4,11 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "common/utf8.h"
 #include "scene/obj_mtl.h"
 
 namespace vt::scene::detail {
 namespace {
-
-void append_utf8(uint32_t cp, std::string* out) {
-  if (cp < 0x80) {
-    out->push_back(static_cast<char>(cp));
-  } else if (cp < 0x800) {
-    out->push_back(static_cast<char>(0xc0 | (cp >> 6)));
-    out->push_back(static_cast<char>(0x80 | (cp & 0x3f)));
-  } else if (cp < 0x10000) {
-    out->push_back(static_cast<char>(0xe0 | (cp >> 12)));
-    out->push_back(static_cast<char>(0x80 | ((cp >> 6) & 0x3f)));
-    out->push_back(static_cast<char>(0x80 | (cp & 0x3f)));
-  } else {
-    out->push_back(static_cast<char>(0xf0 | (cp >> 18)));
-    out->push_back(static_cast<char>(0x80 | ((cp >> 12) & 0x3f)));
-    out->push_back(static_cast<char>(0x80 | ((cp >> 6) & 0x3f)));
-    out->push_back(static_cast<char>(0x80 | (cp & 0x3f)));
-  }
-}
 
 Expected<std::string> utf16_to_utf8(const uint8_t* data, size_t size, bool big_endian,
                                     const std::string& path) {
@@ -51,21 +34,6 @@ Expected<std::string> utf16_to_utf8(const uint8_t* data, size_t size, bool big_e
   return out;
 }
 
-bool valid_utf8(const uint8_t* d, size_t n) {
-  for (size_t i = 0; i < n;) {
-    int extra = d[i] < 0x80           ? 0
-                : (d[i] >> 5) == 0x06 ? 1
-                : (d[i] >> 4) == 0x0e ? 2
-                : (d[i] >> 3) == 0x1e ? 3
-                                      : -1;
-    if (extra < 0 || i + extra >= n) return false;
-    for (int k = 1; k <= extra; ++k)
-      if ((d[i + k] & 0xc0) != 0x80) return false;
-    i += extra + 1;
-  }
-  return true;
-}
-
 }  // namespace
 
 Expected<std::string> decode_text(const std::vector<uint8_t>& bytes, const std::string& path,
@@ -79,12 +47,10 @@ Expected<std::string> decode_text(const std::vector<uint8_t>& bytes, const std::
   // No BOM: ASCII text written as UTF-16 has a zero in every other byte.
   if (n >= 2 && d[0] != 0 && d[1] == 0) return utf16_to_utf8(d, n, false, path);
   if (n >= 2 && d[0] == 0 && d[1] != 0) return utf16_to_utf8(d, n, true, path);
-  if (valid_utf8(d, n)) return std::string(d, d + n);
-  // Older exporters write names in an 8-bit code page; Latin-1 is the common one.
+  std::string text(d, d + n);
+  if (valid_utf8(text)) return text;
   *note = "not UTF-8: read as Latin-1";
-  std::string out;
-  for (size_t i = 0; i < n; ++i) append_utf8(d[i], &out);
-  return out;
+  return as_utf8(text);
 }
 
 void LineCursor::skip_space() {

@@ -6,9 +6,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "common/utf8.h"
 #include "scene/gltf_document.h"
 #include "scene/scene.h"
 #include "scene/scene_io_util.h"
@@ -52,6 +54,51 @@ std::string lower_extension(const std::string& path) {
 std::string parent_folder(const std::string& path) {
   size_t slash = path.find_last_of("/\\");
   return slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
+}
+
+void untexture_surfaces_without_uvs(Scene* scene) {
+  std::map<std::pair<int, size_t>, int> copies;  // (material, UV sets) -> its copy
+  for (Mesh& mesh : scene->meshes) {
+    for (Primitive& p : mesh.primitives) {
+      if (p.material < 0 || size_t(p.material) >= scene->materials.size()) continue;
+      Material copy = scene->materials[size_t(p.material)];
+      bool dropped = false;
+      for (TextureRef* r : {&copy.base_color_texture, &copy.normal_texture, &copy.emissive_texture,
+                            &copy.occlusion_texture, &copy.metallic_roughness_texture}) {
+        if (r->valid() && size_t(r->texcoord) >= p.uvs.size()) {
+          *r = TextureRef{};
+          dropped = true;
+        }
+      }
+      if (!dropped) continue;
+      auto [it, fresh] = copies.emplace(std::make_pair(p.material, p.uvs.size()), 0);
+      if (fresh) {
+        scene->warnings.push_back(scene->source_path + ": mesh '" + mesh.name +
+                                  "' has no UV set for the textures of material '" + copy.name +
+                                  "': its surfaces bake from the material's factors");
+        scene->materials.push_back(std::move(copy));
+        it->second = int(scene->materials.size() - 1);
+      }
+      p.material = it->second;
+    }
+  }
+}
+
+std::string percent_encode_path(const std::string& path) {
+  static const char kHex[] = "0123456789ABCDEF";
+  std::string out;
+  for (const char c : path) {
+    const auto b = static_cast<unsigned char>(c);
+    const bool unreserved = (b >= 'a' && b <= 'z') || (b >= 'A' && b <= 'Z') ||
+                            (b >= '0' && b <= '9') || c == '-' || c == '.' || c == '_' ||
+                            c == '~' || c == '/';
+    if (unreserved) {
+      out.push_back(c);
+    } else {
+      out += {'%', kHex[b >> 4], kHex[b & 15]};
+    }
+  }
+  return out;
 }
 
 std::string percent_decode(const std::string& uri) {
@@ -396,6 +443,14 @@ Expected<Scene> load_by_extension(const std::string& path, const SceneLoadOption
 Expected<Scene> load_scene(const std::string& path, const SceneLoadOptions& options) {
   VT_RETURN_IF_ERROR(detail::check_regular_file(path));
   VT_ASSIGN_OR_RETURN(Scene scene, load_by_extension(path, options));
+  // Names go into messages, JSON reports, the metadata and the unwrapped glTF: UTF-8 from here
+  // on. File paths stay as the disk has them.
+  for (Material& m : scene.materials) m.name = as_utf8(m.name);
+  for (Image& im : scene.images) im.name = as_utf8(im.name);
+  for (Mesh& m : scene.meshes) m.name = as_utf8(m.name);
+  for (Light& l : scene.lights) l.name = as_utf8(l.name);
+  for (Node& n : scene.nodes) n.name = as_utf8(n.name);
+  for (std::string& w : scene.warnings) w = as_utf8(w);
   for (size_t i = 0; i < scene.images.size(); ++i)
     if (!scene.images[i].embedded())
       VT_RETURN_IF_ERROR(detail::check_inside_scene_tree(path, scene.images[i].path,

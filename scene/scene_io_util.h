@@ -21,6 +21,9 @@ std::string parent_folder(const std::string& path);  // "" or ends with '/'
 Expected<std::vector<uint8_t>> decode_data_uri(const std::string& uri, std::string* mime);
 std::string base64_encode(const uint8_t* data, size_t size);
 std::string percent_decode(const std::string& uri);
+// A relative path as a URI: bytes other than unreserved characters and '/' as %XX (spaces,
+// '#', '%', non-ASCII file names), so that percent_decode gives the path back.
+std::string percent_encode_path(const std::string& path);
 
 // The file an exporter meant by `written` (relative to `folder`, "" or ending in '/'):
 // backslashes read as '/', a leading "./" dropped; when that file does not exist, a
@@ -42,6 +45,12 @@ std::string scene_folder_tree(const std::string& scene_path);
 // buffer) and the path.
 Status check_inside_scene_tree(const std::string& scene_path, const std::string& file,
                                const std::string& what, const SceneLoadOptions& options);
+// A primitive without the UV set its material's textures read (faces without `vt` under an
+// OBJ `map_Kd`; gl-117's 3DS trucks, Maya cubes under a textured material) cannot sample them:
+// it gets a copy of the material without those textures, so it bakes from the factors, with a
+// warning, instead of the whole model being refused. The copy keeps the name (density files
+// and messages use it). For the formats that do not forbid it (glTF does).
+void untexture_surfaces_without_uvs(Scene* scene);
 // Appends one warning per kind of degenerate geometry with counts: zero-area triangles,
 // primitives with no area at all (they get no texels).
 void warn_about_degenerate_geometry(Scene* scene);

@@ -72,10 +72,11 @@ class JsonSchema : public ::testing::Test {
     std::vector<std::string> order;
     for (const auto& [key, value] : j.items()) order.push_back(key);
     EXPECT_GE(order.size(), 4u);
-    if (order.size() >= 4)
+    if (order.size() >= 4) {
       EXPECT_EQ(std::vector<std::string>(order.begin(), order.begin() + 4),
                 (std::vector<std::string>{"schema", "command", "ok", "exit"}))
           << args;
+    }
     EXPECT_EQ(j["schema"], 1);
     EXPECT_EQ(j["command"], row.substr(0, row.find(' ')));
     EXPECT_EQ(j["ok"], exit_code == 0);
@@ -182,6 +183,8 @@ TEST_F(JsonSchema, ErrorsAreObjectsOnStdout) {
   check_error("extract", "extract " + missing + " --level 0 -o " + dir_ + "/x.png", 2, "not_found");
   check_error("bake", "bake " + dir_ + "/missing.gltf -o " + dir_ + "/x.vtpf", 2, "not_found");
   check_error("build", "build " + dir_ + "/missing.png -o " + dir_ + "/x.vtpf", 2, "not_found");
+  // A message quoting a file name that is not UTF-8 (Latin-1) is still a JSON error object.
+  check_error("build", "build '" + dir_ + "/caf\xe9.png' -o " + dir_ + "/x.vtpf", 2, "not_found");
   check_error("clean", "clean " + dir_ + "/no-such-folder", 2, "not_found");
   // Errors found while parsing the command line are objects too.
   check_error("info", "info", 2, "usage");

@@ -325,5 +325,70 @@ TEST(AssimpImport, OpacityZeroOutsideColladaIsTransparent) {
   EXPECT_TRUE(warned);
 }
 
+TEST(AssimpImport, MeshWithoutUvsUnderATexturedMaterialBakesFromItsFactors) {
+  // gl-117's 3DS trucks: a Maya cube without UVs under a textured material. It cannot sample
+  // the texture: it gets a copy of the material without it (the bake used to refuse the model).
+  fs::path d = fresh_dir("no_uvs");
+  write_text(d / "wall.png", "not read by the importer");
+  std::string dae = collada_quad("wall.png");
+  const size_t texcoord = dae.find("      <input semantic=\"TEXCOORD\"");
+  ASSERT_NE(texcoord, std::string::npos);
+  dae.erase(texcoord, dae.find('\n', texcoord) + 1 - texcoord);
+  write_text(d / "bare.dae", dae);
+  auto s = scene::load_scene((d / "bare.dae").string());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  const scene::Primitive& prim = s->meshes[s->instances()[0].mesh].primitives[0];
+  EXPECT_TRUE(prim.uvs.empty());
+  ASSERT_GE(prim.material, 0);
+  const scene::Material& m = s->materials[prim.material];
+  EXPECT_EQ(m.name, "Painted");
+  EXPECT_FALSE(m.base_color_texture.valid());
+  bool warned = false;
+  for (const std::string& w : s->warnings)
+    warned |= w.find("has no UV set for the textures of material 'Painted'") != std::string::npos;
+  EXPECT_TRUE(warned);
+  // With its UVs the same quad keeps the texture (the copy is made only where UVs are missing).
+  write_text(d / "quad.dae", collada_quad("wall.png"));
+  auto with_uvs = scene::load_scene((d / "quad.dae").string());
+  ASSERT_TRUE(with_uvs.ok()) << with_uvs.status().message();
+  EXPECT_EQ(with_uvs->materials.size(), 1u);
+  EXPECT_TRUE(with_uvs->materials[0].base_color_texture.valid());
+}
+
+TEST(AssimpImport, NamesInAnEightBitCodePageReadAsLatin1) {
+  // Older formats do not say their encoding; a European author's 3ds Max writes "Par d\xe9faut"
+  // in Windows-1252 (Sauerbraten's rocket.iqm). Names become UTF-8 (reports, JSON and the glTF
+  // need it); a texture's file name stays as the disk spells it.
+  fs::path d = fresh_dir("latin1");
+  write_text(d / "d\xe9"
+                 "cor.png",
+             "not read by the importer");
+  write_text(d / "m.ac",
+             "AC3Db\n"
+             "MATERIAL \"Par d\xe9"
+             "faut\" rgb 1 1 1  amb 0.2 0.2 0.2  emis 0 0 0  "
+             "spec 0.5 0.5 0.5  shi 10  trans 0\n"
+             "OBJECT world\nkids 1\nOBJECT poly\nname \"caf\xe9\"\ntexture \"d\xe9"
+             "cor.png\"\n"
+             "numvert 4\n0 0 0\n1 0 0\n1 1 0\n0 1 0\nnumsurf 1\nSURF 0x10\nmat 0\nrefs 4\n"
+             "0 0 0\n1 1 0\n2 1 1\n3 0 1\nkids 0\n");
+  auto s = scene::load_scene((d / "m.ac").string());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  bool material_named = false, node_named = false;
+  for (const scene::Material& m : s->materials) {
+    material_named |= m.name ==
+                      "Par d\xc3\xa9"
+                      "faut";
+    if (m.base_color_texture.valid()) {
+      EXPECT_EQ(s->images[m.base_color_texture.image].path, (d / "d\xe9"
+                                                                 "cor.png")
+                                                                .string());
+    }
+  }
+  for (const scene::Node& n : s->nodes) node_named |= n.name == "caf\xc3\xa9";
+  EXPECT_TRUE(material_named);
+  EXPECT_TRUE(node_named);
+}
+
 }  // namespace
 }  // namespace vt::test

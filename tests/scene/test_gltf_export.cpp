@@ -96,6 +96,21 @@ TEST(GltfExport, GlbAndGltfHoldTheSameDocumentAndBuffer) {
   EXPECT_FALSE(std::filesystem::exists(temp("same.gltf.tmp")));
 }
 
+TEST(GltfExport, ImageUrisArePercentEncoded) {
+  // A texture path with a space, a '#' and a byte that is not UTF-8 (a Latin-1 file name): the
+  // uri is ASCII that decodes to the same bytes (the JSON writer refused the raw byte).
+  Scene s = textured_ball();
+  s.images[0].path = ::testing::TempDir() +
+                     "textures/my d\xe9"
+                     "cor #1.png";
+  ASSERT_TRUE(scene::save_gltf(s, temp("uri.gltf")).ok());
+  const json doc = json::parse(read_all(temp("uri.gltf")));
+  EXPECT_EQ(doc["images"][0]["uri"], "textures/my%20d%E9cor%20%231.png");
+  auto back = scene::load_scene(temp("uri.gltf"));
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->images[0].path, s.images[0].path);
+}
+
 TEST(GltfExport, GltfLoadsBackAsTheScene) {
   const Scene s = textured_ball();
   ASSERT_TRUE(scene::save_gltf(s, temp("back.gltf")).ok());

@@ -400,6 +400,32 @@ TEST(ObjMtl, MissingLibraryAndMissingMaterialAreWarned) {
       << late.warnings[0];
 }
 
+TEST(ObjMtl, FacesWithoutUvsUnderATexturedMaterialBakeFromItsFactors) {
+  // Faces without `vt` under a `map_Kd` material cannot sample it: they get a copy of the
+  // material without the texture (the bake refused the whole model); faces with UVs under
+  // another textured material keep theirs.
+  std::string dir = folder("no_vt");
+  write_file(dir + "wood.png", tiny_png(1, 1, 3, {200, 100, 50}));
+  scene::Scene s = load(
+      dir,
+      "newmtl wood\nKd 0.5 0.25 0\nmap_Kd wood.png\n"
+      "newmtl stone\nmap_Kd wood.png\n",
+      "mtllib a.mtl\n" + kQuadVertices + "usemtl stone\nf 1/1 2/2 3/3\nusemtl wood\nf 1 3 4\n");
+  bool textured = false, bare = false;
+  for (const scene::Primitive& p : s.meshes[0].primitives) {
+    ASSERT_GE(p.material, 0);
+    const scene::Material& m = s.materials[size_t(p.material)];
+    EXPECT_EQ(m.name, p.uvs.empty() ? "wood" : "stone");
+    EXPECT_EQ(m.base_color_texture.valid(), !p.uvs.empty());
+    if (p.uvs.empty()) {
+      EXPECT_FLOAT_EQ(m.base_color_factor[1], 0.25f);
+    }
+    (p.uvs.empty() ? bare : textured) = true;
+  }
+  EXPECT_TRUE(textured && bare);
+  EXPECT_EQ(warnings_with(s, {"a.obj", "has no UV set", "material 'wood'", "factors"}), 1);
+}
+
 // The same triangle as UTF-8, UTF-8 with a BOM, UTF-16 LE and BE with BOMs.
 TEST(ObjMtl, Utf16AndBomText) {
   const std::string text = "# t\r\nv 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n";
