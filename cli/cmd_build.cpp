@@ -14,6 +14,7 @@
 #include "cli/command.h"
 #include "cli/json_output.h"
 #include "cli/layer_error_text.h"
+#include "common/utf8.h"
 #include "format/atomic_output.h"
 #include "samples/procedural.h"
 
@@ -102,14 +103,19 @@ int run_build(BuildArgs& f, const vt::cli::GlobalOptions& global) {
   // Positional images: the first is the albedo, the others custom layers named by file.
   std::vector<std::pair<std::string, std::string>> inputs;  // layer name, path
   for (size_t i = 0; i < f.images.size(); ++i) {
-    inputs.emplace_back(i == 0 ? "albedo" : std::filesystem::path(f.images[i]).stem().string(),
-                        f.images[i]);
+    // A layer name is UTF-8 (the file format's rule): a file name in another encoding gives its
+    // Latin-1 reading.
+    inputs.emplace_back(
+        i == 0 ? "albedo" : vt::as_utf8(std::filesystem::path(f.images[i]).stem().string()),
+        f.images[i]);
   }
   for (const std::string& spec : f.layers) {
     auto eq = spec.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size()) {
       return bad("--layer expects NAME=PATH, got '" + spec + "'");
     }
+    if (!vt::valid_utf8(spec.substr(0, eq)))
+      return bad("--layer: the name '" + spec.substr(0, eq) + "' is not UTF-8");
     inputs.emplace_back(spec.substr(0, eq), spec.substr(eq + 1));
   }
   if (inputs.empty()) return bad("no input image (give IMAGE or --layer NAME=PATH)");

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "common/status.h"
+#include "common/utf8.h"
 #include "format/page_file.h"
 
 namespace vt::pagefile {
@@ -107,6 +108,7 @@ inline std::string layer_problem(const LayerSpec& l) {
   if (uint8_t(l.color_space) > uint8_t(ColorSpace::kSrgb)) return "unknown colour space";
   if (uint8_t(l.address_mode) > uint8_t(AddressMode::kWrap)) return "unknown address mode";
   if (l.name.size() > 255) return "name longer than 255 bytes";
+  if (!valid_utf8(l.name)) return "name is not UTF-8";
   if (l.codec_tables.size() > kMaxCodecTablesBytes) return "codec tables larger than 16 MiB";
   if (l.codec == PageCodec::kDct && l.texel_type != TexelType::kU8) return "dct needs 8-bit texels";
   if (l.codec == PageCodec::kDct && l.codec_tables.empty()) return "dct layer without codec tables";

@@ -185,6 +185,9 @@ TEST_F(JsonSchema, ErrorsAreObjectsOnStdout) {
   check_error("build", "build " + dir_ + "/missing.png -o " + dir_ + "/x.vtpf", 2, "not_found");
   // A message quoting a file name that is not UTF-8 (Latin-1) is still a JSON error object.
   check_error("build", "build '" + dir_ + "/caf\xe9.png' -o " + dir_ + "/x.vtpf", 2, "not_found");
+  check_error("build",
+              "build procedural:64x64 --layer 'd\xe9tail=procedural:64x64' -o " + dir_ + "/x.vtpf",
+              2, "usage");
   check_error("clean", "clean " + dir_ + "/no-such-folder", 2, "not_found");
   // Errors found while parsing the command line are objects too.
   check_error("info", "info", 2, "usage");

@@ -203,6 +203,11 @@ TEST(PageFileWriter, RejectsBadDescriptions) {
   desc.layers[0].name = std::string(256, 'a');
   EXPECT_FALSE(PageFileWriter::create(path, desc).ok());
   desc = mixed_desc();
+  desc.layers[0].name = "d\xe9tail";  // Latin-1: names are UTF-8 (docs/FORMAT.md)
+  EXPECT_FALSE(PageFileWriter::create(path, desc).ok());
+  desc.layers[0].name = "d\xc3\xa9tail";
+  EXPECT_TRUE(PageFileWriter::create(path, desc).ok());
+  desc = mixed_desc();
   desc.layers[0].semantic = LayerSemantic::kLitAlbedo;  // the last semantic known
   desc.layers[0].name = "lit";
   EXPECT_TRUE(PageFileWriter::create(path, desc).ok());
