@@ -92,8 +92,7 @@ class AssimpScene {
           fewest[p.material] = std::min(fewest[p.material], p.uvs.size());
     for (size_t i = 0; i < scene_.materials.size(); ++i) {
       Material& mat = scene_.materials[i];
-      for (TextureRef* r : {&mat.base_color_texture, &mat.normal_texture, &mat.emissive_texture,
-                            &mat.occlusion_texture, &mat.metallic_roughness_texture}) {
+      for (TextureRef* r : mat.textures()) {
         if (!r->valid() || fewest[i] == SIZE_MAX || fewest[i] == 0 ||
             size_t(r->texcoord) < fewest[i])
           continue;

@@ -76,6 +76,12 @@ struct Material {
   // Its own atlas density, texels per world unit (glTF extras.vtbake_texels_per_unit); 0 = the
   // scene's. A density file overrides it.
   double texels_per_unit = 0;
+
+  // The five texture slots, for code that treats them alike.
+  std::array<TextureRef*, 5> textures() {
+    return {&base_color_texture, &metallic_roughness_texture, &normal_texture, &occlusion_texture,
+            &emissive_texture};
+  }
 };
 
 // An image a material uses: either a file (uri, resolved relative to the scene file's folder

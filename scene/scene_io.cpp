@@ -63,8 +63,7 @@ void untexture_surfaces_without_uvs(Scene* scene) {
       if (p.material < 0 || size_t(p.material) >= scene->materials.size()) continue;
       Material copy = scene->materials[size_t(p.material)];
       bool dropped = false;
-      for (TextureRef* r : {&copy.base_color_texture, &copy.normal_texture, &copy.emissive_texture,
-                            &copy.occlusion_texture, &copy.metallic_roughness_texture}) {
+      for (TextureRef* r : copy.textures()) {
         if (r->valid() && size_t(r->texcoord) >= p.uvs.size()) {
           *r = TextureRef{};
           dropped = true;
