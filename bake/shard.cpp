@@ -26,6 +26,7 @@
 #include "bake/level_store.h"
 #include "bake/unwrap/unwrap.h"
 #include "bake/update.h"
+#include "common/utf8.h"
 #include "format/atomic_output.h"
 
 #ifndef VTBAKE_VERSION
@@ -370,6 +371,15 @@ Expected<PlanSummary> plan_bake(const std::string& scene_path, const SceneBakeOp
   std::vector<std::string> staged_layers;
   std::string staged_coverage, staged_tables, staged_glb;
   const std::string dir = work_dir.empty() ? "" : absolute(work_dir);
+  // The plan records these paths as JSON text, which is UTF-8, and the shards open them again.
+  for (const std::string& path : {scene_path, output, glb, dir}) {
+    if (!valid_utf8(path)) {
+      return Error(ErrorCode::kInvalidArgument,
+                   path +
+                       ": a farm plan records its paths as JSON text, which must be UTF-8, and "
+                       "this one is not (rename it, or bake in one process)");
+    }
+  }
   if (!dir.empty()) {
     std::error_code ec;
     fs::create_directories(fs::path(dir) / "level0", ec);

@@ -235,7 +235,8 @@ std::string report_json(const ValidationReport& r) {
                 {"total", r.seconds.total}}},
               {"exact", to_json(r.exact)},
               {"view_plan", to_json(r.view_plan)}};
-  return doc.dump(2);
+  // Paths are quoted as the disk spells them, which need not be UTF-8 (U+FFFD then).
+  return doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 Status write_report_json(const std::string& path, const ValidationReport& r) {

@@ -201,6 +201,18 @@ TEST_F(FarmCli, MergeRefusesPartsOfAnotherPlan) {
   EXPECT_EQ(run_vtbake("merge " + work("a") + " --missing 2", true).out, "1\n");
 }
 
+TEST_F(FarmCli, PlanRefusesPathsThatAreNotUtf8) {
+  // The plan records its paths as JSON text and the shards open them again: a Latin-1 folder
+  // name is refused before any work (it was an internal error of the JSON writer at the end).
+  const std::string latin1 = dir_ + "/caf\xe9";
+  RunResult r = run_vtbake("-q bake " + scene() + " -o '" + latin1 + "/out.vtpf' " + flags() +
+                               " --work '" + latin1 + "/work' --plan '" + latin1 + "/plan.json'",
+                           true);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("must be UTF-8"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(latin1 + "/work"));
+}
+
 // The plan writes every coarser level as its pyramid pass makes it (dilated, with the alpha
 // scale of coverage-preserving alpha), and the shards read them instead of redoing the pyramid:
 // the merge stays byte-identical with a per-level alpha scale, and a damaged level file fails the

@@ -171,6 +171,15 @@ TEST_F(ValidateCli, JsonPrintsTheReportOnStdout) {
   for (const char* key : {"schema", "command", "ok", "exit", "input", "output"}) body.erase(key);
   EXPECT_EQ(body, read_json(out + "/report.json"));
   EXPECT_EQ(printed["views"].size(), 1u);
+  // A report folder whose name is not UTF-8 (Latin-1): the report is written, its path quoted
+  // with U+FFFD (the JSON writer threw: an internal error after all the work).
+  const std::string latin1 = dir_ + "/caf\xe9";
+  RunResult l =
+      vt::testing::run_vtbake("validate " + dir_ + "/scene.gltf " + dir_ +
+                                  "/bake.vtpf --views 1 --size 160x90 --out '" + latin1 + "'",
+                              /*merge_stderr=*/true);
+  ASSERT_EQ(l.exit_code, 0) << l.out;
+  EXPECT_TRUE(read_json(latin1 + "/report.json").is_object());
 }
 
 TEST_F(ValidateCli, CameraFileViewPassesAndAShuffledBakeFails) {
