@@ -59,11 +59,17 @@ inline bool valid_utf8(std::string_view text) {
   return true;
 }
 
-inline std::string as_utf8(std::string_view text) {
-  if (valid_utf8(text)) return std::string(text);
+// Every byte as the code point of its value (Latin-1).
+inline std::string latin1_to_utf8(std::string_view text) {
   std::string out;
   for (const char c : text) append_utf8(static_cast<unsigned char>(c), &out);
   return out;
+}
+
+// `text` when it is UTF-8, else its Latin-1 reading: names from formats that do not say their
+// encoding (3DS, ASE, IQM, MD3, old OBJ) are mostly in an 8-bit Windows code page.
+inline std::string as_utf8(std::string_view text) {
+  return valid_utf8(text) ? std::string(text) : latin1_to_utf8(text);
 }
 
 }  // namespace vt

@@ -50,7 +50,7 @@ Expected<std::string> decode_text(const std::vector<uint8_t>& bytes, const std::
   std::string text(d, d + n);
   if (valid_utf8(text)) return text;
   *note = "not UTF-8: read as Latin-1";
-  return as_utf8(text);
+  return latin1_to_utf8(text);
 }
 
 void LineCursor::skip_space() {
