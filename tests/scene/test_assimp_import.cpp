@@ -77,6 +77,17 @@ std::string collada_quad(const std::string& image, const std::string& uvs = "0 0
 )";
 }
 
+// An AC3D quad under one material: `name` (quoted as AC3D writes it), its `trans` field, and
+// the object's lines before its vertices (name, texture).
+std::string ac3d_quad(const std::string& name, const std::string& trans,
+                      const std::string& object_lines) {
+  return "AC3Db\nMATERIAL " + name +
+         " rgb 1 1 1  amb 0.2 0.2 0.2  emis 0 0 0  spec 0.5 0.5 0.5  shi 10  " + trans +
+         "\nOBJECT world\nkids 1\nOBJECT poly\n" + object_lines +
+         "numvert 4\n0 0 0\n1 0 0\n1 1 0\n0 1 0\nnumsurf 1\nSURF 0x10\nmat 0\nrefs 4\n"
+         "0 0 0\n1 1 0\n2 1 1\n3 0 1\nkids 0\n";
+}
+
 TEST(AssimpImport, ColladaQuadWithTextureColoursAndTransform) {
   fs::path d = fresh_dir("dae");
   fs::create_directories(d / "maps");
@@ -305,13 +316,7 @@ TEST(AssimpImport, ColladaOpacityZeroIsReadAsOpaque) {
 TEST(AssimpImport, OpacityZeroOutsideColladaIsTransparent) {
   // AC3D's "trans 1" (FlightGear's light halos): the author's word, not an exporter's inversion.
   fs::path d = fresh_dir("ac_opacity");
-  write_text(d / "halo.ac",
-             "AC3Db\n"
-             "MATERIAL \"halo\" rgb 1 1 1  amb 0.2 0.2 0.2  emis 0 0 0  spec 0.5 0.5 0.5  shi 10  "
-             "trans 1\n"
-             "OBJECT world\nkids 1\nOBJECT poly\nname \"quad\"\nnumvert 4\n"
-             "0 0 0\n1 0 0\n1 1 0\n0 1 0\nnumsurf 1\nSURF 0x10\nmat 0\nrefs 4\n"
-             "0 0 0\n1 1 0\n2 1 1\n3 0 1\nkids 0\n");
+  write_text(d / "halo.ac", ac3d_quad("\"halo\"", "trans 1", "name \"quad\"\n"));
   auto s = scene::load_scene((d / "halo.ac").string());
   ASSERT_TRUE(s.ok()) << s.status().message();
   ASSERT_GE(s->materials.size(), 1u);
@@ -363,15 +368,11 @@ TEST(AssimpImport, NamesInAnEightBitCodePageReadAsLatin1) {
   write_text(d / "d\xe9"
                  "cor.png",
              "not read by the importer");
-  write_text(d / "m.ac",
-             "AC3Db\n"
-             "MATERIAL \"Par d\xe9"
-             "faut\" rgb 1 1 1  amb 0.2 0.2 0.2  emis 0 0 0  "
-             "spec 0.5 0.5 0.5  shi 10  trans 0\n"
-             "OBJECT world\nkids 1\nOBJECT poly\nname \"caf\xe9\"\ntexture \"d\xe9"
-             "cor.png\"\n"
-             "numvert 4\n0 0 0\n1 0 0\n1 1 0\n0 1 0\nnumsurf 1\nSURF 0x10\nmat 0\nrefs 4\n"
-             "0 0 0\n1 1 0\n2 1 1\n3 0 1\nkids 0\n");
+  write_text(d / "m.ac", ac3d_quad("\"Par d\xe9"
+                                   "faut\"",
+                                   "trans 0",
+                                   "name \"caf\xe9\"\ntexture \"d\xe9"
+                                   "cor.png\"\n"));
   auto s = scene::load_scene((d / "m.ac").string());
   ASSERT_TRUE(s.ok()) << s.status().message();
   bool material_named = false, node_named = false;
