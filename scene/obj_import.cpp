@@ -1,7 +1,8 @@
-// Wavefront OBJ: one primitive per `usemtl` name, polygons fanned into triangles, vertices shared
-// by identical (position, uv, normal) triples. OBJ's v-up UVs become glTF's v-down. Materials
-// come from the MTL libraries (scene/mtl_import.cpp), resolved by name once the whole file is
-// read, so `usemtl` may come before `mtllib`.
+// Wavefront OBJ: one primitive per `usemtl` name (two where some of its faces have no `vt`),
+// polygons fanned into triangles, vertices shared by identical (position, uv, normal) triples.
+// OBJ's v-up UVs become glTF's v-down. Materials come from the MTL libraries
+// (scene/mtl_import.cpp), resolved by name once the whole file is read, so `usemtl` may come
+// before `mtllib`.
 // Vertex colours (`v x y z r g b [a]`) are read as sRGB-encoded, the way MeshLab, ZBrush and
 // Blender write them (8-bit colours over 255, what their viewports show), and stored linear.
 // A file with a component above 1 wrote 0..255 and is scaled (with a warning).
@@ -24,7 +25,9 @@ struct KeyHash {
   }
 };
 
-// The triangles of one `usemtl` name.
+// The triangles of one `usemtl` name, with UVs or without: a face with no `vt` has no place in
+// its material's textures, so it gets a primitive of its own that bakes from the factors
+// (untexture_surfaces_without_uvs) instead of reading the texel at UV (0, 0).
 struct Builder {
   std::string material_name;
   Primitive prim;
@@ -64,9 +67,9 @@ class ObjReader {
   std::vector<Vec4> colors_;  // per `v`, as written; empty while no `v` had a colour
   float color_peak_ = 0.0f;
   std::vector<Builder> builders_;
-  std::map<std::string, size_t> builder_of_;  // usemtl name -> builders_ index
-  std::string current_;                       // the current usemtl name
-  size_t ignored_elements_ = 0;               // points, lines, curves
+  std::map<std::pair<std::string, bool>, size_t> builder_of_;  // (usemtl, has UVs) -> builder
+  std::string current_;                                        // the current usemtl name
+  size_t ignored_elements_ = 0;                                // points, lines, curves
   std::vector<std::array<int, 3>> face_;
 };
 
@@ -112,7 +115,8 @@ Status ObjReader::face(LineCursor* c) {
     face_.push_back(idx);
   }
   if (face_.size() < 3) return Status::Ok();
-  auto [slot, added] = builder_of_.try_emplace(current_, builders_.size());
+  const bool has_uv = std::all_of(face_.begin(), face_.end(), [](const auto& k) { return k[1]; });
+  auto [slot, added] = builder_of_.try_emplace({current_, has_uv}, builders_.size());
   if (added) builders_.emplace_back().material_name = current_;
   Builder& b = builders_[slot->second];
   auto vertex = [&](const std::array<int, 3>& k) {
@@ -121,9 +125,9 @@ Status ObjReader::face(LineCursor* c) {
       b.prim.positions.push_back(v_[k[0] - 1]);
       b.position_of.push_back(k[0] - 1);
       b.prim.uvs.resize(1);
-      b.prim.uvs[0].push_back(k[1] ? vt_[k[1] - 1] : Vec2{0, 0});
+      b.prim.uvs[0].push_back(has_uv ? vt_[k[1] - 1] : Vec2{0, 0});
       b.prim.normals.push_back(k[2] ? vn_[k[2] - 1] : Vec3{0, 0, 0});
-      b.any_uv |= k[1] != 0;
+      b.any_uv |= has_uv;
       b.any_normal |= k[2] != 0;
     }
     return it->second;

@@ -426,6 +426,36 @@ TEST(ObjMtl, FacesWithoutUvsUnderATexturedMaterialBakeFromItsFactors) {
   EXPECT_EQ(warnings_with(s, {"a.obj", "has no UV set", "material 'wood'", "factors"}), 1);
 }
 
+TEST(ObjMtl, FacesWithoutUvsAmongFacesWithThemKeepOutOfTheTexture) {
+  // One material, faces with and without `vt`: the faces without would have read the texel at
+  // UV (0, 0) and baked that colour over their whole surface. They become a primitive of their
+  // own under the untextured copy; the faces with UVs keep the texture and their UVs.
+  std::string dir = folder("mixed_vt");
+  write_file(dir + "wood.png", tiny_png(1, 1, 3, {200, 100, 50}));
+  scene::Scene s = load(
+      dir, "newmtl wood\nKd 0.5 0.25 0\nmap_Kd wood.png\n",
+      "mtllib a.mtl\n" + kQuadVertices + "usemtl wood\nf 1/1 2/2 3/3\nf 1 3 4\nf 4/4 1/1 2/2\n");
+  ASSERT_EQ(s.meshes[0].primitives.size(), 2u);
+  size_t textured_triangles = 0, bare_triangles = 0;
+  for (const scene::Primitive& p : s.meshes[0].primitives) {
+    ASSERT_GE(p.material, 0);
+    const scene::Material& m = s.materials[size_t(p.material)];
+    EXPECT_EQ(m.name, "wood");
+    EXPECT_EQ(m.base_color_texture.valid(), !p.uvs.empty());
+    (p.uvs.empty() ? bare_triangles : textured_triangles) += p.indices.size() / 3;
+    if (!p.uvs.empty()) {  // this quad's vt k sits at v k: uv = (x, 1 - y) after the flip
+      ASSERT_EQ(p.uvs[0].size(), p.positions.size());
+      for (size_t i = 0; i < p.positions.size(); ++i) {
+        EXPECT_FLOAT_EQ(p.uvs[0][i][0], p.positions[i][0]);
+        EXPECT_FLOAT_EQ(p.uvs[0][i][1], 1.0f - p.positions[i][1]);
+      }
+    }
+  }
+  EXPECT_EQ(textured_triangles, 2u);
+  EXPECT_EQ(bare_triangles, 1u);
+  EXPECT_EQ(warnings_with(s, {"a.obj", "has no UV set", "material 'wood'", "factors"}), 1);
+}
+
 // The same triangle as UTF-8, UTF-8 with a BOM, UTF-16 LE and BE with BOMs.
 TEST(ObjMtl, Utf16AndBomText) {
   const std::string text = "# t\r\nv 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n";
