@@ -345,9 +345,10 @@ int run_batch(BakeArgs& a, const vt::cli::GlobalOptions& global) {
 vt::cli::CommandRunner make_bake(CLI::App& app) {
   auto args = std::make_shared<BakeArgs>();
   vt::SceneBakeOptions& o = args->options;
-  app.add_option("scene", args->scenes,
-                 "Scene(s) to bake (.gltf, .glb, .obj, .ply, .drc, or what assimp reads: .fbx, "
-                 ".dae, .3ds, .md3, ...); several = a batch (--out-dir)");
+  app.add_option(
+      "scene", args->scenes,
+      "Scene(s) to bake (.gltf, .glb, .obj, .ply, .drc, .ac, .acc, or what assimp reads: .fbx, "
+      ".dae, .3ds, .md3, ...); several = a batch (--out-dir)");
   CLI::Option* out_dir = app.add_option(
       "--out-dir", args->out_dir,
       "Batch: write each scene's page file (and .glb) as DIR/STEM.vtpf; parent folders "

@@ -32,9 +32,10 @@ std::string stem(const std::string& path) {
 
 vt::cli::CommandRunner make_unwrap(CLI::App& sub) {
   auto args = std::make_shared<Args>();
-  sub.add_option("scene", args->input,
-                 "Input scene: .gltf, .glb, .obj, .ply, .drc, or what assimp reads (.fbx, .dae, "
-                 ".3ds, .md3, ...)")
+  sub.add_option(
+         "scene", args->input,
+         "Input scene: .gltf, .glb, .obj, .ply, .drc, .ac, .acc, or what assimp reads (.fbx, .dae, "
+         ".3ds, .md3, ...)")
       ->required();
   sub.add_option("-o,--output", args->output, "Output .glb with the atlas UV set added")
       ->required();

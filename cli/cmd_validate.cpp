@@ -97,8 +97,9 @@ int run(ValidateArgs& a, const vt::cli::GlobalOptions& global) {
 vt::cli::CommandRunner make_validate(CLI::App& app) {
   auto args = std::make_shared<ValidateArgs>();
   vt::render::BakeValidationOptions& f = args->options;
-  app.add_option("scene", f.scene,
-                 "The original scene (.gltf, .glb, .obj, .ply, .drc, or what assimp reads)")
+  app.add_option(
+         "scene", f.scene,
+         "The original scene (.gltf, .glb, .obj, .ply, .drc, .ac, .acc, or what assimp reads)")
       ->required();
   app.add_option("page_file", f.page_file, "The baked page file (.vtpf)")->required();
   app.add_option("--unwrapped", f.unwrapped,

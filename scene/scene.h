@@ -189,6 +189,11 @@ struct SceneLoadOptions {
   // resolved. A file outside is an error naming the scene, the image and the path; true
   // reads it anyway (--allow-outside-paths). Missing files are reported as before.
   bool allow_outside_paths = false;
+  // Folders to look in for an image that is not where the scene says (a game's shared texture
+  // folder: TORCS's data/textures, FlightGear's Textures): in order, the name as written below
+  // each, then its base name, letter case ignored, then another image extension. Images found
+  // there may lie outside the scene's folder tree (--texture-path).
+  std::vector<std::string> texture_folders;
 };
 
 // Loads .gltf, .glb, .obj, .ply or .drc (chosen by extension, case-insensitive). OBJ, PLY and

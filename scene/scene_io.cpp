@@ -318,6 +318,18 @@ std::string resolve_written_path(const std::string& folder, const std::string& w
   return windows_absolute ? folder + base : as_written;
 }
 
+std::string find_in_texture_folders(const Image& image, const std::vector<std::string>& folders) {
+  const std::string base = std::filesystem::path(image.path).filename().string();
+  for (std::string dir : folders) {
+    if (!dir.empty() && dir.back() != '/') dir += '/';
+    std::string found = find_ignoring_case(dir, image.uri);
+    if (found.empty()) found = find_ignoring_case(dir, base);
+    if (found.empty()) found = find_other_extension(dir, base);
+    if (!found.empty()) return found;
+  }
+  return "";
+}
+
 std::string scene_folder_tree(const std::string& scene_path) {
   std::error_code ec;
   std::filesystem::path folder = std::filesystem::absolute(scene_path, ec).parent_path();
@@ -421,6 +433,7 @@ Expected<Scene> load_by_extension(const std::string& path, const SceneLoadOption
   if (ext == "obj") return detail::load_obj(path, options);
   if (ext == "ply") return detail::load_ply(path);
   if (ext == "drc") return detail::load_drc(path);
+  if (ext == "ac" || ext == "acc" || ext == "ac3d") return detail::load_ac3d(path);
   if (ext == "pk3" || ext == "bsp") {
     // assimp 5.2's Q3BSP importer fails on real maps (its own test map too, assimp issue 2862;
     // OpenArena's maps alike) and overflows its heap on crafted lump sizes (issue 6711, fixed
@@ -431,10 +444,11 @@ Expected<Scene> load_by_extension(const std::string& path, const SceneLoadOption
                      "maps and is unsafe on crafted ones); bake the map's models (.md3) instead");
   }
   if (detail::assimp_reads(ext)) return detail::load_assimp(path);
-  return Error(ErrorCode::kUnsupported,
-               path +
-                   ": unknown scene format (expected .gltf, .glb, .obj, .ply, .drc or a format "
-                   "assimp reads: .fbx, .dae, .3ds, .blend, ...)");
+  return Error(
+      ErrorCode::kUnsupported,
+      path +
+          ": unknown scene format (expected .gltf, .glb, .obj, .ply, .drc, .ac or a format "
+          "assimp reads: .fbx, .dae, .3ds, .blend, ...)");
 }
 
 }  // namespace
@@ -450,10 +464,26 @@ Expected<Scene> load_scene(const std::string& path, const SceneLoadOptions& opti
   for (Light& l : scene.lights) l.name = as_utf8(l.name);
   for (Node& n : scene.nodes) n.name = as_utf8(n.name);
   for (std::string& w : scene.warnings) w = as_utf8(w);
-  for (size_t i = 0; i < scene.images.size(); ++i)
-    if (!scene.images[i].embedded())
-      VT_RETURN_IF_ERROR(detail::check_inside_scene_tree(path, scene.images[i].path,
-                                                         image_user(scene, i), options));
+  size_t from_texture_folders = 0;
+  for (size_t i = 0; i < scene.images.size(); ++i) {
+    Image& image = scene.images[i];
+    if (image.embedded()) continue;
+    if (!options.texture_folders.empty() && !detail::exists(image.path)) {
+      std::string found = detail::find_in_texture_folders(image, options.texture_folders);
+      if (!found.empty()) {
+        if (from_texture_folders++ == 0)
+          scene.warnings.push_back(path + ": image '" + image.name + "' read from '" + found +
+                                   "' (--texture-path)");
+        image.path = std::move(found);
+        continue;  // the user named that folder: it may lie outside the scene's tree
+      }
+    }
+    VT_RETURN_IF_ERROR(
+        detail::check_inside_scene_tree(path, image.path, image_user(scene, i), options));
+  }
+  if (from_texture_folders > 1)
+    scene.warnings.push_back(path + ": " + std::to_string(from_texture_folders) +
+                             " images in all read from the --texture-path folders");
   detail::warn_about_degenerate_geometry(&scene);
   return scene;
 }

@@ -59,6 +59,8 @@ Expected<Scene> load_gltf(const std::string& path, const SceneLoadOptions& optio
 Expected<Scene> load_obj(const std::string& path, const SceneLoadOptions& options);
 Expected<Scene> load_ply(const std::string& path);
 Expected<Scene> load_drc(const std::string& path);
+// AC3D (.ac, .ac3d) and ACC (.acc, TORCS's AC3D with triangle strips and texture layers).
+Expected<Scene> load_ac3d(const std::string& path);
 // Any other format assimp reads (FBX, COLLADA, 3DS, ...; glTF 1.0).
 Expected<Scene> load_assimp(const std::string& path);
 bool assimp_reads(const std::string& extension);  // lower case, without the dot

@@ -77,17 +77,6 @@ std::string collada_quad(const std::string& image, const std::string& uvs = "0 0
 )";
 }
 
-// An AC3D quad under one material: `name` (quoted as AC3D writes it), its `trans` field, and
-// the object's lines before its vertices (name, texture).
-std::string ac3d_quad(const std::string& name, const std::string& trans,
-                      const std::string& object_lines) {
-  return "AC3Db\nMATERIAL " + name +
-         " rgb 1 1 1  amb 0.2 0.2 0.2  emis 0 0 0  spec 0.5 0.5 0.5  shi 10  " + trans +
-         "\nOBJECT world\nkids 1\nOBJECT poly\n" + object_lines +
-         "numvert 4\n0 0 0\n1 0 0\n1 1 0\n0 1 0\nnumsurf 1\nSURF 0x10\nmat 0\nrefs 4\n"
-         "0 0 0\n1 1 0\n2 1 1\n3 0 1\nkids 0\n";
-}
-
 TEST(AssimpImport, ColladaQuadWithTextureColoursAndTransform) {
   fs::path d = fresh_dir("dae");
   fs::create_directories(d / "maps");
@@ -313,23 +302,6 @@ TEST(AssimpImport, ColladaOpacityZeroIsReadAsOpaque) {
   EXPECT_TRUE(warned);
 }
 
-TEST(AssimpImport, OpacityZeroOutsideColladaIsTransparent) {
-  // AC3D's "trans 1" (FlightGear's light halos): the author's word, not an exporter's inversion.
-  fs::path d = fresh_dir("ac_opacity");
-  write_text(d / "halo.ac", ac3d_quad("\"halo\"", "trans 1", "name \"quad\"\n"));
-  auto s = scene::load_scene((d / "halo.ac").string());
-  ASSERT_TRUE(s.ok()) << s.status().message();
-  ASSERT_GE(s->materials.size(), 1u);
-  const scene::Material& m = s->materials[0];
-  EXPECT_EQ(m.name, "halo");
-  EXPECT_EQ(m.alpha_mode, scene::AlphaMode::kBlend);
-  EXPECT_FLOAT_EQ(m.base_color_factor[3], 0.0f);
-  bool warned = false;
-  for (const std::string& w : s->warnings)
-    warned |= w.find("bake fully transparent") != std::string::npos;
-  EXPECT_TRUE(warned);
-}
-
 TEST(AssimpImport, MeshWithoutUvsUnderATexturedMaterialBakesFromItsFactors) {
   // gl-117's 3DS trucks: a Maya cube without UVs under a textured material. It cannot sample
   // the texture: it gets a copy of the material without it (the bake used to refuse the model).
@@ -358,37 +330,6 @@ TEST(AssimpImport, MeshWithoutUvsUnderATexturedMaterialBakesFromItsFactors) {
   ASSERT_TRUE(with_uvs.ok()) << with_uvs.status().message();
   EXPECT_EQ(with_uvs->materials.size(), 1u);
   EXPECT_TRUE(with_uvs->materials[0].base_color_texture.valid());
-}
-
-TEST(AssimpImport, NamesInAnEightBitCodePageReadAsLatin1) {
-  // Older formats do not say their encoding; a European author's 3ds Max writes "Par d\xe9faut"
-  // in Windows-1252 (Sauerbraten's rocket.iqm). Names become UTF-8 (reports, JSON and the glTF
-  // need it); a texture's file name stays as the disk spells it.
-  fs::path d = fresh_dir("latin1");
-  write_text(d / "d\xe9"
-                 "cor.png",
-             "not read by the importer");
-  write_text(d / "m.ac", ac3d_quad("\"Par d\xe9"
-                                   "faut\"",
-                                   "trans 0",
-                                   "name \"caf\xe9\"\ntexture \"d\xe9"
-                                   "cor.png\"\n"));
-  auto s = scene::load_scene((d / "m.ac").string());
-  ASSERT_TRUE(s.ok()) << s.status().message();
-  bool material_named = false, node_named = false;
-  for (const scene::Material& m : s->materials) {
-    material_named |= m.name ==
-                      "Par d\xc3\xa9"
-                      "faut";
-    if (m.base_color_texture.valid()) {
-      EXPECT_EQ(s->images[m.base_color_texture.image].path, (d / "d\xe9"
-                                                                 "cor.png")
-                                                                .string());
-    }
-  }
-  for (const scene::Node& n : s->nodes) node_named |= n.name == "caf\xc3\xa9";
-  EXPECT_TRUE(material_named);
-  EXPECT_TRUE(node_named);
 }
 
 }  // namespace
