@@ -63,10 +63,13 @@ struct PrimitiveBuilder {
 // Ear clipping in the polygon's own plane (projected along the axis its Newell normal is
 // largest on), so concave outlines (FlightGear's buildings) keep their shape; a polygon that
 // has no ear left (self-intersecting) is fanned from there. `out` gets corner indices.
+// Polygons of more corners are fanned: clipping costs up to n^3 steps.
+constexpr size_t kMaxClippedCorners = 1024;
+
 void triangulate_polygon(const std::vector<Vec3>& p, std::vector<std::array<size_t, 3>>* out) {
   const size_t n = p.size();
-  if (n == 3) {
-    out->push_back({0, 1, 2});
+  if (n == 3 || n > kMaxClippedCorners) {
+    for (size_t i = 1; i + 1 < n; ++i) out->push_back({0, i, i + 1});
     return;
   }
   double normal[3] = {0, 0, 0};
@@ -404,6 +407,7 @@ class Ac3dReader {
                                        : std::array<size_t, 3>{i + 1, i, i + 2});
       }
     } else {
+      if (refs.size() > kMaxClippedCorners) ++fanned_polygons_;
       std::vector<Vec3> corners;
       for (uint32_t r : refs) corners.push_back(o.vertices[r]);
       triangulate_polygon(corners, &triangles);
@@ -452,7 +456,8 @@ class Ac3dReader {
   int material_for(int mat, bool two_sided, const std::string& texture) {
     auto [it, added] = material_of_.try_emplace({mat, two_sided, texture}, 0);
     if (!added) return it->second;
-    const AcMaterial& src = materials_[size_t(mat)];
+    // A surface without a `mat` line in a file without MATERIAL lines: AC3D's default, white.
+    const AcMaterial src = size_t(mat) < materials_.size() ? materials_[size_t(mat)] : AcMaterial{};
     Material m;
     m.name = src.name;
     m.base_color_factor = {src.rgb[0], src.rgb[1], src.rgb[2], 1.0f - src.trans};
@@ -495,6 +500,10 @@ class Ac3dReader {
            " child objects short of what its 'kids' lines announce (miscounted or cut short): "
            "the objects read are baked");
     if (lines_ > 0) warn(std::to_string(lines_) + " line surfaces skipped (no area)");
+    if (fanned_polygons_ > 0)
+      warn(std::to_string(fanned_polygons_) + " polygons of over " +
+           std::to_string(kMaxClippedCorners) + " corners fanned from their first (right only " +
+           "where they are convex)");
     if (short_surfaces_ > 0)
       warn(std::to_string(short_surfaces_) + " surfaces of fewer than 3 vertices skipped");
     if (unknown_surfaces_ > 0)
@@ -521,6 +530,7 @@ class Ac3dReader {
   std::set<std::string> unknown_, transparent_warned_;
   uint64_t triangles_ = 0, lines_ = 0, short_surfaces_ = 0, unknown_surfaces_ = 0;
   uint64_t ignored_layers_ = 0, subdivided_ = 0, lights_ = 0, missing_children_ = 0;
+  uint64_t fanned_polygons_ = 0;
 };
 
 }  // namespace

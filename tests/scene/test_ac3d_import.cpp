@@ -193,6 +193,29 @@ TEST(Ac3dImport, OvercountedKidsKeepWhatIsThereWithAWarning) {
   EXPECT_TRUE(warned(*s, "1 child objects short of what its 'kids' lines announce"));
 }
 
+TEST(Ac3dImport, FilesWithoutMaterialsAndHugePolygonsLoad) {
+  // No MATERIAL line and no `mat` line: AC3D's white default. A polygon of 5,000 corners (a
+  // circle) is fanned, not ear-clipped in n^3 steps, with a warning.
+  fs::path d = fresh_dir("huge");
+  const int n = 5000;
+  std::string ac = "AC3Db\nOBJECT world\nkids 1\nOBJECT poly\nnumvert " + std::to_string(n) + "\n";
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * M_PI * i / n;
+    ac += std::to_string(std::cos(a)) + " " + std::to_string(std::sin(a)) + " 0\n";
+  }
+  ac += "numsurf 1\nSURF 0\nrefs " + std::to_string(n) + "\n";
+  for (int i = 0; i < n; ++i) ac += std::to_string(i) + " 0 0\n";
+  auto s = load_text(d, "circle.ac", ac + "kids 0\n");
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  const scene::Primitive& p = s->meshes[0].primitives[0];
+  EXPECT_EQ(p.triangle_count(), size_t(n - 2));
+  double area = 0;
+  for (size_t t = 0; t < p.triangle_count(); ++t) area += triangle_area(p, t);
+  EXPECT_NEAR(area, M_PI, 1e-3);
+  EXPECT_FLOAT_EQ(s->materials[size_t(p.material)].base_color_factor[0], 1.0f);
+  EXPECT_TRUE(warned(*s, "1 polygons of over 1024 corners fanned"));
+}
+
 TEST(Ac3dImport, DamagedFilesAndFilesWithoutSurfacesAreClearErrors) {
   fs::path d = fresh_dir("damaged");
   const std::string head = "AC3Db\n" + kMaterials + "OBJECT world\nkids 1\nOBJECT poly\n";
