@@ -222,6 +222,31 @@ void ply_seeds(const fs::path& dir) {
   }
 }
 
+// An ACC car part (a strip, texture layers, normals, refs with two UV pairs) under a moved and
+// turned group, an AC3D polygon, a line and a light.
+void ac3d_seeds(const fs::path& dir) {
+  const std::string materials =
+      "MATERIAL \"paint\" rgb 0.8 0.1 0.1  amb 0.2 0.2 0.2  emis 0 0 0  spec 0.5 0.5 0.5  shi 10  "
+      "trans 0\nMATERIAL \"glass\" rgb 1 1 1  amb 1 1 1  emis 0.4 0.4 0.4  spec 0 0 0  shi 0  "
+      "trans 0.5\n";
+  write(dir / "car.acc",
+        "AC3Db\n" + materials +
+            "OBJECT world\nkids 2\nOBJECT group\nname \"body\"\nloc 1 0 0\n"
+            "rot 0 -1 0 1 0 0 0 0 1\nkids 1\nOBJECT poly\nname \"door\"\n"
+            "texture \"paint.png\" base\ntexture \"shadow.rgb\" tiled\n"
+            "texture empty_texture_no_mapping skids\ntexture empty_texture_no_mapping shad\n"
+            "texrep 2 1\ntexoff 0.5 0\ncrease 45\nnumvert 4\n0 0 0 0 0 1\n0 1 0 0 0 1\n"
+            "1 0 0 0 0 1\n1 1 0 0 0 1\nnumsurf 1\nSURF 0x34\nmat 0\nrefs 5\n"
+            "0 0 0 0 0\n1 0 1 0 1\n2 1 0 1 0\n3 1 1 1 1\n3 1 1 1 1\nkids 0\n"
+            "OBJECT light\nname \"lamp\"\nloc 0 2 0\nkids 0\n");
+  write(dir / "house.ac",
+        "AC3Db\n" + materials +
+            "OBJECT world\nkids 1\nOBJECT poly\nname \"wall\"\ndata 4\nwall\n"
+            "texture \"wall.png\"\nnumvert 6\n0 0 0\n2 0 0\n2 1 0\n1 1 0\n1 2 0\n0 2 0\n"
+            "numsurf 2\nSURF 0x20\nmat 1\nrefs 6\n2 1 0.5\n3 0.5 0.5\n4 0.5 1\n5 0 1\n"
+            "0 0 0\n1 1 0\nSURF 0x2\nmat 0\nrefs 2\n0 0 0\n1 1 0\nkids 0\n");
+}
+
 }  // namespace
 }  // namespace vt::fuzz
 
@@ -229,13 +254,14 @@ int main(int argc, char** argv) {
   using namespace vt::fuzz;
   if (argc != 2) fail("usage: vt_fuzz_seeds DIR");
   const fs::path root = argv[1];
-  for (const char* t : {"page_file", "dct", "gltf", "obj", "ply", "scratch"})
+  for (const char* t : {"page_file", "dct", "gltf", "obj", "ply", "ac3d", "scratch"})
     fs::create_directories(root / t);
   page_file_seeds(root / "page_file");
   dct_seeds(root / "dct");
   gltf_seeds(root / "gltf", root / "scratch");
   obj_seeds(root / "obj");
   ply_seeds(root / "ply");
+  ac3d_seeds(root / "ac3d");
   fs::remove_all(root / "scratch");
   return 0;
 }

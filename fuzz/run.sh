@@ -32,6 +32,7 @@ targets=(
   "gltf gltf gltf.dict 65536"
   "obj obj obj.dict 65536"
   "ply ply ply.dict 65536"
+  "ac3d ac3d ac3d.dict 65536"
 )
 
 run_one() {

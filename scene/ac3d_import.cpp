@@ -13,7 +13,8 @@
 // - the object's first `texture` is its base colour map, with `texrep`/`texoff` applied to its
 //   UVs; ACC's further layers (tiled, skids, shad) are ignored with a count; a texture with an
 //   alpha channel blends, as those renderers draw it;
-// - ACC vertex normals (six numbers a vertex) are kept; without them the bake makes its own.
+// - ACC vertex normals (six numbers a vertex) are kept; without them a shaded surface (SURF flag
+//   0x10) is smoothed within the object's `crease` angle, a flat one takes its faces' normals.
 // Names are as written (load_scene makes them UTF-8); texture paths as the disk spells them.
 #include <algorithm>
 #include <array>
@@ -32,6 +33,7 @@ namespace {
 
 constexpr int kMaxDepth = 1024;
 constexpr const char* kNoTexture = "empty_texture_no_mapping";  // ACC's placeholder layer
+constexpr const char* kNullName = "(null)";
 
 enum SurfaceType { kPolygon = 0, kClosedLine = 1, kLine = 2, kTriangleStrip = 4 };
 constexpr unsigned kSurfaceTwoSided = 0x20;
@@ -52,13 +54,42 @@ struct AcObject {
   std::array<double, 9> rot = {1, 0, 0, 0, 1, 0, 0, 0, 1};  // row-major
   Vec3 loc = {0, 0, 0};
   std::vector<Vec3> vertices, normals;  // normals: all or none
+  float crease = 61;                    // degrees; OpenSceneGraph's default
 };
 
-// A primitive being filled: vertices shared by identical (vertex, u, v).
+constexpr unsigned kSurfaceShaded = 0x10;
+
+// One triangle of a surface, its corners as the scene takes them (UVs with texrep, texoff and
+// the v flip applied; ACC's normals when the file gives them).
+struct AcTriangle {
+  int mat = 0;
+  unsigned flags = 0;
+  std::array<uint32_t, 3> vertex{};  // indices into the object's vertices, for smoothing
+  std::array<Vec3, 3> position{};
+  std::array<Vec2, 3> uv{};
+  std::array<Vec3, 3> normal{};
+  bool has_normals = false;
+};
+
+// A primitive being filled: vertices shared by identical (vertex, uv, normal).
 struct PrimitiveBuilder {
   Primitive prim;
-  std::map<std::tuple<uint32_t, float, float>, uint32_t> index_of;
+  std::map<std::tuple<uint32_t, float, float, float, float, float, float, float, float>, uint32_t>
+      index_of;
 };
+
+Vec3 cross(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double u[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
+  const double v[3] = {double(c[0]) - a[0], double(c[1]) - a[1], double(c[2]) - a[2]};
+  return {float(u[1] * v[2] - u[2] * v[1]), float(u[2] * v[0] - u[0] * v[2]),
+          float(u[0] * v[1] - u[1] * v[0])};
+}
+
+Vec3 normalized(const Vec3& v) {
+  const double l = std::sqrt(double(v[0]) * v[0] + double(v[1]) * v[1] + double(v[2]) * v[2]);
+  if (!(l > 0) || !std::isfinite(l)) return {0, 0, 0};
+  return {float(v[0] / l), float(v[1] / l), float(v[2] / l)};
+}
 
 // Ear clipping in the polygon's own plane (projected along the axis its Newell normal is
 // largest on), so concave outlines (FlightGear's buildings) keep their shape; a polygon that
@@ -183,7 +214,7 @@ class Ac3dReader {
     if (end == std::string::npos) end = text_.size();
     line_.assign(text_, pos_, end - pos_);
     if (!line_.empty() && line_.back() == '\r') line_.pop_back();
-    pos_ = end + 1;
+    pos_ = std::min(end + 1, text_.size());
     ++line_number_;
     tokens_ = split_tokens(line_);
     return true;
@@ -241,7 +272,7 @@ class Ac3dReader {
     const std::string kind = tokens_.size() > 1 ? tokens_[1].text : "";
     if (kind == "light") ++lights_;
     AcObject o;
-    std::map<std::pair<int, bool>, PrimitiveBuilder> builders;
+    std::vector<AcTriangle> triangles;  // every surface's, made into primitives at `kids`
     const int node_index = int(scene_.nodes.size());
     scene_.nodes.emplace_back();
     while (true) {
@@ -263,16 +294,19 @@ class Ac3dReader {
         VT_RETURN_IF_ERROR(numbers(1, &o.rot, "rot"));
       } else if (key == "loc") {
         VT_RETURN_IF_ERROR(numbers(1, &o.loc, "loc"));
+      } else if (key == "crease") {
+        double degrees;
+        if (number(1, &degrees) && degrees >= 0 && degrees <= 180) o.crease = float(degrees);
       } else if (key == "subdiv") {
         double levels = 0;
         if (number(1, &levels) && levels > 0) ++subdivided_;
       } else if (key == "numvert") {
         VT_RETURN_IF_ERROR(vertices(&o));
       } else if (key == "numsurf") {
-        VT_RETURN_IF_ERROR(surfaces(o, &builders));
+        VT_RETURN_IF_ERROR(surfaces(o, &triangles));
       } else if (key == "kids") {
         VT_ASSIGN_OR_RETURN(size_t kids, count("kids"));
-        finish_object(node_index, o, &builders);
+        finish_object(node_index, o, triangles);
         for (size_t k = 0; k < kids; ++k) {
           // TORCS's track maker overcounts `kids`: PLIB and OpenSceneGraph draw what is there.
           do {
@@ -288,22 +322,23 @@ class Ac3dReader {
           scene_.nodes[node_index].children.push_back(child);
         }
         return node_index;
-      } else if (key != "crease" && key != "url" && key != "hidden" && key != "locked" &&
-                 key != "folded" && key != "shader") {
+      } else if (key != "url" && key != "hidden" && key != "locked" && key != "folded" &&
+                 key != "shader") {
         unknown(key);
       }
     }
   }
 
-  // The first texture line is the base layer (unless it is ACC's placeholder); true for a line
-  // after it that names an image (a layer this bake ignores).
-  static bool take_texture(AcObject* o, const std::string& file) {
-    if (!o->texture_seen) {
-      o->texture_seen = true;
-      if (file != kNoTexture) o->texture = file;
-      return false;
-    }
-    return !file.empty() && file != kNoTexture;
+  // The first texture line is the base layer; true for a later line that names an image (a
+  // layer this bake ignores). ACC's placeholder and "(null)" (a track exporter printing a missing
+  // name: TORCS's g-track-3) mean no texture.
+  bool take_texture(AcObject* o, const std::string& file) {
+    const bool none = file.empty() || file == kNoTexture || file == kNullName;
+    if (o->texture_seen) return !none;
+    o->texture_seen = true;
+    null_textures_ += file == kNullName;
+    if (!none) o->texture = file;
+    return false;
   }
 
   // `data` is followed by a line break and that many bytes (which may hold line breaks).
@@ -334,7 +369,7 @@ class Ac3dReader {
     return Status::Ok();
   }
 
-  Status surfaces(const AcObject& o, std::map<std::pair<int, bool>, PrimitiveBuilder>* builders) {
+  Status surfaces(const AcObject& o, std::vector<AcTriangle>* out) {
     VT_ASSIGN_OR_RETURN(size_t n, count("numsurf"));
     for (size_t s = 0; s < n; ++s) {
       do {
@@ -376,14 +411,13 @@ class Ac3dReader {
           return corrupt("'" + tokens_[0].text + "' inside a surface (expected mat or refs)");
         }
       }
-      add_surface(o, flags, mat, refs, uvs, builders);
+      add_surface(o, flags, mat, refs, uvs, out);
     }
     return Status::Ok();
   }
 
   void add_surface(const AcObject& o, unsigned flags, int mat, const std::vector<uint32_t>& refs,
-                   const std::vector<Vec2>& uvs,
-                   std::map<std::pair<int, bool>, PrimitiveBuilder>* builders) {
+                   const std::vector<Vec2>& uvs, std::vector<AcTriangle>* out) {
     const unsigned type = flags & 0xf;
     if (type == kClosedLine || type == kLine) {
       ++lines_;
@@ -412,43 +446,99 @@ class Ac3dReader {
       for (uint32_t r : refs) corners.push_back(o.vertices[r]);
       triangulate_polygon(corners, &triangles);
     }
-    PrimitiveBuilder& b = (*builders)[{mat, (flags & kSurfaceTwoSided) != 0}];
-    auto vertex = [&](size_t corner) {
-      const uint32_t r = refs[corner];
-      // AC3D's UVs have v up, and texrep/texoff scale and move them; the scene's have v down.
-      const Vec2 uv = {uvs[corner][0] * o.texrep[0] + o.texoff[0],
-                       1.0f - (uvs[corner][1] * o.texrep[1] + o.texoff[1])};
-      auto [it, added] =
-          b.index_of.try_emplace({r, uv[0], uv[1]}, uint32_t(b.prim.positions.size()));
-      if (added) {
-        b.prim.positions.push_back(o.vertices[r]);
-        if (!o.normals.empty()) b.prim.normals.push_back(o.normals[r]);
-        b.prim.uvs.resize(1);
-        b.prim.uvs[0].push_back(uv);
+    for (const auto& t : triangles) {
+      AcTriangle& tri = out->emplace_back();
+      tri.mat = mat;
+      tri.flags = flags;
+      tri.has_normals = !o.normals.empty();
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t r = refs[t[size_t(k)]];
+        const Vec2& uv = uvs[t[size_t(k)]];
+        tri.vertex[size_t(k)] = r;
+        tri.position[size_t(k)] = o.vertices[r];
+        // AC3D's UVs have v up, and texrep/texoff scale and move them; the scene's have v down.
+        tri.uv[size_t(k)] = {uv[0] * o.texrep[0] + o.texoff[0],
+                             1.0f - (uv[1] * o.texrep[1] + o.texoff[1])};
+        if (tri.has_normals) tri.normal[size_t(k)] = o.normals[r];
       }
-      return it->second;
-    };
-    for (const auto& t : triangles)
-      for (size_t corner : t) b.prim.indices.push_back(vertex(corner));
+    }
     triangles_ += triangles.size();
   }
 
+  // Normals where the file gives none, as AC3D's renderers make them: a shaded surface's corner
+  // takes the area-weighted normals of the object's shaded triangles at that vertex within the
+  // crease angle of its own, a flat surface its triangle's.
+  static void make_normals(const AcObject& o, std::vector<AcTriangle>* triangles) {
+    std::vector<Vec3> face(triangles->size());  // area-weighted
+    std::multimap<uint32_t, size_t> at_vertex;
+    for (size_t t = 0; t < triangles->size(); ++t) {
+      const AcTriangle& tri = (*triangles)[t];
+      face[t] = cross(tri.position[0], tri.position[1], tri.position[2]);
+      if (tri.flags & kSurfaceShaded)
+        for (uint32_t v : tri.vertex) at_vertex.emplace(v, t);
+    }
+    const double min_cos = std::cos(double(o.crease) * M_PI / 180.0);
+    for (size_t t = 0; t < triangles->size(); ++t) {
+      AcTriangle& tri = (*triangles)[t];
+      if (tri.has_normals) continue;
+      const Vec3 own = normalized(face[t]);
+      for (int k = 0; k < 3; ++k) {
+        Vec3 sum = face[t];
+        if (tri.flags & kSurfaceShaded) {
+          sum = {0, 0, 0};
+          const auto [first, last] = at_vertex.equal_range(tri.vertex[size_t(k)]);
+          for (auto it = first; it != last; ++it) {
+            const Vec3 other = normalized(face[it->second]);
+            if (double(own[0]) * other[0] + double(own[1]) * other[1] + double(own[2]) * other[2] <
+                min_cos - 1e-6)
+              continue;
+            for (int c = 0; c < 3; ++c) sum[size_t(c)] += face[it->second][size_t(c)];
+          }
+        }
+        Vec3 n = normalized(sum);
+        if (n == Vec3{0, 0, 0}) n = own == Vec3{0, 0, 0} ? Vec3{0, 0, 1} : own;
+        tri.normal[size_t(k)] = n;
+      }
+    }
+  }
+
   // The node's transform and name, and a mesh of its primitives when it has any.
-  void finish_object(int node_index, const AcObject& o,
-                     std::map<std::pair<int, bool>, PrimitiveBuilder>* builders) {
+  void finish_object(int node_index, const AcObject& o, std::vector<AcTriangle>& triangles) {
     Node& node = scene_.nodes[size_t(node_index)];
     node.name = o.name;
     const auto& r = o.rot;  // row-major; Mat4 is column-major
     node.local = {r[0], r[3], r[6], 0, r[1],     r[4],     r[7],     0,
                   r[2], r[5], r[8], 0, o.loc[0], o.loc[1], o.loc[2], 1};
-    if (builders->empty()) return;
+    if (triangles.empty()) return;
+    make_normals(o, &triangles);
+    std::map<std::pair<int, bool>, PrimitiveBuilder> builders;
+    for (const AcTriangle& tri : triangles) {
+      PrimitiveBuilder& b = builders[{tri.mat, (tri.flags & kSurfaceTwoSided) != 0}];
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t v = tri.vertex[size_t(k)];
+        const Vec2& uv = tri.uv[size_t(k)];
+        const Vec3& n = tri.normal[size_t(k)];
+        // The position is in the key too: a second `numvert` list reuses the indices.
+        const Vec3& p = tri.position[size_t(k)];
+        auto [it, added] =
+            b.index_of.try_emplace({v, uv[0], uv[1], n[0], n[1], n[2], p[0], p[1], p[2]},
+                                   uint32_t(b.prim.positions.size()));
+        if (added) {
+          b.prim.positions.push_back(tri.position[size_t(k)]);
+          b.prim.normals.push_back(n);
+          b.prim.uvs.resize(1);
+          b.prim.uvs[0].push_back(uv);
+        }
+        b.prim.indices.push_back(it->second);
+      }
+    }
     Mesh mesh;
     mesh.name = o.name;
-    for (auto& [key, b] : *builders) {
+    for (auto& [key, b] : builders) {
       b.prim.material = material_for(key.first, key.second, o.texture);
       mesh.primitives.push_back(std::move(b.prim));
     }
-    builders->clear();
+    triangles.clear();
     scene_.meshes.push_back(std::move(mesh));
     node.mesh = int(scene_.meshes.size() - 1);
   }
@@ -500,6 +590,10 @@ class Ac3dReader {
            " child objects short of what its 'kids' lines announce (miscounted or cut short): "
            "the objects read are baked");
     if (lines_ > 0) warn(std::to_string(lines_) + " line surfaces skipped (no area)");
+    if (null_textures_ > 0)
+      warn(std::to_string(null_textures_) +
+           " objects name their texture \"(null)\" (an exporter's missing name): they bake "
+           "untextured");
     if (fanned_polygons_ > 0)
       warn(std::to_string(fanned_polygons_) + " polygons of over " +
            std::to_string(kMaxClippedCorners) + " corners fanned from their first (right only " +
@@ -530,7 +624,7 @@ class Ac3dReader {
   std::set<std::string> unknown_, transparent_warned_;
   uint64_t triangles_ = 0, lines_ = 0, short_surfaces_ = 0, unknown_surfaces_ = 0;
   uint64_t ignored_layers_ = 0, subdivided_ = 0, lights_ = 0, missing_children_ = 0;
-  uint64_t fanned_polygons_ = 0;
+  uint64_t fanned_polygons_ = 0, null_textures_ = 0;
 };
 
 }  // namespace

@@ -75,7 +75,7 @@ TEST(Ac3dImport, AccTriangleStripsTakeTheBaseTextureAndItsUvs) {
   ASSERT_TRUE(write_tga32((d / "road.tga").string(), 4, 4, texels, 0));
   ASSERT_TRUE(write_tga32((d / "shadow.tga").string(), 4, 4, texels, 0));
   std::string acc = "AC3Db\n" + kMaterials +
-                    "OBJECT world\nkids 1\nOBJECT poly\nname \"road\"\n"
+                    "OBJECT world\nkids 2\nOBJECT poly\nname \"road\"\n"
                     "texture \"road.tga\" base\ntexture \"shadow.tga\" tiled\n"
                     "texture empty_texture_no_mapping skids\n"
                     "texture empty_texture_no_mapping shad\n"
@@ -89,12 +89,19 @@ TEST(Ac3dImport, AccTriangleStripsTakeTheBaseTextureAndItsUvs) {
            " 7 7\n";
   }
   acc += "5 1 1 7 7\nkids 0\n";  // a repeated vertex, as strips join runs: no triangle
+  // A second object whose exporter printed a missing name: untextured, with a warning.
+  acc +=
+      "OBJECT poly\ntexture \"(null)\" base\nnumvert 3\n0 0 0\n1 0 0\n0 1 0\nnumsurf 1\n"
+      "SURF 0\nmat 0\nrefs 3\n0 0 0\n1 1 0\n2 0 1\nkids 0\n";
   auto s = load_text(d, "track.acc", acc);
   ASSERT_TRUE(s.ok()) << s.status().message();
-  ASSERT_EQ(s->meshes.size(), 1u);
+  ASSERT_EQ(s->meshes.size(), 2u);
   ASSERT_EQ(s->meshes[0].primitives.size(), 1u);
   const scene::Primitive& p = s->meshes[0].primitives[0];
   ASSERT_EQ(p.triangle_count(), 4u);
+  const scene::Primitive& unnamed = s->meshes[1].primitives[0];
+  EXPECT_FALSE(s->materials[size_t(unnamed.material)].base_color_texture.valid());
+  EXPECT_TRUE(warned(*s, "1 objects name their texture \"(null)\""));
   // Every strip triangle faces as the first does (-Z here): odd ones are taken in the other
   // order, as OpenGL draws a strip.
   for (size_t t = 0; t < 4; ++t) EXPECT_NEAR(triangle_area(p, t), -0.5, 1e-6) << t;
@@ -216,6 +223,59 @@ TEST(Ac3dImport, FilesWithoutMaterialsAndHugePolygonsLoad) {
   EXPECT_TRUE(warned(*s, "1 polygons of over 1024 corners fanned"));
 }
 
+TEST(Ac3dImport, ASecondVertexListKeepsEveryAttributeWhole) {
+  // An object with two `numvert` lists, normals in the first only (a fuzzer's find): one
+  // primitive, whose normals would have covered some vertices only. Every array stays whole.
+  fs::path d = fresh_dir("two_lists");
+  const std::string surface = "numsurf 1\nSURF 0\nmat 0\nrefs 3\n0 0 0\n1 1 0\n2 0 1\n";
+  auto s = load_text(d, "two.acc",
+                     "AC3Db\n" + kMaterials +
+                         "OBJECT world\nkids 1\nOBJECT poly\nnumvert 3\n0 0 0 0 0 1\n"
+                         "1 0 0 0 0 1\n0 1 0 0 0 1\n" +
+                         surface + "numvert 3\n5 0 0\n6 0 0\n5 1 0\n" + surface + "kids 0\n");
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  const scene::Primitive& p = s->meshes[0].primitives[0];
+  EXPECT_EQ(p.triangle_count(), 2u);
+  EXPECT_EQ(p.positions.size(), 6u);
+  ASSERT_EQ(p.normals.size(), 6u);  // the file's for the first list, made for the second
+  for (const scene::Vec3& n : p.normals) EXPECT_FLOAT_EQ(n[2], 1.0f);
+  EXPECT_EQ(p.uvs[0].size(), 6u);
+}
+
+TEST(Ac3dImport, NormalsAreMadeWithinTheCreaseAngle) {
+  // A quad folded 90 degrees along x = 1 (two shaded surfaces sharing vertices 1 and 2): with
+  // crease 45 each face keeps its own normal; with crease 100 the shared corners take the
+  // average; a flat surface (SURF 0x0) never does.
+  fs::path d = fresh_dir("crease");
+  auto folded = [&](const std::string& crease, const std::string& surf) {
+    return "AC3Db\n" + kMaterials + "OBJECT world\nkids 1\nOBJECT poly\n" + crease +
+           "numvert 4\n0 0 0\n1 0 0\n1 1 0\n1 0 -1\nnumsurf 2\nSURF " + surf +
+           "\nmat 0\nrefs 3\n0 0 0\n1 1 0\n2 1 1\nSURF " + surf +
+           "\nmat 0\nrefs 3\n1 0 0\n3 1 0\n2 1 1\nkids 0\n";
+  };
+  auto normal_at_shared_corner = [](const scene::Scene& s) {
+    const scene::Primitive& p = s.meshes[0].primitives[0];
+    std::vector<scene::Vec3> out;
+    for (size_t v = 0; v < p.positions.size(); ++v)
+      if (p.positions[v] == scene::Vec3{1, 1, 0}) out.push_back(p.normals[v]);
+    return out;
+  };
+  auto sharp = load_text(d, "sharp.ac", folded("crease 45\n", "0x10"));
+  ASSERT_TRUE(sharp.ok()) << sharp.status().message();
+  EXPECT_EQ(normal_at_shared_corner(*sharp).size(), 2u);  // one a face: split
+  auto smooth = load_text(d, "smooth.ac", folded("crease 100\n", "0x10"));
+  ASSERT_TRUE(smooth.ok()) << smooth.status().message();
+  const std::vector<scene::Vec3> shared = normal_at_shared_corner(*smooth);
+  ASSERT_EQ(shared.size(), 1u);
+  // Faces +Z (area 0.5) and +X (area 0.5): the average is (1, 0, 1) / sqrt 2.
+  EXPECT_NEAR(shared[0][0], std::sqrt(0.5), 1e-6);
+  EXPECT_NEAR(shared[0][1], 0.0, 1e-6);
+  EXPECT_NEAR(shared[0][2], std::sqrt(0.5), 1e-6);
+  auto flat = load_text(d, "flat.ac", folded("crease 100\n", "0x0"));
+  ASSERT_TRUE(flat.ok()) << flat.status().message();
+  EXPECT_EQ(normal_at_shared_corner(*flat).size(), 2u);
+}
+
 TEST(Ac3dImport, DamagedFilesAndFilesWithoutSurfacesAreClearErrors) {
   fs::path d = fresh_dir("damaged");
   const std::string head = "AC3Db\n" + kMaterials + "OBJECT world\nkids 1\nOBJECT poly\n";
@@ -224,6 +284,8 @@ TEST(Ac3dImport, DamagedFilesAndFilesWithoutSurfacesAreClearErrors) {
     ErrorCode code;
   } cases[] = {
       {"OBJ\n", "not an AC3D file", ErrorCode::kCorrupt},
+      // `data` on the last line, with no line break after it (a fuzzer's find: read past the end).
+      {head + "data 10 4", "the file ends inside an OBJECT", ErrorCode::kCorrupt},
       {head + "numvert 3\n0 0 0\n1 0 0\n", "k.ac:9: the file ends after 2 of 3 vertices",
        ErrorCode::kCorrupt},
       {head + "numvert 3\n0 0 0\n1 0 0\n0 1 0\nnumsurf 1\nSURF 0\nmat 0\nrefs 3\n0 0 0\n1 0 0\n"
