@@ -36,7 +36,7 @@ constexpr const char* kNoTexture = "empty_texture_no_mapping";  // ACC's placeho
 constexpr const char* kNullName = "(null)";
 
 enum SurfaceType { kPolygon = 0, kClosedLine = 1, kLine = 2, kTriangleStrip = 4 };
-constexpr unsigned kSurfaceTwoSided = 0x20;
+constexpr unsigned kSurfaceShaded = 0x10, kSurfaceTwoSided = 0x20;  // SURF flags
 
 struct AcMaterial {
   std::string name;
@@ -56,8 +56,6 @@ struct AcObject {
   std::vector<Vec3> vertices, normals;  // normals: all or none
   float crease = 61;                    // degrees; OpenSceneGraph's default
 };
-
-constexpr unsigned kSurfaceShaded = 0x10;
 
 // One triangle of a surface, its corners as the scene takes them (UVs with texrep, texoff and
 // the v flip applied; ACC's normals when the file gives them).
@@ -220,13 +218,14 @@ class Ac3dReader {
     return true;
   }
 
-  // Token i as a number; false when there is none or it is not one.
+  // Token i as a finite number; false when there is none or it is not one (NaN and infinity
+  // included: every caller refuses them or does without).
   bool number(size_t i, double* out) const {
     if (i >= tokens_.size()) return false;
     const char* s = tokens_[i].text.c_str();
     char* end = nullptr;
     *out = std::strtod(s, &end);
-    return end != s;
+    return end != s && std::isfinite(*out);
   }
   template <size_t N, class T>
   Status numbers(size_t first, std::array<T, N>* out, const char* what) const {
@@ -401,8 +400,9 @@ class Ac3dReader {
               return corrupt("surface refers to vertex '" +
                              (tokens_.empty() ? std::string() : tokens_[0].text) + "' of " +
                              std::to_string(o.vertices.size()));
-            number(1, &u);  // ACC lists a pair for each texture layer: the first is the base's
-            number(2, &v);
+            // ACC lists a pair for each texture layer: the first is the base's.
+            if (tokens_.size() > 1 && (!number(1, &u) || !number(2, &v)))
+              return corrupt("bad texture coordinates '" + tokens_[1].text + "'");
             refs.push_back(uint32_t(index));
             uvs.push_back({float(u), float(v)});
           }
@@ -556,9 +556,7 @@ class Ac3dReader {
     m.double_sided = two_sided;
     if (src.trans > 0) m.alpha_mode = AlphaMode::kBlend;
     if (src.trans >= 1 && transparent_warned_.insert(src.name).second)
-      warn("material '" + src.name +
-           "': trans 1 (fully transparent): its surfaces bake fully "
-           "transparent");
+      warn("material '" + src.name + "': trans 1: its surfaces bake fully transparent");
     if (!texture.empty()) {
       m.base_color_texture.image = image_for(texture);
       if (image_has_alpha_[size_t(m.base_color_texture.image)]) m.alpha_mode = AlphaMode::kBlend;

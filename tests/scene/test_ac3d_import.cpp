@@ -291,6 +291,12 @@ TEST(Ac3dImport, DamagedFilesAndFilesWithoutSurfacesAreClearErrors) {
       {head + "numvert 3\n0 0 0\n1 0 0\n0 1 0\nnumsurf 1\nSURF 0\nmat 0\nrefs 3\n0 0 0\n1 0 0\n"
               "7 0 0\nkids 0\n",
        "k.ac:17: surface refers to vertex '7' of 3", ErrorCode::kCorrupt},
+      // NaN as a vertex reference (a fuzzer's find: it passed the range check) and as a UV.
+      {head + "numvert 3\n0 0 0\n1 0 0\n0 1 0\nnumsurf 1\nSURF 0\nmat 0\nrefs 3\nnan 0 0\n",
+       "surface refers to vertex 'nan' of 3", ErrorCode::kCorrupt},
+      {head + "numvert 3\n0 0 0\n1 0 0\n0 1 0\nnumsurf 1\nSURF 0\nmat 0\nrefs 3\n0 nan 0\n",
+       "k.ac:15: bad texture coordinates 'nan'", ErrorCode::kCorrupt},
+      {head + "loc 0 inf 0\n", "k.ac:7: bad 'loc' line", ErrorCode::kCorrupt},
       {head + "numvert 3\n0 0 0\n1 0 0\n0 1 0\nnumsurf 1\nSURF 0\nmat 9\n",
        "surface material '9' is not one of the file's 2 materials", ErrorCode::kCorrupt},
       {head + "numvert 2\n0 0 0\n1 0 0\nnumsurf 1\nSURF 0x2\nmat 0\nrefs 2\n0 0 0\n1 0 0\n"
