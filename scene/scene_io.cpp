@@ -320,9 +320,13 @@ std::string resolve_written_path(const std::string& folder, const std::string& w
 
 std::string find_in_texture_folders(const Image& image, const std::vector<std::string>& folders) {
   const std::string base = std::filesystem::path(image.path).filename().string();
+  // The path as written only when it stays below the folder: no "..", not absolute.
+  const std::filesystem::path written(image.uri);
+  const bool below =
+      !written.is_absolute() && std::find(written.begin(), written.end(), "..") == written.end();
   for (std::string dir : folders) {
     if (!dir.empty() && dir.back() != '/') dir += '/';
-    std::string found = find_ignoring_case(dir, image.uri);
+    std::string found = below ? find_ignoring_case(dir, image.uri) : "";
     if (found.empty()) found = find_ignoring_case(dir, base);
     if (found.empty()) found = find_other_extension(dir, base);
     if (!found.empty()) return found;

@@ -335,6 +335,14 @@ TEST(Ac3dImport, TexturePathFindsAGamesSharedTextures) {
   EXPECT_EQ(s->images[0].path, (d / "data" / "textures" / "TR-Dirt.tga").string());
   EXPECT_TRUE(warned(*s, "read from '" + (d / "data" / "textures" / "TR-Dirt.tga").string() +
                              "' (--texture-path)"));
+  // A path that climbs out of the named folder is looked up by its base name only.
+  fs::create_directories(d / "outside");
+  ASSERT_TRUE(write_tga32((d / "outside" / "secret.tga").string(), 2, 2, texels, 0));
+  std::string climbing = ac;
+  climbing.replace(climbing.find("tr-dirt.tga"), 11, "../../outside/secret.tga");
+  auto c = load_text(track, "climb.ac", climbing, options);
+  ASSERT_TRUE(c.ok()) << c.status().message();
+  EXPECT_FALSE(fs::exists(c->images[0].path)) << c->images[0].path;
 }
 
 TEST(Ac3dImport, TransOneIsFullyTransparent) {
