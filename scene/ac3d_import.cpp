@@ -24,6 +24,7 @@
 #include <set>
 #include <tuple>
 
+#include "common/vec.h"
 #include "scene/image_load.h"
 #include "scene/obj_mtl.h"
 #include "scene/scene_io_util.h"
@@ -76,17 +77,8 @@ struct PrimitiveBuilder {
       index_of;
 };
 
-Vec3 cross(const Vec3& a, const Vec3& b, const Vec3& c) {
-  const double u[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
-  const double v[3] = {double(c[0]) - a[0], double(c[1]) - a[1], double(c[2]) - a[2]};
-  return {float(u[1] * v[2] - u[2] * v[1]), float(u[2] * v[0] - u[0] * v[2]),
-          float(u[0] * v[1] - u[1] * v[0])};
-}
-
-Vec3 normalized(const Vec3& v) {
-  const double l = std::sqrt(double(v[0]) * v[0] + double(v[1]) * v[1] + double(v[2]) * v[2]);
-  if (!(l > 0) || !std::isfinite(l)) return {0, 0, 0};
-  return {float(v[0] / l), float(v[1] / l), float(v[2] / l)};
+Vec3d v3(const Vec3& a) {
+  return {a[0], a[1], a[2]};
 }
 
 // Ear clipping in the polygon's own plane (projected along the axis its Newell normal is
@@ -114,7 +106,7 @@ void triangulate_polygon(const std::vector<Vec3>& p, std::vector<std::array<size
     if (std::abs(normal[k]) > std::abs(normal[axis])) axis = k;
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
   const double orientation = normal[axis] < 0 ? -1.0 : 1.0;
-  auto cross = [&](size_t a, size_t b, size_t c) {
+  auto turn = [&](size_t a, size_t b, size_t c) {  // > 0: a left turn in the plane
     return orientation * ((double(p[b][u]) - p[a][u]) * (double(p[c][v]) - p[a][v]) -
                           (double(p[b][v]) - p[a][v]) * (double(p[c][u]) - p[a][u]));
   };
@@ -126,11 +118,11 @@ void triangulate_polygon(const std::vector<Vec3>& p, std::vector<std::array<size
     for (size_t i = 0; i < left.size() && !clipped; ++i) {
       const size_t a = left[(i + left.size() - 1) % left.size()], b = left[i],
                    c = left[(i + 1) % left.size()];
-      if (cross(a, b, c) <= 0) continue;  // reflex or flat corner
+      if (turn(a, b, c) <= 0) continue;  // reflex or flat corner
       bool inside = false;
       for (size_t q : left) {
         if (q == a || q == b || q == c) continue;
-        if (cross(a, b, q) >= 0 && cross(b, c, q) >= 0 && cross(c, a, q) >= 0) {
+        if (turn(a, b, q) >= 0 && turn(b, c, q) >= 0 && turn(c, a, q) >= 0) {
           inside = true;
           break;
         }
@@ -469,11 +461,15 @@ class Ac3dReader {
   // takes the area-weighted normals of the object's shaded triangles at that vertex within the
   // crease angle of its own, a flat surface its triangle's.
   static void make_normals(const AcObject& o, std::vector<AcTriangle>* triangles) {
-    std::vector<Vec3> face(triangles->size());  // area-weighted
+    // Each triangle's normal weighted by its area (twice it), and of unit length (zero when it
+    // has no area).
+    std::vector<Vec3d> face(triangles->size()), unit(triangles->size());
     std::multimap<uint32_t, size_t> at_vertex;
     for (size_t t = 0; t < triangles->size(); ++t) {
       const AcTriangle& tri = (*triangles)[t];
-      face[t] = cross(tri.position[0], tri.position[1], tri.position[2]);
+      const Vec3d p0 = v3(tri.position[0]);
+      face[t] = cross(v3(tri.position[1]) - p0, v3(tri.position[2]) - p0);
+      unit[t] = normalized(face[t], Vec3d{});
       if (tri.flags & kSurfaceShaded)
         for (uint32_t v : tri.vertex) at_vertex.emplace(v, t);
     }
@@ -481,23 +477,17 @@ class Ac3dReader {
     for (size_t t = 0; t < triangles->size(); ++t) {
       AcTriangle& tri = (*triangles)[t];
       if (tri.has_normals) continue;
-      const Vec3 own = normalized(face[t]);
+      const Vec3d own = normalized(face[t], Vec3d{0, 0, 1});
       for (int k = 0; k < 3; ++k) {
-        Vec3 sum = face[t];
+        Vec3d sum = face[t];
         if (tri.flags & kSurfaceShaded) {
-          sum = {0, 0, 0};
+          sum = {};
           const auto [first, last] = at_vertex.equal_range(tri.vertex[size_t(k)]);
-          for (auto it = first; it != last; ++it) {
-            const Vec3 other = normalized(face[it->second]);
-            if (double(own[0]) * other[0] + double(own[1]) * other[1] + double(own[2]) * other[2] <
-                min_cos - 1e-6)
-              continue;
-            for (int c = 0; c < 3; ++c) sum[size_t(c)] += face[it->second][size_t(c)];
-          }
+          for (auto it = first; it != last; ++it)
+            if (dot(unit[t], unit[it->second]) >= min_cos - 1e-6) sum = sum + face[it->second];
         }
-        Vec3 n = normalized(sum);
-        if (n == Vec3{0, 0, 0}) n = own == Vec3{0, 0, 0} ? Vec3{0, 0, 1} : own;
-        tri.normal[size_t(k)] = n;
+        const Vec3d n = normalized(sum, own);
+        tri.normal[size_t(k)] = {float(n.x), float(n.y), float(n.z)};
       }
     }
   }
