@@ -577,8 +577,17 @@ bool LayerPlan::store_page(float* texels, uint32_t side, float alpha_scale, uint
   if (clipped && reference) {
     std::vector<float> unclipped(texels, texels + count * wc);
     if (to_storage) to_storage->apply(unclipped.data(), count, int(wc));
-    for (size_t i = 0; i < count * wc; ++i)
-      reference[i] = std::min(unclipped[i], kFloatMax / 256) * 255.0f;
+    for (size_t i = 0; i < count * wc; ++i) {
+      float u = std::min(unclipped[i], kFloatMax / 256);
+      // Colour under alpha composites times alpha, so its clipping costs that much: a filter's
+      // overshoot unpremultiplied under near-zero alpha reads huge and shows as nothing.
+      const int c = int(i % wc);
+      if (alpha >= 0 && c != alpha) {
+        const float clip = std::clamp(u, 0.0f, 1.0f);
+        u = clip + (u - clip) * std::clamp(texels[i - c + alpha], 0.0f, 1.0f);
+      }
+      reference[i] = u * 255.0f;
+    }
   }
   if (to_storage) {
     to_storage->apply_to_u8(texels, count, int(wc), out);

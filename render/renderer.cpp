@@ -1038,16 +1038,17 @@ void fill_lit_frame(const Buffer& frame, const LitFrameOptions& o) {
   LitFrameBlock b{};
   for (int c = 0; c < 3; ++c)
     b.eye[c] = o.eye[c], b.key[c] = o.key_dir[c], b.fill[c] = o.fill_dir[c];
-  b.eye[3] = o.shading_normals ? -1.0f : o.ambient;  // lit.glsl lit_normals_frame
+  b.eye[3] = o.ambient;
   b.key[3] = o.key;
   b.fill[3] = o.fill;
   std::memcpy(frame.mapped(), &b, sizeof(b));
 }
 
-// The shader's input bits (lit.glsl kLitNormal, kLitOrm, kLitEmissive) from LitFrameOptions'.
-int32_t lit_input_bits(uint32_t inputs) {
-  auto has = [&](LitInput i) { return (inputs >> uint32_t(i)) & 1u; };
-  return int32_t(has(LitInput::kNormal) | has(LitInput::kOrm) << 1 | has(LitInput::kEmissive) << 2);
+// The shader's frame bits (lit.glsl kLitNormal, kLitOrm, kLitEmissive, kLitNormalsFrame).
+int32_t lit_frame_bits(const LitFrameOptions& o) {
+  auto has = [&](LitInput i) { return (o.inputs >> uint32_t(i)) & 1u; };
+  return int32_t(has(LitInput::kNormal) | has(LitInput::kOrm) << 1 | has(LitInput::kEmissive) << 2 |
+                 uint32_t(o.shading_normals) << 3);
 }
 
 }  // namespace
@@ -1301,7 +1302,7 @@ Expected<ReferenceFrame> Renderer::render_lit_reference(const Camera& camera,
       p.misc[0] = lm.flags;
       p.misc[1] = t.sampler_addressing ? 2 : t.mode == AddressMode::kWrap ? 1 : 0;
       p.misc[2] = int32_t(t.max_level);
-      p.misc[3] = lit_input_bits(o.inputs);
+      p.misc[3] = lit_frame_bits(o);
       draw_mesh(cmd, s.lit.ref_layout, p, m);
     }
   }));
@@ -1335,7 +1336,7 @@ Expected<VirtualFrame> Renderer::render_lit_virtual(const Camera& camera,
       fill_vt_push(p, s.vt);
       p.tex[2] = 1.0f;
       p.tex[3] = m.alpha_cutoff;
-      p.misc[3] = lit_input_bits(o.inputs);
+      p.misc[3] = lit_frame_bits(o);
       draw_mesh(cmd, s.lit.vt_layout, p, m);
     }
   }));

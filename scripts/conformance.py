@@ -3,7 +3,7 @@
 and validates each with `vtbake --json`, and writes the Markdown table.
 
 A model is in the run when it can show whether materials bake right: a glTF 2.0 file with a
-material, or an OBJ/FBX/COLLADA/PLY/3DS file that names a texture. Each gets one of:
+material, or an OBJ/FBX/COLLADA/PLY/3DS/AC3D file that names a texture. Each gets one of:
   pass     baked, and validate passed every view within the default bounds
   refused  vtbake said no with exit status 2 and a message (an unsupported feature, a bad file)
   FAIL     anything else: a crash, a timeout, exit 1, or a bake that does not validate
@@ -18,7 +18,7 @@ import sys
 import time
 
 SCENE_EXTS = {".gltf": "glTF", ".glb": "glTF", ".obj": "OBJ", ".fbx": "FBX", ".dae": "COLLADA",
-              ".ply": "PLY", ".3ds": "3DS"}
+              ".ply": "PLY", ".3ds": "3DS", ".ac": "AC3D", ".acc": "AC3D", ".ac3d": "AC3D"}
 IMAGE_EXT_RE = re.compile(rb"\.(png|jpe?g|tga|bmp|dds|tiff?|exr|gif)\b", re.I)
 NAME_BYTES = set(b"abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-. \\/:")
 
@@ -281,7 +281,7 @@ def write_table(args, rows):
         "",
         "Written by `scripts/conformance.sh` (do not edit by hand): every model of the",
         "`assimp-testmodels` package that has a material (glTF) or names a texture (OBJ, FBX,",
-        "COLLADA, PLY, 3DS), baked with default flags and validated with default bounds.",
+        "COLLADA, PLY, 3DS, AC3D), baked with default flags and validated with default bounds.",
         "**pass**: baked and validate passed every check on every layer; **refused**: exit 2 with",
         "the message shown, either for a feature vtbake does not support (*unsupported*) or for a",
         "defect of the file (*invalid file*: it breaks the glTF schema or spec, or names a file the",

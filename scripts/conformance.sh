@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # The conformance run (issue 14): bakes and validates every model of Debian's assimp-testmodels
-# package that has a material (glTF 2.0) or carries textures (OBJ, FBX, COLLADA, PLY, 3DS), and
-# writes the table to docs/CONFORMANCE.md (or --out FILE). The corpus is fetched with apt-get
-# download and unpacked with dpkg -x into a cache folder outside the repository; nothing of it
-# is ever committed. Not part of the CI suite: `ctest -L conformance` runs it.
+# package that has a material (glTF 2.0) or carries textures (OBJ, FBX, COLLADA, PLY, 3DS,
+# AC3D), and writes the table to docs/CONFORMANCE.md (or --out FILE). The corpus is fetched
+# with apt-get download and unpacked with dpkg -x into a cache folder outside the repository;
+# nothing of it is ever committed. Not part of the CI suite: `ctest -L conformance` runs it.
 #
 #   scripts/conformance.sh [--vtbake PATH] [--corpus DIR] [--work DIR] [--out FILE]
 #                          [--only REGEX] [--timeout SECONDS]

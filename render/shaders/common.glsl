@@ -20,6 +20,14 @@ layout(push_constant) uniform Push {
 pc;
 
 #ifndef VT_VERTEX_STAGE
+// pc.misc and pc.tex.w as flat inputs (mesh.vert copies them), which every branch reads instead
+// of the push constants: lavapipe (Mesa 22.3) inlines push constants and uniforms that decide a
+// fragment shader's branches, compiling the shader anew on each draw that sets them and never
+// freeing it (5-10 ms and about 1 MB a draw: a 372-mesh track grew 1 GB a view in validate's lit
+// passes, one of 1,465 meshes ran out of 24 GB). Inputs it cannot inline.
+layout(location = 7) flat in ivec4 v_misc;
+layout(location = 8) flat in float v_alpha_cutoff;
+
 // At most this many taps per pixel: 16x anisotropic, as GPUs' highest setting. A fixed, smaller
 // count blurred footprints beyond its ratio isotropically in each texture's own space, and the
 // source's UV space and the atlas's differ in shape: grazing faces then differed by up to 8 dB
@@ -40,7 +48,7 @@ const float kAlphaEdge = 40.0 / 255.0;
 // renders: colour under zero alpha is never seen and must not count (the bake bleeds colour
 // there, the source keeps whatever its artist left).
 const float kAlphaBlended = -2.0;
-bool alpha_blended() { return pc.tex.w <= kAlphaBlended; }
+bool alpha_blended() { return v_alpha_cutoff <= kAlphaBlended; }
 
 // Anisotropic footprint: `taps` taps (the anisotropy ratio, rounded up, 1..kMaxTaps) along the
 // major axis of the pixel's footprint; the LOD comes from the larger of the minor axis and the
@@ -85,14 +93,14 @@ Footprint footprint_texels(vec2 dx, vec2 dy, vec2 texel, float max_lod) {
 
 Footprint footprint(vec2 uv, float deriv_scale) {
   return footprint_texels(dFdx(uv) * pc.tex.xy * deriv_scale, dFdy(uv) * pc.tex.xy * deriv_scale,
-                          1.0 / pc.tex.xy, float(pc.misc.z));
+                          1.0 / pc.tex.xy, float(v_misc.z));
 }
 
 vec2 tap_offset(Footprint f, int i) { return f.step * (float(i) - 0.5 * float(f.taps - 1)); }
 
 vec2 tap_uv(vec2 uv, Footprint f, int i) {
   vec2 u = uv + tap_offset(f, i);
-  if (pc.misc.y == 2) return u;
-  return pc.misc.y == 1 ? fract(u) : clamp(u, 0.0, 1.0);
+  if (v_misc.y == 2) return u;
+  return v_misc.y == 1 ? fract(u) : clamp(u, 0.0, 1.0);
 }
 #endif  // VT_VERTEX_STAGE

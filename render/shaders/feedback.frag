@@ -17,12 +17,12 @@ layout(location = 0) out uint out_request;
 void main() {
   Footprint f = footprint(v_uv, pc.tex.z);
   int level = int(floor(f.lod));
-  if (pc.tex.w >= 0.0 && pc.misc.w != 1) {
+  if (v_alpha_cutoff >= 0.0 && v_misc.w != 1) {
     int sampled;
     vec4 c = vt_filtered(u_cache, u_page_table, v_uv, f, sampled);
-    if (sampled <= level && c.a < pc.tex.w) discard;
+    if (sampled <= level && c.a < v_alpha_cutoff) discard;
   }
-  int tap = (pc.misc.x + int(gl_FragCoord.x) + 2 * int(gl_FragCoord.y)) % f.taps;
+  int tap = (v_misc.x + int(gl_FragCoord.x) + 2 * int(gl_FragCoord.y)) % f.taps;
   ivec2 page = vt_page(tap_uv(v_uv, f, tap), level);
   out_request = uint(page.x) | (uint(page.y) << 12) | (uint(level) << 24);
 }

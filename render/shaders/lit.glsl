@@ -3,15 +3,16 @@
 // common.glsl and after defining LIT_FRAME_BINDING.
 //
 // Push constants as common.glsl, plus misc.w: which inputs come from the materials or layers
-// (kLitNormal, kLitOrm, kLitEmissive); an input not set takes the same fixed value on both paths.
+// (kLitNormal, kLitOrm, kLitEmissive; an input not set takes the same fixed value on both paths)
+// and kLitNormalsFrame.
 
 const int kLitNormal = 1;
 const int kLitOrm = 2;
 const int kLitEmissive = 4;
+const int kLitNormalsFrame = 8;
 
 // The lights of one view (world space): the key and fill lights' directions towards the light
-// (w: intensity), fixed relative to the camera so that every view is lit; eye.w: ambient, or
-// negative for a normals frame (lit_normals_frame).
+// (w: intensity), fixed relative to the camera so that every view is lit; eye.w: ambient.
 layout(set = 0, binding = LIT_FRAME_BINDING) uniform LitFrame {
   vec4 eye;
   vec4 key;
@@ -21,7 +22,7 @@ lit;
 
 // A normals frame writes the normal map's detail instead of a colour: the shading normal minus
 // the interpolated vertex normal `n` (both facing the eye), * 0.5 + 0.5 (render/normal_check.h).
-bool lit_normals_frame() { return lit.eye.w < 0.0; }
+bool lit_normals_frame() { return (v_misc.w & kLitNormalsFrame) != 0; }
 vec4 lit_normal_detail(vec3 shading, vec3 n, vec3 world) {
   vec3 g = dot(n, lit.eye.xyz - world) < 0.0 ? -n : n;
   return vec4((shading - g) * 0.5 + 0.5, 1.0);

@@ -43,23 +43,23 @@ void main() {
   for (int i = 0; i < f.taps; ++i) albedo += textureLod(u_albedo, tap_uv(v_uv, f, i), f.lod);
   albedo /= float(f.taps);
   albedo.a *= v_color.a;
-  if (pc.tex.w >= 0.0 && albedo.a < pc.tex.w) discard;
+  if (v_alpha_cutoff >= 0.0 && albedo.a < v_alpha_cutoff) discard;
   // Only the inputs this frame shades with (uniform branches).
-  const bool normal_in = (pc.misc.w & kLitNormal) != 0, orm_in = (pc.misc.w & kLitOrm) != 0;
+  const bool normal_in = (v_misc.w & kLitNormal) != 0, orm_in = (v_misc.w & kLitOrm) != 0;
   vec4 tn = normal_in ? sample_taps(u_normal, v_tex_uv01.xy) : vec4(0.5, 0.5, 1.0, 1.0);
   float occlusion = orm_in ? sample_taps(u_occlusion, v_tex_uv01.zw).r : 1.0;
   vec4 tmr = orm_in ? sample_taps(u_orm, v_tex_uv23.xy) : vec4(0.0);
-  vec4 te = (pc.misc.w & kLitEmissive) != 0 ? sample_taps(u_emissive, v_tex_uv23.zw) : vec4(0.0);
+  vec4 te = (v_misc.w & kLitEmissive) != 0 ? sample_taps(u_emissive, v_tex_uv23.zw) : vec4(0.0);
 
   vec3 n = normalize(v_normal);
   vec3 shading = n;
-  if ((pc.misc.w & kLitNormal) != 0 && (pc.misc.x & 1) != 0) {
+  if ((v_misc.w & kLitNormal) != 0 && (v_misc.x & 1) != 0) {
     vec3 t = v_tangent.xyz - n * dot(n, v_tangent.xyz);
     t = dot(t, t) > 1e-12 ? normalize(t) : normalize(cross(abs(n.x) < 0.9 ? vec3(1, 0, 0) : vec3(0, 1, 0), n));
     vec3 b = cross(n, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0);
     float scale = intBitsToFloat(pc.vt.w);
     vec2 xy = (tn.xy * 2.0 - 1.0) * scale;
-    float z = (pc.misc.x & 2) != 0 ? sqrt(max(0.0, 1.0 - dot(xy, xy))) : tn.z * 2.0 - 1.0;
+    float z = (v_misc.x & 2) != 0 ? sqrt(max(0.0, 1.0 - dot(xy, xy))) : tn.z * 2.0 - 1.0;
     vec3 w = t * xy.x + b * xy.y + n * z;
     shading = dot(w, w) > 1e-12 ? normalize(w) : n;
   }
@@ -70,9 +70,9 @@ void main() {
     out_covered = 1u;
     return;
   }
-  vec3 orm = (pc.misc.w & kLitOrm) != 0 ? vec3(occlusion, tmr.gb) : kLitDefaultOrm;
+  vec3 orm = (v_misc.w & kLitOrm) != 0 ? vec3(occlusion, tmr.gb) : kLitDefaultOrm;
   vec3 emissive = vec3(0.0);
-  if ((pc.misc.w & kLitEmissive) != 0) {
+  if ((v_misc.w & kLitEmissive) != 0) {
     emissive = srgb_to_linear3(te.rgb) *
                vec3(intBitsToFloat(pc.vt.x), intBitsToFloat(pc.vt.y), intBitsToFloat(pc.vt.z));
   }

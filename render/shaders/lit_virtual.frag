@@ -40,9 +40,9 @@ Inputs sample_level(vec2 uv, int level, inout int sampled) {
   // Only the inputs this frame shades with (uniform branches): the emissive-only frame reads two
   // caches of four.
   r.albedo = textureLod(u_albedo, phys, 0.0);
-  r.normal = (pc.misc.w & kLitNormal) != 0 ? textureLod(u_normal, phys, 0.0) : vec4(0.5);
-  r.orm = (pc.misc.w & kLitOrm) != 0 ? textureLod(u_orm, phys, 0.0) : vec4(0.0);
-  r.emissive = (pc.misc.w & kLitEmissive) != 0 ? textureLod(u_emissive, phys, 0.0) : vec4(0.0);
+  r.normal = (v_misc.w & kLitNormal) != 0 ? textureLod(u_normal, phys, 0.0) : vec4(0.5);
+  r.orm = (v_misc.w & kLitOrm) != 0 ? textureLod(u_orm, phys, 0.0) : vec4(0.0);
+  r.emissive = (v_misc.w & kLitEmissive) != 0 ? textureLod(u_emissive, phys, 0.0) : vec4(0.0);
   return r;
 }
 
@@ -53,7 +53,7 @@ void main() {
   vec2 dux = dFdx(v_uv), duy = dFdy(v_uv);
   Footprint f = footprint(v_uv, 1.0);
   int l0 = int(floor(f.lod));
-  int l1 = min(l0 + 1, pc.misc.z);
+  int l1 = min(l0 + 1, v_misc.z);
   float blend = f.lod - float(l0);
   int sampled = 0, ignored = 0;
   Inputs c = Inputs(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
@@ -67,11 +67,11 @@ void main() {
     c.emissive += mix(a.emissive, b.emissive, blend);
   }
   vec4 albedo = c.albedo / float(f.taps);
-  if (pc.tex.w >= 0.0 && albedo.a < pc.tex.w) discard;
+  if (v_alpha_cutoff >= 0.0 && albedo.a < v_alpha_cutoff) discard;
 
   vec3 n = normalize(v_normal);
   vec3 shading = n;
-  if ((pc.misc.w & kLitNormal) != 0) {
+  if ((v_misc.w & kLitNormal) != 0) {
     float det = dux.x * duy.y - dux.y * duy.x;
     vec3 dpdu = (dpx * duy.y - dpy * dux.y) * sign(det);
     vec3 dpdv = (dpy * dux.x - dpx * duy.x) * sign(det);
@@ -88,9 +88,9 @@ void main() {
     out_status = 0x80000000u | uint(l0) | (uint(sampled) << 8);
     return;
   }
-  vec3 orm = (pc.misc.w & kLitOrm) != 0 ? c.orm.rgb / float(f.taps) : kLitDefaultOrm;
+  vec3 orm = (v_misc.w & kLitOrm) != 0 ? c.orm.rgb / float(f.taps) : kLitDefaultOrm;
   vec3 emissive =
-      (pc.misc.w & kLitEmissive) != 0 ? srgb_to_linear3(c.emissive.rgb / float(f.taps)) : vec3(0.0);
+      (v_misc.w & kLitEmissive) != 0 ? srgb_to_linear3(c.emissive.rgb / float(f.taps)) : vec3(0.0);
   vec3 lin = shade(v_world, shading, srgb_to_linear3(albedo.rgb), orm, emissive);
   out_color = vec4(linear_to_srgb3(alpha_blended() ? lin * albedo.a : lin), 1.0);
   out_status = 0x80000000u | uint(l0) | (uint(sampled) << 8);

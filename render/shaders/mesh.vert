@@ -18,6 +18,8 @@ layout(location = 3) out vec4 v_tangent;
 layout(location = 4) out vec3 v_world;
 layout(location = 5) out vec4 v_tex_uv01;
 layout(location = 6) out vec4 v_tex_uv23;
+layout(location = 7) flat out ivec4 v_misc;  // common.glsl: the fragment stages branch on these
+layout(location = 8) flat out float v_alpha_cutoff;
 
 void main() {
   gl_Position = pc.mvp * vec4(in_position, 1.0);
@@ -28,4 +30,6 @@ void main() {
   v_world = in_position;
   v_tex_uv01 = in_tex_uv01;
   v_tex_uv23 = in_tex_uv23;
+  v_misc = pc.misc;
+  v_alpha_cutoff = pc.tex.w;
 }

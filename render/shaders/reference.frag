@@ -30,9 +30,9 @@ void main() {
     c.rgb = linear_to_srgb(clamp(srgb_to_linear(c.rgb) * v_color.rgb, 0.0, 1.0));
   }
   c.a *= v_color.a;
-  if (pc.tex.w >= 0.0 && c.a < pc.tex.w) discard;
+  if (v_alpha_cutoff >= 0.0 && c.a < v_alpha_cutoff) discard;
   if (alpha_blended()) c.rgb *= c.a;
   out_color = c;
   // Bit 1: alpha-tested with alpha within kAlphaEdge of the cutoff (virtual.frag's bit 30).
-  out_covered = pc.tex.w >= 0.0 && c.a < pc.tex.w + kAlphaEdge ? 3u : 1u;
+  out_covered = v_alpha_cutoff >= 0.0 && c.a < v_alpha_cutoff + kAlphaEdge ? 3u : 1u;
 }

@@ -20,10 +20,10 @@ void main() {
   Footprint f = footprint(v_uv, 1.0);
   int sampled;
   vec4 c = vt_filtered(u_cache, u_page_table, v_uv, f, sampled);
-  const bool tested = pc.tex.w >= 0.0 && pc.misc.w != 1;
-  if (tested && c.a < pc.tex.w) discard;
-  bool edge = tested && c.a < pc.tex.w + kAlphaEdge;
-  if (pc.misc.w == 1) c.rgb = max(c.rgb, vec3(0.0)) / (1.0 + max(c.rgb, vec3(0.0)));
+  const bool tested = v_alpha_cutoff >= 0.0 && v_misc.w != 1;
+  if (tested && c.a < v_alpha_cutoff) discard;
+  bool edge = tested && c.a < v_alpha_cutoff + kAlphaEdge;
+  if (v_misc.w == 1) c.rgb = max(c.rgb, vec3(0.0)) / (1.0 + max(c.rgb, vec3(0.0)));
   else if (alpha_blended()) c.rgb *= c.a;
   out_color = c;
   // The status bits: VirtualFrame::kStatus* (render/renderer.h).

@@ -57,7 +57,7 @@ vec4 vt_sample_level(sampler2D cache, usampler2D table, vec2 uv, int level, inou
 // vt_coarse_fallback: a tap of the coarser level read an ancestor of its page (a fallback too).
 vec4 vt_filtered(sampler2D cache, usampler2D table, vec2 uv, Footprint f, out int sampled) {
   int l0 = int(floor(f.lod));
-  int l1 = min(l0 + 1, pc.misc.z);
+  int l1 = min(l0 + 1, v_misc.z);
   float blend = f.lod - float(l0);
   sampled = 0;
   int coarse = l1;

@@ -111,6 +111,33 @@ TEST(FloatLayers, ClippedHdrIsCountedWarnedAndMeasured) {
   }
 }
 
+TEST(FloatLayers, ClippedColourUnderAlphaCostsWhatItComposites) {
+  // The hot texels at alpha `a`: clipping 8.0 to 1 changes what composites by (8 - 1) x a.
+  auto rgba = [](float a) {
+    const std::vector<float> rgb = hdr_rgb();
+    std::vector<float> t(size_t(kW) * kH * 4);
+    for (size_t i = 0; i < size_t(kW) * kH; ++i) {
+      std::copy_n(&rgb[i * 3], 3, &t[i * 4]);
+      t[i * 4 + 3] = rgb[i * 3] == 8.0f ? a : 1.0f;
+    }
+    return float_image(4, std::move(t));
+  };
+  for (CodecKind codec : {CodecKind::kDct, CodecKind::kBc}) {
+    BuildOptions opaque = options_for(LayerSemantic::kAlbedo, rgba(1.0f));
+    BuildOptions faint = options_for(LayerSemantic::kAlbedo, rgba(0.01f));
+    opaque.codec.codec = faint.codec.codec = codec;
+    auto o = test::build_in_memory(opaque);
+    auto f = test::build_in_memory(faint);
+    ASSERT_TRUE(o && f);
+    ASSERT_EQ(f->summary.layers[0].spec.channels, 4u);
+    EXPECT_EQ(f->summary.layers[0].clipped.values, 2 * kHotTexels);  // still counted and warned
+    EXPECT_GE(o->summary.layers[0].max_error, 360u);
+    // sRGB(8) - 255 is 371 codes; at alpha 0.01 that is under 4 (plus the codec's own error).
+    EXPECT_LE(f->summary.layers[0].max_error, 40u) << int(codec);
+    EXPECT_GT(f->summary.layers[0].psnr_db, o->summary.layers[0].psnr_db + 10);
+  }
+}
+
 TEST(FloatLayers, DataLayersClipBothWaysAndLosslessLayersReportIt) {
   // A one-channel custom layer from an 8-bit source holding out-of-range values: stored raw
   // (lossless) it is still not exact, and its PSNR says so.
