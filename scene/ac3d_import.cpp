@@ -619,7 +619,14 @@ class Ac3dReader {
 
 Expected<Scene> load_ac3d(const std::string& path) {
   VT_ASSIGN_OR_RETURN(auto bytes, read_file(path));
-  return Ac3dReader(path, std::string(bytes.begin(), bytes.end())).read();
+  // A byte-order mark or UTF-16 text (assimp's test models have both) reads as UTF-8. Text that
+  // is not UTF-8 stays as it is: the reader takes its names as Latin-1 and keeps texture file
+  // names as the disk spells them.
+  std::string note;
+  VT_ASSIGN_OR_RETURN(std::string text, decode_text(bytes, path, &note));
+  if (!note.empty()) text.assign(bytes.begin(), bytes.end());
+  bytes = {};
+  return Ac3dReader(path, std::move(text)).read();
 }
 
 }  // namespace vt::scene::detail

@@ -139,6 +139,8 @@ def select(corpus, only):
                 if names:
                     picked.append((path, fmt, ["MTL maps: %d" % len(names)]))
                 continue
+            if data[:2] in (b"\xff\xfe", b"\xfe\xff"):  # UTF-16 with its byte-order mark
+                data = data.decode("utf-16", "replace").encode("utf-8")
             hits = image_names(data)
             if hits:
                 picked.append((path, fmt, ["textures named: %d" % len(hits)]))

@@ -363,6 +363,32 @@ TEST(Ac3dImport, TransOneIsFullyTransparent) {
   EXPECT_TRUE(warned);
 }
 
+TEST(Ac3dImport, ByteOrderMarksAndUtf16ReadAsText) {
+  // As assimp's test models SphereWithLight_UTF8BOM.ac and SphereWithLight_UTF16LE.ac have it.
+  fs::path d = fresh_dir("bom");
+  const std::string text = ac3d_quad("\"m\"", "trans 0", "name \"caf\xc3\xa9\"\n");
+  std::string utf16le = "\xff\xfe", utf16be = "\xfe\xff";
+  for (size_t i = 0; i < text.size(); ++i) {
+    // The one non-ASCII character, U+00E9, is two UTF-8 bytes and one UTF-16 unit.
+    const char c = text[i] == '\xc3' ? '\xe9' : text[i];
+    if (text[i] == '\xa9') continue;
+    utf16le += std::string{c, '\0'};
+    utf16be += std::string{'\0', c};
+  }
+  for (const auto& [name, bytes] :
+       {std::pair<std::string, std::string>{"bom8.ac", "\xef\xbb\xbf" + text},
+        {"le.ac", utf16le},
+        {"be.ac", utf16be}}) {
+    auto s = load_text(d, name, bytes);
+    ASSERT_TRUE(s.ok()) << name << ": " << s.status().message();
+    ASSERT_EQ(s->meshes.size(), 1u) << name;
+    EXPECT_EQ(s->meshes[0].primitives[0].triangle_count(), 2u) << name;
+    bool named = false;
+    for (const scene::Node& n : s->nodes) named |= n.name == "caf\xc3\xa9";
+    EXPECT_TRUE(named) << name;
+  }
+}
+
 TEST(Ac3dImport, NamesInAnEightBitCodePageReadAsLatin1) {
   // Older formats do not say their encoding; a European author's 3ds Max writes "Par d\xe9faut"
   // in Windows-1252 (Sauerbraten's rocket.iqm). Names become UTF-8 (reports, JSON and the glTF
