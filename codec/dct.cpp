@@ -631,11 +631,6 @@ std::vector<float> token_bits(const std::vector<TokenModel>& models) {
   return bits;
 }
 
-inline float uint_bits(const float* bits, int model, unsigned v) {
-  const int t = uint_token(v);
-  return bits[model * kTokens + t] + float(kUintExtra[t]);
-}
-
 // Bit k set where AC position k of block z is nonzero; in `ones`, where it is +-1.
 inline uint64_t ac_masks(const int16_t* z, uint64_t* ones) {
   uint64_t nonzero = 0, one = 0;
