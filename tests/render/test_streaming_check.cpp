@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/scene_bake.h"
+#include "codec/metrics.h"
 #include "format/runtime_format.h"
 #include "render/scene_draws.h"
 #include "render/streaming_check.h"
@@ -183,6 +184,36 @@ TEST(StreamingCompare, OneRenderPixelsAreAlphaFlipsOnlyWhereTheDrawingRenderFlag
   EXPECT_EQ(m->coverage_mismatch, 2u);    // pixels 1 (virtual only) and 3 (reference only)
   EXPECT_EQ(m->excluded_alpha_edge, 3u);  // 0 and 2 (one render, flagged), 5 (both, flagged)
   EXPECT_EQ(m->pixels, 1u);               // 4: both drew it, no flag
+}
+
+// Pixels reading page borders have their own bounds and stay out of the tiles: a 16 x 16 tile
+// of them 30 steps apart (within the border bound) beside a tile of interior pixels 1 step
+// apart; the worst tile is the interior one.
+TEST(StreamingCompare, BorderPixelsStayOutOfTheTiles) {
+  ReferenceFrame levels;
+  VirtualFrame frame;
+  levels.color.width = frame.color.width = 32;
+  levels.color.height = frame.color.height = 16;
+  levels.color.texels.assign(32 * 16 * 4, 100);
+  frame.color.texels.assign(32 * 16 * 4, 101);
+  levels.covered.assign(32 * 16, 1);
+  frame.status.assign(32 * 16, VirtualFrame::kStatusDrawn);
+  for (uint32_t y = 0; y < 16; ++y)
+    for (uint32_t x = 0; x < 16; ++x) {
+      frame.status[y * 32 + x] |= VirtualFrame::kStatusBorderRead;
+      for (int c = 0; c < 3; ++c) frame.color.texels[(y * 32 + x) * 4 + c] = 130;
+    }
+  LevelTexture texture;
+  texture.texture.levels.resize(1);
+  texture.level_count = 1;
+  auto m = compare_streaming(levels, frame, texture, 4);
+  ASSERT_TRUE(m.ok()) << m.status().message();
+  EXPECT_EQ(m->pixels, 512u);
+  EXPECT_EQ(m->border_pixels, 256u);
+  EXPECT_EQ(m->border_max_abs, 30);
+  EXPECT_EQ(m->max_abs, 1);
+  EXPECT_NEAR(m->worst_tile_psnr, psnr_from_mse(1.0), 1e-9);
+  EXPECT_EQ(m->worst_tile_x, 16u);
 }
 
 // A page source that passes another one through, except for what `edit` changes in an upload.
