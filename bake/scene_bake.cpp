@@ -311,6 +311,9 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
   if (!cache.empty() && !summary.unwrap_reused)
     (void)write_unwrap_cache(unwrap_cache, unwrap_key, input, *unwrapped);
   summary.unwrap = unwrapped->stats;
+  // The unwrap's own (materials baked coarser than their sources) reach the summary's list, which
+  // the CLI prints; in UnwrapStats alone they were in the JSON only.
+  for (const std::string& w : unwrapped->stats.warnings) summary.warnings.push_back(w);
   summary.peak_rss.push_back({"unwrap", peak_rss_bytes()});
   summary.triangles = uint64_t(unwrapped->stats.faces);
   // Charts that cover almost nothing (degenerate or needle geometry, one huge chart beside

@@ -70,6 +70,7 @@ vt::cli::CommandRunner make_unwrap(CLI::App& sub) {
     st = vt::unwrap::write_atlas_picture(*result, a.picture);
     if (!st.ok()) std::fprintf(stderr, "vtbake unwrap: warning: %s\n", st.message().c_str());
     const auto& s = result->stats;
+    for (const std::string& w : s.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     bool valid = s.flipped_triangles == 0 && s.overlapping_triangles == 0 &&
                  s.overlapping_texels == 0 && s.unmapped_faces == 0;
     if (global.json) {

@@ -23,7 +23,7 @@ pc;
 // pc.misc and pc.tex.w as flat inputs (mesh.vert copies them), which every branch reads instead
 // of the push constants: lavapipe (Mesa 22.3) inlines push constants and uniforms that decide a
 // fragment shader's branches, compiling the shader anew on each draw that sets them and never
-// freeing it (5-10 ms and about 1 MB a draw: a 372-mesh track grew 1 GB a view in validate's lit
+// freeing it (about 12 ms and 1.7 MB a draw: a 372-mesh track grew 1 GB a view in validate's lit
 // passes, one of 1,465 meshes ran out of 24 GB). Inputs it cannot inline.
 layout(location = 7) flat in ivec4 v_misc;
 layout(location = 8) flat in float v_alpha_cutoff;

@@ -470,13 +470,16 @@ TEST(TransferRules, SceneBakeReportsClippingMissesAndWarnings) {
   EXPECT_EQ(range.max_value, 4.0f);
   EXPECT_TRUE(range.clipped);
   ASSERT_EQ(summary->missing_textures.size(), 1u);
-  ASSERT_EQ(summary->warnings.size(), 3u);
+  // The scene's, the unwrap's (the missing image does not size the atlas), the transfer's, the
+  // build's.
+  ASSERT_EQ(summary->warnings.size(), 4u);
   EXPECT_EQ(summary->warnings[0], s.warnings[0]);
-  EXPECT_EQ(summary->warnings[1].rfind("material 'Lamp' baseColorTexture: cannot read image", 0),
+  EXPECT_EQ(summary->warnings[1].rfind("1 image(s) gave no size", 0), 0u) << summary->warnings[1];
+  EXPECT_EQ(summary->warnings[2].rfind("material 'Lamp' baseColorTexture: cannot read image", 0),
             0u)
-      << summary->warnings[1];
+      << summary->warnings[2];
   // The clipped layer's line is the build's (red 4 and green 2 of each covered texel).
-  EXPECT_EQ(summary->warnings[2], "layer 'emissive': " + std::to_string(covered) + " texels (" +
+  EXPECT_EQ(summary->warnings[3], "layer 'emissive': " + std::to_string(covered) + " texels (" +
                                       std::to_string(2 * covered) +
                                       " values) outside [0, 1], up to 4, clipped by its 8-bit dct "
                                       "storage; its PSNR counts the clipping (--float-texels half "
@@ -497,7 +500,7 @@ TEST(TransferRules, SceneBakeReportsClippingMissesAndWarnings) {
   EXPECT_EQ(j["transfer"]["above_one"][0]["max_value"], 4.0);
   EXPECT_EQ(j["transfer"]["missing_textures"][0]["slot"], "baseColorTexture");
   EXPECT_EQ(j["transfer"]["missing_textures"][0]["path"], dir.file("gone.png"));
-  EXPECT_EQ(j["warnings"].size(), 3u);
+  EXPECT_EQ(j["warnings"].size(), 4u);
 
   // Raw storage keeps floats: nothing is clipped and level 0 holds the values.
   o.build.codec.codec = CodecKind::kRaw;
