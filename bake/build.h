@@ -166,7 +166,8 @@ struct LayerSummary {
   HdrError hdr;
   NonFiniteReport non_finite;
   // Out-of-range values the storage clipped. In an 8-bit layer psnr_db, max_error and the
-  // runtime figures are then measured against the unclipped values (clipping counts as error).
+  // runtime figures are then measured against the unclipped values (clipping counts as error;
+  // a colour's under alpha times that alpha, as it composites: LayerPlan::store_page).
   ClipReport clipped;
   bool alpha_dropped = false;  // the input's alpha was opaque everywhere and is not stored
 };
