@@ -90,12 +90,19 @@ RoundTrip bake_and_compare(const scene::Scene& s, const test::ScratchDir& dir, d
   return out;
 }
 
-TEST(SceneBake, TexturedQuadRoundTripsAbove40dB) {
-  test::ScratchDir dir;
-  ASSERT_TRUE(write_texture(dir.file("quad.png"), 256, 256, 3, smooth_colour).ok());
+// A unit quad under material 'quad', textured with smooth_colour at 256 x 256 (quad.png in
+// `dir`); no meshes when the texture could not be written.
+scene::Scene textured_quad(const test::ScratchDir& dir) {
+  if (!write_texture(dir.file("quad.png"), 256, 256, 3, smooth_colour).ok()) return {};
   scene::Material m;
   m.name = "quad";
-  scene::Scene s = test::textured_scene(make_grid(1.0f, 1, 1), dir.file("quad.png"), m);
+  return test::textured_scene(make_grid(1.0f, 1, 1), dir.file("quad.png"), m);
+}
+
+TEST(SceneBake, TexturedQuadRoundTripsAbove40dB) {
+  test::ScratchDir dir;
+  scene::Scene s = textured_quad(dir);
+  ASSERT_FALSE(s.meshes.empty());
   RoundTrip r = bake_and_compare(s, dir, 256, 256, 256);
   ASSERT_TRUE(r.reader);
   EXPECT_GT(r.samples, 3u * 250 * 250);
@@ -635,10 +642,8 @@ TEST(SceneBake, BandedBakeWritesTheBytesOfTheInMemoryBake) {
 // sources without a word, and validate then failed every view on density.
 TEST(SceneBake, AnAtlasCoarserThanItsSourcesIsAWarning) {
   test::ScratchDir dir;
-  ASSERT_TRUE(write_texture(dir.file("quad.png"), 256, 256, 3, smooth_colour).ok());
-  scene::Material m;
-  m.name = "quad";
-  scene::Scene s = test::textured_scene(make_grid(1.0f, 1, 1), dir.file("quad.png"), m);
+  scene::Scene s = textured_quad(dir);
+  ASSERT_FALSE(s.meshes.empty());
   SceneBakeOptions o;
   o.build.output = dir.file("out.vtpf");
   const int default_max = o.unwrap.max_size_pages;
