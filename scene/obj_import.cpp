@@ -2,7 +2,9 @@
 // polygons fanned into triangles, vertices shared by identical (position, uv, normal) triples.
 // OBJ's v-up UVs become glTF's v-down. Materials come from the MTL libraries
 // (scene/mtl_import.cpp), resolved by name once the whole file is read, so `usemtl` may come
-// before `mtllib`.
+// before `mtllib`. Faces, too, are built once the whole file is read: a positive index may name
+// a `v`, `vt` or `vn` written further down (Sweet Home 3D's catalogue has such files, and the
+// readers that load everything first accept them); a negative one counts back from the line.
 // Vertex colours (`v x y z r g b [a]`) are read as sRGB-encoded, the way MeshLab, ZBrush and
 // Blender write them (8-bit colours over 255, what their viewports show), and stored linear.
 // A file with a component above 1 wrote 0..255 and is scaled (with a warning).
@@ -43,7 +45,7 @@ class ObjReader {
     scene_.source_path = path;
   }
   Status statement(const std::string& key, LineCursor* c);
-  Scene finish() &&;
+  Expected<Scene> finish() &&;
   void warn(std::string what) { scene_.warnings.push_back(std::move(what)); }
   size_t line = 1;
 
@@ -51,6 +53,7 @@ class ObjReader {
   std::string where() const { return path_ + ":" + std::to_string(line); }
   Status vertex(LineCursor* c);
   Status face(LineCursor* c);
+  Status build_faces();
   Status mtllib(const std::string& rest);
   Status load_library(const std::string& written);
   int material_index(const std::string& name);
@@ -70,7 +73,14 @@ class ObjReader {
   std::map<std::pair<std::string, bool>, size_t> builder_of_;  // (usemtl, has UVs) -> builder
   std::string current_;                                        // the current usemtl name
   size_t ignored_elements_ = 0;                                // points, lines, curves
-  std::vector<std::array<int, 3>> face_;
+  // Faces as read, built by build_faces: corners (v, vt, vn; 0 = none), 1-based and absolute.
+  struct Face {
+    size_t builder, line;
+    uint32_t first, count;
+    bool has_uv;  // every corner has a `vt`
+  };
+  std::vector<std::array<int, 3>> corners_;
+  std::vector<Face> faces_;
 };
 
 Status ObjReader::vertex(LineCursor* c) {
@@ -93,7 +103,7 @@ Status ObjReader::vertex(LineCursor* c) {
 }
 
 Status ObjReader::face(LineCursor* c) {
-  face_.clear();
+  const size_t first = corners_.size();
   while (!c->at_line_end()) {
     std::string w = c->word();
     std::array<int, 3> idx = {0, 0, 0};
@@ -109,35 +119,65 @@ Status ObjReader::face(LineCursor* c) {
     const size_t counts[3] = {v_.size(), vt_.size(), vn_.size()};
     for (int k = 0; k < 3; ++k) {
       if (idx[k] < 0) idx[k] = static_cast<int>(counts[k]) + idx[k] + 1;
-      if (idx[k] < 0 || static_cast<size_t>(idx[k]) > counts[k] || (k == 0 && idx[k] == 0))
+      // Positive indices past the elements read so far are checked once the file is read.
+      if (idx[k] < 0 || (k == 0 && idx[k] == 0))
         return Error(ErrorCode::kCorrupt, where() + ": face index '" + w + "' out of range");
     }
-    face_.push_back(idx);
+    corners_.push_back(idx);
   }
-  if (face_.size() < 3) return Status::Ok();
-  const bool has_uv = std::all_of(face_.begin(), face_.end(), [](const auto& k) { return k[1]; });
+  const size_t count = corners_.size() - first;
+  if (count < 3) {
+    corners_.resize(first);
+    return Status::Ok();
+  }
+  const bool has_uv = std::all_of(corners_.begin() + first, corners_.end(),
+                                  [](const auto& k) { return k[1] != 0; });
   auto [slot, added] = builder_of_.try_emplace({current_, has_uv}, builders_.size());
   if (added) builders_.emplace_back().material_name = current_;
-  Builder& b = builders_[slot->second];
-  auto vertex = [&](const std::array<int, 3>& k) {
-    auto [it, inserted] = b.map.try_emplace(k, static_cast<uint32_t>(b.prim.positions.size()));
-    if (inserted) {
-      b.prim.positions.push_back(v_[k[0] - 1]);
-      b.position_of.push_back(k[0] - 1);
-      b.prim.uvs.resize(1);
-      b.prim.uvs[0].push_back(has_uv ? vt_[k[1] - 1] : Vec2{0, 0});
-      b.prim.normals.push_back(k[2] ? vn_[k[2] - 1] : Vec3{0, 0, 0});
-      b.any_uv |= has_uv;
-      b.any_normal |= k[2] != 0;
+  faces_.push_back({slot->second, line, uint32_t(first), uint32_t(count), has_uv});
+  return Status::Ok();
+}
+
+Status ObjReader::build_faces() {
+  const size_t counts[3] = {v_.size(), vt_.size(), vn_.size()};
+  for (const Face& f : faces_) {
+    for (uint32_t i = 0; i < f.count; ++i) {
+      const auto& k = corners_[f.first + i];
+      for (int e = 0; e < 3; ++e) {
+        if (static_cast<size_t>(k[e]) <= counts[e]) continue;
+        static const char* kNames[3] = {"v", "vt", "vn"};
+        return Error(ErrorCode::kCorrupt,
+                     path_ + ":" + std::to_string(f.line) + ": face index " + std::to_string(k[e]) +
+                         " out of range (the file has " + std::to_string(counts[e]) + " '" +
+                         kNames[e] + "' lines)");
+      }
     }
-    return it->second;
-  };
-  uint32_t first = vertex(face_[0]);
-  for (size_t i = 1; i + 1 < face_.size(); ++i) {
-    b.prim.indices.push_back(first);
-    b.prim.indices.push_back(vertex(face_[i]));
-    b.prim.indices.push_back(vertex(face_[i + 1]));
   }
+  for (const Face& f : faces_) {
+    Builder& b = builders_[f.builder];
+    const auto* face = corners_.data() + f.first;
+    auto vertex = [&](const std::array<int, 3>& k) {
+      auto [it, inserted] = b.map.try_emplace(k, static_cast<uint32_t>(b.prim.positions.size()));
+      if (inserted) {
+        b.prim.positions.push_back(v_[k[0] - 1]);
+        b.position_of.push_back(k[0] - 1);
+        b.prim.uvs.resize(1);
+        b.prim.uvs[0].push_back(f.has_uv ? vt_[k[1] - 1] : Vec2{0, 0});
+        b.prim.normals.push_back(k[2] ? vn_[k[2] - 1] : Vec3{0, 0, 0});
+        b.any_uv |= f.has_uv;
+        b.any_normal |= k[2] != 0;
+      }
+      return it->second;
+    };
+    const uint32_t first = vertex(face[0]);
+    for (uint32_t i = 1; i + 1 < f.count; ++i) {
+      b.prim.indices.push_back(first);
+      b.prim.indices.push_back(vertex(face[i]));
+      b.prim.indices.push_back(vertex(face[i + 1]));
+    }
+  }
+  corners_ = {};
+  faces_ = {};
   return Status::Ok();
 }
 
@@ -224,7 +264,8 @@ void ObjReader::fill_colors(Builder* b) const {
   }
 }
 
-Scene ObjReader::finish() && {
+Expected<Scene> ObjReader::finish() && {
+  VT_RETURN_IF_ERROR(build_faces());
   if (!colors_.empty() && color_peak_ > 1.0f)
     scene_.warnings.push_back(path_ + ": vertex colours above 1 (up to " +
                               std::to_string(color_peak_) + ") read as 0..255");

@@ -456,6 +456,46 @@ TEST(ObjMtl, FacesWithoutUvsAmongFacesWithThemKeepOutOfTheTexture) {
   EXPECT_EQ(warnings_with(s, {"a.obj", "has no UV set", "material 'wood'", "factors"}), 1);
 }
 
+TEST(ObjMtl, FacesMayNameElementsWrittenFurtherDown) {
+  // Sweet Home 3D's catalogue truck: a face names `vt` 3773 when 3772 have been written; the
+  // rest follow. A positive index is absolute and resolved once the whole file is read; a
+  // negative one counts back from its own line.
+  std::string dir = folder("forward");
+  scene::Scene s = load(dir, "",
+                        "v 0 0 0\nv 1 0 0\nvt 0 0\nvt 1 0\n"
+                        "f 1/1 2/2 3/3\n"      // v 3 and vt 3 come later
+                        "f -2/-2 -1/-1 3/3\n"  // the same face, partly relative
+                        "v 1 1 0\nvt 1 1\nv 0 1 0\nvt 0 1\n"
+                        "f 1/1 3/3 4/4\n");
+  ASSERT_EQ(s.meshes.size(), 1u);
+  ASSERT_EQ(s.meshes[0].primitives.size(), 1u);
+  const scene::Primitive& p = s.meshes[0].primitives[0];
+  ASSERT_EQ(p.indices.size(), 9u);
+  ASSERT_EQ(p.uvs.size(), 1u);
+  // Both first faces are v 1, 2, 3 with vt 1, 2, 3: one set of three vertices.
+  ASSERT_EQ(p.positions.size(), 4u);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(p.indices[size_t(i)], p.indices[size_t(i + 3)]);
+  const scene::Vec3 want[4] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  for (size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(p.positions[i], want[i]) << i;
+    EXPECT_FLOAT_EQ(p.uvs[0][i][0], want[i][0]);
+    EXPECT_FLOAT_EQ(p.uvs[0][i][1], 1.0f - want[i][1]);
+  }
+
+  // An index past the whole file's elements is still refused, naming the face's line.
+  write_file(dir + "b.obj",
+             "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\nf 1//1 2//2 3//1\n");
+  auto bad = scene::load_scene(dir + "b.obj");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.status().message(),
+            dir + "b.obj:6: face index 2 out of range (the file has 1 'vn' lines)");
+  // And a relative index before the first element, at its own line.
+  write_file(dir + "c.obj", "v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n");
+  auto before = scene::load_scene(dir + "c.obj");
+  ASSERT_FALSE(before.ok());
+  EXPECT_EQ(before.status().message(), dir + "c.obj:3: face index '-3' out of range");
+}
+
 // The same triangle as UTF-8, UTF-8 with a BOM, UTF-16 LE and BE with BOMs.
 TEST(ObjMtl, Utf16AndBomText) {
   const std::string text = "# t\r\nv 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n";
