@@ -390,6 +390,7 @@ Expected<DensityPlan> plan_density(const scene::Scene& scene, const UnwrapOption
   } else {
     plan.mode = DensityPlan::Mode::kFitPages, plan.pages = kDefaultSizePages;
     plan.rule = "default size";
+    plan.may_grow = true;
   }
   return plan;
 }

@@ -116,7 +116,40 @@ void weld(const scene::Primitive& p, Surface* s, const scene::Mat4& world) {
   for (size_t i = 0; i < p.indices.size(); ++i) s->tri[i] = s->weld[p.indices[i]];
 }
 
-void build_topology(Surface* s) {
+// Links the corners of `s` still open (adj -1) across edges that exactly two of them use in
+// opposite directions, the edges named by `corners`' vertex indices.
+void pair_edges(const std::vector<uint32_t>& corners, Surface& s) {
+  struct Edge {
+    uint64_t key;
+    uint32_t corner;
+    bool forward;
+  };
+  std::vector<Edge> edges;
+  edges.reserve(corners.size());
+  for (size_t f = 0; f < corners.size() / 3; ++f) {
+    if (s.degenerate[f]) continue;
+    for (int e = 0; e < 3; ++e) {
+      if (s.adj[3 * f + e] >= 0) continue;
+      uint32_t a = corners[3 * f + e], b = corners[3 * f + (e + 1) % 3];
+      uint64_t key = (static_cast<uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+      edges.push_back({key, static_cast<uint32_t>(3 * f + e), a < b});
+    }
+  }
+  std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) {
+    return x.key != y.key ? x.key < y.key : x.corner < y.corner;
+  });
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    while (j < edges.size() && edges[j].key == edges[i].key) ++j;
+    if (j - i == 2 && edges[i].forward != edges[i + 1].forward) {
+      s.adj[edges[i].corner] = static_cast<int32_t>(edges[i + 1].corner / 3);
+      s.adj[edges[i + 1].corner] = static_cast<int32_t>(edges[i].corner / 3);
+    }
+    i = j;
+  }
+}
+
+void build_topology(const std::vector<uint32_t>& source_indices, Surface* s) {
   size_t faces = s->tri.size() / 3;
   s->normal.resize(faces);
   s->area.resize(faces);
@@ -139,35 +172,14 @@ void build_topology(Surface* s) {
     }
   }
   // Faces are neighbours across an edge used by exactly two faces in opposite directions
-  // (consistent winding). Non-manifold and inconsistently wound edges cut.
-  struct Edge {
-    uint64_t key;
-    uint32_t corner;
-    bool forward;
-  };
-  std::vector<Edge> edges;
-  edges.reserve(s->tri.size());
-  for (size_t f = 0; f < faces; ++f) {
-    if (s->degenerate[f]) continue;
-    for (int e = 0; e < 3; ++e) {
-      uint32_t a = s->tri[3 * f + e], b = s->tri[3 * f + (e + 1) % 3];
-      uint64_t key = (static_cast<uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
-      edges.push_back({key, static_cast<uint32_t>(3 * f + e), a < b});
-    }
-  }
-  std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) {
-    return x.key != y.key ? x.key < y.key : x.corner < y.corner;
-  });
+  // (consistent winding), first in the source's own vertex indices, then, for the edges left
+  // open, in welded vertices (which rejoin vertices a format split by normal or by face).
+  // Non-manifold and inconsistently wound edges cut. The source's indices come first because
+  // welding makes coincident copies of a surface (Sweet Home 3D's lily: every petal two to four
+  // times over) one non-manifold sheet, where every edge would cut: a chart a triangle.
   s->adj.assign(s->tri.size(), -1);
-  for (size_t i = 0; i < edges.size();) {
-    size_t j = i;
-    while (j < edges.size() && edges[j].key == edges[i].key) ++j;
-    if (j - i == 2 && edges[i].forward != edges[i + 1].forward) {
-      s->adj[edges[i].corner] = static_cast<int32_t>(edges[i + 1].corner / 3);
-      s->adj[edges[i + 1].corner] = static_cast<int32_t>(edges[i].corner / 3);
-    }
-    i = j;
-  }
+  pair_edges(source_indices, *s);
+  pair_edges(s->tri, *s);
 }
 
 // ---- segmentation ---------------------------------------------------------------------
@@ -674,7 +686,7 @@ Expected<std::vector<Surface>> collect_surfaces(const scene::Scene& in, const Un
   parallel_for(surfaces.size(), threads, [&](size_t i) {
     Surface& s = surfaces[i];
     weld(in.meshes[s.source_mesh].primitives[s.out_prim], &s, jobs[s.out_mesh].world);
-    build_topology(&s);
+    build_topology(in.meshes[s.source_mesh].primitives[s.out_prim].indices, &s);
   });
   for (const auto& s : surfaces)
     for (const Vec3d& p : s.pos)
@@ -827,6 +839,23 @@ double next_density_step(bool fits, int estimated_width, int width) {
   return fits ? 1.3 : 0.7;
 }
 
+// The atlas side in pages below which `count` charts cannot fit at any density: each takes at
+// least a texel, and charts keep `padding` texels apart.
+int gutter_pages(size_t count, const UnwrapOptions& opt) {
+  const double side = std::sqrt(static_cast<double>(count)) * (1.0 + opt.padding);
+  return std::max(1, static_cast<int>(std::ceil(side / opt.page_payload)));
+}
+
+// Why `count` charts do not fit `pages` x `pages` at any density searched.
+Status charts_do_not_fit(size_t count, int pages, const UnwrapOptions& opt) {
+  return Error(ErrorCode::kResourceLimit,
+               std::to_string(count) + " charts do not fit in " + std::to_string(pages) +
+                   " pages at any density (with --padding " + std::to_string(opt.padding) +
+                   " between charts they need at least " +
+                   std::to_string(gutter_pages(count, opt)) +
+                   "): a larger --size or --max-size, or a smaller --padding");
+}
+
 // The densest scale at which the charts fit `pages` x `pages` (bisection on the scale).
 Expected<PackedAtlas> pack_to_fit(const std::vector<Chart>& charts,
                                   const std::vector<double>& weight, int pages,
@@ -836,6 +865,8 @@ Expected<PackedAtlas> pack_to_fit(const std::vector<Chart>& charts,
   if (static_cast<int64_t>(width) * width > opt.max_atlas_texels)
     return Error(ErrorCode::kResourceLimit,
                  "atlas of " + std::to_string(pages) + " pages exceeds the atlas limit");
+  // Gutters alone over the atlas: no density fits, and each of the 16 trials would pack.
+  if (gutter_pages(charts.size(), opt) > pages) return charts_do_not_fit(charts.size(), pages, opt);
   best.width = width;
   best.square = true;
   double lo = 0, hi = 0;
@@ -863,10 +894,23 @@ Expected<PackedAtlas> pack_to_fit(const std::vector<Chart>& charts,
     if (lo > 0 && hi > 0 && hi / lo < 1.02) break;
     tpu = lo > 0 && hi > 0 ? std::sqrt(lo * hi) : tpu * next_density_step(fits, w, width);
   }
-  if (!have_fit)
-    return Error(ErrorCode::kResourceLimit,
-                 "charts do not fit in " + std::to_string(pages) + " pages");
+  if (!have_fit) return charts_do_not_fit(charts.size(), pages, opt);
   return best;
+}
+
+// pack_to_fit at `pages`, or where the plan lets the atlas grow, at the first size from there
+// (x1.5 a step, from the gutters' bound) that the charts fit, up to max_pages.
+Expected<PackedAtlas> pack_to_fit_or_grow(const std::vector<Chart>& charts,
+                                          const std::vector<double>& weight, int pages,
+                                          const detail::DensityPlan& plan, const UnwrapOptions& opt,
+                                          int threads) {
+  if (plan.may_grow)
+    pages = std::max(pages, std::min(gutter_pages(charts.size(), opt), plan.max_pages));
+  for (;;) {
+    auto fitted = pack_to_fit(charts, weight, pages, opt, threads);
+    if (fitted.ok() || !plan.may_grow || pages >= plan.max_pages) return fitted;
+    pages = std::min(plan.max_pages, std::max(pages + 1, pages * 3 / 2));
+  }
 }
 
 // Stage 4: chooses the texel density and packs, as the density plan says: at a given density,
@@ -879,7 +923,12 @@ Expected<PackedAtlas> choose_density_and_pack(const std::vector<Chart>& charts,
   using Mode = detail::DensityPlan::Mode;
   if (plan.mode == Mode::kExact)
     return pack_at_density(charts, weight, plan.texels_per_unit, opt, threads);
-  if (plan.mode == Mode::kFitPages) return pack_to_fit(charts, weight, plan.pages, opt, threads);
+  if (plan.mode == Mode::kFitPages) {
+    auto fitted = pack_to_fit_or_grow(charts, weight, plan.pages, plan, opt, threads);
+    if (fitted.ok() && fitted->width > plan.pages * opt.page_payload)
+      fitted->bound = ", grown to fit its charts";
+    return fitted;
+  }
   const int lo = plan.min_pages * opt.page_payload, hi = plan.max_pages * opt.page_payload;
   // The width estimate alone rules out an atlas far over the cap before any packing.
   int width = atlas_width_for(make_pack_charts(charts, weight, plan.texels_per_unit, threads), opt);

@@ -86,6 +86,9 @@ struct DensityPlan {
   double texels_per_unit = 0;  // the density of a chart with no density of its own; 0 = none
   int pages = 0;
   int min_pages = 0, max_pages = 0;
+  // kFitPages at the default size (nothing asked for a size): when the charts cannot fit
+  // `pages` at any density, the atlas grows instead, up to max_pages.
+  bool may_grow = false;
   // Own densities per material (density file, else glTF extras) and per node (subtrees applied).
   std::vector<OwnDensity> materials, nodes;
   // Per node: the scale its own sources ask for where nothing was given (object_scales), 0 = none.

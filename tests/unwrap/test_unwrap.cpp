@@ -2,6 +2,7 @@
 // [0, 1]), stretch, seams, instances and determinism.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <set>
 
 #include "mesh_gen.h"
@@ -72,6 +73,61 @@ TEST(Unwrap, OriginalUvSeamsAlwaysCut) {
   auto r2 = unwrap::unwrap_scene(s2, small_options());
   ASSERT_TRUE(r2.ok());
   EXPECT_EQ(r2->stats.charts, 1);
+}
+
+TEST(Unwrap, CoincidentCopiesOfASurfaceStayWholeCharts) {
+  // The same grid three times over, vertices of its own each, positions and indices equal
+  // (Sweet Home 3D's lily: petals stacked two to four deep), the third wound the other way (a
+  // back side). Welded, every edge is used six times and cut, a chart a triangle; the copies'
+  // own indices keep each a sheet: one chart each.
+  const Primitive grid = flat_grid(8, 8);
+  Primitive p;
+  for (int copy = 0; copy < 3; ++copy) {
+    const uint32_t base = static_cast<uint32_t>(p.positions.size());
+    p.positions.insert(p.positions.end(), grid.positions.begin(), grid.positions.end());
+    for (size_t i = 0; i < grid.indices.size(); i += 3) {
+      const uint32_t a = grid.indices[i], b = grid.indices[i + 1], c = grid.indices[i + 2];
+      for (uint32_t v : copy == 2 ? std::array{a, c, b} : std::array{a, b, c})
+        p.indices.push_back(base + v);
+    }
+  }
+  Scene s = scene_of(p);
+  auto r = unwrap::unwrap_scene(s, small_options());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  expect_valid(s, *r, 4);
+  EXPECT_EQ(r->stats.charts, 3);
+}
+
+TEST(Unwrap, DefaultSizeGrowsWhereTheChartsCannotFitIt) {
+  // 1,000 separate triangles, nothing textured, 64 texels between charts: the gutters alone
+  // need ceil(sqrt(1000) * 65 / 120) = 18 pages, over the default 16.
+  Primitive p;
+  for (int i = 0; i < 1000; ++i) {
+    const float x = float(i % 40) * 3.0f, y = float(i / 40) * 3.0f;
+    const uint32_t base = static_cast<uint32_t>(p.positions.size());
+    p.positions.push_back({x, y, 0});
+    p.positions.push_back({x + 1, y, 0});
+    p.positions.push_back({x, y + 1, 0});
+    p.indices.insert(p.indices.end(), {base, base + 1, base + 2});
+  }
+  Scene s = scene_of(p);
+  unwrap::UnwrapOptions o;
+  o.padding = 64;
+  o.threads = 2;
+  auto grown = unwrap::unwrap_scene(s, o);
+  ASSERT_TRUE(grown.ok()) << grown.status().message();
+  expect_valid(s, *grown, 64);
+  EXPECT_EQ(grown->stats.charts, 1000);
+  EXPECT_GE(grown->stats.pages_x, 18);
+  EXPECT_EQ(grown->stats.pages_x, grown->stats.pages_y);
+  EXPECT_EQ(grown->stats.density_rule, "default size, grown to fit its charts");
+  // A size asked for is kept, and the error says what would fit.
+  o.size_pages = 16;
+  auto asked = unwrap::unwrap_scene(s, o);
+  ASSERT_FALSE(asked.ok());
+  EXPECT_EQ(asked.status().message(),
+            "1000 charts do not fit in 16 pages at any density (with --padding 64 between charts "
+            "they need at least 18): a larger --size or --max-size, or a smaller --padding");
 }
 
 TEST(Unwrap, MaterialBoundariesCut) {
