@@ -20,6 +20,7 @@
 #include "bake/unwrap/unwrap.h"
 #include "bake/unwrap/unwrap_internal.h"
 #include "common/parallel.h"
+#include "scene/tangent_frame.h"
 
 namespace vt::unwrap {
 namespace {
@@ -1037,7 +1038,14 @@ void write_surface_uvs(const Surface& s, const std::vector<Chart>& charts,
     to = std::move(v);
   };
   gather(src.positions, dst->positions);
-  gather(src.normals, dst->normals);
+  // Without normals of its own a primitive is shaded with normals smoothed over its shared
+  // vertices, by the validator's reference, the transfer and the lighting alike; split along
+  // the charts they would turn flat at every chart edge (a box lit with gradients in the
+  // reference, flat in the bake). The unwrapped scene carries the source's.
+  gather(src.normals.size() == src.positions.size() || src.indices.empty()
+             ? src.normals
+             : scene::compute_normals(src),
+         dst->normals);
   gather(src.tangents, dst->tangents);
   gather(src.colors, dst->colors);
   dst->uvs.resize(src.uvs.size());

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "mesh_gen.h"
+#include "scene/tangent_frame.h"
 
 namespace vt::test {
 namespace {
@@ -128,6 +129,37 @@ TEST(Unwrap, DefaultSizeGrowsWhereTheChartsCannotFitIt) {
   EXPECT_EQ(asked.status().message(),
             "1000 charts do not fit in 16 pages at any density (with --padding 64 between charts "
             "they need at least 18): a larger --size or --max-size, or a smaller --padding");
+}
+
+TEST(Unwrap, ACornerSharedAcrossChartsKeepsItsSmoothNormal) {
+  // A box of 8 shared corners and no normals: every consumer shades it with normals smoothed
+  // over the shared corners (scene::compute_normals). Its faces land in different charts, and
+  // normals recomputed on the split corners would be flat; the unwrapped box carries the
+  // source's instead, so the bake and the validator's reference light it alike.
+  Primitive box;
+  for (int i = 0; i < 8; ++i)
+    box.positions.push_back({float(i & 1), float(i >> 1 & 1), float(i >> 2)});
+  const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads)
+    box.indices.insert(box.indices.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
+  const std::vector<scene::Vec3> smooth = scene::compute_normals(box);
+  Scene s = scene_of(box);
+  auto r = unwrap::unwrap_scene(s, small_options());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  expect_valid(s, *r, 4);
+  EXPECT_GT(r->stats.charts, 1);
+  const Primitive& out = r->scene.meshes[0].primitives[0];
+  ASSERT_GT(out.positions.size(), 8u);  // corners split along the charts
+  ASSERT_EQ(out.normals.size(), out.positions.size());
+  for (size_t v = 0; v < out.positions.size(); ++v) {
+    const auto& q = out.positions[v];
+    const size_t source = size_t(q[0]) | size_t(q[1]) << 1 | size_t(q[2]) << 2;
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_FLOAT_EQ(out.normals[v][k], smooth[source][k]) << v;
+      EXPECT_GT(std::abs(out.normals[v][k]), 0.1f) << v;  // between its three faces, not flat
+    }
+  }
 }
 
 TEST(Unwrap, MaterialBoundariesCut) {
