@@ -841,9 +841,11 @@ double next_density_step(bool fits, int estimated_width, int width) {
 }
 
 // The atlas side in pages below which `count` charts cannot fit at any density: each takes at
-// least a texel, and charts keep `padding` texels apart.
+// least a texel, and charts keep `padding` texels apart (a square grid of one-texel charts is
+// the densest arrangement).
 int gutter_pages(size_t count, const UnwrapOptions& opt) {
-  const double side = std::sqrt(static_cast<double>(count)) * (1.0 + opt.padding);
+  const double side = std::sqrt(static_cast<double>(count)) * (1.0 + opt.padding) -
+                      static_cast<double>(opt.padding);
   return std::max(1, static_cast<int>(std::ceil(side / opt.page_payload)));
 }
 
