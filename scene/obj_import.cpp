@@ -5,6 +5,10 @@
 // before `mtllib`. Faces, too, are built once the whole file is read: a positive index may name
 // a `v`, `vt` or `vn` written further down (Sweet Home 3D's catalogue has such files, and the
 // readers that load everything first accept them); a negative one counts back from the line.
+// A corner without `vn` gets its normal from the smoothing groups, as Blender and 3ds Max read
+// them: the face's own under `s off` (flat), else the area-weighted mean over the faces of its
+// group that share the `v`, so that the bake, the validator and the unwrapped scene all shade
+// the model as its author saw it.
 // Vertex colours (`v x y z r g b [a]`) are read as sRGB-encoded, the way MeshLab, ZBrush and
 // Blender write them (8-bit colours over 255, what their viewports show), and stored linear.
 // A file with a component above 1 wrote 0..255 and is scaled (with a warning).
@@ -14,16 +18,20 @@
 #include <unordered_map>
 
 #include "common/srgb.h"
+#include "common/vec.h"
 #include "scene/obj_mtl.h"
 #include "scene/scene_io_util.h"
 
 namespace vt::scene::detail {
 namespace {
 
+// A vertex: v, vt, vn (0 = none) and, for a normal made from the smoothing groups, the group
+// (smooth) or the face (flat: -1 - face), else 0.
+using VertexKey = std::array<int, 4>;
 struct KeyHash {
-  size_t operator()(const std::array<int, 3>& k) const {
+  size_t operator()(const VertexKey& k) const {
     return (static_cast<size_t>(k[0]) * 73856093u) ^ (static_cast<size_t>(k[1]) * 19349663u) ^
-           (static_cast<size_t>(k[2]) * 83492791u);
+           (static_cast<size_t>(k[2]) * 83492791u) ^ (static_cast<size_t>(k[3]) * 2654435761u);
   }
 };
 
@@ -33,9 +41,9 @@ struct KeyHash {
 struct Builder {
   std::string material_name;
   Primitive prim;
-  std::unordered_map<std::array<int, 3>, uint32_t, KeyHash> map;
+  std::unordered_map<VertexKey, uint32_t, KeyHash> map;
   std::vector<int> position_of;  // per vertex: its `v` (for colours, filled in at the end)
-  bool any_uv = false, any_normal = false;
+  bool any_uv = false;
 };
 
 class ObjReader {
@@ -77,10 +85,12 @@ class ObjReader {
   struct Face {
     size_t builder, line;
     uint32_t first, count;
-    bool has_uv;  // every corner has a `vt`
+    bool has_uv;    // every corner has a `vt`
+    int smoothing;  // its `s` group, 0 = off
   };
   std::vector<std::array<int, 3>> corners_;
   std::vector<Face> faces_;
+  int smoothing_ = 0;  // the current `s` group
 };
 
 Status ObjReader::vertex(LineCursor* c) {
@@ -134,7 +144,7 @@ Status ObjReader::face(LineCursor* c) {
                                   [](const auto& k) { return k[1] != 0; });
   auto [slot, added] = builder_of_.try_emplace({current_, has_uv}, builders_.size());
   if (added) builders_.emplace_back().material_name = current_;
-  faces_.push_back({slot->second, line, uint32_t(first), uint32_t(count), has_uv});
+  faces_.push_back({slot->second, line, uint32_t(first), uint32_t(count), has_uv, smoothing_});
   return Status::Ok();
 }
 
@@ -153,19 +163,49 @@ Status ObjReader::build_faces() {
       }
     }
   }
-  for (const Face& f : faces_) {
+  // Normals for corners without `vn`: each face's (twice its area times its unit normal, summed
+  // over its fan), and per (group, v) the sum over the group's faces.
+  std::vector<Vec3d> face_normal(faces_.size());
+  std::map<std::pair<int, int>, Vec3d> smooth;
+  for (size_t i = 0; i < faces_.size(); ++i) {
+    const Face& f = faces_[i];
+    const auto* face = corners_.data() + f.first;
+    bool wanted = false;
+    for (uint32_t c = 0; c < f.count; ++c) wanted |= face[c][2] == 0;
+    if (!wanted) continue;
+    auto at = [&](uint32_t c) {
+      const Vec3& p = v_[face[c][0] - 1];
+      return Vec3d{p[0], p[1], p[2]};
+    };
+    for (uint32_t c = 1; c + 1 < f.count; ++c)
+      face_normal[i] = face_normal[i] + cross(at(c) - at(0), at(c + 1) - at(0));
+    if (f.smoothing == 0) continue;
+    for (uint32_t c = 0; c < f.count; ++c) {
+      Vec3d& sum = smooth[{f.smoothing, face[c][0]}];
+      sum = sum + face_normal[i];
+    }
+  }
+  for (size_t i = 0; i < faces_.size(); ++i) {
+    const Face& f = faces_[i];
     Builder& b = builders_[f.builder];
     const auto* face = corners_.data() + f.first;
     auto vertex = [&](const std::array<int, 3>& k) {
-      auto [it, inserted] = b.map.try_emplace(k, static_cast<uint32_t>(b.prim.positions.size()));
+      const int made = k[2] ? 0 : f.smoothing ? f.smoothing : -1 - static_cast<int>(i);
+      const VertexKey key = {k[0], k[1], k[2], made};
+      auto [it, inserted] = b.map.try_emplace(key, static_cast<uint32_t>(b.prim.positions.size()));
       if (inserted) {
         b.prim.positions.push_back(v_[k[0] - 1]);
         b.position_of.push_back(k[0] - 1);
         b.prim.uvs.resize(1);
         b.prim.uvs[0].push_back(f.has_uv ? vt_[k[1] - 1] : Vec2{0, 0});
-        b.prim.normals.push_back(k[2] ? vn_[k[2] - 1] : Vec3{0, 0, 0});
+        Vec3 n = k[2] ? vn_[k[2] - 1] : Vec3{0, 0, 0};
+        if (!k[2]) {
+          const Vec3d m = normalized(f.smoothing ? smooth[{f.smoothing, k[0]}] : face_normal[i],
+                                     Vec3d{0, 0, 1});
+          n = {float(m.x), float(m.y), float(m.z)};
+        }
+        b.prim.normals.push_back(n);
         b.any_uv |= f.has_uv;
-        b.any_normal |= k[2] != 0;
       }
       return it->second;
     };
@@ -232,6 +272,9 @@ Status ObjReader::statement(const std::string& key, LineCursor* c) {
     vn_.push_back(n);
   } else if (key == "usemtl") {
     current_ = c->rest_of_line();
+  } else if (key == "s") {
+    const std::string group = c->word();  // "off" or 0: flat
+    smoothing_ = group == "off" ? 0 : std::max(0, std::atoi(group.c_str()));
   } else if (key == "mtllib") {
     std::string rest = c->rest_of_line();
     if (!rest.empty()) VT_RETURN_IF_ERROR(mtllib(rest));
@@ -282,7 +325,6 @@ Expected<Scene> ObjReader::finish() && {
   for (auto [material, i] : order) {
     Builder& b = builders_[i];
     if (!b.any_uv) b.prim.uvs.clear();
-    if (!b.any_normal) b.prim.normals.clear();
     fill_colors(&b);
     b.prim.material = material;
     mesh.primitives.push_back(std::move(b.prim));

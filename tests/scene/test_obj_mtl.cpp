@@ -462,7 +462,7 @@ TEST(ObjMtl, FacesMayNameElementsWrittenFurtherDown) {
   // negative one counts back from its own line.
   std::string dir = folder("forward");
   scene::Scene s = load(dir, "",
-                        "v 0 0 0\nv 1 0 0\nvt 0 0\nvt 1 0\n"
+                        "s 1\nv 0 0 0\nv 1 0 0\nvt 0 0\nvt 1 0\n"
                         "f 1/1 2/2 3/3\n"      // v 3 and vt 3 come later
                         "f -2/-2 -1/-1 3/3\n"  // the same face, partly relative
                         "v 1 1 0\nvt 1 1\nv 0 1 0\nvt 0 1\n"
@@ -494,6 +494,44 @@ TEST(ObjMtl, FacesMayNameElementsWrittenFurtherDown) {
   auto before = scene::load_scene(dir + "c.obj");
   ASSERT_FALSE(before.ok());
   EXPECT_EQ(before.status().message(), dir + "c.obj:3: face index '-3' out of range");
+}
+
+TEST(ObjMtl, CornersWithoutNormalsFollowTheSmoothingGroups) {
+  // A unit cube of six quads, wound outwards, no `vn`: under `s off` every face is flat (4
+  // corners of its own, its axis normal); under `s 1` its 8 corners are shared and point along
+  // the cube's diagonals; a `vn` given is kept.
+  const std::string cube =
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+      "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n";
+  std::string dir = folder("smoothing");
+  scene::Scene flat = load(dir, "", "s off\n" + cube);
+  const scene::Primitive& f = flat.meshes[0].primitives[0];
+  ASSERT_EQ(f.positions.size(), 24u);
+  ASSERT_EQ(f.normals.size(), 24u);
+  for (size_t i = 0; i < f.indices.size(); i += 3) {
+    const scene::Vec3 &a = f.positions[f.indices[i]], &b = f.positions[f.indices[i + 1]],
+                      &c = f.positions[f.indices[i + 2]];
+    for (int k = 0; k < 3; ++k) {  // the axis the face is constant along, and its side
+      if (a[k] != b[k] || b[k] != c[k]) continue;
+      for (size_t j = 0; j < 3; ++j) {
+        const scene::Vec3& n = f.normals[f.indices[i + j]];
+        for (int e = 0; e < 3; ++e) EXPECT_FLOAT_EQ(n[e], e == k ? a[k] * 2 - 1 : 0.0f) << i;
+      }
+    }
+  }
+  scene::Scene smooth = load(dir, "", "s 1\n" + cube);
+  const scene::Primitive& m = smooth.meshes[0].primitives[0];
+  ASSERT_EQ(m.positions.size(), 8u);
+  ASSERT_EQ(m.normals.size(), 8u);
+  for (size_t v = 0; v < 8; ++v)
+    for (int e = 0; e < 3; ++e)
+      EXPECT_NEAR(m.normals[v][e], (m.positions[v][e] * 2 - 1) / std::sqrt(3.0f), 1e-6) << v;
+  // A corner with its own `vn` keeps it; the others are made.
+  scene::Scene given = load(dir, "", "vn 0 1 0\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2 3\n");
+  const scene::Primitive& g = given.meshes[0].primitives[0];
+  ASSERT_EQ(g.normals.size(), 3u);
+  EXPECT_EQ(g.normals[0], (scene::Vec3{0, 1, 0}));
+  EXPECT_EQ(g.normals[1], (scene::Vec3{0, 0, 1}));
 }
 
 // The same triangle as UTF-8, UTF-8 with a BOM, UTF-16 LE and BE with BOMs.
