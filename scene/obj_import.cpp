@@ -210,10 +210,10 @@ Status ObjReader::build_faces() {
       return it->second;
     };
     const uint32_t first = vertex(face[0]);
-    for (uint32_t i = 1; i + 1 < f.count; ++i) {
+    for (uint32_t c = 1; c + 1 < f.count; ++c) {
       b.prim.indices.push_back(first);
-      b.prim.indices.push_back(vertex(face[i]));
-      b.prim.indices.push_back(vertex(face[i + 1]));
+      b.prim.indices.push_back(vertex(face[c]));
+      b.prim.indices.push_back(vertex(face[c + 1]));
     }
   }
   corners_ = {};
