@@ -17,6 +17,7 @@
 #include "bake/color.h"
 #include "bake_test_util.h"
 #include "format/page_file_inspect.h"
+#include "tests/process_temp_dir.h"
 
 namespace vt {
 namespace {
@@ -41,9 +42,8 @@ constexpr double kAcescgToRec709[3][3] = {{1.70505099, -0.62179212, -0.08325887}
                                           {-0.02400336, -0.12896886, 1.15297223}};
 
 fs::path temp_dir() {
-  fs::path d =
-      fs::temp_directory_path() / ("vt_color_" + std::to_string(::getpid()) + "_" +
-                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  fs::path d = test::process_temp_dir("vt_color") /
+               ::testing::UnitTest::GetInstance()->current_test_info()->name();
   fs::remove_all(d);
   fs::create_directories(d);
   return d;

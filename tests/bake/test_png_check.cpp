@@ -10,6 +10,7 @@
 
 #include "bake/image_source.h"
 #include "bake/png_check.h"
+#include "tests/process_temp_dir.h"
 
 namespace vt {
 namespace {
@@ -17,8 +18,7 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string write_png(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("vtbake_png_check_" + std::to_string(::getpid()));
+  const fs::path dir = test::process_temp_dir("vtbake_png_check");
   fs::create_directories(dir);
   const std::string path = (dir / name).string();
   auto out = OIIO::ImageOutput::create(path);

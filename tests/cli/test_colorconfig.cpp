@@ -13,6 +13,7 @@
 #include "format/page_file.h"
 #include "format/page_file_inspect.h"
 #include "tests/cli/cli_test_util.h"
+#include "tests/process_temp_dir.h"
 
 namespace vt {
 namespace {
@@ -25,9 +26,8 @@ bool contains(const std::string& s, const std::string& part) {
 }
 
 fs::path temp_dir() {
-  fs::path d =
-      fs::temp_directory_path() / ("vt_cli_colour_" + std::to_string(::getpid()) + "_" +
-                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  fs::path d = test::process_temp_dir("vt_cli_colour") /
+               ::testing::UnitTest::GetInstance()->current_test_info()->name();
   fs::remove_all(d);
   fs::create_directories(d);
   return d;

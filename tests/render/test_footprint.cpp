@@ -17,6 +17,7 @@
 #include "render/scene_draws.h"
 #include "render/vulkan_context.h"
 #include "scene/scene.h"
+#include "tests/process_temp_dir.h"
 #include "tests/render/one_primitive_scene.h"
 #include "tests/render/png_file.h"
 
@@ -78,8 +79,7 @@ double rows_at(double t) {
 // With the ellipse's axes (16 taps at LOD 0.5): worst 2.7, RMS 2.0.
 TEST(Footprint, ShearedMappingKeepsItsNarrowAxisSharp) {
   if (!vulkan()) GTEST_SKIP() << "no Vulkan device";
-  const auto dir =
-      std::filesystem::temp_directory_path() / ("vt_footprint_" + std::to_string(::getpid()));
+  const auto dir = test::process_temp_dir("vt_footprint");
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const std::string png = write_rows_png(dir.string());

@@ -18,6 +18,7 @@
 #include "render/vulkan_context.h"
 #include "scene/material_rules.h"
 #include "scene/scene.h"
+#include "tests/process_temp_dir.h"
 #include "tests/render/one_primitive_scene.h"
 #include "tests/render/png_file.h"
 
@@ -28,8 +29,7 @@ constexpr uint32_t kSize = 64;  // render, pixels per side
 constexpr int kTexels = 8;      // occlusion texture side
 
 std::string test_dir(const std::string& name) {
-  auto d = std::filesystem::temp_directory_path() / ("vt_lit_rules_" + std::to_string(::getpid())) /
-           name;
+  auto d = test::process_temp_dir("vt_lit_rules") / name;
   std::filesystem::remove_all(d);
   std::filesystem::create_directories(d);
   return d.string();

@@ -26,6 +26,7 @@
 #include "scene/gltf_export.h"
 #include "scene/material_rules.h"
 #include "scene/scene.h"
+#include "tests/process_temp_dir.h"
 #include "tests/render/one_primitive_scene.h"
 #include "tests/render/png_file.h"
 
@@ -44,8 +45,7 @@ VulkanContext* vulkan() {
   if (!vulkan()) GTEST_SKIP() << "no Vulkan device"
 
 std::string test_dir(const std::string& name) {
-  auto d = std::filesystem::temp_directory_path() /
-           ("vt_reference_rules_" + std::to_string(::getpid())) / name;
+  auto d = test::process_temp_dir("vt_reference_rules") / name;
   std::filesystem::remove_all(d);
   std::filesystem::create_directories(d);
   return d.string();

@@ -8,14 +8,14 @@
 #include <vector>
 
 #include "format/page_file.h"
+#include "tests/process_temp_dir.h"
 
 namespace vt::runtime_test {
 
 // A path in a fresh per-process, per-call folder (tests in one binary never share a file).
 inline std::string temp_file(const std::string& name) {
   static int counter = 0;
-  auto dir = std::filesystem::temp_directory_path() /
-             ("vtbake_runtime_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+  auto dir = vt::test::process_temp_dir("vtbake_runtime") / std::to_string(counter++);
   std::filesystem::create_directories(dir);
   return (dir / name).string();
 }
