@@ -69,7 +69,8 @@ struct UnwrapStats {
   double source_texels_per_unit = 0;  // the sources' density (kSourcePercentile), 0 = none
   // How the density was chosen: "texels_per_unit" (asked), "size" (fit size_pages), "sources",
   // "sources, capped" (fitted to max_size_pages), "sources, floored" (to min_size_pages),
-  // "default size" (nothing textured).
+  // "default size" (nothing textured), "default size, grown to fit its charts" (more charts
+  // than kDefaultSizePages hold at any density).
   std::string density_rule;
   std::string density_file;  // the density file read, "" = none
   struct MaterialDensity {
