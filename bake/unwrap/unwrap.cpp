@@ -901,16 +901,18 @@ Expected<PackedAtlas> pack_to_fit(const std::vector<Chart>& charts,
   return best;
 }
 
-// pack_to_fit at `pages`, or where the plan lets the atlas grow, at the first size from there
+// pack_to_fit at plan.pages, or where the plan lets the atlas grow, at the first size from there
 // (x1.5 a step, from the gutters' bound) that the charts fit, up to max_pages.
 Expected<PackedAtlas> pack_to_fit_or_grow(const std::vector<Chart>& charts,
-                                          const std::vector<double>& weight, int pages,
+                                          const std::vector<double>& weight,
                                           const detail::DensityPlan& plan, const UnwrapOptions& opt,
                                           int threads) {
+  int pages = plan.pages;
   if (plan.may_grow)
     pages = std::max(pages, std::min(gutter_pages(charts.size(), opt), plan.max_pages));
   for (;;) {
     auto fitted = pack_to_fit(charts, weight, pages, opt, threads);
+    if (fitted.ok() && pages > plan.pages) fitted->bound = ", grown to fit its charts";
     if (fitted.ok() || !plan.may_grow || pages >= plan.max_pages) return fitted;
     pages = std::min(plan.max_pages, std::max(pages + 1, pages * 3 / 2));
   }
@@ -926,12 +928,7 @@ Expected<PackedAtlas> choose_density_and_pack(const std::vector<Chart>& charts,
   using Mode = detail::DensityPlan::Mode;
   if (plan.mode == Mode::kExact)
     return pack_at_density(charts, weight, plan.texels_per_unit, opt, threads);
-  if (plan.mode == Mode::kFitPages) {
-    auto fitted = pack_to_fit_or_grow(charts, weight, plan.pages, plan, opt, threads);
-    if (fitted.ok() && fitted->width > plan.pages * opt.page_payload)
-      fitted->bound = ", grown to fit its charts";
-    return fitted;
-  }
+  if (plan.mode == Mode::kFitPages) return pack_to_fit_or_grow(charts, weight, plan, opt, threads);
   const int lo = plan.min_pages * opt.page_payload, hi = plan.max_pages * opt.page_payload;
   // The width estimate alone rules out an atlas far over the cap before any packing.
   int width = atlas_width_for(make_pack_charts(charts, weight, plan.texels_per_unit, threads), opt);
@@ -1044,10 +1041,10 @@ void write_surface_uvs(const Surface& s, const std::vector<Chart>& charts,
   // vertices, by the validator's reference, the transfer and the lighting alike; split along
   // the charts they would turn flat at every chart edge (a box lit with gradients in the
   // reference, flat in the bake). The unwrapped scene carries the source's.
-  gather(src.normals.size() == src.positions.size() || src.indices.empty()
-             ? src.normals
-             : scene::compute_normals(src),
-         dst->normals);
+  const bool own_normals = src.normals.size() == src.positions.size() || src.indices.empty();
+  const std::vector<scene::Vec3> smoothed =
+      own_normals ? std::vector<scene::Vec3>{} : scene::compute_normals(src);
+  gather(own_normals ? src.normals : smoothed, dst->normals);
   gather(src.tangents, dst->tangents);
   gather(src.colors, dst->colors);
   dst->uvs.resize(src.uvs.size());
