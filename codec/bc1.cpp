@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "common/target_clones.h"
+
 // a * b + c stays two roundings in every build, the AVX-512 clone below included: the codec is
 // compiled with -ffp-contract=off (codec/CMakeLists.txt).
 
@@ -292,14 +294,7 @@ template <class Vec, class T>
   std::memcpy(&x, v, sizeof x);
 }
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(_WIN32) && \
-    !defined(__SANITIZE_ADDRESS__)
-#define VT_BC1_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define VT_BC1_CLONES
-#endif
-
-VT_BC1_CLONES
+VT_TARGET_CLONES
 void encode_realtime_lanes(const uint32_t (&texels)[16][kLanes], uint16_t c0_out[kLanes],
                            uint16_t c1_out[kLanes], uint32_t bits_out[kLanes],
                            bool constant_out[kLanes]) {

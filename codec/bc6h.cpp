@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "codec/bptc_tables.h"
+#include "common/target_clones.h"
 
 namespace vt {
 namespace {
@@ -731,13 +732,6 @@ void pack(const Candidate& c, uint8_t out[16]) {
 // unscored): weight 0 and 64 interpolate to the endpoints themselves.
 constexpr int kLanes = 16;
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(_WIN32) && \
-    !defined(__SANITIZE_ADDRESS__)
-#define VT_BC6H_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define VT_BC6H_CLONES
-#endif
-
 struct RealtimeLanes {
   uint16_t h[48][kLanes];   // in: the blocks' half floats, texel-major RGB (3 * texel + channel)
   int32_t mode[kLanes];     // out: mode index (10-13)
@@ -1020,7 +1014,7 @@ template <bool kSigned>
   }
 }
 
-VT_BC6H_CLONES
+VT_TARGET_CLONES
 void encode_realtime_lanes(RealtimeLanes& io, bool is_signed) {
   if (is_signed)
     realtime_lanes<true>(io);

@@ -20,18 +20,12 @@
 
 #include "codec/bc7.h"
 #include "codec/bptc_tables.h"
+#include "common/target_clones.h"
 
 namespace vt {
 namespace {
 
 constexpr int kLanes = 16;
-
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(_WIN32) && \
-    !defined(__SANITIZE_ADDRESS__)
-#define VT_BC7_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define VT_BC7_CLONES
-#endif
 
 // What the kernel gives for each lane: mode 6's stored fields.
 struct Mode6Lanes {
@@ -44,8 +38,8 @@ struct Mode6Lanes {
 // (alpha stored as 127 with the p-bits), NCH = 4 fits RGBA. `pbit_pairs`: bit k set = try p-bits
 // (k & 1, k >> 1).
 template <int NCH>
-VT_BC7_CLONES void fit_mode6_lanes(const uint32_t (&texels)[16][kLanes], unsigned pbit_pairs,
-                                   Mode6Lanes& out) {
+VT_TARGET_CLONES void fit_mode6_lanes(const uint32_t (&texels)[16][kLanes], unsigned pbit_pairs,
+                                      Mode6Lanes& out) {
   float x[NCH][16][kLanes];
   float xx[16][kLanes];  // |x|^2, an integer
   for (int i = 0; i < 16; ++i) {

@@ -881,7 +881,7 @@ Expected<PackedAtlas> pack_to_fit(const std::vector<Chart>& charts,
     bool fits = false;
     detail::PackResult pr;
     if (w <= 2 * width) {  // hopeless widths are skipped: their charts cannot fit
-      pr = detail::pack_charts(trial, width, opt.padding, threads);
+      pr = detail::pack_charts(trial, width, opt.padding, threads, width);
       double max_w = 0;
       for (const auto& pc : trial) max_w = std::max(max_w, std::min(pc.width, pc.height));
       fits = !pr.overflow && pr.height <= width && max_w < width;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include <string>
@@ -68,8 +69,11 @@ struct PackResult {
 };
 
 // Skyline packing of conservative chart footprints, `padding` empty texels between charts,
-// into an atlas `width` texels wide. Deterministic.
-PackResult pack_charts(const std::vector<PackChart>& charts, int width, int padding, int threads);
+// into an atlas `width` texels wide. Deterministic. Once the packed height passes
+// `give_up_above` the packing stops (a trial that cannot fit a height): the height returned is
+// then over it and the placements incomplete.
+PackResult pack_charts(const std::vector<PackChart>& charts, int width, int padding, int threads,
+                       int give_up_above = std::numeric_limits<int>::max());
 
 // Applies a placement to a local point (the inverse of nothing: used to write atlas UVs).
 Vec2d place_point(const PackChart& chart, const Placement& placement, const Vec2d& p);

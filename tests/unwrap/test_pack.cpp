@@ -37,6 +37,17 @@ PackChart random_chart(std::mt19937& rng) {
   return c;
 }
 
+// A w x h texel rectangle inset by a quarter texel: its half turn (and, square, its quarter
+// turns) have the same profile as the unturned chart, which the packer searches once.
+PackChart box_chart(int w, int h) {
+  PackChart c;
+  const double e = 0.25;
+  c.points = {{e, e}, {w - e, e}, {w - e, h - e}, {e, h - e}};
+  c.tris = {{0, 1, 2}, {0, 2, 3}};
+  c.width = w, c.height = h;
+  return c;
+}
+
 TEST(Bounds, HoldEveryPointAndAreInvertedWhenEmpty) {
   const auto [lo, hi] = bounds_of(std::vector<Vec2d>{{1, -2}, {-3, 4}, {0.5, 0}});
   EXPECT_EQ(lo.x, -3);
@@ -220,8 +231,12 @@ PackResult reference_pack(const std::vector<PackChart>& charts, int width, int p
 TEST(Pack, PlacementsAreThoseOfTheCellByCellScan) {
   for (int padding : {0, 1, 3, 8}) {
     std::mt19937 rng(21 + padding);
+    std::uniform_int_distribution<int> side(1, 7);
     std::vector<PackChart> charts;
-    for (int i = 0; i < 120; ++i) charts.push_back(random_chart(rng));
+    for (int i = 0; i < 120; ++i) {
+      charts.push_back(random_chart(rng));
+      if (i % 3 == 0) charts.push_back(box_chart(side(rng), side(rng)));
+    }
     for (int width : {40, 97, 256}) {
       const PackResult got = pack_charts(charts, width, padding, 2);
       const PackResult want = reference_pack(charts, width, padding);
@@ -234,6 +249,25 @@ TEST(Pack, PlacementsAreThoseOfTheCellByCellScan) {
       }
     }
   }
+}
+
+TEST(Pack, GivesUpOnceTheHeightPassesTheLimitAndOnlyThen) {
+  std::mt19937 rng(33);
+  std::vector<PackChart> charts;
+  for (int i = 0; i < 200; ++i) charts.push_back(random_chart(rng));
+  const PackResult all = pack_charts(charts, 120, 2, 1);
+  // A limit the whole packing stays under changes nothing.
+  const PackResult under = pack_charts(charts, 120, 2, 1, all.height);
+  EXPECT_EQ(under.height, all.height);
+  for (size_t c = 0; c < charts.size(); ++c) {
+    EXPECT_EQ(under.placements[c].x, all.placements[c].x) << c;
+    EXPECT_EQ(under.placements[c].y, all.placements[c].y) << c;
+  }
+  // A lower one stops as soon as the top passes it: over the limit, under the whole height.
+  const int limit = all.height / 2;
+  const PackResult stopped = pack_charts(charts, 120, 2, 1, limit);
+  EXPECT_GT(stopped.height, limit);
+  EXPECT_LT(stopped.height, all.height);
 }
 
 TEST(Pack, LongChartsTurnToFitAndTooLargeOnesOverflow) {
