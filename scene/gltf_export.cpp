@@ -221,10 +221,10 @@ class DocumentBuilder {
     attrs["POSITION"] = add_floats<3>(p.positions, true);
     const bool atlas_frame =
         options_.atlas_tangents && n && !p.uvs.empty() && p.uvs.back().size() == n;
-    // glTF ignores TANGENT without NORMAL: the atlas frame comes with the smooth normals the
-    // bake used.
+    // A primitive without normals is shaded smooth here (compute_normals), where a glTF reader
+    // makes it flat and ignores its TANGENT: the normals the bake used are written.
     std::vector<Vec3> computed;
-    if (atlas_frame && p.normals.size() != n) computed = compute_normals(p);
+    if (p.normals.size() != n) computed = compute_normals(p);
     const std::vector<Vec3>& normals = computed.empty() ? p.normals : computed;
     if (normals.size() == n && n) attrs["NORMAL"] = add_floats<3>(normals, false);
     if (atlas_frame) {

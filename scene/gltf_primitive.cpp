@@ -5,6 +5,7 @@
 
 #include "scene/gltf_document.h"
 #include "scene/scene_io_util.h"
+#include "scene/tangent_frame.h"
 
 namespace vt::scene::detail {
 namespace {
@@ -190,6 +191,9 @@ Expected<Primitive> read_primitive(const Gltf& g, const json& p, const std::stri
     VT_RETURN_IF_ERROR(triangulate(g, mode.is_number_integer() ? mode.get<int>() : 4,
                                    std::move(idx), where, &prim.indices));
   }
+  // glTF: "When normals are not specified, client implementations MUST calculate flat normals
+  // and the provided tangents (if present) MUST be ignored."
+  if (prim.normals.empty()) make_flat_normals(prim);
   const json& material = member(p, "material");
   prim.material = material.is_number_unsigned() ? material.get<int>() : -1;
   if (prim.material >= static_cast<int>(member(g.doc, "materials").size())) prim.material = -1;

@@ -61,4 +61,63 @@ std::vector<Vec3> compute_normals(const Primitive& p) {
   return out;
 }
 
+void make_flat_normals(Primitive& p) {
+  const size_t faces = p.indices.size() / 3;
+  std::vector<Vec3d> face_normal(faces);
+  for (size_t f = 0; f < faces; ++f) {
+    const uint32_t* t = &p.indices[3 * f];
+    face_normal[f] = normalized(cross(v3(p.positions[t[1]]) - v3(p.positions[t[0]]),
+                                      v3(p.positions[t[2]]) - v3(p.positions[t[0]])),
+                                {});
+  }
+  // Each vertex's normals so far, as a chain of (normal, vertex) through `next`; the first is
+  // the vertex itself.
+  struct Version {
+    Vec3d normal;
+    uint32_t vertex;
+    int64_t next;
+  };
+  constexpr double kSameWay = 1 - 1.5e-8;  // cos(0.01 degrees)
+  const size_t n = p.positions.size();
+  std::vector<int64_t> first(n, -1);
+  std::vector<Version> versions;
+  auto copy_vertex = [&p](uint32_t v) {
+    auto copy = [v](auto& values) {
+      if (values.size() > v) values.push_back(values[v]);
+    };
+    copy(p.positions);
+    for (auto& uv : p.uvs) copy(uv);
+    copy(p.colors);
+    return static_cast<uint32_t>(p.positions.size() - 1);
+  };
+  auto vertex_for = [&](uint32_t v, const Vec3d& normal, bool degenerate) {
+    if (first[v] < 0) {
+      first[v] = static_cast<int64_t>(versions.size());
+      versions.push_back({degenerate ? Vec3d{0, 0, 1} : normal, v, -1});
+      return v;
+    }
+    int64_t k = first[v];
+    if (degenerate) return versions[size_t(k)].vertex;
+    for (;; k = versions[size_t(k)].next) {
+      if (dot(versions[size_t(k)].normal, normal) >= kSameWay) return versions[size_t(k)].vertex;
+      if (versions[size_t(k)].next < 0) break;
+    }
+    versions[size_t(k)].next = static_cast<int64_t>(versions.size());
+    versions.push_back({normal, copy_vertex(v), -1});
+    return versions.back().vertex;
+  };
+  // Faces with a normal first, so that a degenerate face never decides a vertex's first normal.
+  for (bool degenerate : {false, true})
+    for (size_t f = 0; f < faces; ++f) {
+      if ((dot(face_normal[f], face_normal[f]) == 0) != degenerate) continue;
+      for (int c = 0; c < 3; ++c)
+        p.indices[3 * f + c] = vertex_for(p.indices[3 * f + c], face_normal[f], degenerate);
+    }
+  p.normals.assign(p.positions.size(), {0, 0, 1});
+  for (const Version& version : versions)
+    p.normals[version.vertex] = {float(version.normal.x), float(version.normal.y),
+                                 float(version.normal.z)};
+  p.tangents.clear();
+}
+
 }  // namespace vt::scene

@@ -12,6 +12,13 @@ namespace vt::scene {
 // Area-weighted vertex normals (unit; +Z where a vertex touches only degenerate faces).
 std::vector<Vec3> compute_normals(const Primitive& p);
 
+// glTF's rule for a primitive without NORMAL: flat shading. Gives `p` normals, each face's own,
+// splitting a vertex (all its attributes copied) where the faces around it do not face the same
+// way; faces within a hundredth of a degree share a vertex, so a flat mesh stays as indexed as it
+// was. Degenerate faces take a vertex's first normal (+Z where that is all they touch). Any
+// tangents are dropped: they were given for the absent normals (glTF: ignored).
+void make_flat_normals(Primitive& p);
+
 // Tangents from UV set `uv_set` per vertex (MikkTSpace-like: area-weighted per-face tangents,
 // Gram-Schmidt against the normal, handedness from the bitangent sum; glTF: v points down, the
 // bitangent points up the image). `normals` has one entry per vertex.

@@ -112,6 +112,45 @@ TEST(GltfAccessors, SparseOverABaseViewWithEveryIndexType) {
   }
 }
 
+// glTF: a primitive without NORMAL is shaded flat and its TANGENT ignored.
+TEST(GltfPrimitive, WithoutNormalsIsFlatAndSplitOnlyWhereItsFacesTurn) {
+  // A tent (faces +Z and -Y sharing the edge v0 v1), a flat quad (two faces, +Z) and a zero-area
+  // face along the quad's edge out to v8, which nothing else touches.
+  const float pos[27] = {0, 0, 0, 1, 0, 0, 0.5f, 1, 0, 0.5f, 0, -1,  // tent
+                         0, 0, 5, 1, 0, 5, 1,    1, 5, 0,    1, 5,   // quad
+                         2, 0, 5};
+  float uv[18], tangent[36];
+  for (int v = 0; v < 9; ++v) uv[2 * v] = v * 0.1f, uv[2 * v + 1] = 1 - v * 0.1f;
+  for (int v = 0; v < 9; ++v)
+    tangent[4 * v] = 1, tangent[4 * v + 1] = tangent[4 * v + 2] = 0, tangent[4 * v + 3] = 1;
+  const uint16_t idx[15] = {0, 1, 2, 1, 0, 3, 4, 5, 6, 4, 6, 7, 4, 5, 8};
+  GltfFile f;
+  json& attrs = f.primitive()["attributes"];
+  attrs["POSITION"] = f.accessor(f.view(pos, sizeof(pos)), 5126, "VEC3", 9);
+  attrs["TEXCOORD_0"] = f.accessor(f.view(uv, sizeof(uv)), 5126, "VEC2", 9);
+  attrs["TANGENT"] = f.accessor(f.view(tangent, sizeof(tangent)), 5126, "VEC4", 9);
+  f.primitive()["indices"] = f.accessor(f.view(idx, sizeof(idx)), 5123, "SCALAR", 15);
+  auto s = f.load("flat");
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  const auto& p = only_primitive(*s);
+  // The tent's shared edge is split (two more vertices); the quad stays four vertices.
+  ASSERT_EQ(p.positions.size(), 11u);
+  ASSERT_EQ(p.normals.size(), 11u);
+  EXPECT_TRUE(p.tangents.empty());
+  ASSERT_EQ(p.indices.size(), 15u);
+  const scene::Vec3 up = {0, 0, 1}, down_y = {0, -1, 0};
+  const scene::Vec3 face_normal[5] = {up, down_y, up, up, up};
+  for (size_t c = 0; c < 15; ++c) {
+    // Every corner keeps its position and UV, and has its face's normal.
+    const uint32_t v = p.indices[c], was = idx[c];
+    EXPECT_EQ(p.positions[v], (scene::Vec3{pos[3 * was], pos[3 * was + 1], pos[3 * was + 2]})) << c;
+    EXPECT_EQ(p.uvs[0][v], (scene::Vec2{uv[2 * was], uv[2 * was + 1]})) << c;
+    EXPECT_EQ(p.normals[v], face_normal[c / 3]) << c;
+  }
+  for (size_t c : {6, 7, 8, 9, 10, 11}) EXPECT_EQ(p.indices[c], idx[c]) << c;  // the quad's own
+  EXPECT_EQ(p.indices[13], p.indices[7]);  // the zero-area face takes v5's normal, splits nothing
+}
+
 TEST(GltfAccessors, SparseWithoutBaseViewStartsFromZeros) {
   GltfFile f = triangle_file();
   const uint16_t idx[1] = {2};
