@@ -1,5 +1,6 @@
 #include "scene/tangent_frame.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/vec.h"
@@ -11,6 +12,28 @@ Vec3d v3(const Vec3& a) {
   return {a[0], a[1], a[2]};
 }
 
+// A primitive's positions in units of about its largest coordinate: normals and tangents come from
+// sums of cross products that normalized() gives up on below 1e-30, which a model in 1e-16 units
+// reaches (every face would read as degenerate and get +Z); scaled, they do not depend on the
+// scene's unit.
+struct ScaledPositions {
+  const std::vector<Vec3>& positions;
+  double scale = 1;
+  explicit ScaledPositions(const Primitive& p) : positions(p.positions) {
+    double largest = 0;
+    for (const Vec3& q : positions)
+      for (float c : q) largest = std::max(largest, std::abs(double(c)));
+    // A power of two: exact, so that a model in ordinary units gets the same bits as unscaled.
+    if (largest > 0 && std::isfinite(largest)) scale = std::ldexp(1.0, -std::ilogb(largest));
+  }
+  Vec3d operator[](uint32_t i) const { return v3(positions[i]) * scale; }
+  // The face's normal scaled by twice its area (in these units).
+  Vec3d face_cross(const uint32_t* t) const {
+    const Vec3d o = (*this)[t[0]];
+    return cross((*this)[t[1]] - o, (*this)[t[2]] - o);
+  }
+};
+
 }  // namespace
 
 std::vector<Vec4> compute_tangents(const Primitive& p, const std::vector<Vec3>& normals,
@@ -18,10 +41,10 @@ std::vector<Vec4> compute_tangents(const Primitive& p, const std::vector<Vec3>& 
   size_t n = p.positions.size();
   std::vector<Vec3d> tsum(n), bsum(n);
   const auto& uv = p.uvs[uv_set];
+  const ScaledPositions at(p);
   for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
     uint32_t i0 = p.indices[f], i1 = p.indices[f + 1], i2 = p.indices[f + 2];
-    Vec3d e1 = v3(p.positions[i1]) - v3(p.positions[i0]),
-          e2 = v3(p.positions[i2]) - v3(p.positions[i0]);
+    Vec3d e1 = at[i1] - at[i0], e2 = at[i2] - at[i0];
     double du1 = uv[i1][0] - uv[i0][0], dv1 = uv[i1][1] - uv[i0][1];
     double du2 = uv[i2][0] - uv[i0][0], dv2 = uv[i2][1] - uv[i0][1];
     double det = du1 * dv2 - du2 * dv1;
@@ -47,11 +70,10 @@ std::vector<Vec4> compute_tangents(const Primitive& p, const std::vector<Vec3>& 
 
 std::vector<Vec3> compute_normals(const Primitive& p) {
   std::vector<Vec3d> sum(p.positions.size());
+  const ScaledPositions at(p);
   for (size_t f = 0; f + 2 < p.indices.size(); f += 3) {
-    uint32_t i0 = p.indices[f], i1 = p.indices[f + 1], i2 = p.indices[f + 2];
-    Vec3d n =
-        cross(v3(p.positions[i1]) - v3(p.positions[i0]), v3(p.positions[i2]) - v3(p.positions[i0]));
-    for (uint32_t i : {i0, i1, i2}) sum[i] = sum[i] + n;
+    const Vec3d n = at.face_cross(&p.indices[f]);
+    for (int c = 0; c < 3; ++c) sum[p.indices[f + c]] = sum[p.indices[f + c]] + n;
   }
   std::vector<Vec3> out(sum.size());
   for (size_t i = 0; i < sum.size(); ++i) {
@@ -64,11 +86,10 @@ std::vector<Vec3> compute_normals(const Primitive& p) {
 void make_flat_normals(Primitive& p) {
   const size_t faces = p.indices.size() / 3;
   std::vector<Vec3d> face_normal(faces);
-  for (size_t f = 0; f < faces; ++f) {
-    const uint32_t* t = &p.indices[3 * f];
-    face_normal[f] = normalized(cross(v3(p.positions[t[1]]) - v3(p.positions[t[0]]),
-                                      v3(p.positions[t[2]]) - v3(p.positions[t[0]])),
-                                {});
+  {
+    const ScaledPositions at(p);  // before copies are appended to the positions
+    for (size_t f = 0; f < faces; ++f)
+      face_normal[f] = normalized(at.face_cross(&p.indices[3 * f]), {});
   }
   // Each vertex's normals so far, as a chain of (normal, vertex) through `next`; the first is
   // the vertex itself.

@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "scene/scene.h"
+#include "scene/tangent_frame.h"
 #include "tests/scene/alloc_probe.h"
 
 namespace vt::test {
@@ -112,13 +113,15 @@ TEST(GltfAccessors, SparseOverABaseViewWithEveryIndexType) {
   }
 }
 
-// glTF: a primitive without NORMAL is shaded flat and its TANGENT ignored.
-TEST(GltfPrimitive, WithoutNormalsIsFlatAndSplitOnlyWhereItsFacesTurn) {
-  // A tent (faces +Z and -Y sharing the edge v0 v1), a flat quad (two faces, +Z) and a zero-area
-  // face along the quad's edge out to v8, which nothing else touches.
-  const float pos[27] = {0, 0, 0, 1, 0, 0, 0.5f, 1, 0, 0.5f, 0, -1,  // tent
-                         0, 0, 5, 1, 0, 5, 1,    1, 5, 0,    1, 5,   // quad
-                         2, 0, 5};
+// glTF: a primitive without NORMAL is shaded flat and its TANGENT ignored. A tent (faces +Z and
+// -Y sharing the edge v0 v1), a flat quad (two faces, +Z) and a zero-area face along the quad's
+// edge out to v8, which nothing else touches; in metres and in units of 1e-18, whose cross
+// products are far below what a normal is taken from unscaled.
+void expect_flat_tent_and_quad(float unit) {
+  float pos[27] = {0, 0, 0, 1, 0, 0, 0.5f, 1, 0, 0.5f, 0, -1,  // tent
+                   0, 0, 5, 1, 0, 5, 1,    1, 5, 0,    1, 5,   // quad
+                   2, 0, 5};
+  for (float& c : pos) c *= unit;
   float uv[18], tangent[36];
   for (int v = 0; v < 9; ++v) uv[2 * v] = v * 0.1f, uv[2 * v + 1] = 1 - v * 0.1f;
   for (int v = 0; v < 9; ++v)
@@ -130,7 +133,7 @@ TEST(GltfPrimitive, WithoutNormalsIsFlatAndSplitOnlyWhereItsFacesTurn) {
   attrs["TEXCOORD_0"] = f.accessor(f.view(uv, sizeof(uv)), 5126, "VEC2", 9);
   attrs["TANGENT"] = f.accessor(f.view(tangent, sizeof(tangent)), 5126, "VEC4", 9);
   f.primitive()["indices"] = f.accessor(f.view(idx, sizeof(idx)), 5123, "SCALAR", 15);
-  auto s = f.load("flat");
+  auto s = f.load(unit == 1 ? "flat" : "flat_tiny");
   ASSERT_TRUE(s.ok()) << s.status().message();
   const auto& p = only_primitive(*s);
   // The tent's shared edge is split (two more vertices); the quad stays four vertices.
@@ -149,6 +152,17 @@ TEST(GltfPrimitive, WithoutNormalsIsFlatAndSplitOnlyWhereItsFacesTurn) {
   }
   for (size_t c : {6, 7, 8, 9, 10, 11}) EXPECT_EQ(p.indices[c], idx[c]) << c;  // the quad's own
   EXPECT_EQ(p.indices[13], p.indices[7]);  // the zero-area face takes v5's normal, splits nothing
+  // The smooth normals other formats get are as free of the unit: the quad's corners face +Z.
+  const std::vector<scene::Vec3> smooth = scene::compute_normals(p);
+  for (uint32_t v : {4, 5, 6, 7}) EXPECT_EQ(smooth[v], up) << v;
+}
+
+TEST(GltfPrimitive, WithoutNormalsIsFlatAndSplitOnlyWhereItsFacesTurn) {
+  expect_flat_tent_and_quad(1);
+}
+
+TEST(GltfPrimitive, NormalsDoNotDependOnTheSceneUnit) {
+  expect_flat_tent_and_quad(1e-18f);
 }
 
 TEST(GltfAccessors, SparseWithoutBaseViewStartsFromZeros) {
