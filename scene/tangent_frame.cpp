@@ -84,22 +84,27 @@ std::vector<Vec3> compute_normals(const Primitive& p) {
 }
 
 void make_flat_normals(Primitive& p) {
-  const size_t faces = p.indices.size() / 3;
+  const size_t faces = p.indices.size() / 3, n = p.positions.size();
+  // Faces naming a vertex past the end are left as they are, for the geometry check to name.
+  auto in_range = [&](size_t f) {
+    return std::max({p.indices[3 * f], p.indices[3 * f + 1], p.indices[3 * f + 2]}) < n;
+  };
   std::vector<Vec3d> face_normal(faces);
   {
     const ScaledPositions at(p);  // before copies are appended to the positions
     for (size_t f = 0; f < faces; ++f)
-      face_normal[f] = normalized(at.face_cross(&p.indices[3 * f]), {});
+      if (in_range(f)) face_normal[f] = normalized(at.face_cross(&p.indices[3 * f]), {});
   }
-  // Each vertex's normals so far, as a chain of (normal, vertex) through `next`; the first is
-  // the vertex itself.
+  // Each vertex's normals so far, as a chain of (normal, vertex) through `next`: the vertex
+  // itself, then its copies, newest first. The search stops after kSearched of them, so that a
+  // vertex shared by a million faces that all turn (a crafted fan) costs no more than that.
+  constexpr int kSearched = 64;
   struct Version {
     Vec3d normal;
     uint32_t vertex;
     int64_t next;
   };
   constexpr double kSameWay = 1 - 1.5e-8;  // cos(0.01 degrees)
-  const size_t n = p.positions.size();
   std::vector<int64_t> first(n, -1);
   std::vector<Version> versions;
   auto copy_vertex = [&p](uint32_t v) {
@@ -117,20 +122,21 @@ void make_flat_normals(Primitive& p) {
       versions.push_back({degenerate ? Vec3d{0, 0, 1} : normal, v, -1});
       return v;
     }
-    int64_t k = first[v];
-    if (degenerate) return versions[size_t(k)].vertex;
-    for (;; k = versions[size_t(k)].next) {
+    Version& own = versions[size_t(first[v])];
+    if (degenerate) return own.vertex;
+    int searched = 0;
+    for (int64_t k = first[v]; k >= 0 && searched < kSearched;
+         k = versions[size_t(k)].next, ++searched)
       if (dot(versions[size_t(k)].normal, normal) >= kSameWay) return versions[size_t(k)].vertex;
-      if (versions[size_t(k)].next < 0) break;
-    }
-    versions[size_t(k)].next = static_cast<int64_t>(versions.size());
-    versions.push_back({normal, copy_vertex(v), -1});
+    const int64_t after_own = own.next;
+    own.next = static_cast<int64_t>(versions.size());
+    versions.push_back({normal, copy_vertex(v), after_own});
     return versions.back().vertex;
   };
   // Faces with a normal first, so that a degenerate face never decides a vertex's first normal.
   for (bool degenerate : {false, true})
     for (size_t f = 0; f < faces; ++f) {
-      if ((dot(face_normal[f], face_normal[f]) == 0) != degenerate) continue;
+      if (!in_range(f) || (dot(face_normal[f], face_normal[f]) == 0) != degenerate) continue;
       for (int c = 0; c < 3; ++c)
         p.indices[3 * f + c] = vertex_for(p.indices[3 * f + c], face_normal[f], degenerate);
     }

@@ -165,6 +165,18 @@ TEST(GltfPrimitive, NormalsDoNotDependOnTheSceneUnit) {
   expect_flat_tent_and_quad(1e-18f);
 }
 
+TEST(GltfPrimitive, WithoutNormalsAnIndexPastTheEndIsStillNamed) {
+  GltfFile f = triangle_file();
+  const uint16_t idx[6] = {0, 1, 2, 2, 1, 40000};
+  f.primitive()["indices"] = f.accessor(f.view(idx, sizeof(idx)), 5123, "SCALAR", 6);
+  auto s = f.load("flat_bad_index");
+  ASSERT_TRUE(s.ok()) << s.status().message();  // geometry is checked by those who use it
+  const Status checked = scene::validate_geometry(*s);
+  ASSERT_FALSE(checked.ok());
+  EXPECT_NE(checked.message().find("triangle 1 uses vertex 40000 of 3"), std::string::npos)
+      << checked.message();
+}
+
 TEST(GltfAccessors, SparseWithoutBaseViewStartsFromZeros) {
   GltfFile f = triangle_file();
   const uint16_t idx[1] = {2};
