@@ -352,6 +352,13 @@ Expected<ValidationReport> validate_views(Renderer& renderer,
       view.failures.push_back("did not converge in " + std::to_string(converge.max_frames) +
                               " frames");
     }
+    // A cache too small for the view settles on coarser levels (or never settles): the one
+    // cause of those failures that a flag of the command mends, so it is named.
+    if (!view.failures.empty() && view.converge.thrashing) {
+      view.failures.push_back(
+          "the view's pages do not fit the cache's " + std::to_string(options.streamer.slots_x) +
+          " x " + std::to_string(options.streamer.slots_y) + " slots (a larger --slots)");
+    }
     if (view.converge.load_errors > 0) {
       view.failures.push_back(std::to_string(view.converge.load_errors) + " pages failed to load");
     }

@@ -737,12 +737,14 @@ INSTANTIATE_TEST_SUITE_P(Validate, ValidateFault, testing::ValuesIn(kFaultCases)
                          });
 
 // validate_views over the first `view_count` views of the synthetic bake `name` (RGBA8 cache).
+// `slots` per side of the cache.
 Expected<ValidationReport> validate_bake(Renderer& renderer, const std::string& name, Fault fault,
-                                         size_t view_count, const std::string& out_dir = "") {
+                                         size_t view_count, const std::string& out_dir = "",
+                                         uint32_t slots = 16) {
   auto source = open_source(write_bake(name, RuntimeFormat::kRgba8, fault));
   if (!source) return Error(ErrorCode::kInternal, "cannot open " + name);
   ValidateOptions options;
-  options.streamer.slots_x = options.streamer.slots_y = 16;
+  options.streamer.slots_x = options.streamer.slots_y = slots;
   options.out_dir = out_dir;
   std::vector<Camera> cams = views();
   return validate_views(renderer, source, std::span(cams).first(view_count), options);
@@ -806,6 +808,21 @@ TEST(Validate, ReportFailsABrokenBake) {
   for (const std::string& why : report->views[0].failures)
     tile |= why.find("tile") != std::string::npos;
   EXPECT_TRUE(tile);
+}
+
+// A cache too small for a view's pages cannot converge; the failure says which flag mends it.
+TEST(Validate, ACacheTooSmallForTheViewSaysSo) {
+  REQUIRE_VULKAN();
+  std::unique_ptr<Renderer> renderer = make_renderer();
+  ASSERT_TRUE(renderer);
+  auto report = validate_bake(*renderer, "report_small_cache", Fault::kNone, 1, "", 2);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  EXPECT_FALSE(report->passed());
+  EXPECT_TRUE(report->views[0].converge.thrashing);
+  bool named = false;
+  for (const std::string& why : report->views[0].failures)
+    named |= why.find("do not fit the cache's 2 x 2 slots (a larger --slots)") != std::string::npos;
+  EXPECT_TRUE(named) << ::testing::PrintToString(report->views[0].failures);
 }
 
 TEST(Report, HeatMapAndDifferenceMap) {
