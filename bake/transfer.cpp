@@ -518,6 +518,10 @@ Status Transfer::setup_images(const std::vector<bool>* wanted) {
     std::string path = img.embedded() ? slot.tried : img.path;
     slot.name =
         img.embedded() ? "embedded image " + std::to_string(i) + " '" + img.name + "'" : img.path;
+    if (img.has_no_data()) {
+      slot.error = "the scene holds no data for it";
+      continue;  // reported per material slot by check_missing_textures
+    }
     if (img.embedded() && path.empty()) {
       // OpenImageIO reads by file name: a private copy is the robust way.
       const std::string ext = img.embedded_extension();
@@ -610,7 +614,7 @@ Status Transfer::check_missing_textures() {
       miss.image = !img.name.empty()  ? img.name
                    : !img.uri.empty() ? img.uri
                                       : "image " + std::to_string(r.image);
-      if (img.embedded()) miss.image += " (embedded)";
+      if (img.embedded() && !img.has_no_data()) miss.image += " (embedded)";
       miss.path = images_[r.image].tried;
       miss.reason = images_[r.image].error;
       if (opt_.missing_textures == MissingTextures::kError) {
@@ -1412,7 +1416,7 @@ Expected<MissingTextures> parse_missing_textures(const std::string& name) {
 
 std::string MissingTexture::message() const {
   return material_label(material, material_index) + " " + slot + ": cannot read image '" + image +
-         "' (tried " + path + "): " + reason;
+         "'" + (path.empty() ? "" : " (tried " + path + ")") + ": " + reason;
 }
 
 std::vector<std::array<double, 2>> supersample_pattern(int supersample) {

@@ -63,9 +63,15 @@ Status load_images(const Gltf& g, const JsonFields& root, Scene* scene) {
     std::string uri = im.string("uri");
     int view = im.index("bufferView", "bufferViews");
     VT_RETURN_IF_ERROR(root.errors()->status());
-    if (im.has("uri") == im.has("bufferView"))
-      return g.fail(im.where() + ": an image needs exactly one of uri and bufferView");
-    if (uri.rfind("data:", 0) == 0) {
+    if (im.has("uri") && im.has("bufferView"))
+      return g.fail(im.where() + ": an image has both a uri and a bufferView");
+    if (!im.has("uri") && !im.has("bufferView")) {
+      // No data at all: gltfpack writes this for an image it could not read. Kept as an
+      // embedded image without bytes: the textures that name it are missing textures (refused,
+      // or baked from their factors under --missing-textures warn), named by material slot.
+      scene->warnings.push_back(g.path + ": " + im.where() +
+                                ": neither uri nor bufferView (the image's data was left out)");
+    } else if (uri.rfind("data:", 0) == 0) {
       auto data = decode_data_uri(uri, &image.mime_type);
       if (!data.ok()) return data.status().with_context(g.path + ": " + im.where());
       image.bytes = std::move(data).value();

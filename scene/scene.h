@@ -93,6 +93,8 @@ struct Image {
   std::string mime_type;       // "image/png", "image/jpeg", ... (may be empty for files)
   std::vector<uint8_t> bytes;  // embedded data; empty for files
   bool embedded() const { return path.empty(); }
+  // Neither a file nor bytes (a glTF image without uri or bufferView): a missing texture.
+  bool has_no_data() const { return path.empty() && bytes.empty(); }
   // The file extension embedded bytes are read as (".png", ".jpg", ".exr", ".webp"): readers
   // pick their decoder by name. The MIME type, else the bytes' magic, else ".png".
   const char* embedded_extension() const;

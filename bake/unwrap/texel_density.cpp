@@ -126,6 +126,7 @@ double triangle_source_density(double width, double height, double uv_area, doub
 }
 
 Expected<std::array<int, 2>> image_size(const scene::Image& image) {
+  if (image.has_no_data()) return Error(ErrorCode::kNotFound, "the scene holds no data for it");
   std::string err;
   OIIO::Filesystem::IOMemReader proxy(image.bytes.data(), image.bytes.size());
   const std::unique_ptr<OIIO::ImageInput> in =

@@ -561,6 +561,20 @@ TEST(GltfMaterials, NodeGraphMustBeAForest) {
   EXPECT_EQ(s->instances().size(), 2u);
 }
 
+// gltfpack writes `{}` for an image it could not read: the textures naming it are missing
+// textures, which the bake refuses or bakes from their factors (--missing-textures), not a
+// refusal of the whole file.
+TEST(GltfMaterials, AnImageWithoutDataLoadsAsAMissingImage) {
+  json doc = triangle_doc();
+  doc["images"][0] = json::object();
+  const auto s = load("image_without_data.gltf", doc);
+  expect_warnings(s, "image_without_data.gltf",
+                  {"images[0]: neither uri nor bufferView (the image's data was left out)"});
+  ASSERT_TRUE(s.ok());
+  EXPECT_TRUE(s->images[0].has_no_data());
+  EXPECT_EQ(s->materials[0].base_color_texture.image, 0);
+}
+
 TEST(GltfMaterials, OutOfRangeIndicesNameTheirPlace) {
   const std::vector<BadField> cases = {
       {"tex", "/materials/0/pbrMetallicRoughness/baseColorTexture/index"_json_pointer, 5,
@@ -617,8 +631,9 @@ TEST(GltfMaterials, BadTypesAndValuesSayWhatWasExpected) {
        "materials[0] 'm'.pbrMetallicRoughness.baseColorTexture.index: expected a texture index"},
       {"required", "/extensionsRequired"_json_pointer, "KHR_texture_transform",
        "extensionsRequired: expected an array of strings"},
-      {"image", "/images/0"_json_pointer, json::object({{"name", "nothing"}}),
-       "images[0] 'nothing': an image needs exactly one of uri and bufferView"},
+      {"image", "/images/0"_json_pointer,
+       json::object({{"name", "both"}, {"uri", "a.png"}, {"bufferView", 0}}),
+       "images[0] 'both': an image has both a uri and a bufferView"},
   };
   expect_each_fails(cases, "type_");
   expect_error(load_text("syntax.gltf", "{\"asset\": "), "syntax.gltf", ErrorCode::kCorrupt,

@@ -239,6 +239,36 @@ TEST(TransferRules, MissingTextureIsAnErrorNamingMaterialSlotAndPath) {
   EXPECT_GT(r.status().message().size(), want.size());  // OpenImageIO's reason follows
 }
 
+// An image the scene holds no data for (a glTF image without uri or bufferView) is a missing
+// texture like a missing file: refused by default, the factor alone under kWarn.
+TEST(TransferRules, AnImageWithoutDataIsAMissingTexture) {
+  test::ScratchDir dir;
+  scene::Scene s = brick_scene(dir);
+  const Expected<TransferResult> missing_file = [&] {
+    TransferOptions o = atlas_options();
+    o.missing_textures = MissingTextures::kWarn;
+    return transfer_materials(s, o);
+  }();
+  ASSERT_TRUE(missing_file.ok()) << missing_file.status().message();
+  scene::Image& im = s.images[0];
+  im.path.clear(), im.uri.clear(), im.name = "lost";
+  ASSERT_TRUE(im.has_no_data());
+  auto refused = transfer_materials(s, atlas_options());
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), ErrorCode::kNotFound);
+  EXPECT_EQ(refused.status().message(),
+            "material 'Brick' baseColorTexture: cannot read image 'lost': the scene holds no data "
+            "for it (--missing-textures warn bakes the slot from its factor)");
+  TransferOptions o = atlas_options();
+  o.missing_textures = MissingTextures::kWarn;
+  auto warned = transfer_materials(s, o);
+  ASSERT_TRUE(warned.ok()) << warned.status().message();
+  ASSERT_EQ(warned->missing_textures.size(), 1u);
+  ASSERT_TRUE(find(*warned, LayerSemantic::kAlbedo) && find(*missing_file, LayerSemantic::kAlbedo));
+  EXPECT_EQ(find(*warned, LayerSemantic::kAlbedo)->texels,
+            find(*missing_file, LayerSemantic::kAlbedo)->texels);
+}
+
 // With a band cache, the textures load on a thread of their own beside the cached bands (issue
 // 16): the texels are those of a transfer without a cache whether every band is cached, none is
 // (the texture repainted) or the texture is gone (an error naming it, or its factor alone).
