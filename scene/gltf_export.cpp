@@ -111,9 +111,11 @@ class DocumentBuilder {
 
   void add_images(const Scene& scene) {
     for (const Image& im : scene.images) {
-      json j;
+      json j = json::object();
       if (!im.name.empty()) j["name"] = im.name;
-      if (im.embedded()) {
+      if (im.has_no_data()) {
+        // Written as read, with neither (a zero-length bufferView would break the schema).
+      } else if (im.embedded()) {
         j["bufferView"] = add_view(im.bytes.data(), im.bytes.size(), 0);
         j["mimeType"] = im.mime_type.empty() ? "image/png" : im.mime_type;
       } else {

@@ -111,6 +111,22 @@ TEST(GltfExport, ImageUrisArePercentEncoded) {
   EXPECT_EQ(back->images[0].path, s.images[0].path);
 }
 
+// An image the scene holds no data for is written with neither uri nor bufferView (a view of
+// zero bytes would break the schema) and reads back the same, a missing image.
+TEST(GltfExport, AnImageWithoutDataStaysWithout) {
+  Scene s = textured_ball();
+  s.images[1].bytes.clear();
+  ASSERT_TRUE(s.images[1].has_no_data());
+  ASSERT_TRUE(scene::save_gltf(s, temp("no_data.gltf")).ok());
+  const json doc = json::parse(read_all(temp("no_data.gltf")));
+  EXPECT_FALSE(doc["images"][1].contains("bufferView"));
+  EXPECT_FALSE(doc["images"][1].contains("uri"));
+  auto back = scene::load_scene(temp("no_data.gltf"));
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_TRUE(back->images[1].has_no_data());
+  EXPECT_EQ(back->images[0].path, s.images[0].path);
+}
+
 TEST(GltfExport, GltfLoadsBackAsTheScene) {
   const Scene s = textured_ball();
   ASSERT_TRUE(scene::save_gltf(s, temp("back.gltf")).ok());
