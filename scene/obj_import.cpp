@@ -21,6 +21,7 @@
 #include "common/vec.h"
 #include "scene/obj_mtl.h"
 #include "scene/scene_io_util.h"
+#include "scene/tangent_frame.h"
 
 namespace vt::scene::detail {
 namespace {
@@ -167,6 +168,7 @@ Status ObjReader::build_faces() {
   // over its fan), and per (group, v) the sum over the group's faces.
   std::vector<Vec3d> face_normal(faces_.size());
   std::map<std::pair<int, int>, Vec3d> smooth;
+  const double scale = unit_scale(v_);
   for (size_t i = 0; i < faces_.size(); ++i) {
     const Face& f = faces_[i];
     const auto* face = corners_.data() + f.first;
@@ -175,7 +177,7 @@ Status ObjReader::build_faces() {
     if (!wanted) continue;
     auto at = [&](uint32_t c) {
       const Vec3& p = v_[face[c][0] - 1];
-      return Vec3d{p[0], p[1], p[2]};
+      return Vec3d{p[0], p[1], p[2]} * scale;
     };
     for (uint32_t c = 1; c + 1 < f.count; ++c)
       face_normal[i] = face_normal[i] + cross(at(c) - at(0), at(c + 1) - at(0));

@@ -12,20 +12,12 @@ Vec3d v3(const Vec3& a) {
   return {a[0], a[1], a[2]};
 }
 
-// A primitive's positions in units of about its largest coordinate: normals and tangents come from
-// sums of cross products that normalized() gives up on below 1e-30, which a model in 1e-16 units
-// reaches (every face would read as degenerate and get +Z); scaled, they do not depend on the
-// scene's unit.
+// A primitive's positions in units of unit_scale.
 struct ScaledPositions {
   const std::vector<Vec3>& positions;
-  double scale = 1;
-  explicit ScaledPositions(const Primitive& p) : positions(p.positions) {
-    double largest = 0;
-    for (const Vec3& q : positions)
-      for (float c : q) largest = std::max(largest, std::abs(double(c)));
-    // A power of two: exact, so that a model in ordinary units gets the same bits as unscaled.
-    if (largest > 0 && std::isfinite(largest)) scale = std::ldexp(1.0, -std::ilogb(largest));
-  }
+  double scale;
+  explicit ScaledPositions(const Primitive& p)
+      : positions(p.positions), scale(unit_scale(p.positions)) {}
   Vec3d operator[](uint32_t i) const { return v3(positions[i]) * scale; }
   // The face's normal scaled by twice its area (in these units).
   Vec3d face_cross(const uint32_t* t) const {
@@ -35,6 +27,14 @@ struct ScaledPositions {
 };
 
 }  // namespace
+
+double unit_scale(const std::vector<Vec3>& positions) {
+  double largest = 0;
+  for (const Vec3& q : positions)
+    for (float c : q) largest = std::max(largest, std::abs(double(c)));
+  // A power of two: exact, so that a model in ordinary units gets the same bits as unscaled.
+  return largest > 0 && std::isfinite(largest) ? std::ldexp(1.0, -std::ilogb(largest)) : 1.0;
+}
 
 std::vector<Vec4> compute_tangents(const Primitive& p, const std::vector<Vec3>& normals,
                                    int uv_set) {

@@ -9,6 +9,12 @@
 
 namespace vt::scene {
 
+// The power of two that brings `positions` to about unit size (1 when there is none): normals
+// are taken from cross products of scaled positions, which normalized() would give up on below
+// 1e-30 in a model of 1e-16 units (every face read as degenerate, facing +Z). Exact, so that
+// ordinary units get the same bits as unscaled.
+double unit_scale(const std::vector<Vec3>& positions);
+
 // Area-weighted vertex normals (unit; +Z where a vertex touches only degenerate faces).
 std::vector<Vec3> compute_normals(const Primitive& p);
 

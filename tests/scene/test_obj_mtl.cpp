@@ -532,6 +532,12 @@ TEST(ObjMtl, CornersWithoutNormalsFollowTheSmoothingGroups) {
   ASSERT_EQ(g.normals.size(), 3u);
   EXPECT_EQ(g.normals[0], (scene::Vec3{0, 1, 0}));
   EXPECT_EQ(g.normals[1], (scene::Vec3{0, 0, 1}));
+  // In units of 1e-18 (cross products far below what a normal is taken from unscaled): the same
+  // flat normals, not +Z for every face.
+  scene::Scene tiny = load(dir, "", "s off\nv 0 0 0\nv 0 1e-18 0\nv 0 0 1e-18\nf 1 2 3\n");
+  const scene::Primitive& t = tiny.meshes[0].primitives[0];
+  ASSERT_EQ(t.normals.size(), 3u);
+  for (const scene::Vec3& n : t.normals) EXPECT_EQ(n, (scene::Vec3{1, 0, 0}));
 }
 
 // The same triangle as UTF-8, UTF-8 with a BOM, UTF-16 LE and BE with BOMs.
