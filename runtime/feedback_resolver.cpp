@@ -4,7 +4,12 @@
 // bias, the presence map and the ancestor chain, into a second flat table keyed by page index.
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <utility>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "common/hash.h"
 #include "runtime/feedback.h"
@@ -74,34 +79,92 @@ class CountTable {
   std::vector<uint32_t> entry_slot_;
 };
 
+// Calls f(value, length) for each run of equal values in p[0, n), in order. Runs end where a
+// value differs from the one before it, found four positions a compare: the scan carries no
+// dependency from one run to the next, so short runs (a view of many small charts) cost little
+// more than long ones.
+template <class F>
+void for_each_run(const uint32_t* p, size_t n, F&& f) {
+  if (n == 0) return;
+  size_t start = 0, k = 1;
+#if defined(__SSE2__)
+  for (; k + 4 <= n; k += 4) {
+    const __m128i here = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + k));
+    const __m128i before = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + k - 1));
+    unsigned ends =
+        ~unsigned(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(here, before)))) & 0xFu;
+    for (; ends != 0; ends &= ends - 1) {
+      const size_t end = k + size_t(std::countr_zero(ends));
+      f(p[start], end - start);
+      start = end;
+    }
+  }
+#endif
+  for (; k < n; ++k) {
+    if (p[k] != p[k - 1]) {
+      f(p[start], k - start);
+      start = k;
+    }
+  }
+  f(p[start], n - start);
+}
+
+// Sorts keys ascending: least significant byte first, each pass a stable counting sort, passes
+// skipped where every key has the same byte. Thousands of keys cost a few passes over them,
+// where std::sort's comparisons cost several times that.
+void radix_sort(std::vector<uint64_t>& keys, std::vector<uint64_t>& scratch) {
+  if (keys.size() < 2) return;
+  std::array<std::array<uint32_t, 256>, 8> counts{};
+  for (const uint64_t k : keys)
+    for (int d = 0; d < 8; ++d) ++counts[d][(k >> (8 * d)) & 0xFF];
+  scratch.resize(keys.size());
+  for (int d = 0; d < 8; ++d) {
+    auto& c = counts[d];
+    if (c[(keys[0] >> (8 * d)) & 0xFF] == keys.size()) continue;
+    uint32_t sum = 0;
+    for (uint32_t& n : c) sum += std::exchange(n, sum);
+    for (const uint64_t k : keys) scratch[c[(k >> (8 * d)) & 0xFF]++] = k;
+    keys.swap(scratch);
+  }
+}
+
 }  // namespace
 
 struct FeedbackResolver::Impl {
   const PageSource& source;
   uint32_t texture_id = 0;
-  PageGeometry geometry;
   uint32_t levels = 0;
-  std::vector<uint32_t> level_base;
+  // Per level: the first page's key, and the level's pages per axis (the geometry's accessors
+  // are out of line, and these run once per distinct value and page).
+  std::vector<uint32_t> level_base, pages_x, pages_y;
   CountTable values;
   CountTable pages;
   struct Recent {
     uint32_t key = 0;  // value + 1; 0 = empty
     uint32_t index = 0;
   };
-  std::array<Recent, 256> recent;
+  // A row of a view of many small charts holds a hundred or more distinct values: 2,048 entries
+  // (16 KiB, in L1) keep their collisions, each a probe into `values` every row, rare.
+  std::array<Recent, 2048> recent;
   std::vector<std::vector<std::pair<PageId, uint32_t>>> buckets;  // per level: page, entry
+  std::vector<uint64_t> order, order_scratch;                     // sort keys, see resolve()
 
-  Impl(const PageSource& s, uint32_t texture)
-      : source(s), texture_id(texture), geometry(s.geometry()) {
-    levels = geometry.level_count();
+  Impl(const PageSource& s, uint32_t texture) : source(s), texture_id(texture) {
+    const PageGeometry& g = s.geometry();
+    levels = g.level_count();
     uint64_t base = 0;
     for (uint32_t l = 0; l < levels; ++l) {
       level_base.push_back(uint32_t(base));
-      base += geometry.pages_in_level(l);
+      pages_x.push_back(g.pages_x(l));
+      pages_y.push_back(g.pages_y(l));
+      base += uint64_t(pages_x.back()) * pages_y.back();
     }
   }
+  bool contains(const PageId& id) const {
+    return id.level < levels && id.x < pages_x[id.level] && id.y < pages_y[id.level];
+  }
   uint32_t key(const PageId& id) const {
-    return level_base[id.level] + id.y * geometry.pages_x(id.level) + id.x;
+    return level_base[id.level] + id.y * pages_x[id.level] + id.x;
   }
   PageId nearest_present(PageId id) const {
     while (id.level + 1 < levels && !source.present(id)) {
@@ -132,25 +195,18 @@ ResolveStats FeedbackResolver::resolve(std::span<const uint32_t> feedback, uint3
   m.recent.fill({});
   if (m.levels == 0) return stats;
 
-  const size_t n = feedback.size();
-  size_t i = 0;
-  while (i < n) {
-    const uint32_t v = feedback[i];
-    size_t j = i + 1;
-    while (j < n && feedback[j] == v) ++j;
-    if (v != kFeedbackNone) {
-      const uint32_t run = uint32_t(std::min<size_t>(j - i, UINT32_MAX));
-      // Feedback is row-coherent: the values of one row mostly recur in the next rows, so a
-      // tiny direct-mapped cache in L1 answers most runs without probing the big table.
-      auto& r = m.recent[(v * 0x9E3779B1u) >> 24];
-      if (r.key == v + 1) {
-        m.values.add_at(r.index, run);
-      } else {
-        r = {v + 1, m.values.add(v, run).first};
-      }
+  for_each_run(feedback.data(), feedback.size(), [&m](uint32_t v, size_t length) {
+    if (v == kFeedbackNone) return;
+    const uint32_t run = uint32_t(std::min<size_t>(length, UINT32_MAX));
+    // Feedback is row-coherent: the values of one row mostly recur in the next rows, so a
+    // small direct-mapped cache in L1 answers most runs without probing the big table.
+    auto& r = m.recent[(v * 0x9E3779B1u) >> 21];
+    if (r.key == v + 1) {
+      m.values.add_at(r.index, run);
+    } else {
+      r = {v + 1, m.values.add(v, run).first};
     }
-    i = j;
-  }
+  });
   stats.unique_values = uint32_t(m.values.size());
 
   // Each distinct request lands on its nearest present page; then counts flow up one level at
@@ -169,7 +225,7 @@ ResolveStats FeedbackResolver::resolve(std::span<const uint32_t> feedback, uint3
     }
     stats.pixels += count;
     const PageId req = feedback_unpack(v);
-    if (texture != m.texture_id || !m.geometry.contains(req)) {
+    if (texture != m.texture_id || !m.contains(req)) {
       stats.invalid_pixels += count;
       continue;
     }
@@ -187,15 +243,23 @@ ResolveStats FeedbackResolver::resolve(std::span<const uint32_t> feedback, uint3
     }
   }
 
-  out.reserve(m.pages.size());
-  for (const auto& bucket : m.buckets)
-    for (const auto& [id, index] : bucket) out.push_back({id, m.pages.count(index)});
-  std::sort(out.begin(), out.end(), [](const PageRequest& a, const PageRequest& b) {
-    if (a.id.level != b.id.level) return a.id.level > b.id.level;
-    if (a.pixels != b.pixels) return a.pixels > b.pixels;
-    if (a.id.y != b.id.y) return a.id.y < b.id.y;
-    return a.id.x < b.id.x;
-  });
+  // The priority order as one integer per page: level descending, pixels descending, then y
+  // and x (5 + 32 + 12 + 12 bits), so the sort compares integers, not four fields.
+  m.order.clear();
+  for (const auto& bucket : m.buckets) {
+    for (const auto& [id, index] : bucket) {
+      m.order.push_back(uint64_t(kFeedbackMaxLevels - 1 - id.level) << 56 |
+                        uint64_t(~m.pages.count(index)) << 24 | uint64_t(id.y) << 12 | id.x);
+    }
+  }
+  radix_sort(m.order, m.order_scratch);
+  out.resize(m.order.size());
+  for (size_t k = 0; k < m.order.size(); ++k) {
+    const uint64_t o = m.order[k];
+    out[k] = {PageId{kFeedbackMaxLevels - 1 - uint32_t(o >> 56), uint32_t(o & 0xFFF),
+                     uint32_t(o >> 12 & 0xFFF)},
+              ~uint32_t(o >> 24)};
+  }
   return stats;
 }
 

@@ -50,17 +50,25 @@ class PageFileSource final : public PageSource {
         options_(o),
         plans_(std::move(plans)),
         presence_(std::move(presence)),
-        level_base_(std::move(level_base)) {}
+        level_base_(std::move(level_base)) {
+    const PageGeometry& g = reader_->geometry();
+    for (uint32_t l = 0; l < g.level_count(); ++l) {
+      pages_x_.push_back(g.pages_x(l));
+      pages_y_.push_back(g.pages_y(l));
+    }
+  }
 
   const PageGeometry& geometry() const override { return reader_->geometry(); }
   uint32_t layer_count() const override { return uint32_t(plans_.size()); }
   RuntimeFormat upload_format(uint32_t layer) const override { return plans_[layer].upload; }
   size_t upload_bytes(uint32_t layer) const override { return plans_[layer].upload_bytes; }
 
+  // The resolver asks once per distinct page and ancestor a frame: the level sizes are kept
+  // rather than derived again (PageGeometry::contains walks the level chain).
   bool present(const PageId& id) const override {
-    if (!geometry().contains(id)) return false;
-    const uint64_t bit =
-        level_base_[id.level] + uint64_t(id.y) * geometry().pages_x(id.level) + id.x;
+    if (id.level >= pages_x_.size() || id.x >= pages_x_[id.level] || id.y >= pages_y_[id.level])
+      return false;
+    const uint64_t bit = level_base_[id.level] + uint64_t(id.y) * pages_x_[id.level] + id.x;
     return (presence_[bit >> 6] >> (bit & 63)) & 1;
   }
 
@@ -112,6 +120,7 @@ class PageFileSource final : public PageSource {
   std::vector<LayerPlan> plans_;
   std::vector<uint64_t> presence_;
   std::vector<uint64_t> level_base_;
+  std::vector<uint32_t> pages_x_, pages_y_;  // per level
 };
 
 }  // namespace

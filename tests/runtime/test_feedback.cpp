@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 #include <random>
 #include <tuple>
@@ -114,6 +115,28 @@ TEST(FeedbackResolver, MatchesNaiveReferenceOnRandomBuffers) {
     }
     EXPECT_EQ(st.pixels, own);
     EXPECT_EQ(st.other_texture_pixels, other);
+  }
+}
+
+// The run scan works four pixels at a time: every buffer length up to 19 and every place a run
+// can end, including the tail past the last group of four and a change in the last pixel.
+TEST(FeedbackResolver, ShortBuffersAndRunEndsAtEveryPosition) {
+  FakeSource src(small_geometry(13, 9), 1);
+  FeedbackResolver resolver(src);
+  std::vector<PageRequest> got;
+  const uint32_t a = feedback_pack(0, 1, 2), b = feedback_pack(0, 7, 3), c = feedback_pack(1, 2, 1);
+  for (size_t n = 0; n < 20; ++n) {
+    for (size_t cut = 0; cut <= n; ++cut) {
+      // a up to `cut`, then b, with c in the last pixel and background at every fifth.
+      std::vector<uint32_t> fb(n);
+      for (size_t i = 0; i < n; ++i) fb[i] = i < cut ? a : b;
+      if (n > 0) fb[n - 1] = c;
+      for (size_t i = 4; i < n; i += 5) fb[i] = kFeedbackNone;
+      const ResolveStats st = resolver.resolve(fb, 0, got);
+      expect_same(got, naive_resolve(src, fb, 0));
+      EXPECT_EQ(st.pixels, uint64_t(std::count_if(fb.begin(), fb.end(),
+                                                  [](uint32_t v) { return v != kFeedbackNone; })));
+    }
   }
 }
 
