@@ -758,7 +758,10 @@ void Transfer::make_eval(uint32_t t, TriEval& te) const {
     const scene::Mat4& w = pi.world;
     auto point = [&](uint32_t k) { return world_point(w, v3(p.positions[p.indices[3 * f + k]])); };
     const Vec3d A = point(0), B = point(1), C = point(2);
-    te.world_normal = normalized(cross(B - A, C - A), world_vector(w, te.face_normal));
+    // The moved triangle's edges turn with the winding a mirror reverses: the face normal is
+    // the one on the side the surface faces (as world_vector carries the shading normal).
+    const double facing = scene::mirrors(w) ? -1.0 : 1.0;
+    te.world_normal = normalized(cross(B - A, C - A) * facing, world_vector(w, te.face_normal));
     te.footprint =
         std::max(length(world_vector(w, te.dpdx, false)), length(world_vector(w, te.dpdy, false)));
   }

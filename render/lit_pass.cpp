@@ -249,7 +249,7 @@ Status add_shading_frames(const scene::Scene& s, SceneDraws& draws, bool referen
     const Vec3d ax = to_d(scene::transform_point(inst.world, {1, 0, 0})) - o;
     const Vec3d ay = to_d(scene::transform_point(inst.world, {0, 1, 0})) - o;
     const Vec3d az = to_d(scene::transform_point(inst.world, {0, 0, 1})) - o;
-    const float flip = dot(ax, cross(ay, az)) < 0 ? -1.0f : 1.0f;
+    const float flip = scene::mirrors(inst.world) ? -1.0f : 1.0f;
     for (const scene::Primitive& p : mesh.primitives) {
       if (p.indices.empty()) continue;
       if (next >= draws.meshes.size() || draws.meshes[next].vertices.size() != p.positions.size()) {

@@ -76,6 +76,8 @@ Expected<ViewSurfaces> gather_view_surfaces(const scene::Scene& baked, uint32_t 
   for (const scene::Instance& inst : baked.instances()) {
     if (inst.mesh < 0 || size_t(inst.mesh) >= baked.meshes.size()) continue;
     const scene::Mesh& mesh = baked.meshes[inst.mesh];
+    // The side a triangle faces: its moved edges' cross product, turned back under a mirror.
+    const float facing = scene::mirrors(inst.world) ? -1.0f : 1.0f;
     for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
       const scene::Primitive& p = mesh.primitives[pi];
       if (p.indices.empty()) continue;
@@ -102,7 +104,7 @@ Expected<ViewSurfaces> gather_view_surfaces(const scene::Scene& baked, uint32_t 
         const Vec3f n = cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
         const float len = length(n);
         if (!(len > 0) || !std::isfinite(len)) continue;
-        t.normal = n / len;
+        t.normal = n / len * facing;
         t.world_area = len / 2;
         t.atlas_texels = float(uv_area(atlas[a], atlas[b], atlas[c]) * atlas_texels);
         if (bc.uv) {

@@ -53,8 +53,9 @@ std::array<double, 3> transform_point(const Mat4& m, const Vec3& p) {
 }
 
 std::array<double, 3> transform_direction(const Mat4& m, const Vec3& d) {
-  // Cofactor matrix of the upper 3x3 = inverse-transpose times the determinant; the scale
-  // does not matter for a direction and this stays defined for singular matrices.
+  // Cofactor matrix of the upper 3x3 = inverse-transpose times the determinant: defined for
+  // singular matrices too, and the scale does not matter for a direction, but the
+  // determinant's sign does: a mirror's cofactors would turn the normal to the other side.
   auto a = [&](int row, int col) { return m[col * 4 + row]; };
   double c[3][3];
   for (int r = 0; r < 3; ++r)
@@ -62,12 +63,19 @@ std::array<double, 3> transform_direction(const Mat4& m, const Vec3& d) {
       int r1 = (r + 1) % 3, r2 = (r + 2) % 3, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
       c[r][k] = a(r1, k1) * a(r2, k2) - a(r1, k2) * a(r2, k1);
     }
+  const double sign = mirrors(m) ? -1.0 : 1.0;
   std::array<double, 3> out;
-  for (int r = 0; r < 3; ++r) out[r] = c[r][0] * d[0] + c[r][1] * d[1] + c[r][2] * d[2];
+  for (int r = 0; r < 3; ++r) out[r] = sign * (c[r][0] * d[0] + c[r][1] * d[1] + c[r][2] * d[2]);
   double len = std::sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2]);
   if (len > 0)
     for (double& v : out) v /= len;
   return out;
+}
+
+bool mirrors(const Mat4& m) {
+  return m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) +
+             m[8] * (m[1] * m[6] - m[5] * m[2]) <
+         0;
 }
 
 std::array<double, 3> transform_vector(const Mat4& m, const Vec3& d) {

@@ -216,7 +216,13 @@ Status save_glb(const Scene& scene, const std::string& path);
 // Matrix helpers (column-major).
 Mat4 multiply(const Mat4& a, const Mat4& b);
 std::array<double, 3> transform_point(const Mat4& m, const Vec3& p);
-std::array<double, 3> transform_direction(const Mat4& m, const Vec3& d);  // inverse-transpose
+// A normal carried by the transform (the inverse-transpose), unit length: it stays on the side
+// of the surface it was on, also where m mirrors (glTF: the winding is then reversed, and a face
+// normal taken from the moved triangle's edges points the other way; see mirrors()).
+std::array<double, 3> transform_direction(const Mat4& m, const Vec3& d);
+// Whether m's linear part has a negative determinant: it mirrors, and reverses the winding of
+// the triangles it moves.
+bool mirrors(const Mat4& m);
 // The linear part applied to a vector and normalised (a direction carried by the transform,
 // not a normal); {0, 0, 0} when the matrix collapses it.
 std::array<double, 3> transform_vector(const Mat4& m, const Vec3& d);

@@ -435,5 +435,31 @@ TEST(EmbeddedImage, ExtensionFromMimeTypeThenMagic) {
   EXPECT_STREQ(img.embedded_extension(), ".png");
 }
 
+// A normal moved by a mirror stays on the side of the surface it was on, where the moved
+// triangle's edge cross product turns over with the reversed winding.
+TEST(SceneMath, NormalsKeepTheirSideUnderAMirror) {
+  scene::Mat4 m = scene::kIdentity;
+  m[0] = -2, m[5] = 3, m[10] = 0.5;  // mirrored in x, scaled
+  m[12] = 7;
+  EXPECT_TRUE(scene::mirrors(m));
+  EXPECT_FALSE(scene::mirrors(scene::kIdentity));
+  const auto up = scene::transform_direction(m, {0, 1, 0});
+  EXPECT_NEAR(up[1], 1, 1e-12);
+  const auto side = scene::transform_direction(m, {1, 0, 0});
+  EXPECT_NEAR(side[0], -1, 1e-12);
+  // The inverse-transpose: a tilted normal leans as the scaled surface does.
+  const auto tilted = scene::transform_direction(m, {0, 1, 1});
+  EXPECT_NEAR(tilted[1] / tilted[2], (1.0 / 3) / (1.0 / 0.5), 1e-12);
+  // The edge cross product of a moved triangle faces down; its normal says up.
+  const auto a = scene::transform_point(m, {0, 0, 0}), b = scene::transform_point(m, {1, 0, 0}),
+             c = scene::transform_point(m, {0, 0, -1});
+  const double cross_y = (b[2] - a[2]) * (c[0] - a[0]) - (b[0] - a[0]) * (c[2] - a[2]);
+  EXPECT_LT(cross_y, 0);
+  // Two mirrors make a rotation.
+  m[5] = -3;
+  EXPECT_FALSE(scene::mirrors(m));
+  EXPECT_NEAR(scene::transform_direction(m, {0, 1, 0})[1], -1, 1e-12);
+}
+
 }  // namespace
 }  // namespace vt::test

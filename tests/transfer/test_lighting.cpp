@@ -153,6 +153,30 @@ TEST(Lighting, DirectionalLightGivesIlluminanceTimesCosine) {
   }
 }
 
+// A mirroring node reverses the winding of its triangles; the floor still faces the way its
+// normals say (glTF: the front face is then clockwise). Mirrored in x it faces up as before;
+// mirrored in z (the floor at z = 0 stays put) it faces down.
+TEST(Lighting, MirroredInstancesAreLitOnTheSideTheyFace) {
+  for (const int axis : {0, 2}) {
+    for (const double theta : {0.0, std::numbers::pi}) {
+      scene::Scene s = floor_scene();
+      s.nodes[0].local[axis * 5] = -1;
+      add_light(s, light_of(scene::LightType::kDirectional, 1000), turned_about_x(theta));
+      const bool lit = (axis == 0) == (theta == 0.0);
+      TransferResult r = transfer(s);
+      const TransferLayer* l = lighting_layer(r);
+      ASSERT_NE(l, nullptr);
+      int n = 0;
+      for_floor_texels(*l, [&](std::array<double, 2>, const float* t) {
+        ++n;
+        ASSERT_NEAR(t[0], lit ? 1000 : 0, 1e-2)
+            << "mirrored axis " << axis << ", light at " << theta;
+      });
+      EXPECT_GT(n, 1000);
+    }
+  }
+}
+
 TEST(Lighting, PointLightFallsOffAsInverseSquareWithinItsRange) {
   const double h = 0.5, intensity = 10;
   for (float range : {std::numeric_limits<float>::infinity(), 1.2f}) {
