@@ -13,6 +13,7 @@
 
 #include "common/hash.h"
 #include "runtime/feedback.h"
+#include "runtime/page_index.h"
 
 namespace vt {
 
@@ -133,10 +134,7 @@ void radix_sort(std::vector<uint64_t>& keys, std::vector<uint64_t>& scratch) {
 struct FeedbackResolver::Impl {
   const PageSource& source;
   uint32_t texture_id = 0;
-  uint32_t levels = 0;
-  // Per level: the first page's key, and the level's pages per axis (the geometry's accessors
-  // are out of line, and these run once per distinct value and page).
-  std::vector<uint32_t> level_base, pages_x, pages_y;
+  PageIndex index;  // a page's key in `pages` is its number (under 2^32 within the limits)
   CountTable values;
   CountTable pages;
   struct Recent {
@@ -149,24 +147,11 @@ struct FeedbackResolver::Impl {
   std::vector<std::vector<std::pair<PageId, uint32_t>>> buckets;  // per level: page, entry
   std::vector<uint64_t> order, order_scratch;                     // sort keys, see resolve()
 
-  Impl(const PageSource& s, uint32_t texture) : source(s), texture_id(texture) {
-    const PageGeometry& g = s.geometry();
-    levels = g.level_count();
-    uint64_t base = 0;
-    for (uint32_t l = 0; l < levels; ++l) {
-      level_base.push_back(uint32_t(base));
-      pages_x.push_back(g.pages_x(l));
-      pages_y.push_back(g.pages_y(l));
-      base += uint64_t(pages_x.back()) * pages_y.back();
-    }
-  }
-  bool contains(const PageId& id) const {
-    return id.level < levels && id.x < pages_x[id.level] && id.y < pages_y[id.level];
-  }
-  uint32_t key(const PageId& id) const {
-    return level_base[id.level] + id.y * pages_x[id.level] + id.x;
-  }
+  Impl(const PageSource& s, uint32_t texture)
+      : source(s), texture_id(texture), index(s.geometry()) {}
+  uint32_t key(const PageId& id) const { return uint32_t(index.number(id)); }
   PageId nearest_present(PageId id) const {
+    const uint32_t levels = index.levels();
     while (id.level + 1 < levels && !source.present(id)) {
       id = PageId{id.level + 1, id.x / 2, id.y / 2};
     }
@@ -193,7 +178,7 @@ ResolveStats FeedbackResolver::resolve(std::span<const uint32_t> feedback, uint3
   m.values.clear();
   m.pages.clear();
   m.recent.fill({});
-  if (m.levels == 0) return stats;
+  if (m.index.levels() == 0) return stats;
 
   for_each_run(feedback.data(), feedback.size(), [&m](uint32_t v, size_t length) {
     if (v == kFeedbackNone) return;
@@ -212,9 +197,9 @@ ResolveStats FeedbackResolver::resolve(std::span<const uint32_t> feedback, uint3
   // Each distinct request lands on its nearest present page; then counts flow up one level at
   // a time (a parent collects its children's pixels), so each page is visited once instead of
   // once per descendant request.
-  const uint32_t last = m.levels - 1;
+  const uint32_t last = m.index.levels() - 1;
   for (auto& b : m.buckets) b.clear();
-  m.buckets.resize(m.levels);
+  m.buckets.resize(m.index.levels());
   for (uint32_t e = 0; e < m.values.size(); ++e) {
     const uint32_t v = m.values.key(e);
     const uint32_t count = m.values.count(e);
@@ -225,7 +210,7 @@ ResolveStats FeedbackResolver::resolve(std::span<const uint32_t> feedback, uint3
     }
     stats.pixels += count;
     const PageId req = feedback_unpack(v);
-    if (texture != m.texture_id || !m.contains(req)) {
+    if (texture != m.texture_id || !m.index.contains(req)) {
       stats.invalid_pixels += count;
       continue;
     }

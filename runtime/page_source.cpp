@@ -7,6 +7,7 @@
 
 #include "format/layer_codec.h"
 #include "runtime/feedback.h"
+#include "runtime/page_index.h"
 
 namespace vt {
 
@@ -44,31 +45,21 @@ struct LayerPlan {
 class PageFileSource final : public PageSource {
  public:
   PageFileSource(std::shared_ptr<const PageFileReader> reader, const PageFileSourceOptions& o,
-                 std::vector<LayerPlan> plans, std::vector<uint64_t> presence,
-                 std::vector<uint64_t> level_base)
+                 std::vector<LayerPlan> plans, std::vector<uint64_t> presence, PageIndex index)
       : reader_(std::move(reader)),
         options_(o),
         plans_(std::move(plans)),
         presence_(std::move(presence)),
-        level_base_(std::move(level_base)) {
-    const PageGeometry& g = reader_->geometry();
-    for (uint32_t l = 0; l < g.level_count(); ++l) {
-      pages_x_.push_back(g.pages_x(l));
-      pages_y_.push_back(g.pages_y(l));
-    }
-  }
+        index_(std::move(index)) {}
 
   const PageGeometry& geometry() const override { return reader_->geometry(); }
   uint32_t layer_count() const override { return uint32_t(plans_.size()); }
   RuntimeFormat upload_format(uint32_t layer) const override { return plans_[layer].upload; }
   size_t upload_bytes(uint32_t layer) const override { return plans_[layer].upload_bytes; }
 
-  // The resolver asks once per distinct page and ancestor a frame: the level sizes are kept
-  // rather than derived again (PageGeometry::contains walks the level chain).
   bool present(const PageId& id) const override {
-    if (id.level >= pages_x_.size() || id.x >= pages_x_[id.level] || id.y >= pages_y_[id.level])
-      return false;
-    const uint64_t bit = level_base_[id.level] + uint64_t(id.y) * pages_x_[id.level] + id.x;
+    if (!index_.contains(id)) return false;
+    const uint64_t bit = index_.number(id);
     return (presence_[bit >> 6] >> (bit & 63)) & 1;
   }
 
@@ -119,8 +110,7 @@ class PageFileSource final : public PageSource {
   PageFileSourceOptions options_;
   std::vector<LayerPlan> plans_;
   std::vector<uint64_t> presence_;
-  std::vector<uint64_t> level_base_;
-  std::vector<uint32_t> pages_x_, pages_y_;  // per level
+  PageIndex index_;  // presence_'s bit of each page
 };
 
 }  // namespace
@@ -183,16 +173,11 @@ Expected<std::unique_ptr<PageSource>> make_page_file_source(
   }
   if (plans.empty()) return Error(ErrorCode::kCorrupt, path + ": no layers");
 
-  std::vector<uint64_t> level_base;
-  uint64_t total = 0;
-  for (uint32_t l = 0; l < g.level_count(); ++l) {
-    level_base.push_back(total);
-    total += g.pages_in_level(l);
-  }
-  std::vector<uint64_t> presence((total + 63) / 64, 0);
-  for (uint32_t l = 0; l < g.level_count(); ++l)
-    for (uint32_t y = 0; y < g.pages_y(l); ++y)
-      for (uint32_t x = 0; x < g.pages_x(l); ++x) {
+  PageIndex index(g);
+  std::vector<uint64_t> presence((index.total + 63) / 64, 0);
+  for (uint32_t l = 0; l < index.levels(); ++l)
+    for (uint32_t y = 0; y < index.pages_y[l]; ++y)
+      for (uint32_t x = 0; x < index.pages_x[l]; ++x) {
         bool all = true;
         for (uint32_t layer = 0; layer < plans.size() && all; ++layer) {
           auto e = reader->entry(PageId{l, x, y}, layer);
@@ -200,12 +185,12 @@ Expected<std::unique_ptr<PageSource>> make_page_file_source(
           all = e->state != PageState::kAbsent;
         }
         if (all) {
-          const uint64_t bit = level_base[l] + uint64_t(y) * g.pages_x(l) + x;
+          const uint64_t bit = index.number(PageId{l, x, y});
           presence[bit >> 6] |= uint64_t(1) << (bit & 63);
         }
       }
   return std::unique_ptr<PageSource>(new PageFileSource(
-      std::move(reader), options, std::move(plans), std::move(presence), std::move(level_base)));
+      std::move(reader), options, std::move(plans), std::move(presence), std::move(index)));
 }
 
 }  // namespace vt
