@@ -1,7 +1,8 @@
 // Every other scene format assimp reads (FBX, COLLADA, 3DS, Blender, X, LightWave, STL, ...)
 // mapped onto the scene model: one primitive per assimp mesh, the node hierarchy kept (a node
 // with several meshes gets one scene mesh holding them all), materials onto glTF
-// metallic-roughness, embedded textures kept as image bytes. Only the bake side links assimp.
+// metallic-roughness, embedded textures kept as image bytes (uncompressed ones as PNG). Only the
+// bake side links assimp.
 #include <assimp/GltfMaterial.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
@@ -15,6 +16,7 @@
 #include <filesystem>
 #include <map>
 
+#include "scene/image_load.h"
 #include "scene/scene_io_util.h"
 
 namespace vt::scene::detail {
@@ -50,6 +52,9 @@ std::string mime_from_hint(const char* hint) {
   if (h == "dds") return "image/vnd-ms.dds";
   return h.empty() ? std::string() : "image/" + h;
 }
+
+// The diffuse texture assimp's MD2 importer writes when the model names no skin.
+constexpr char kAssimpNoSkin[] = "$texture_dummy.bmp";
 
 class AssimpScene {
  public:
@@ -116,8 +121,13 @@ class AssimpScene {
         image.bytes.assign(bytes, bytes + t->mWidth);
         image.mime_type = mime_from_hint(t->achFormatHint);
       } else {
-        warn("embedded uncompressed texture '" + raw + "' is not supported: slot left empty");
-        return images_[raw] = -1;
+        // Texels (Half-Life and Quake models' palette skins, which assimp expands): a PNG.
+        Expected<Image> png = texels_png(*t, image.name);
+        if (!png.ok()) {
+          warn("embedded texture '" + raw + "': " + png.status().message() + "; slot left empty");
+          return images_[raw] = -1;
+        }
+        image = std::move(*png);
       }
     } else {
       image.name = raw;
@@ -128,6 +138,27 @@ class AssimpScene {
     }
     scene_.images.push_back(std::move(image));
     return images_[raw] = int(scene_.images.size() - 1);
+  }
+
+  // An uncompressed embedded texture (mWidth x mHeight aiTexels, BGRA, rows top first) as an
+  // embedded PNG; without alpha when every texel is opaque.
+  static Expected<Image> texels_png(const aiTexture& t, const std::string& name) {
+    if (t.mWidth > 65536 || t.mHeight > 65536 || !t.pcData)
+      return Error(ErrorCode::kCorrupt, std::to_string(t.mWidth) + "x" + std::to_string(t.mHeight) +
+                                            " texels: not an image");
+    const size_t count = size_t(t.mWidth) * t.mHeight;
+    const bool opaque =
+        std::all_of(t.pcData, t.pcData + count, [](const aiTexel& x) { return x.a == 255; });
+    const int channels = opaque ? 3 : 4;
+    std::vector<uint8_t> texels(count * channels);
+    for (size_t i = 0; i < count; ++i) {
+      const aiTexel& x = t.pcData[i];
+      uint8_t* d = &texels[i * channels];
+      d[0] = x.r, d[1] = x.g, d[2] = x.b;
+      if (!opaque) d[3] = x.a;
+    }
+    const OIIO::ImageSpec spec(int(t.mWidth), int(t.mHeight), channels, OIIO::TypeDesc::UINT8);
+    return embedded_png(name, spec, OIIO::TypeDesc::UINT8, texels.data());
   }
 
   TextureRef texture(const aiMaterial& m, aiTextureType type) {
@@ -147,12 +178,30 @@ class AssimpScene {
            ": a texture with no file name is ignored");
       return ref;
     }
+    std::string written = file.C_Str();
+    if (written == kAssimpNoSkin) {
+      // What assimp's MD2 importer names when the model names no skin: the game gives it one,
+      // by convention the model's own name beside it (Irrlicht's sydney.md2 and sydney.bmp).
+      const std::filesystem::path model(path_);
+      std::string note;  // the guess's own note: it is a guess either way
+      const std::string guess =
+          resolve_written_path(folder_, model.stem().string() + ".png", &note);
+      if (!std::filesystem::is_regular_file(guess) || guess.rfind(folder_, 0) != 0) {
+        warn("the model names no skin (assimp's placeholder '" + written +
+             "'): its surfaces bake from the material's colour; an image named like the model "
+             "beside it (" +
+             model.stem().string() + ".png, .bmp, .tga, ...) would be used");
+        return ref;
+      }
+      written = guess.substr(folder_.size());
+      warn("the model names no skin: '" + written + "' beside it, of the model's name, is used");
+    }
     if (mapping != aiTextureMapping_UV) {
       warn("material '" + std::string(m.GetName().C_Str()) +
            "': a texture with non-UV (projected) mapping is ignored");
       return ref;
     }
-    ref.image = image_for(file.C_Str());
+    ref.image = image_for(written);
     if (ref.image < 0) return {};
     ref.texcoord = int(uv_index);
     ref.wrap_s = wrap_mode(modes[0]);

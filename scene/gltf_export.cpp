@@ -254,7 +254,7 @@ class DocumentBuilder {
 
   void add_nodes(const Scene& scene) {
     for (const Node& n : scene.nodes) {
-      json j;
+      json j = json::object();  // a bare node (no name, mesh or children) is {}, not null
       if (!n.name.empty()) j["name"] = n.name;
       if (n.local != kIdentity) j["matrix"] = n.local;
       if (n.mesh >= 0) j["mesh"] = n.mesh;

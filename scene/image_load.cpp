@@ -133,4 +133,21 @@ Expected<FloatImage> load_float_image(const scene::Image& image) {
   return out;
 }
 
+Expected<Image> embedded_png(const std::string& name, const OIIO::ImageSpec& spec,
+                             OIIO::TypeDesc pixel_type, const void* pixels) {
+  Image out;
+  out.name = name;
+  out.mime_type = "image/png";
+  OIIO::Filesystem::IOVecOutput proxy(out.bytes);
+  auto writer = OIIO::ImageOutput::create("embedded.png", &proxy);
+  OIIO::ImageSpec stored = spec;
+  // Stored as given, like an artist's RGBA PNG: OpenImageIO would otherwise un-premultiply.
+  stored.attribute("oiio:UnassociatedAlpha", 1);
+  if (!writer || !writer->open("embedded.png", stored) ||
+      !writer->write_image(pixel_type, pixels) || !writer->close())
+    return Error(ErrorCode::kIo, name + ": cannot encode the texels as PNG (" +
+                                     (writer ? writer->geterror() : OIIO::geterror()) + ")");
+  return out;
+}
+
 }  // namespace vt::scene

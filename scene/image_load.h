@@ -60,4 +60,12 @@ void associate_alpha(float* texels, size_t count, int channels, int alpha);
 // has a size of 0 or over 65536 per side.
 Expected<FloatImage> load_float_image(const scene::Image& image);
 
+// Texels an importer made (a packed MTL map, a model's uncompressed embedded skin) as an embedded
+// PNG named `name`: every reader of the scene's images, and the unwrapped scene's .glb, then
+// take them as they take a file. `spec` gives the size, channels and stored format (8 or 16
+// bits); `pixels` are of `pixel_type`, rows top first, colour straight. kIo when OpenImageIO
+// cannot encode them.
+Expected<Image> embedded_png(const std::string& name, const OIIO::ImageSpec& spec,
+                             OIIO::TypeDesc pixel_type, const void* pixels);
+
 }  // namespace vt::scene

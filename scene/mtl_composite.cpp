@@ -1,5 +1,4 @@
 // Separate MTL maps packed into the one texture a glTF slot reads (see obj_mtl.h).
-#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
@@ -72,19 +71,8 @@ Expected<Image> composite_image(const std::vector<ChannelSource>& channels,
     for (size_t i = 0; i < plane.size(); ++i) pixels[i * n + c] = plane[i];
   }
   // An embedded PNG: the rest of the pipeline reads it like any image of the scene.
-  Image out;
-  out.name = name;
-  out.mime_type = "image/png";
-  OIIO::Filesystem::IOVecOutput proxy(out.bytes);
-  auto writer = OIIO::ImageOutput::create("composite.png", &proxy);
-  OIIO::ImageSpec spec(w, h, n, wide ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
-  // Stored as given, like an artist's RGBA PNG: OpenImageIO would otherwise un-premultiply.
-  spec.attribute("oiio:UnassociatedAlpha", 1);
-  if (!writer || !writer->open("composite.png", spec) ||
-      !writer->write_image(OIIO::TypeDesc::FLOAT, pixels.data()) || !writer->close())
-    return Error(ErrorCode::kIo, name + ": cannot encode the packed map (" +
-                                     (writer ? writer->geterror() : OIIO::geterror()) + ")");
-  return out;
+  const OIIO::ImageSpec spec(w, h, n, wide ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8);
+  return embedded_png(name, spec, OIIO::TypeDesc::FLOAT, pixels.data());
 }
 
 }  // namespace vt::scene::detail

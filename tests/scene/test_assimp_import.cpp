@@ -3,9 +3,12 @@
 // paths from the author's machine).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
+#include "scene/image_load.h"
 #include "scene/scene.h"
 #include "scene/scene_io_util.h"
 
@@ -300,6 +303,106 @@ TEST(AssimpImport, ColladaOpacityZeroIsReadAsOpaque) {
   bool warned = false;
   for (const std::string& w : s->warnings) warned |= w.find("opacity 0") != std::string::npos;
   EXPECT_TRUE(warned);
+}
+
+// Little-endian binary helpers for the Quake model files below.
+std::string le32(std::initializer_list<int32_t> values) {
+  std::string out;
+  for (int32_t v : values)
+    for (int b = 0; b < 4; ++b) out.push_back(char(uint32_t(v) >> (8 * b)));
+  return out;
+}
+std::string lef(std::initializer_list<float> values) {
+  std::string out;
+  for (float f : values) {
+    uint32_t v;
+    std::memcpy(&v, &f, 4);
+    out += le32({int32_t(v)});
+  }
+  return out;
+}
+
+// A Quake 1 model (IDPO): one triangle and an 8 x 8 palette skin, rows 0-3 colour 15 (the
+// palette's light grey), rows 4-7 colour 0 (black). assimp expands the skin into an uncompressed
+// embedded texture, which became an empty slot (Half-Life's yodan.mdl baked flat grey).
+TEST(AssimpImport, UncompressedEmbeddedSkinsBecomeImages) {
+  fs::path d = fresh_dir("mdl_skin");
+  std::string skin(64, char(0));
+  std::fill(skin.begin(), skin.begin() + 32, char(15));
+  std::string mdl = "IDPO" + le32({6}) + lef({1, 1, 1, 0, 0, 0, 2, 0, 0, 0}) +
+                    le32({1, 8, 8, 3, 1, 1, 0, 0}) + lef({1}) + le32({0}) + skin;
+  // Texture coordinates (onseam, s, t): the triangle lies in the skin's top rows.
+  mdl += le32({0, 1, 1, 0, 6, 1, 0, 1, 2});
+  mdl += le32({1, 0, 1, 2});  // faces front, vertices 0 1 2
+  // One simple frame: bounds, name, three vertices (x y z, normal index).
+  mdl += le32({0}) + std::string("\0\0\0\0\10\10\0\0", 8) + std::string(16, '\0');
+  mdl += std::string("\0\0\0\0\10\0\0\0\0\10\0\0", 12);
+  write_text(d / "tri.mdl", mdl);
+  auto s = scene::load_scene((d / "tri.mdl").string());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  const scene::Primitive& prim = s->meshes.at(s->instances().at(0).mesh).primitives.at(0);
+  ASSERT_GE(prim.material, 0);
+  const scene::TextureRef& ref = s->materials.at(prim.material).base_color_texture;
+  ASSERT_TRUE(ref.valid());
+  const scene::Image& image = s->images.at(ref.image);
+  EXPECT_TRUE(image.embedded());
+  EXPECT_EQ(image.mime_type, "image/png");
+  auto texels = scene::load_float_image(image);
+  ASSERT_TRUE(texels.ok()) << texels.status().message();
+  ASSERT_EQ(texels->width, 8u);
+  ASSERT_EQ(texels->height, 8u);
+  EXPECT_EQ(texels->channels, 3u);  // opaque: no alpha channel
+  // Skin row 0 is the image's top row; every texel of a half is the one palette colour.
+  for (uint32_t y = 0; y < 8; ++y)
+    for (uint32_t x = 0; x < 8; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const float v = texels->at(x, y)[c];
+        if (y < 4)
+          EXPECT_GT(v, 0.8f) << x << " " << y;
+        else
+          EXPECT_EQ(v, 0.0f) << x << " " << y;
+        EXPECT_EQ(v, texels->at(0, y < 4 ? 0 : 7)[0]);
+      }
+  // The UVs read the top rows in glTF's orientation: t + 0.5 texels from the top.
+  ASSERT_EQ(prim.uvs.size(), 1u);
+  for (const auto& uv : prim.uvs[0]) {
+    EXPECT_GT(uv[1], 0.0f);
+    EXPECT_LT(uv[1], 0.5f);
+  }
+}
+
+// A Quake 2 model (IDP2) that names no skin: the game assigns one. assimp names a placeholder
+// ('$texture_dummy.bmp') that the bake refused as a missing file. Now the surfaces bake from the
+// material's colour with a warning, or from an image of the model's name beside it.
+TEST(AssimpImport, Md2WithoutSkinTakesTheImageOfItsName) {
+  fs::path d = fresh_dir("md2_skin");
+  const int32_t frame_size = 40 + 3 * 4;
+  std::string md2 = "IDP2" + le32({8, 8, 8, frame_size, 0, 3, 3, 1, 1, 1});
+  const int32_t st = 68, tris = st + 3 * 4, frames = tris + 12, gl = frames + frame_size;
+  md2 += le32({st, st, tris, frames, gl, gl + 4});
+  md2 += std::string("\1\0\1\0\6\0\1\0\1\0\6\0", 12);      // s t of three vertices (short)
+  md2 += std::string("\0\0\1\0\2\0\0\0\1\0\2\0", 12);      // vertex and UV indices (short)
+  md2 += lef({1, 1, 1, 0, 0, 0}) + std::string(16, '\0');  // scale, translate, name
+  md2 += std::string("\0\0\0\0\10\0\0\0\0\10\0\0", 12);    // three vertices (x y z, normal)
+  md2 += le32({0});                                        // the GL commands' end
+  write_text(d / "guy.md2", md2);
+  auto bare = scene::load_scene((d / "guy.md2").string());
+  ASSERT_TRUE(bare.ok()) << bare.status().message();
+  ASSERT_EQ(bare->materials.size(), 1u);
+  EXPECT_FALSE(bare->materials[0].base_color_texture.valid());
+  auto warned = [](const scene::Scene& s, const std::string& what) {
+    bool found = false;
+    for (const std::string& w : s.warnings) found |= w.find(what) != std::string::npos;
+    return found;
+  };
+  EXPECT_TRUE(warned(*bare, "names no skin (assimp's placeholder")) << bare->warnings.size();
+  write_text(d / "Guy.BMP", "not read by the importer");
+  auto skinned = scene::load_scene((d / "guy.md2").string());
+  ASSERT_TRUE(skinned.ok()) << skinned.status().message();
+  const scene::TextureRef& ref = skinned->materials.at(0).base_color_texture;
+  ASSERT_TRUE(ref.valid());
+  EXPECT_EQ(fs::path(skinned->images.at(ref.image).path).filename(), "Guy.BMP");
+  EXPECT_TRUE(warned(*skinned, "'Guy.BMP' beside it, of the model's name, is used"));
 }
 
 TEST(AssimpImport, MeshWithoutUvsUnderATexturedMaterialBakesFromItsFactors) {

@@ -151,6 +151,21 @@ TEST(GltfExport, GltfLoadsBackAsTheScene) {
   EXPECT_DOUBLE_EQ(back->nodes[0].local[12], -2.5);
 }
 
+// A node with nothing to say (no name, mesh, children or transform: a Half-Life model's empty
+// bone controllers, as assimp gives them) is written as {}, which loads back; it was null, and
+// the validator could not read the unwrapped scene.
+TEST(GltfExport, BareNodesLoadBack) {
+  Scene s = textured_ball();
+  s.nodes.push_back({});
+  s.nodes[0].children.push_back(int(s.nodes.size() - 1));
+  ASSERT_TRUE(scene::save_gltf(s, temp("bare.glb")).ok());
+  auto back = scene::load_scene(temp("bare.glb"));
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  ASSERT_EQ(back->nodes.size(), s.nodes.size());
+  EXPECT_EQ(back->nodes.back().mesh, -1);
+  EXPECT_TRUE(back->nodes.back().children.empty());
+}
+
 // KHR_lights_punctual round trip: the unwrapped scene keeps the lights a lit bake used, with
 // their nodes (placement), types, units, range and cone angles.
 TEST(GltfExport, LightsLoadBackWithTheirNodes) {
