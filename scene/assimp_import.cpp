@@ -3,7 +3,9 @@
 // with several meshes gets one scene mesh holding them all), materials onto glTF
 // metallic-roughness, embedded textures kept as image bytes (uncompressed ones as PNG). Only the
 // bake side links assimp.
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/GltfMaterial.h>
+#include <assimp/MemoryIOWrapper.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -52,6 +54,31 @@ std::string mime_from_hint(const char* hint) {
   if (h == "dds") return "image/vnd-ms.dds";
   return h.empty() ? std::string() : "image/" + h;
 }
+
+// Files that start with a UTF-16 byte-order mark, handed to assimp as UTF-8: its XML readers
+// (COLLADA; Irrlicht's .irr scenes, which Irrlicht writes in UTF-16) and its ASE reader take the
+// bytes as UTF-8, and failed ("malformed XML", "No meshes remaining").
+class Utf16AsUtf8Files : public Assimp::DefaultIOSystem {
+ public:
+  Assimp::IOStream* Open(const char* file, const char* mode) override {
+    Assimp::IOStream* stream = DefaultIOSystem::Open(file, mode);
+    uint8_t mark[2] = {};
+    const bool utf16 =
+        stream && mode[0] == 'r' && stream->FileSize() >= 2 && stream->Read(mark, 1, 2) == 2 &&
+        ((mark[0] == 0xff && mark[1] == 0xfe) || (mark[0] == 0xfe && mark[1] == 0xff));
+    if (stream) stream->Seek(0, aiOrigin_SET);
+    if (!utf16) return stream;
+    std::vector<uint8_t> bytes(stream->FileSize());
+    bytes.resize(stream->Read(bytes.data(), 1, bytes.size()));
+    std::string note;
+    const Expected<std::string> text = decode_text(bytes, file, &note);
+    if (!text.ok()) return stream;  // odd-length UTF-16: assimp's own error says what it finds
+    Close(stream);
+    auto* copy = new uint8_t[text->size()];
+    std::memcpy(copy, text->data(), text->size());
+    return new Assimp::MemoryIOStream(copy, text->size(), /*own=*/true);
+  }
+};
 
 // The diffuse texture assimp's MD2 importer writes when the model names no skin.
 constexpr char kAssimpNoSkin[] = "$texture_dummy.bmp";
@@ -366,6 +393,7 @@ Expected<Scene> load_assimp(const std::string& path) {
   if (!std::filesystem::is_regular_file(path, ec))
     return Error(ErrorCode::kNotFound, path + ": cannot open (no such file)");
   Assimp::Importer importer;
+  importer.SetIOHandler(new Utf16AsUtf8Files);  // the importer owns it
   // Points and lines are dropped by SortByPType; normals are made only where a mesh has none.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                               aiPrimitiveType_POINT | aiPrimitiveType_LINE);

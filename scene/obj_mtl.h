@@ -1,6 +1,6 @@
-// Internal to vt_scene: what the OBJ and MTL readers share. Text as exporters write it (UTF-8
-// with or without a BOM, UTF-16 LE/BE), a line cursor, quoted tokens, and file names as
-// exporters write them (backslashes, Windows drive paths, case that differs from the disk).
+// Internal to vt_scene: what the OBJ and MTL readers share (their text comes through
+// decode_text, scene_io_util.h): a line cursor, quoted tokens, and file names as exporters write
+// them (backslashes, Windows drive paths, case that differs from the disk).
 #pragma once
 
 #include <cstdint>
@@ -13,12 +13,6 @@
 #include "scene/scene_io_util.h"
 
 namespace vt::scene::detail {
-
-// The file's text in UTF-8: a UTF-8 BOM is dropped, UTF-16 (a BOM, or ASCII with every other
-// byte zero) is converted, and text that is not valid UTF-8 is read as Latin-1 (`note` then
-// says so; empty otherwise). The error names `path` (odd-length UTF-16).
-Expected<std::string> decode_text(const std::vector<uint8_t>& bytes, const std::string& path,
-                                  std::string* note);
 
 // Reads one OBJ/MTL statement at a time; `p` is at the start of a line after next_line().
 struct LineCursor {

@@ -27,6 +27,51 @@ Status check_regular_file(const std::string& path) {
   return Status::Ok();
 }
 
+namespace {
+
+Expected<std::string> utf16_to_utf8(const uint8_t* data, size_t size, bool big_endian,
+                                    const std::string& path) {
+  if (size % 2 != 0)
+    return Error(ErrorCode::kCorrupt, path + ": UTF-16 text with an odd number of bytes");
+  auto unit = [&](size_t i) {
+    return big_endian ? uint32_t(data[i] << 8 | data[i + 1]) : uint32_t(data[i + 1] << 8 | data[i]);
+  };
+  std::string out;
+  out.reserve(size / 2);
+  for (size_t i = 0; i < size; i += 2) {
+    uint32_t cp = unit(i);
+    if (cp >= 0xd800 && cp < 0xdc00 && i + 3 < size) {
+      uint32_t low = unit(i + 2);
+      if (low >= 0xdc00 && low < 0xe000) {
+        cp = 0x10000 + ((cp - 0xd800) << 10) + (low - 0xdc00);
+        i += 2;
+      }
+    }
+    if (cp >= 0xd800 && cp < 0xe000) cp = 0xfffd;  // an unpaired surrogate
+    append_utf8(cp, &out);
+  }
+  return out;
+}
+
+}  // namespace
+
+Expected<std::string> decode_text(const std::vector<uint8_t>& bytes, const std::string& path,
+                                  std::string* note) {
+  note->clear();
+  const uint8_t* d = bytes.data();
+  size_t n = bytes.size();
+  if (n >= 3 && d[0] == 0xef && d[1] == 0xbb && d[2] == 0xbf) return std::string(d + 3, d + n);
+  if (n >= 2 && d[0] == 0xff && d[1] == 0xfe) return utf16_to_utf8(d + 2, n - 2, false, path);
+  if (n >= 2 && d[0] == 0xfe && d[1] == 0xff) return utf16_to_utf8(d + 2, n - 2, true, path);
+  // No BOM: ASCII text written as UTF-16 has a zero in every other byte.
+  if (n >= 2 && d[0] != 0 && d[1] == 0) return utf16_to_utf8(d, n, false, path);
+  if (n >= 2 && d[0] == 0 && d[1] != 0) return utf16_to_utf8(d, n, true, path);
+  std::string text(d, d + n);
+  if (valid_utf8(text)) return text;
+  *note = "not UTF-8: read as Latin-1";
+  return latin1_to_utf8(text);
+}
+
 Expected<std::vector<uint8_t>> read_file(const std::string& path) {
   VT_RETURN_IF_ERROR(check_regular_file(path));
   std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);

@@ -15,6 +15,11 @@ namespace vt::scene::detail {
 Status check_regular_file(const std::string& path);
 // The whole file; refuses what is not a regular file.
 Expected<std::vector<uint8_t>> read_file(const std::string& path);
+// The file's text in UTF-8: a UTF-8 BOM is dropped, UTF-16 (a BOM, or ASCII with every other
+// byte zero) is converted, and text that is not valid UTF-8 is read as Latin-1 (`note` then
+// says so; empty otherwise). The error names `path` (odd-length UTF-16).
+Expected<std::string> decode_text(const std::vector<uint8_t>& bytes, const std::string& path,
+                                  std::string* note);
 std::string lower_extension(const std::string& path);
 std::string parent_folder(const std::string& path);  // "" or ends with '/'
 // Decodes a data: URI ("data:<mime>;base64,<payload>"); mime receives the media type.

@@ -405,6 +405,29 @@ TEST(AssimpImport, Md2WithoutSkinTakesTheImageOfItsName) {
   EXPECT_TRUE(warned(*skinned, "'Guy.BMP' beside it, of the model's name, is used"));
 }
 
+// Text scenes in UTF-16 with a byte-order mark (Irrlicht writes its .irr scenes so; assimp's
+// own test models have COLLADA and ASE files so): assimp's XML and ASE readers took the bytes as
+// UTF-8 and refused them ("malformed XML"); they are handed to it as UTF-8.
+TEST(AssimpImport, Utf16TextScenesAreRead) {
+  fs::path d = fresh_dir("utf16");
+  write_text(d / "wall.png", "not read by the importer");
+  const std::string text = collada_quad("wall.png");
+  for (const bool big_endian : {false, true}) {
+    std::string utf16 = big_endian ? "\xfe\xff" : "\xff\xfe";
+    for (const char c : text) utf16 += big_endian ? std::string{'\0', c} : std::string{c, '\0'};
+    const fs::path path = d / (big_endian ? "quad_be.dae" : "quad_le.dae");
+    write_text(path, utf16);
+    auto s = scene::load_scene(path.string());
+    ASSERT_TRUE(s.ok()) << s.status().message();
+    EXPECT_EQ(s->triangle_count(), 2u);
+    ASSERT_EQ(s->materials.size(), 1u);
+    EXPECT_EQ(s->materials[0].name, "Painted");
+    ASSERT_TRUE(s->materials[0].base_color_texture.valid());
+    EXPECT_EQ(fs::path(s->images.at(s->materials[0].base_color_texture.image).path).filename(),
+              "wall.png");
+  }
+}
+
 TEST(AssimpImport, MeshWithoutUvsUnderATexturedMaterialBakesFromItsFactors) {
   // gl-117's 3DS trucks: a Maya cube without UVs under a textured material. It cannot sample
   // the texture: it gets a copy of the material without it (the bake used to refuse the model).
