@@ -9,6 +9,7 @@
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <assimp/version.h>
 
 #include <algorithm>
 #include <assimp/Importer.hpp>
@@ -392,6 +393,14 @@ Expected<Scene> load_assimp(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     return Error(ErrorCode::kNotFound, path + ": cannot open (no such file)");
+  const std::string ext = lower_extension(path);
+  if ((ext == "irr" || ext == "irrmesh") && aiGetVersionMajor() * 100 + aiGetVersionMinor() < 503)
+    return Error(
+        ErrorCode::kUnsupported,
+        path + ": Irrlicht scenes and meshes (.irr, .irrmesh) are not supported with assimp " +
+            std::to_string(aiGetVersionMajor()) + "." + std::to_string(aiGetVersionMinor()) +
+            ", whose reader of them finds no meshes (assimp issues 4553 and 5014, fixed "
+            "in 5.3); bake the meshes the scene names (.3ds, .x, .b3d, .obj) instead");
   Assimp::Importer importer;
   importer.SetIOHandler(new Utf16AsUtf8Files);  // the importer owns it
   // Points and lines are dropped by SortByPType; normals are made only where a mesh has none.

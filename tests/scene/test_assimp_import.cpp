@@ -1,6 +1,7 @@
 // Scenes read through assimp (COLLADA and STL written by the tests), glTF 1.0 routed to it, and
 // the texture-path resolution every importer shares (Windows separators, letter case, absolute
 // paths from the author's machine).
+#include <assimp/version.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -247,6 +248,15 @@ TEST(AssimpImport, AsciiStlAndUnreadableFiles) {
   ASSERT_FALSE(map.ok());
   EXPECT_EQ(map.status().code(), ErrorCode::kUnsupported);
   EXPECT_NE(map.status().message().find("Quake 3 BSP maps are not supported"), std::string::npos);
+  // Irrlicht scenes: assimp before 5.3 reads no meshes from them (or fails on UTF-16 ones).
+  write_text(d / "box.irr",
+             "<?xml version=\"1.0\"?>\n<irr_scene><node type=\"cube\"></node></irr_scene>\n");
+  auto irr = scene::load_scene((d / "box.irr").string());
+  if (aiGetVersionMajor() * 100 + aiGetVersionMinor() < 503) {
+    ASSERT_FALSE(irr.ok());
+    EXPECT_EQ(irr.status().code(), ErrorCode::kUnsupported);
+    EXPECT_NE(irr.status().message().find("Irrlicht scenes and meshes"), std::string::npos);
+  }
   auto unknown = scene::load_scene((d / "x.notaformat").string());
   ASSERT_FALSE(unknown.ok());
   EXPECT_NE(unknown.status().message().find("unknown scene format"), std::string::npos);
