@@ -415,6 +415,28 @@ TEST(AssimpImport, Md2WithoutSkinTakesTheImageOfItsName) {
   EXPECT_TRUE(warned(*skinned, "'Guy.BMP' beside it, of the model's name, is used"));
 }
 
+// An OFF file's counts are checked against its size before assimp allocates for them: assimp's
+// own invalid/OutOfMemory.off (300 bytes, 353,535,235,358 vertices declared) took 16 GB and 90 s.
+TEST(AssimpImport, OffCountsBeyondTheFileAreRefusedBeforeAssimpReadsThem) {
+  fs::path d = fresh_dir("off");
+  write_text(d / "tri.off", "OFF\n# a comment\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  auto tri = scene::load_scene((d / "tri.off").string());
+  ASSERT_TRUE(tri.ok()) << tri.status().message();
+  EXPECT_EQ(tri->triangle_count(), 1u);
+  write_text(d / "huge.off", "OFF\n353535235358 6 0\n-0.5 -0.5 0.5\n0.5 -0.5 0.5\n");
+  auto huge = scene::load_scene((d / "huge.off").string());
+  ASSERT_FALSE(huge.ok());
+  EXPECT_EQ(huge.status().code(), ErrorCode::kCorrupt);
+  EXPECT_NE(huge.status().message().find("OFF vertices: count 353535235358"), std::string::npos)
+      << huge.status().message();
+  // Counts on the keyword's line, faces beyond the file.
+  write_text(d / "faces.off", "OFF 3 99999 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  auto faces = scene::load_scene((d / "faces.off").string());
+  ASSERT_FALSE(faces.ok());
+  EXPECT_NE(faces.status().message().find("OFF faces"), std::string::npos)
+      << faces.status().message();
+}
+
 // Text scenes in UTF-16 with a byte-order mark (Irrlicht writes its .irr scenes so; assimp's
 // own test models have COLLADA and ASE files so): assimp's XML and ASE readers took the bytes as
 // UTF-8 and refused them ("malformed XML"); they are handed to it as UTF-8.
