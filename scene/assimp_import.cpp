@@ -90,9 +90,9 @@ constexpr char kAssimpNoSkin[] = "$texture_dummy.bmp";
 
 class AssimpScene {
  public:
-  // `animations`: how many the file had (dropped before assimp's validation).
-  AssimpScene(const std::string& path, const aiScene& ai, unsigned animations)
-      : path_(path), ai_(ai), animations_(animations) {
+  // `animations`, `lights`: how many the file had (dropped before assimp's validation).
+  AssimpScene(const std::string& path, const aiScene& ai, unsigned animations, unsigned lights)
+      : path_(path), ai_(ai), animations_(animations), lights_(lights) {
     scene_.source_path = path;
     folder_ = parent_folder(path);
   }
@@ -110,8 +110,8 @@ class AssimpScene {
       warn(std::to_string(animations_) + " animations ignored (baked in the rest pose)");
     if (boned_meshes_ > 0)
       warn(std::to_string(boned_meshes_) + " skinned meshes baked in their bind pose");
-    if (ai_.mNumLights > 0)
-      warn(std::to_string(ai_.mNumLights) +
+    if (lights_ > 0)
+      warn(std::to_string(lights_) +
            " lights ignored (only glTF KHR_lights_punctual lights are baked)");
     return std::move(scene_);
   }
@@ -377,7 +377,7 @@ class AssimpScene {
 
   std::string path_, folder_;
   const aiScene& ai_;
-  unsigned animations_ = 0;
+  unsigned animations_ = 0, lights_ = 0;
   Scene scene_;
   std::map<std::string, int> images_;
   std::map<std::vector<unsigned>, int> meshes_;
@@ -422,6 +422,15 @@ Status check_off_counts(const std::string& path) {
   VT_RETURN_IF_ERROR(check_backed(path + ": OFF faces", counts[1], 2, "the file", size));
   VT_RETURN_IF_ERROR(check_ceiling(path + ": OFF vertices", counts[0], kMaxVertices, "vertices"));
   return check_ceiling(path + ": OFF faces", counts[1], kMaxIndices / 3, "faces");
+}
+
+// Deletes an aiScene array of owned pointers (animations, lights, cameras) and empties it.
+template <class T>
+void drop(T**& items, unsigned& count) {
+  for (unsigned i = 0; i < count; ++i) delete items[i];
+  delete[] items;
+  items = nullptr;
+  count = 0;
 }
 
 }  // namespace
@@ -469,12 +478,14 @@ Expected<Scene> load_assimp(const std::string& path) {
                                            " animations only: bake the model they animate)"
                                      : std::string()));
   }
-  if (ai && animations > 0) {
+  // Lights and cameras go too: the bake ignores them (the warning counts the lights), and
+  // assimp's validation refused OpenGEX files over a light without a node.
+  const unsigned lights = ai ? ai->mNumLights : 0;
+  if (ai) {
     aiScene* owned = const_cast<aiScene*>(ai);  // the importer's own scene, changed in place
-    for (unsigned i = 0; i < animations; ++i) delete owned->mAnimations[i];
-    delete[] owned->mAnimations;
-    owned->mAnimations = nullptr;
-    owned->mNumAnimations = 0;
+    drop(owned->mAnimations, owned->mNumAnimations);
+    drop(owned->mLights, owned->mNumLights);
+    drop(owned->mCameras, owned->mNumCameras);
   }
   if (ai) ai = importer.ApplyPostProcessing(flags);
   if (!ai || !ai->mRootNode) {
@@ -486,7 +497,7 @@ Expected<Scene> load_assimp(const std::string& path) {
   }
   if (ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE)
     return Error(ErrorCode::kCorrupt, path + ": assimp read an incomplete scene (no meshes?)");
-  return AssimpScene(path, *ai, animations).convert();
+  return AssimpScene(path, *ai, animations, lights).convert();
 }
 
 }  // namespace vt::scene::detail

@@ -437,6 +437,33 @@ TEST(AssimpImport, OffCountsBeyondTheFileAreRefusedBeforeAssimpReadsThem) {
       << faces.status().message();
 }
 
+// Lights and cameras are dropped before assimp's validation, as animations are: the bake ignores
+// them, and assimp 5.2's OpenGEX reader makes a light twice, once without a node, which the
+// validation refused (assimp's own OpenGEX/camera.ogex and collada.ogex).
+TEST(AssimpImport, LightsAreDroppedBeforeAssimpValidatesTheScene) {
+  fs::path d = fresh_dir("ogex");
+  write_text(d / "lamp.ogex", R"(Metric (key = "distance") {float {1.0}}
+GeometryNode $node1 {Name {string {"Tri"}} ObjectRef {ref {$geometry1}}}
+LightNode $node2 {Name {string {"Lamp"}} ObjectRef {ref {$light1}}}
+GeometryObject $geometry1
+{
+  Mesh (primitive = "triangles")
+  {
+    VertexArray (attrib = "position") {float[3] {{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}}}
+    IndexArray {unsigned_int32[3] {{0, 1, 2}}}
+  }
+}
+LightObject $light1 (type = "point") {Color (attrib = "light") {float[3] {{1.0, 1.0, 1.0}}}}
+)");
+  auto s = scene::load_scene((d / "lamp.ogex").string());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  EXPECT_EQ(s->triangle_count(), 1u);
+  EXPECT_TRUE(s->lights.empty());
+  bool warned = false;
+  for (const std::string& w : s->warnings) warned |= w.find("lights ignored") != w.npos;
+  EXPECT_TRUE(warned);
+}
+
 // Text scenes in UTF-16 with a byte-order mark (Irrlicht writes its .irr scenes so; assimp's
 // own test models have COLLADA and ASE files so): assimp's XML and ASE readers took the bytes as
 // UTF-8 and refused them ("malformed XML"); they are handed to it as UTF-8.
