@@ -77,7 +77,10 @@ class Utf16AsUtf8Files : public Assimp::DefaultIOSystem {
     bytes.resize(stream->Read(bytes.data(), 1, bytes.size()));
     std::string note;
     const Expected<std::string> text = decode_text(bytes, file, &note);
-    if (!text.ok()) return stream;  // odd-length UTF-16: assimp's own error says what it finds
+    if (!text.ok()) {  // odd-length UTF-16: assimp's own error says what it finds
+      stream->Seek(0, aiOrigin_SET);
+      return stream;
+    }
     Close(stream);
     auto* copy = new uint8_t[text->size()];
     std::memcpy(copy, text->data(), text->size());
@@ -387,7 +390,7 @@ class AssimpScene {
 };
 
 // An OFF file's vertex and face counts against its size, before assimp allocates for them: a
-// 300-byte file declaring 353,535,235,358 vertices (assimp's own invalid/OutOfMemory.off) made
+// 309-byte file declaring 353,535,235,358 vertices (assimp's own invalid/OutOfMemory.off) made
 // it take 16 GB and 90 s. ASCII OFF: every vertex takes at least "0 0 0\n", every face "0\n".
 Status check_off_counts(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

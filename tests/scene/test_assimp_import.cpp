@@ -416,7 +416,7 @@ TEST(AssimpImport, Md2WithoutSkinTakesTheImageOfItsName) {
 }
 
 // An OFF file's counts are checked against its size before assimp allocates for them: assimp's
-// own invalid/OutOfMemory.off (300 bytes, 353,535,235,358 vertices declared) took 16 GB and 90 s.
+// own invalid/OutOfMemory.off (309 bytes, 353,535,235,358 vertices declared) took 16 GB and 90 s.
 TEST(AssimpImport, OffCountsBeyondTheFileAreRefusedBeforeAssimpReadsThem) {
   fs::path d = fresh_dir("off");
   write_text(d / "tri.off", "OFF\n# a comment\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
