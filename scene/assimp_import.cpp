@@ -91,11 +91,15 @@ class Utf16AsUtf8Files : public Assimp::DefaultIOSystem {
 // The diffuse texture assimp's MD2 importer writes when the model names no skin.
 constexpr char kAssimpNoSkin[] = "$texture_dummy.bmp";
 
+// What the file had that was dropped before assimp's validation, for the warnings.
+struct Dropped {
+  unsigned animations = 0, lights = 0, empty_meshes = 0;
+};
+
 class AssimpScene {
  public:
-  // `animations`, `lights`: how many the file had (dropped before assimp's validation).
-  AssimpScene(const std::string& path, const aiScene& ai, unsigned animations, unsigned lights)
-      : path_(path), ai_(ai), animations_(animations), lights_(lights) {
+  AssimpScene(const std::string& path, const aiScene& ai, const Dropped& dropped)
+      : path_(path), ai_(ai), dropped_(dropped) {
     scene_.source_path = path;
     folder_ = parent_folder(path);
   }
@@ -109,12 +113,15 @@ class AssimpScene {
     untexture_surfaces_without_uvs(&scene_);
     if (skipped_faces_ > 0)
       warn(std::to_string(skipped_faces_) + " point and line primitives skipped (no surface)");
-    if (animations_ > 0)
-      warn(std::to_string(animations_) + " animations ignored (baked in the rest pose)");
+    if (dropped_.animations > 0)
+      warn(std::to_string(dropped_.animations) + " animations ignored (baked in the rest pose)");
+    if (dropped_.empty_meshes > 0)
+      warn(std::to_string(dropped_.empty_meshes) +
+           " meshes without vertices or faces skipped (nothing to bake in them)");
     if (boned_meshes_ > 0)
       warn(std::to_string(boned_meshes_) + " skinned meshes baked in their bind pose");
-    if (lights_ > 0)
-      warn(std::to_string(lights_) +
+    if (dropped_.lights > 0)
+      warn(std::to_string(dropped_.lights) +
            " lights ignored (only glTF KHR_lights_punctual lights are baked)");
     return std::move(scene_);
   }
@@ -380,7 +387,7 @@ class AssimpScene {
 
   std::string path_, folder_;
   const aiScene& ai_;
-  unsigned animations_ = 0, lights_ = 0;
+  Dropped dropped_;
   Scene scene_;
   std::map<std::string, int> images_;
   std::map<std::vector<unsigned>, int> meshes_;
@@ -425,6 +432,39 @@ Status check_off_counts(const std::string& path) {
   VT_RETURN_IF_ERROR(check_backed(path + ": OFF faces", counts[1], 2, "the file", size));
   VT_RETURN_IF_ERROR(check_ceiling(path + ": OFF vertices", counts[0], kMaxVertices, "vertices"));
   return check_ceiling(path + ": OFF faces", counts[1], kMaxIndices / 3, "faces");
+}
+
+// Deletes the meshes without vertices or faces (an STL's empty solid, an exporter's empty
+// geometry) and the nodes' references to them: assimp's validation refuses a whole scene over
+// one. Returns how many went.
+unsigned drop_empty_meshes(aiScene& scene) {
+  std::vector<int> remap(scene.mNumMeshes, -1);
+  unsigned kept = 0;
+  for (unsigned i = 0; i < scene.mNumMeshes; ++i) {
+    aiMesh* m = scene.mMeshes[i];
+    if (m->mNumVertices == 0 || m->mNumFaces == 0) {
+      delete m;
+      continue;
+    }
+    remap[i] = int(kept);
+    scene.mMeshes[kept++] = m;
+  }
+  const unsigned dropped = scene.mNumMeshes - kept;
+  scene.mNumMeshes = kept;
+  if (dropped == 0) return 0;
+  std::vector<aiNode*> stack = {scene.mRootNode};
+  while (!stack.empty()) {
+    aiNode* node = stack.back();
+    stack.pop_back();
+    if (!node) continue;
+    unsigned n = 0;
+    for (unsigned k = 0; k < node->mNumMeshes; ++k)
+      if (node->mMeshes[k] < remap.size() && remap[node->mMeshes[k]] >= 0)
+        node->mMeshes[n++] = unsigned(remap[node->mMeshes[k]]);
+    node->mNumMeshes = n;
+    stack.insert(stack.end(), node->mChildren, node->mChildren + node->mNumChildren);
+  }
+  return dropped;
 }
 
 // Deletes an aiScene array of owned pointers (animations, lights, cameras) and empties it.
@@ -481,14 +521,21 @@ Expected<Scene> load_assimp(const std::string& path) {
                                            " animations only: bake the model they animate)"
                                      : std::string()));
   }
-  // Lights and cameras go too: the bake ignores them (the warning counts the lights), and
-  // assimp's validation refused OpenGEX files over a light without a node.
+  // Lights, cameras and empty meshes go too: the bake ignores them (the warnings count them),
+  // and assimp's validation refused OpenGEX files over a light without a node and STL files
+  // over an empty solid.
   const unsigned lights = ai ? ai->mNumLights : 0;
+  unsigned empty_meshes = 0;
   if (ai) {
     aiScene* owned = const_cast<aiScene*>(ai);  // the importer's own scene, changed in place
     drop(owned->mAnimations, owned->mNumAnimations);
     drop(owned->mLights, owned->mNumLights);
     drop(owned->mCameras, owned->mNumCameras);
+    empty_meshes = drop_empty_meshes(*owned);
+    if (owned->mNumMeshes == 0)
+      return Error(ErrorCode::kInvalidArgument, path + ": no meshes: nothing to bake (its " +
+                                                    std::to_string(empty_meshes) +
+                                                    " meshes have no vertices or no faces)");
   }
   if (ai) ai = importer.ApplyPostProcessing(flags);
   if (!ai || !ai->mRootNode) {
@@ -500,7 +547,7 @@ Expected<Scene> load_assimp(const std::string& path) {
   }
   if (ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE)
     return Error(ErrorCode::kCorrupt, path + ": assimp read an incomplete scene (no meshes?)");
-  return AssimpScene(path, *ai, animations, lights).convert();
+  return AssimpScene(path, *ai, {animations, lights, empty_meshes}).convert();
 }
 
 }  // namespace vt::scene::detail

@@ -464,6 +464,29 @@ LightObject $light1 (type = "point") {Color (attrib = "light") {float[3] {{1.0, 
   EXPECT_TRUE(warned);
 }
 
+// A mesh without vertices or faces (an STL's empty solid beside a real one, as assimp's own
+// STL/triangle_with_empty_solid.stl has) is skipped with a warning: assimp's validation refused
+// the whole file. A file of empty meshes only has nothing to bake.
+TEST(AssimpImport, EmptyMeshesAreSkipped) {
+  fs::path d = fresh_dir("empty_mesh");
+  const std::string triangle =
+      "solid tri\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+      "endloop\nendfacet\nendsolid tri\n";
+  write_text(d / "two.stl", triangle + "solid empty\nendsolid empty\n");
+  auto s = scene::load_scene((d / "two.stl").string());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  EXPECT_EQ(s->triangle_count(), 1u);
+  bool warned = false;
+  for (const std::string& w : s->warnings)
+    warned |= w.find("1 meshes without vertices or faces skipped") != w.npos;
+  EXPECT_TRUE(warned);
+  write_text(d / "none.stl", "solid empty\nendsolid empty\n");
+  auto none = scene::load_scene((d / "none.stl").string());
+  ASSERT_FALSE(none.ok());
+  EXPECT_NE(none.status().message().find("nothing to bake"), std::string::npos)
+      << none.status().message();
+}
+
 // Text scenes in UTF-16 with a byte-order mark (Irrlicht writes its .irr scenes so; assimp's
 // own test models have COLLADA and ASE files so): assimp's XML and ASE readers took the bytes as
 // UTF-8 and refused them ("malformed XML"); they are handed to it as UTF-8.
