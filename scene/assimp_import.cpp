@@ -91,6 +91,38 @@ class Utf16AsUtf8Files : public Assimp::DefaultIOSystem {
 // The diffuse texture assimp's MD2 importer writes when the model names no skin.
 constexpr char kAssimpNoSkin[] = "$texture_dummy.bmp";
 
+}  // namespace
+
+Expected<Image> embedded_texels_png(const aiTexture& t, const std::string& name,
+                                    const aiColor3D* colour_key) {
+  if (t.mWidth > 65536 || t.mHeight > 65536 || !t.pcData)
+    return Error(ErrorCode::kCorrupt, std::to_string(t.mWidth) + "x" + std::to_string(t.mHeight) +
+                                          " texels: not an image");
+  // assimp gives Half-Life's key (its palette's last entry) in 0-255, other keys in 0-1.
+  const auto key_byte = [](float c) { return int(std::lround(c > 1.0f ? c : c * 255.0f)); };
+  const int key[3] = {colour_key ? key_byte(colour_key->r) : -1,
+                      colour_key ? key_byte(colour_key->g) : -1,
+                      colour_key ? key_byte(colour_key->b) : -1};
+  const auto alpha = [&](const aiTexel& x) {
+    return x.r == key[0] && x.g == key[1] && x.b == key[2] ? uint8_t(0) : x.a;
+  };
+  const size_t count = size_t(t.mWidth) * t.mHeight;
+  const bool opaque =
+      std::all_of(t.pcData, t.pcData + count, [&](const aiTexel& x) { return alpha(x) == 255; });
+  const int channels = opaque ? 3 : 4;
+  std::vector<uint8_t> texels(count * channels);
+  for (size_t i = 0; i < count; ++i) {
+    const aiTexel& x = t.pcData[i];
+    uint8_t* d = &texels[i * channels];
+    d[0] = x.r, d[1] = x.g, d[2] = x.b;
+    if (!opaque) d[3] = alpha(x);
+  }
+  const OIIO::ImageSpec spec(int(t.mWidth), int(t.mHeight), channels, OIIO::TypeDesc::UINT8);
+  return embedded_png(name, spec, OIIO::TypeDesc::UINT8, texels.data());
+}
+
+namespace {
+
 // What the file had that was dropped before assimp's validation, for the warnings.
 struct Dropped {
   unsigned animations = 0, lights = 0, empty_meshes = 0;
@@ -152,8 +184,10 @@ class AssimpScene {
 
   // The image for a texture path: an embedded texture ("*N" or a name assimp holds) or a file
   // beside the scene; one Scene::Image per distinct path.
+  // While colour_key_ is set, uncompressed texels of that colour become transparent.
   int image_for(const std::string& raw) {
-    auto it = images_.find(raw);
+    const std::string cache_key = colour_key_ ? raw + "\n(colour-keyed)" : raw;
+    auto it = images_.find(cache_key);
     if (it != images_.end()) return it->second;
     Image image;
     if (const aiTexture* t = ai_.GetEmbeddedTexture(raw.c_str())) {
@@ -164,10 +198,10 @@ class AssimpScene {
         image.mime_type = mime_from_hint(t->achFormatHint);
       } else {
         // Texels (Half-Life and Quake models' palette skins, which assimp expands): a PNG.
-        Expected<Image> png = texels_png(*t, image.name);
+        Expected<Image> png = embedded_texels_png(*t, image.name, colour_key_);
         if (!png.ok()) {
           warn("embedded texture '" + raw + "': " + png.status().message() + "; slot left empty");
-          return images_[raw] = -1;
+          return images_[cache_key] = -1;
         }
         image = std::move(*png);
       }
@@ -179,28 +213,7 @@ class AssimpScene {
       if (!note.empty()) warn("texture " + note);
     }
     scene_.images.push_back(std::move(image));
-    return images_[raw] = int(scene_.images.size() - 1);
-  }
-
-  // An uncompressed embedded texture (mWidth x mHeight aiTexels, BGRA, rows top first) as an
-  // embedded PNG; without alpha when every texel is opaque.
-  static Expected<Image> texels_png(const aiTexture& t, const std::string& name) {
-    if (t.mWidth > 65536 || t.mHeight > 65536 || !t.pcData)
-      return Error(ErrorCode::kCorrupt, std::to_string(t.mWidth) + "x" + std::to_string(t.mHeight) +
-                                            " texels: not an image");
-    const size_t count = size_t(t.mWidth) * t.mHeight;
-    const bool opaque =
-        std::all_of(t.pcData, t.pcData + count, [](const aiTexel& x) { return x.a == 255; });
-    const int channels = opaque ? 3 : 4;
-    std::vector<uint8_t> texels(count * channels);
-    for (size_t i = 0; i < count; ++i) {
-      const aiTexel& x = t.pcData[i];
-      uint8_t* d = &texels[i * channels];
-      d[0] = x.r, d[1] = x.g, d[2] = x.b;
-      if (!opaque) d[3] = x.a;
-    }
-    const OIIO::ImageSpec spec(int(t.mWidth), int(t.mHeight), channels, OIIO::TypeDesc::UINT8);
-    return embedded_png(name, spec, OIIO::TypeDesc::UINT8, texels.data());
+    return images_[cache_key] = int(scene_.images.size() - 1);
   }
 
   TextureRef texture(const aiMaterial& m, aiTextureType type) {
@@ -282,8 +295,20 @@ class AssimpScene {
       mat.base_color_factor[3] *= opacity;
       mat.alpha_mode = AlphaMode::kBlend;
     }
+    // Half-Life's masked textures (grates, foliage): palette entry 255 is cut out. assimp says
+    // so with the texture flag UseAlpha and the entry's colour as the transparent colour; its
+    // texels are all opaque.
+    int flags = 0;
+    aiColor3D key;
+    const bool keyed = m.Get(AI_MATKEY_TEXFLAGS(aiTextureType_DIFFUSE, 0), flags) == AI_SUCCESS &&
+                       (flags & aiTextureFlags_UseAlpha) &&
+                       m.Get(AI_MATKEY_COLOR_TRANSPARENT, key) == AI_SUCCESS;
+    colour_key_ = keyed ? &key : nullptr;
     mat.base_color_texture = texture(m, aiTextureType_BASE_COLOR);
     if (!mat.base_color_texture.valid()) mat.base_color_texture = texture(m, aiTextureType_DIFFUSE);
+    colour_key_ = nullptr;
+    if (keyed && mat.base_color_texture.valid() && mat.alpha_mode == AlphaMode::kOpaque)
+      mat.alpha_mode = AlphaMode::kMask;
     mat.normal_texture = texture(m, aiTextureType_NORMALS);
     if (!mat.normal_texture.valid() && m.GetTextureCount(aiTextureType_HEIGHT) > 0)
       warn("material '" + mat.name + "': a height (bump) map is ignored (only normal maps bake)");
@@ -388,6 +413,7 @@ class AssimpScene {
   std::string path_, folder_;
   const aiScene& ai_;
   Dropped dropped_;
+  const aiColor3D* colour_key_ = nullptr;  // see image_for
   Scene scene_;
   std::map<std::string, int> images_;
   std::map<std::vector<unsigned>, int> meshes_;

@@ -8,6 +8,9 @@
 #include "common/status.h"
 #include "scene/scene.h"
 
+struct aiColor3D;  // assimp's, for embedded_texels_png
+struct aiTexture;
+
 namespace vt::scene::detail {
 
 // kInvalidArgument when something other than a regular file is at `path` (never opened: a
@@ -68,6 +71,11 @@ Expected<Scene> load_drc(const std::string& path);
 Expected<Scene> load_ac3d(const std::string& path);
 // Any other format assimp reads (FBX, COLLADA, 3DS, ...; glTF 1.0).
 Expected<Scene> load_assimp(const std::string& path);
+// An uncompressed assimp texture (aiTexels, BGRA, rows top first: Half-Life's and Quake's
+// palette skins) as an embedded PNG, RGB when every texel is opaque; with `colour_key` (a
+// Half-Life masked texture's transparent colour, 0-1 or 0-255) texels of that colour get alpha 0.
+Expected<Image> embedded_texels_png(const aiTexture& t, const std::string& name,
+                                    const aiColor3D* colour_key = nullptr);
 bool assimp_reads(const std::string& extension);  // lower case, without the dot
 // Decodes a Draco-compressed mesh into a primitive. attribute_ids maps glTF attribute names
 // (POSITION, NORMAL, TEXCOORD_n, COLOR_0, TANGENT) to Draco unique ids; when empty the Draco

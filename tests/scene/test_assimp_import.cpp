@@ -1,6 +1,7 @@
 // Scenes read through assimp (COLLADA and STL written by the tests), glTF 1.0 routed to it, and
 // the texture-path resolution every importer shares (Windows separators, letter case, absolute
 // paths from the author's machine).
+#include <assimp/texture.h>
 #include <assimp/version.h>
 #include <gtest/gtest.h>
 
@@ -379,6 +380,34 @@ TEST(AssimpImport, UncompressedEmbeddedSkinsBecomeImages) {
     EXPECT_GT(uv[1], 0.0f);
     EXPECT_LT(uv[1], 0.5f);
   }
+}
+
+// Half-Life's masked textures (palette entry 255 cut out): assimp gives opaque texels, the
+// texture flag UseAlpha and the entry's colour as the material's transparent colour, in 0-255.
+// Those texels get alpha 0 (the material then bakes as MASK); without a key the PNG stays RGB.
+TEST(AssimpImport, ColourKeyedEmbeddedTexelsGetAlpha) {
+  aiTexture t;
+  t.mWidth = 2;
+  t.mHeight = 1;
+  t.pcData = new aiTexel[2];
+  t.pcData[0] = {255, 0, 0, 255};  // b g r a: the key, pure blue
+  t.pcData[1] = {0, 0, 255, 255};  // red
+  for (const aiColor3D& key : {aiColor3D(0, 0, 255), aiColor3D(0, 0, 1)}) {
+    auto keyed = scene::detail::embedded_texels_png(t, "masked", &key);
+    ASSERT_TRUE(keyed.ok()) << keyed.status().message();
+    auto texels = scene::load_float_image(*keyed);
+    ASSERT_TRUE(texels.ok()) << texels.status().message();
+    ASSERT_EQ(texels->channels, 4u);
+    EXPECT_EQ(texels->at(0, 0)[3], 0.0f);
+    EXPECT_EQ(texels->at(0, 0)[2], 1.0f);  // the colour under the cut stays as stored
+    EXPECT_EQ(texels->at(1, 0)[3], 1.0f);
+    EXPECT_EQ(texels->at(1, 0)[0], 1.0f);
+  }
+  auto plain = scene::detail::embedded_texels_png(t, "plain");
+  ASSERT_TRUE(plain.ok()) << plain.status().message();
+  auto texels = scene::load_float_image(*plain);
+  ASSERT_TRUE(texels.ok()) << texels.status().message();
+  EXPECT_EQ(texels->channels, 3u);
 }
 
 // A Quake 2 model (IDP2) that names no skin: the game assigns one. assimp names a placeholder
