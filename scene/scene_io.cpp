@@ -533,6 +533,20 @@ Expected<Scene> load_scene(const std::string& path, const SceneLoadOptions& opti
   if (from_texture_folders > 1)
     scene.warnings.push_back(path + ": " + std::to_string(from_texture_folders) +
                              " images in all read from the --texture-path folders");
+  // PCX images (Quake 2's skins) become embedded PNGs: OpenImageIO has no PCX reader.
+  for (Image& image : scene.images) {
+    if (image.embedded() || detail::lower_extension(image.path) != "pcx" ||
+        !detail::exists(image.path))
+      continue;
+    Expected<Image> png = detail::pcx_as_png(image.path);
+    if (!png.ok()) {
+      scene.warnings.push_back(png.status().message());  // the texture's read then fails
+      continue;
+    }
+    image.bytes = std::move(png->bytes);
+    image.mime_type = png->mime_type;
+    image.path.clear();
+  }
   detail::warn_about_degenerate_geometry(&scene);
   return scene;
 }

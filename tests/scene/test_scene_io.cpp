@@ -9,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "scene/image_load.h"
 #include "tests/unwrap/mesh_gen.h"
 
 namespace vt::test {
@@ -414,6 +415,71 @@ TEST(SceneIo, UnwrappedSceneSurvivesGlbRoundTrip) {
 
 // Embedded images are read by a name whose extension picks the decoder: MIME type first, then
 // the bytes' magic (a .glb image with a missing or wrong mimeType), PNG last.
+// PCX images (Quake 2's skins; OpenImageIO has no reader for them) are decoded at load and
+// carried as embedded PNGs: a 256-colour image (run-length runs, the palette at the end) and a
+// 24-bit one (three planes, a byte of 0xC0 or more escaped as a run of one).
+TEST(SceneIo, PcxTexturesAreReadAsEmbeddedImages) {
+  auto header = [](int w, int h, int planes, int line_bytes) {
+    std::string b(128, '\0');
+    b[0] = 0x0a, b[1] = 5, b[2] = 1, b[3] = 8;
+    b[8] = char(w - 1), b[10] = char(h - 1);
+    b[65] = char(planes), b[66] = char(line_bytes);
+    return b;
+  };
+  // 3 x 2, indices {1 2 1} {2 2 1}; lines padded to 4 bytes.
+  std::string pal = header(3, 2, 1, 4) + std::string("\x01\x02\x01\x00\xc2\x02\x01\x00", 8);
+  std::string palette(768, '\0');
+  palette[3] = char(255);  // 1: red
+  palette[8] = char(255);  // 2: blue
+  pal += '\x0c' + palette;
+  write_text(temp("pal.pcx"), pal);
+  // 3 x 1 RGB: R {200 20 30}, G {40 50 60}, B {70 80 90}.
+  write_text(
+      temp("rgb.pcx"),
+      header(3, 1, 3, 4) + std::string("\xc1\xc8\x14\x1e\x00\x28\x32\x3c\x00\x46\x50\x5a\x00", 13));
+  write_text(temp("pcx.mtl"), "newmtl pal\nmap_Kd " + temp("pal.pcx") + "\nnewmtl rgb\nmap_Kd " +
+                                  temp("rgb.pcx") + "\n");
+  auto s = write_and_load("pcx.obj", "mtllib " + temp("pcx.mtl") +
+                                         "\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                                         "usemtl pal\nf 1/1 2/2 3/3\nusemtl rgb\nf 1/1 3/3 2/2\n");
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  ASSERT_EQ(s->images.size(), 2u);
+  auto texels = [&](int i) {
+    EXPECT_TRUE(s->images[i].embedded());
+    EXPECT_EQ(s->images[i].mime_type, "image/png");
+    auto t = scene::load_float_image(s->images[i]);
+    EXPECT_TRUE(t.ok()) << t.status().message();
+    return t.ok() ? *t : scene::FloatImage{};
+  };
+  const scene::FloatImage p = texels(0);
+  ASSERT_EQ(p.width, 3u);
+  ASSERT_EQ(p.height, 2u);
+  const int want[2][3] = {{1, 2, 1}, {2, 2, 1}};  // 1 red, 2 blue
+  for (uint32_t y = 0; y < 2; ++y)
+    for (uint32_t x = 0; x < 3; ++x) {
+      EXPECT_EQ(p.at(x, y)[0], want[y][x] == 1 ? 1.0f : 0.0f) << x << " " << y;
+      EXPECT_EQ(p.at(x, y)[2], want[y][x] == 2 ? 1.0f : 0.0f) << x << " " << y;
+    }
+  const scene::FloatImage c = texels(1);
+  ASSERT_EQ(c.width, 3u);
+  ASSERT_EQ(c.height, 1u);
+  const int rgb[3][3] = {{200, 40, 70}, {20, 50, 80}, {30, 60, 90}};
+  for (uint32_t x = 0; x < 3; ++x)
+    for (int ch = 0; ch < 3; ++ch)
+      EXPECT_NEAR(c.at(x, 0)[ch] * 255.0f, rgb[x][ch], 1e-3) << x << " " << ch;
+  // A PCX kind it does not read: a warning naming the file; the image stays a file.
+  std::string ega = header(3, 1, 4, 4);
+  ega[3] = 1;
+  write_text(temp("pal.pcx"), ega + std::string(16, '\0'));
+  auto warned = scene::load_scene(temp("pcx.obj"));
+  ASSERT_TRUE(warned.ok()) << warned.status().message();
+  EXPECT_FALSE(warned->images[0].embedded());
+  bool found = false;
+  for (const std::string& w : warned->warnings)
+    found |= w.find("pal.pcx: not a readable PCX image (1 bits x 4 planes") != w.npos;
+  EXPECT_TRUE(found);
+}
+
 TEST(EmbeddedImage, ExtensionFromMimeTypeThenMagic) {
   scene::Image img;
   img.mime_type = "image/jpeg";
