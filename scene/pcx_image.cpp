@@ -40,6 +40,10 @@ Expected<Image> pcx_as_png(const std::string& path) {
   if (paletted && (end < kHeader || bytes[end] != 0x0c)) return bad("no 256-colour palette");
   // Each scan line holds every plane's line_bytes in turn; run-length runs may cross lines.
   const size_t line = size_t(planes) * line_bytes;
+  // A run is two bytes for at most 63: a crafted header cannot ask for more than that.
+  if (line * height / (encoding == 1 ? 63 : 1) > end - kHeader)
+    return bad(std::to_string(width) + " x " + std::to_string(height) +
+               " texels need more data than the file holds");
   std::vector<uint8_t> raw(line * height);
   size_t at = kHeader, out = 0;
   while (out < raw.size()) {

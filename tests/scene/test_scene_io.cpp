@@ -467,6 +467,18 @@ TEST(SceneIo, PcxTexturesAreReadAsEmbeddedImages) {
   for (uint32_t x = 0; x < 3; ++x)
     for (int ch = 0; ch < 3; ++ch)
       EXPECT_NEAR(c.at(x, 0)[ch] * 255.0f, rgb[x][ch], 1e-3) << x << " " << ch;
+  // A header asking for 65,535 x 65,536 texels of four planes from a few bytes.
+  std::string huge = header(1, 1, 4, 255);
+  huge[8] = char(254), huge[9] = huge[10] = huge[11] = char(255);  // 65,535 x 65,536
+  huge[66] = huge[67] = char(255);
+  write_text(temp("rgb.pcx"), huge + std::string(64, '\xff'));
+  auto big = scene::load_scene(temp("pcx.obj"));
+  ASSERT_TRUE(big.ok()) << big.status().message();
+  EXPECT_FALSE(big->images[1].embedded());
+  bool refused = false;
+  for (const std::string& w : big->warnings)
+    refused |= w.find("65535 x 65536 texels need more data than the file holds") != w.npos;
+  EXPECT_TRUE(refused);
   // A PCX kind it does not read: a warning naming the file; the image stays a file.
   std::string ega = header(3, 1, 4, 4);
   ega[3] = 1;
