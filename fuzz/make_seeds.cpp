@@ -247,6 +247,23 @@ void ac3d_seeds(const fs::path& dir) {
             "0 0 0\n1 1 0\nSURF 0x2\nmat 0\nrefs 2\n0 0 0\n1 1 0\nkids 0\n");
 }
 
+void pcx_seeds(const fs::path& dir) {
+  auto header = [](int w, int h, int planes, int line_bytes) {
+    std::string b(128, '\0');
+    b[0] = 0x0a, b[1] = 5, b[2] = 1, b[3] = 8;
+    b[8] = char(w - 1), b[10] = char(h - 1);
+    b[65] = char(planes), b[66] = char(line_bytes);
+    return b;
+  };
+  std::string palette(768, '\0');
+  for (int i = 0; i < 768; ++i) palette[i] = char(i / 3);
+  write(dir / "palette.pcx",
+        header(3, 2, 1, 4) + std::string("\x01\x02\x01\x00\xc2\x02\x01\x00", 8) + '\x0c' + palette);
+  write(
+      dir / "rgb.pcx",
+      header(3, 1, 3, 4) + std::string("\xc1\xc8\x14\x1e\x00\x28\x32\x3c\x00\x46\x50\x5a\x00", 13));
+}
+
 }  // namespace
 }  // namespace vt::fuzz
 
@@ -254,7 +271,7 @@ int main(int argc, char** argv) {
   using namespace vt::fuzz;
   if (argc != 2) fail("usage: vt_fuzz_seeds DIR");
   const fs::path root = argv[1];
-  for (const char* t : {"page_file", "dct", "gltf", "obj", "ply", "ac3d", "scratch"})
+  for (const char* t : {"page_file", "dct", "gltf", "obj", "ply", "ac3d", "pcx", "scratch"})
     fs::create_directories(root / t);
   page_file_seeds(root / "page_file");
   dct_seeds(root / "dct");
@@ -262,6 +279,7 @@ int main(int argc, char** argv) {
   obj_seeds(root / "obj");
   ply_seeds(root / "ply");
   ac3d_seeds(root / "ac3d");
+  pcx_seeds(root / "pcx");
   fs::remove_all(root / "scratch");
   return 0;
 }

@@ -33,6 +33,7 @@ targets=(
   "obj obj obj.dict 65536"
   "ply ply ply.dict 65536"
   "ac3d ac3d ac3d.dict 65536"
+  "pcx pcx - 65536"
 )
 
 run_one() {
