@@ -15,6 +15,7 @@
 #include "scene/gltf_export.h"
 #include "scene/scene.h"
 #include "scene/scene_io_util.h"
+#include "tests/scene/pcx_files.h"
 
 namespace vt::fuzz {
 namespace {
@@ -248,20 +249,8 @@ void ac3d_seeds(const fs::path& dir) {
 }
 
 void pcx_seeds(const fs::path& dir) {
-  auto header = [](int w, int h, int planes, int line_bytes) {
-    std::string b(128, '\0');
-    b[0] = 0x0a, b[1] = 5, b[2] = 1, b[3] = 8;
-    b[8] = char(w - 1), b[10] = char(h - 1);
-    b[65] = char(planes), b[66] = char(line_bytes);
-    return b;
-  };
-  std::string palette(768, '\0');
-  for (int i = 0; i < 768; ++i) palette[i] = char(i / 3);
-  write(dir / "palette.pcx",
-        header(3, 2, 1, 4) + std::string("\x01\x02\x01\x00\xc2\x02\x01\x00", 8) + '\x0c' + palette);
-  write(
-      dir / "rgb.pcx",
-      header(3, 1, 3, 4) + std::string("\xc1\xc8\x14\x1e\x00\x28\x32\x3c\x00\x46\x50\x5a\x00", 13));
+  write(dir / "palette.pcx", test::pcx_paletted_3x2());
+  write(dir / "rgb.pcx", test::pcx_rgb_3x1());
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "scene/image_load.h"
+#include "tests/scene/pcx_files.h"
 #include "tests/unwrap/mesh_gen.h"
 
 namespace vt::test {
@@ -419,24 +420,8 @@ TEST(SceneIo, UnwrappedSceneSurvivesGlbRoundTrip) {
 // carried as embedded PNGs: a 256-colour image (run-length runs, the palette at the end) and a
 // 24-bit one (three planes, a byte of 0xC0 or more escaped as a run of one).
 TEST(SceneIo, PcxTexturesAreReadAsEmbeddedImages) {
-  auto header = [](int w, int h, int planes, int line_bytes) {
-    std::string b(128, '\0');
-    b[0] = 0x0a, b[1] = 5, b[2] = 1, b[3] = 8;
-    b[8] = char(w - 1), b[10] = char(h - 1);
-    b[65] = char(planes), b[66] = char(line_bytes);
-    return b;
-  };
-  // 3 x 2, indices {1 2 1} {2 2 1}; lines padded to 4 bytes.
-  std::string pal = header(3, 2, 1, 4) + std::string("\x01\x02\x01\x00\xc2\x02\x01\x00", 8);
-  std::string palette(768, '\0');
-  palette[3] = char(255);  // 1: red
-  palette[8] = char(255);  // 2: blue
-  pal += '\x0c' + palette;
-  write_text(temp("pal.pcx"), pal);
-  // 3 x 1 RGB: R {200 20 30}, G {40 50 60}, B {70 80 90}.
-  write_text(
-      temp("rgb.pcx"),
-      header(3, 1, 3, 4) + std::string("\xc1\xc8\x14\x1e\x00\x28\x32\x3c\x00\x46\x50\x5a\x00", 13));
+  write_text(temp("pal.pcx"), pcx_paletted_3x2());
+  write_text(temp("rgb.pcx"), pcx_rgb_3x1());
   write_text(temp("pcx.mtl"), "newmtl pal\nmap_Kd " + temp("pal.pcx") + "\nnewmtl rgb\nmap_Kd " +
                                   temp("rgb.pcx") + "\n");
   auto s = write_and_load("pcx.obj", "mtllib " + temp("pcx.mtl") +
@@ -468,7 +453,7 @@ TEST(SceneIo, PcxTexturesAreReadAsEmbeddedImages) {
     for (int ch = 0; ch < 3; ++ch)
       EXPECT_NEAR(c.at(x, 0)[ch] * 255.0f, rgb[x][ch], 1e-3) << x << " " << ch;
   // A header asking for 65,535 x 65,536 texels of four planes from a few bytes.
-  std::string huge = header(1, 1, 4, 255);
+  std::string huge = pcx_header(1, 1, 4, 255);
   huge[8] = char(254), huge[9] = huge[10] = huge[11] = char(255);  // 65,535 x 65,536
   huge[66] = huge[67] = char(255);
   write_text(temp("rgb.pcx"), huge + std::string(64, '\xff'));
@@ -480,7 +465,7 @@ TEST(SceneIo, PcxTexturesAreReadAsEmbeddedImages) {
     refused |= w.find("65535 x 65536 texels need more data than the file holds") != w.npos;
   EXPECT_TRUE(refused);
   // A PCX kind it does not read: a warning naming the file; the image stays a file.
-  std::string ega = header(3, 1, 4, 4);
+  std::string ega = pcx_header(3, 1, 4, 4);
   ega[3] = 1;
   write_text(temp("pal.pcx"), ega + std::string(16, '\0'));
   auto warned = scene::load_scene(temp("pcx.obj"));
