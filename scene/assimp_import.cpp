@@ -184,9 +184,9 @@ class AssimpScene {
 
   // The image for a texture path: an embedded texture ("*N" or a name assimp holds) or a file
   // beside the scene; one Scene::Image per distinct path.
-  // While colour_key_ is set, uncompressed texels of that colour become transparent.
-  int image_for(const std::string& raw) {
-    const std::string cache_key = colour_key_ ? raw + "\n(colour-keyed)" : raw;
+  // With `colour_key`, uncompressed texels of that colour become transparent.
+  int image_for(const std::string& raw, const aiColor3D* colour_key) {
+    const std::string cache_key = colour_key ? raw + "\n(colour-keyed)" : raw;
     auto it = images_.find(cache_key);
     if (it != images_.end()) return it->second;
     Image image;
@@ -198,7 +198,7 @@ class AssimpScene {
         image.mime_type = mime_from_hint(t->achFormatHint);
       } else {
         // Texels (Half-Life and Quake models' palette skins, which assimp expands): a PNG.
-        Expected<Image> png = embedded_texels_png(*t, image.name, colour_key_);
+        Expected<Image> png = embedded_texels_png(*t, image.name, colour_key);
         if (!png.ok()) {
           warn("embedded texture '" + raw + "': " + png.status().message() + "; slot left empty");
           return images_[cache_key] = -1;
@@ -216,7 +216,8 @@ class AssimpScene {
     return images_[cache_key] = int(scene_.images.size() - 1);
   }
 
-  TextureRef texture(const aiMaterial& m, aiTextureType type) {
+  TextureRef texture(const aiMaterial& m, aiTextureType type,
+                     const aiColor3D* colour_key = nullptr) {
     TextureRef ref;
     if (m.GetTextureCount(type) == 0) return ref;
     aiString file;
@@ -256,7 +257,7 @@ class AssimpScene {
            "': a texture with non-UV (projected) mapping is ignored");
       return ref;
     }
-    ref.image = image_for(written);
+    ref.image = image_for(written, colour_key);
     if (ref.image < 0) return {};
     ref.texcoord = int(uv_index);
     ref.wrap_s = wrap_mode(modes[0]);
@@ -303,10 +304,10 @@ class AssimpScene {
     const bool keyed = m.Get(AI_MATKEY_TEXFLAGS(aiTextureType_DIFFUSE, 0), flags) == AI_SUCCESS &&
                        (flags & aiTextureFlags_UseAlpha) &&
                        m.Get(AI_MATKEY_COLOR_TRANSPARENT, key) == AI_SUCCESS;
-    colour_key_ = keyed ? &key : nullptr;
-    mat.base_color_texture = texture(m, aiTextureType_BASE_COLOR);
-    if (!mat.base_color_texture.valid()) mat.base_color_texture = texture(m, aiTextureType_DIFFUSE);
-    colour_key_ = nullptr;
+    const aiColor3D* colour_key = keyed ? &key : nullptr;
+    mat.base_color_texture = texture(m, aiTextureType_BASE_COLOR, colour_key);
+    if (!mat.base_color_texture.valid())
+      mat.base_color_texture = texture(m, aiTextureType_DIFFUSE, colour_key);
     if (keyed && mat.base_color_texture.valid() && mat.alpha_mode == AlphaMode::kOpaque)
       mat.alpha_mode = AlphaMode::kMask;
     mat.normal_texture = texture(m, aiTextureType_NORMALS);
@@ -413,7 +414,6 @@ class AssimpScene {
   std::string path_, folder_;
   const aiScene& ai_;
   Dropped dropped_;
-  const aiColor3D* colour_key_ = nullptr;  // see image_for
   Scene scene_;
   std::map<std::string, int> images_;
   std::map<std::vector<unsigned>, int> meshes_;
