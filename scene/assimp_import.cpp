@@ -60,31 +60,64 @@ std::string mime_from_hint(const char* hint) {
   return h.empty() ? std::string() : "image/" + h;
 }
 
-// Files that start with a UTF-16 byte-order mark, handed to assimp as UTF-8: its XML readers
-// (COLLADA; Irrlicht's .irr scenes, which Irrlicht writes in UTF-16) and its ASE reader take the
-// bytes as UTF-8, and failed ("malformed XML", "No meshes remaining").
-class Utf16AsUtf8Files : public Assimp::DefaultIOSystem {
+// Quake 2 models (MD2) whose last section ends at the end of the file: assimp 5.2 counts a
+// section ending there as outside the file (`>=` where `>` is meant: "Invalid MD2 header: Some
+// offsets are outside the file"), so every MD2 without GL commands after its frames was refused
+// (UFO: Alien Invasion's 859 models nearly all). True when the header's sections all lie in the
+// file and one of those assimp checks ends exactly at its end.
+bool md2_ends_at_its_last_section(const std::vector<uint8_t>& bytes) {
+  if (bytes.size() < 68 || std::memcmp(bytes.data(), "IDP2", 4) != 0) return false;
+  const auto field = [&](int i) {
+    uint32_t v;
+    std::memcpy(&v, &bytes[4 + 4 * i], 4);
+    return uint64_t(v);
+  };
+  // skins, texture coordinates, triangles, frames (assimp's sizes; a frame is 40 bytes + 4 a
+  // vertex), GL commands.
+  const uint64_t ends[5] = {field(10) + field(4) * 64, field(11) + field(6) * 4,
+                            field(12) + field(7) * 12, field(13) + field(9) * (40 + 4 * field(5)),
+                            field(14) + field(8) * 4};
+  const uint64_t size = bytes.size();
+  return std::all_of(std::begin(ends), std::end(ends), [&](uint64_t e) { return e <= size; }) &&
+         field(15) <= size && std::any_of(ends, ends + 4, [&](uint64_t e) { return e == size; });
+}
+
+// Files handed to assimp as its readers need them:
+// - files that start with a UTF-16 byte-order mark, as UTF-8: its XML readers (COLLADA;
+//   Irrlicht's .irr scenes, which Irrlicht writes in UTF-16) and its ASE reader take the bytes
+//   as UTF-8, and failed ("malformed XML", "No meshes remaining");
+// - MD2 models whose last section ends the file, with one zero byte after it (above).
+class FilesAsAssimpReadsThem : public Assimp::DefaultIOSystem {
  public:
   Assimp::IOStream* Open(const char* file, const char* mode) override {
     Assimp::IOStream* stream = DefaultIOSystem::Open(file, mode);
-    uint8_t mark[2] = {};
-    const bool utf16 =
-        stream && mode[0] == 'r' && stream->FileSize() >= 2 && stream->Read(mark, 1, 2) == 2 &&
-        ((mark[0] == 0xff && mark[1] == 0xfe) || (mark[0] == 0xfe && mark[1] == 0xff));
-    if (stream) stream->Seek(0, aiOrigin_SET);
-    if (!utf16) return stream;
-    std::vector<uint8_t> bytes(stream->FileSize());
-    bytes.resize(stream->Read(bytes.data(), 1, bytes.size()));
-    std::string note;
-    const Expected<std::string> text = decode_text(bytes, file, &note);
-    if (!text.ok()) {  // odd-length UTF-16: assimp's own error says what it finds
-      stream->Seek(0, aiOrigin_SET);
+    uint8_t mark[4] = {};
+    if (!stream || mode[0] != 'r' || stream->FileSize() < 4 || stream->Read(mark, 1, 4) != 4) {
+      if (stream) stream->Seek(0, aiOrigin_SET);
       return stream;
     }
+    stream->Seek(0, aiOrigin_SET);
+    const bool utf16 = (mark[0] == 0xff && mark[1] == 0xfe) || (mark[0] == 0xfe && mark[1] == 0xff);
+    const bool md2 = std::memcmp(mark, "IDP2", 4) == 0;
+    if (!utf16 && !md2) return stream;
+    std::vector<uint8_t> bytes(stream->FileSize());
+    bytes.resize(stream->Read(bytes.data(), 1, bytes.size()));
+    stream->Seek(0, aiOrigin_SET);
+    std::string served;
+    if (utf16) {
+      std::string note;
+      Expected<std::string> text = decode_text(bytes, file, &note);
+      if (!text.ok()) return stream;  // odd-length UTF-16: assimp's own error says what it finds
+      served = std::move(*text);
+    } else {
+      if (!md2_ends_at_its_last_section(bytes)) return stream;
+      served.assign(bytes.begin(), bytes.end());
+      served.push_back('\0');
+    }
     Close(stream);
-    auto* copy = new uint8_t[text->size()];
-    std::memcpy(copy, text->data(), text->size());
-    return new Assimp::MemoryIOStream(copy, text->size(), /*own=*/true);
+    auto* copy = new uint8_t[served.size()];
+    std::memcpy(copy, served.data(), served.size());
+    return new Assimp::MemoryIOStream(copy, served.size(), /*own=*/true);
   }
 };
 
@@ -523,7 +556,7 @@ Expected<Scene> load_assimp(const std::string& path) {
             "in 5.3); bake the meshes the scene names (.3ds, .x, .b3d, .obj) instead");
   if (ext == "off") VT_RETURN_IF_ERROR(check_off_counts(path));
   Assimp::Importer importer;
-  importer.SetIOHandler(new Utf16AsUtf8Files);  // the importer owns it
+  importer.SetIOHandler(new FilesAsAssimpReadsThem);  // the importer owns it
   // Points and lines are dropped by SortByPType; normals are made only where a mesh has none.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                               aiPrimitiveType_POINT | aiPrimitiveType_LINE);

@@ -360,6 +360,17 @@ std::string resolve_written_path(const std::string& folder, const std::string& w
     *note = "'" + written + "' not found; using '" + other + "' (same name, another extension)";
     return other;
   }
+  // UFO: Alien Invasion's MD2 skins: ".name" is the image `name` beside the model, of any
+  // extension (the game's convention; Quake 2's own skins are paths).
+  if (s.size() > 1 && s[0] == '.' && s[1] != '.' && s.find('/') == std::string::npos) {
+    const std::string found = resolve_written_path(folder, s.substr(1), note);
+    if (exists(found)) {
+      *note = "'" + written + "' not found; using '" + found +
+              "' (a leading dot: the name beside the model, any extension)";
+      return found;
+    }
+    note->clear();
+  }
   return windows_absolute ? folder + base : as_written;
 }
 

@@ -30,6 +30,12 @@ void write_text(const fs::path& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
 }
 
+// True when one of the scene's warnings says `what`.
+bool warned(const scene::Scene& s, const std::string& what) {
+  return std::any_of(s.warnings.begin(), s.warnings.end(),
+                     [&](const std::string& w) { return w.find(what) != std::string::npos; });
+}
+
 // A COLLADA quad (two triangles) with UVs (`uvs`: four S T pairs), vertex colours and a diffuse
 // texture `image`, a node translated by (5, 0, 0).
 std::string collada_quad(const std::string& image, const std::string& uvs = "0 0 1 0 1 1 0 1") {
@@ -207,9 +213,7 @@ TEST(AssimpImport, AnimationKeysPastTheEndDoNotRefuseTheModel) {
   ASSERT_TRUE(s.ok()) << s.status().message();
   ASSERT_EQ(s->meshes.size(), 1u);
   EXPECT_EQ(s->meshes[0].primitives.at(0).positions.size(), 3u);
-  bool warned = false;
-  for (const std::string& w : s->warnings) warned |= w.find("1 animations ignored") != w.npos;
-  EXPECT_TRUE(warned);
+  EXPECT_TRUE(warned(*s, "1 animations ignored"));
 }
 
 TEST(AssimpImport, UvSetWithOneCoordinateEverywhereIsKept) {
@@ -287,9 +291,7 @@ TEST(AssimpImport, Gltf1IsReadThroughAssimp) {
   auto s = scene::load_scene((d / "tri.gltf").string());
   ASSERT_TRUE(s.ok()) << s.status().message();
   EXPECT_EQ(s->triangle_count(), 1u);
-  bool noted = false;
-  for (const auto& w : s->warnings) noted |= w.find("glTF 1.0") != std::string::npos;
-  EXPECT_TRUE(noted);
+  EXPECT_TRUE(warned(*s, "glTF 1.0"));
 }
 
 // 3ds Max's COLLADA exporter writes <transparency> inverted: opacity 0 would hide the whole
@@ -311,9 +313,7 @@ TEST(AssimpImport, ColladaOpacityZeroIsReadAsOpaque) {
   const scene::Material& m = s->materials[0];
   EXPECT_EQ(m.alpha_mode, scene::AlphaMode::kOpaque);
   EXPECT_FLOAT_EQ(m.base_color_factor[3], 1.0f);
-  bool warned = false;
-  for (const std::string& w : s->warnings) warned |= w.find("opacity 0") != std::string::npos;
-  EXPECT_TRUE(warned);
+  EXPECT_TRUE(warned(*s, "opacity 0"));
 }
 
 // Little-endian binary helpers for the Quake model files below.
@@ -410,30 +410,33 @@ TEST(AssimpImport, ColourKeyedEmbeddedTexelsGetAlpha) {
   EXPECT_EQ(texels->channels, 3u);
 }
 
-// A Quake 2 model (IDP2) that names no skin: the game assigns one. assimp names a placeholder
-// ('$texture_dummy.bmp') that the bake refused as a missing file. Now the surfaces bake from the
-// material's colour with a warning, or from an image of the model's name beside it.
-TEST(AssimpImport, Md2WithoutSkinTakesTheImageOfItsName) {
-  fs::path d = fresh_dir("md2_skin");
-  const int32_t frame_size = 40 + 3 * 4;
-  std::string md2 = "IDP2" + le32({8, 8, 8, frame_size, 0, 3, 3, 1, 1, 1});
-  const int32_t st = 68, tris = st + 3 * 4, frames = tris + 12, gl = frames + frame_size;
-  md2 += le32({st, st, tris, frames, gl, gl + 4});
+// A Quake 2 model (IDP2) of one triangle, naming `skin` (none when empty), its frame followed by
+// the GL commands' end marker or, as UFO: Alien Invasion's models are, ending the file.
+std::string quake2_triangle(const std::string& skin, bool gl_commands) {
+  const int32_t frame_size = 40 + 3 * 4, skins = skin.empty() ? 0 : 1;
+  std::string md2 = "IDP2" + le32({8, 8, 8, frame_size, skins, 3, 3, 1, gl_commands ? 1 : 0, 1});
+  const int32_t st = 68 + 64 * skins, tris = st + 3 * 4, frames = tris + 12,
+                gl = frames + frame_size;
+  md2 += le32({68, st, tris, frames, gl_commands ? gl : 0, gl_commands ? gl + 4 : gl});
+  if (skins) md2 += skin + std::string(64 - skin.size(), '\0');
   md2 += std::string("\1\0\1\0\6\0\1\0\1\0\6\0", 12);      // s t of three vertices (short)
   md2 += std::string("\0\0\1\0\2\0\0\0\1\0\2\0", 12);      // vertex and UV indices (short)
   md2 += lef({1, 1, 1, 0, 0, 0}) + std::string(16, '\0');  // scale, translate, name
   md2 += std::string("\0\0\0\0\10\0\0\0\0\10\0\0", 12);    // three vertices (x y z, normal)
-  md2 += le32({0});                                        // the GL commands' end
-  write_text(d / "guy.md2", md2);
+  if (gl_commands) md2 += le32({0});
+  return md2;
+}
+
+// A Quake 2 model that names no skin: the game assigns one. assimp names a placeholder
+// ('$texture_dummy.bmp') that the bake refused as a missing file. Now the surfaces bake from the
+// material's colour with a warning, or from an image of the model's name beside it.
+TEST(AssimpImport, Md2WithoutSkinTakesTheImageOfItsName) {
+  fs::path d = fresh_dir("md2_skin");
+  write_text(d / "guy.md2", quake2_triangle("", true));
   auto bare = scene::load_scene((d / "guy.md2").string());
   ASSERT_TRUE(bare.ok()) << bare.status().message();
   ASSERT_EQ(bare->materials.size(), 1u);
   EXPECT_FALSE(bare->materials[0].base_color_texture.valid());
-  auto warned = [](const scene::Scene& s, const std::string& what) {
-    bool found = false;
-    for (const std::string& w : s.warnings) found |= w.find(what) != std::string::npos;
-    return found;
-  };
   EXPECT_TRUE(warned(*bare, "names no skin (assimp's placeholder")) << bare->warnings.size();
   write_text(d / "Guy.BMP", "not read by the importer");
   auto skinned = scene::load_scene((d / "guy.md2").string());
@@ -442,6 +445,30 @@ TEST(AssimpImport, Md2WithoutSkinTakesTheImageOfItsName) {
   ASSERT_TRUE(ref.valid());
   EXPECT_EQ(fs::path(skinned->images.at(ref.image).path).filename(), "Guy.BMP");
   EXPECT_TRUE(warned(*skinned, "'Guy.BMP' beside it, of the model's name, is used"));
+}
+
+// UFO: Alien Invasion's models: no GL commands, so the frames end the file (assimp 5.2 refused
+// that as "offsets outside the file"), and skins named ".name": the image `name` beside the
+// model, of any extension.
+TEST(AssimpImport, Md2EndingAtItsFramesWithADottedSkinIsRead) {
+  fs::path d = fresh_dir("md2_ufoai");
+  write_text(d / "crate.md2", quake2_triangle(".crate_1", false));
+  write_text(d / "crate_1.png", "not read by the importer");
+  auto crate = scene::load_scene((d / "crate.md2").string());
+  ASSERT_TRUE(crate.ok()) << crate.status().message();
+  EXPECT_EQ(crate->triangle_count(), 1u);
+  const scene::TextureRef& ref = crate->materials.at(0).base_color_texture;
+  ASSERT_TRUE(ref.valid());
+  EXPECT_EQ(fs::path(crate->images.at(ref.image).path).filename(), "crate_1.png");
+  EXPECT_TRUE(warned(*crate, "(a leading dot: the name beside the model, any extension)"));
+  // A frame cut short is still refused by assimp: only a file that holds every section is padded.
+  std::string cut = quake2_triangle(".crate_1", false);
+  cut.resize(cut.size() - 2);
+  write_text(d / "cut.md2", cut);
+  auto refused = scene::load_scene((d / "cut.md2").string());
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.status().message().find("Invalid MD2 file"), std::string::npos)
+      << refused.status().message();
 }
 
 // An OFF file's counts are checked against its size before assimp allocates for them: assimp's
@@ -488,9 +515,7 @@ LightObject $light1 (type = "point") {Color (attrib = "light") {float[3] {{1.0, 
   ASSERT_TRUE(s.ok()) << s.status().message();
   EXPECT_EQ(s->triangle_count(), 1u);
   EXPECT_TRUE(s->lights.empty());
-  bool warned = false;
-  for (const std::string& w : s->warnings) warned |= w.find("lights ignored") != w.npos;
-  EXPECT_TRUE(warned);
+  EXPECT_TRUE(warned(*s, "lights ignored"));
 }
 
 // A mesh without vertices or faces (an STL's empty solid beside a real one, as assimp's own
@@ -505,10 +530,7 @@ TEST(AssimpImport, EmptyMeshesAreSkipped) {
   auto s = scene::load_scene((d / "two.stl").string());
   ASSERT_TRUE(s.ok()) << s.status().message();
   EXPECT_EQ(s->triangle_count(), 1u);
-  bool warned = false;
-  for (const std::string& w : s->warnings)
-    warned |= w.find("1 meshes without vertices or faces skipped") != w.npos;
-  EXPECT_TRUE(warned);
+  EXPECT_TRUE(warned(*s, "1 meshes without vertices or faces skipped"));
   write_text(d / "none.stl", "solid empty\nendsolid empty\n");
   auto none = scene::load_scene((d / "none.stl").string());
   ASSERT_FALSE(none.ok());
@@ -557,10 +579,7 @@ TEST(AssimpImport, MeshWithoutUvsUnderATexturedMaterialBakesFromItsFactors) {
   const scene::Material& m = s->materials[prim.material];
   EXPECT_EQ(m.name, "Painted");
   EXPECT_FALSE(m.base_color_texture.valid());
-  bool warned = false;
-  for (const std::string& w : s->warnings)
-    warned |= w.find("has no UV set for the textures of material 'Painted'") != std::string::npos;
-  EXPECT_TRUE(warned);
+  EXPECT_TRUE(warned(*s, "has no UV set for the textures of material 'Painted'"));
   // With its UVs the same quad keeps the texture (the copy is made only where UVs are missing).
   write_text(d / "quad.dae", collada_quad("wall.png"));
   auto with_uvs = scene::load_scene((d / "quad.dae").string());
