@@ -185,6 +185,7 @@ struct Renderer::Impl {
     Image image;
     VkDescriptorSet set = VK_NULL_HANDLE;
     uint32_t width = 0, height = 0, max_level = 0;
+    uint32_t levels_width = 0, levels_height = 0;  // ReferenceTexture's
     AddressMode mode = AddressMode::kClamp;
     bool sampler_addressing = false;     // a material sampler addresses the taps
     VkSampler sampler = VK_NULL_HANDLE;  // reference_sampler(); owned by Impl
@@ -327,6 +328,7 @@ Status Renderer::Impl::upload_pages(Image& cache, RuntimeFormat format,
 
 Expected<VkSampler> Renderer::Impl::reference_sampler(const ReferenceTexture& tex) {
   if (tex.sampler) return material_sampler(*tex.sampler);
+  if (tex.levels_width) return trilinear_repeat;  // the padding addresses the edges
   return tex.address_mode == AddressMode::kWrap ? trilinear_repeat : trilinear_clamp;
 }
 
@@ -711,6 +713,8 @@ Status Renderer::set_reference_textures(std::span<const ReferenceTexture> textur
     g.width = tex.width;
     g.height = tex.height;
     g.max_level = std::min(levels - 1, tex.max_level);
+    g.levels_width = tex.levels_width;
+    g.levels_height = tex.levels_height;
     g.mode = tex.address_mode;
     g.sampler_addressing = tex.sampler.has_value();
     VT_ASSIGN_OR_RETURN(VkSampler sampler, s.reference_sampler(tex));
@@ -943,12 +947,14 @@ Expected<ReferenceFrame> Renderer::render_reference(const Camera& camera) {
                               nullptr);
       Push p{};
       std::memcpy(p.mvp, camera.view_proj.m.data(), sizeof(p.mvp));
-      p.tex[0] = float(t.width);
-      p.tex[1] = float(t.height);
+      const bool file_levels = t.levels_width != 0;
+      p.tex[0] = float(file_levels ? t.levels_width : t.width);
+      p.tex[1] = float(file_levels ? t.levels_height : t.height);
       p.tex[2] = 1.0f;
       p.tex[3] = m.alpha_cutoff;
       p.misc[1] = t.sampler_addressing ? 2 : t.mode == AddressMode::kWrap ? 1 : 0;
       p.misc[2] = int32_t(t.max_level);
+      p.misc[3] = file_levels ? 1 : 0;
       draw_mesh(cmd, s.ref_layout, p, m);
     }
   }));

@@ -66,6 +66,12 @@ struct ReferenceTexture {
   AddressMode address_mode = AddressMode::kClamp;
   std::optional<TextureSampler> sampler;
   uint32_t max_level = ~0u;  // LOD clamp (the virtual texture's last level, to compare alike)
+  // Non-zero for a page file's levels (the exact check's level texture), whose sizes halve with
+  // ceil: level L's ceil(levels_width / 2^L) x ceil(levels_height / 2^L) texels lie in the
+  // top-left corner of mip L of the padded width x height chain, which a REPEAT sampler reads
+  // (the padding holds what the level's edges address), and each level is sampled at its own
+  // scale, as the virtual texture samples it (shaders/reference.frag).
+  uint32_t levels_width = 0, levels_height = 0;
 };
 
 // Builds a mip chain from level 0 by 2x box filtering (odd sizes: the last row/column is

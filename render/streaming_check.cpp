@@ -19,31 +19,48 @@ double ms_since(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
 }
 
-// The levels [first, end) the texture can hold: the finest one within max_side, then as long as
-// each level is the previous one halved with floor (Vulkan's mip sizes).
-std::pair<uint32_t, uint32_t> held_levels(const PageGeometry& g, uint32_t max_side) {
+// The finest level the texture holds: the first within max_side (the last level otherwise).
+uint32_t first_held_level(const PageGeometry& g, uint32_t max_side) {
   uint32_t first = 0;
   while (first + 1 < g.level_count() &&
          (g.level_width(first) > max_side || g.level_height(first) > max_side))
     ++first;
-  uint32_t end = first + 1;
-  while (end < g.level_count() &&
-         g.level_width(end) == std::max(1u, g.level_width(first) >> (end - first)) &&
-         g.level_height(end) == std::max(1u, g.level_height(first) >> (end - first)))
-    ++end;
-  return {first, end};
+  return first;
 }
 
-// One level's texels (RGBA8, level size) from its pages' payloads; absent pages from `coarser`
-// (the next level, already assembled), nearest.
+// A side of the padded chain holding `levels` file levels from one `side` texels long: a
+// multiple of 2^(levels - 1), so that every mip halves exactly, and at least 2 texels longer
+// than its level at each of them (side + 2^levels is): the padding's first texels are read past
+// the level's end, its last ones before texel 0 (a REPEAT sampler), as a page's border is.
+uint32_t padded_side(uint32_t side, uint32_t levels) {
+  const uint32_t align = 1u << (levels - 1);
+  return (side + (1u << levels) + align - 1) / align * align;
+}
+
+// Fills the texels of a mip (mw x mh) beyond its level (w x h, top-left) with the level's texels
+// addressed by `mode`, as the bake fills page borders past the atlas's edge.
+void fill_padding(std::vector<uint8_t>& t, uint32_t w, uint32_t h, uint32_t mw, uint32_t mh,
+                  AddressMode mode) {
+  const auto from = [&](uint32_t i, uint32_t n, uint32_t mn) {
+    if (i < n) return i;
+    const int64_t c = i - n < (mn - n) / 2 ? int64_t(i) : int64_t(i) - int64_t(mn);
+    return uint32_t(address_texel(c, n, mode));
+  };
+  for (uint32_t y = 0; y < mh; ++y)
+    for (uint32_t x = y < h ? w : 0; x < mw; ++x)
+      std::memcpy(&t[(size_t(y) * mw + x) * 4],
+                  &t[(size_t(from(y, h, mh)) * mw + from(x, w, mw)) * 4], 4);
+}
+
+// One level's texels (RGBA8) from its pages' payloads, in the top-left corner of a mip `stride`
+// texels wide; absent pages from `coarser` (the next level's mip, already assembled), nearest.
 Status assemble_level(const PageSource& source, const LayerSpec& spec, uint32_t layer,
-                      uint32_t level, const std::vector<uint8_t>* coarser, int threads,
-                      std::vector<uint8_t>& out, uint64_t& absent) {
+                      uint32_t level, const std::vector<uint8_t>* coarser, uint32_t stride,
+                      int threads, std::vector<uint8_t>& out, uint64_t& absent) {
   const PageGeometry& g = source.geometry();
   const uint32_t w = g.level_width(level), h = g.level_height(level);
   const uint32_t px = g.pages_x(level), P = g.payload, B = g.border, S = g.page_size();
-  const uint32_t ch = spec.channels;
-  out.assign(size_t(w) * h * 4, 0);
+  const uint32_t ch = spec.channels, coarse_stride = stride / 2;
   const size_t pages = g.pages_in_level(level);
   std::vector<Status> status(pages);
   std::vector<uint8_t> was_absent(pages, 0);
@@ -54,11 +71,10 @@ Status assemble_level(const PageSource& source, const LayerSpec& spec, uint32_t 
     if (!source.present(id)) {
       was_absent[k] = 1;
       if (!coarser) return;  // the last level is always present in a valid file
-      const uint32_t cw = g.level_width(level + 1);
       for (uint32_t y = y0; y < y1; ++y)
         for (uint32_t x = x0; x < x1; ++x)
-          std::memcpy(&out[(size_t(y) * w + x) * 4], &(*coarser)[(size_t(y / 2) * cw + x / 2) * 4],
-                      4);
+          std::memcpy(&out[(size_t(y) * stride + x) * 4],
+                      &(*coarser)[(size_t(y / 2) * coarse_stride + x / 2) * 4], 4);
       return;
     }
     thread_local std::vector<uint8_t> upload, texels;
@@ -68,7 +84,7 @@ Status assemble_level(const PageSource& source, const LayerSpec& spec, uint32_t 
     for (uint32_t y = y0; y < y1; ++y)
       for (uint32_t x = x0; x < x1; ++x) {
         const uint8_t* s = &texels[(size_t(y - y0 + B) * S + (x - x0 + B)) * ch];
-        uint8_t* d = &out[(size_t(y) * w + x) * 4];
+        uint8_t* d = &out[(size_t(y) * stride + x) * 4];
         for (uint32_t c = 0; c < 4; ++c) d[c] = c < ch ? s[c] : (c == 3 ? 255 : 0);
       }
   });
@@ -99,19 +115,25 @@ Expected<LevelTexture> assemble_level_texture(const PageSource& source, uint32_t
   LayerSpec spec;
   spec.channels = info->channels;
   spec.texel_type = TexelType::kU8;
-  const auto [first, end] = held_levels(g, max_side);
+  const uint32_t first = first_held_level(g, max_side), end = g.level_count();
   LevelTexture t;
   t.first_level = first;
-  t.level_count = g.level_count();
-  t.texture.width = g.level_width(first);
-  t.texture.height = g.level_height(first);
+  t.level_count = end;
+  t.texture.levels_width = g.level_width(first);
+  t.texture.levels_height = g.level_height(first);
+  t.texture.width = padded_side(t.texture.levels_width, end - first);
+  t.texture.height = padded_side(t.texture.levels_height, end - first);
   t.texture.address_mode = address_mode;
   t.texture.levels.resize(end - first);
   // Coarse to fine, so that an absent page's ancestor level is ready.
   for (uint32_t l = end; l-- > first;) {
     const std::vector<uint8_t>* coarser = l + 1 < end ? &t.texture.levels[l + 1 - first] : nullptr;
-    VT_RETURN_IF_ERROR(assemble_level(source, spec, layer, l, coarser, threads,
-                                      t.texture.levels[l - first], t.absent_pages));
+    const uint32_t mw = t.texture.width >> (l - first), mh = t.texture.height >> (l - first);
+    std::vector<uint8_t>& mip = t.texture.levels[l - first];
+    mip.assign(size_t(mw) * mh * 4, 0);
+    VT_RETURN_IF_ERROR(
+        assemble_level(source, spec, layer, l, coarser, mw, threads, mip, t.absent_pages));
+    fill_padding(mip, g.level_width(l), g.level_height(l), mw, mh, address_mode);
   }
   t.texture.max_level = end - first - 1;
   return t;
@@ -317,8 +339,7 @@ Expected<StreamingCheckReport> run_streaming_check(Renderer& renderer, const Pag
                   std::to_string(report.first_level + report.levels_held - 1) + " of " +
                   std::to_string(report.level_count) + " held (finer than " +
                   std::to_string(o.max_level_side) +
-                  " texels or not halving as Vulkan mips do are dropped); pixels wanting them "
-                  "are excluded";
+                  " texels are dropped); pixels wanting them are excluded";
   }
   VT_RETURN_IF_ERROR(renderer.set_reference_meshes(meshes));
   VT_RETURN_IF_ERROR(renderer.set_reference_textures(std::span(&texture->texture, 1)));

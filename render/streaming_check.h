@@ -24,8 +24,9 @@ namespace vt::render {
 // that want them are excluded (and counted). 8192 x 8192 RGBA8 with its mips is 358 MB.
 inline constexpr uint32_t kMaxLevelTextureSide = 8192;
 
-// The baked levels of one layer as one mip chain (Vulkan sizes). Level i of `texture` is the
-// file's level first_level + i; levels past first_level + texture.levels.size() are dropped.
+// The baked levels of one layer as one mip chain. Level i of `texture` is the file's level
+// first_level + i, in the top-left corner of a mip padded so that the chain halves as Vulkan's
+// mips do where the file's levels halve with ceil (ReferenceTexture::levels_width).
 struct LevelTexture {
   ReferenceTexture texture;
   uint32_t first_level = 0;   // finest level held (0 unless the atlas is over the side limit)
@@ -34,10 +35,10 @@ struct LevelTexture {
 };
 
 // Tiles the payload of every page of `layer` (as source.load() uploads it, BC blocks decoded,
-// missing channels as the GPU reads them: G, B 0 and A 255) into its level, borders ignored.
-// Levels wider or taller than `max_side` are dropped from the fine end; coarse levels whose size
-// is not the previous one halved (floor, as Vulkan's mips halve; the page grid halves with ceil)
-// are dropped from the coarse end. Float layers give kUnsupported.
+// missing channels as the GPU reads them: G, B 0 and A 255) into its level, borders ignored; the
+// padding around a level holds its edge texels addressed by `address_mode`, as page borders
+// past the atlas's edge do. Levels wider or taller than `max_side` are dropped from the fine
+// end, every coarser level is held. Float layers give kUnsupported.
 Expected<LevelTexture> assemble_level_texture(const PageSource& source, uint32_t layer,
                                               AddressMode address_mode,
                                               uint32_t max_side = kMaxLevelTextureSide,

@@ -14,7 +14,8 @@ layout(push_constant) uniform Push {
   // x: frame index (feedback tap rotation), y: address mode (0 clamp, 1 wrap, 2 the sampler's:
   // taps are left as they are, for material samplers with per-axis modes), z: max LOD; w, in the
   // feedback and virtual passes: 1 = an HDR lighting layer (rgb tone-mapped x / (1 + x), alpha
-  // is AO: no alpha test), 0 otherwise (the lit passes use w for their inputs, lit.glsl).
+  // is AO: no alpha test), 0 otherwise; in the reference pass: 1 = a page file's levels
+  // (reference.frag); the lit passes use w for their inputs (lit.glsl).
   ivec4 misc;
 }
 pc;
@@ -94,6 +95,12 @@ Footprint footprint_texels(vec2 dx, vec2 dy, vec2 texel, float max_lod) {
 Footprint footprint(vec2 uv, float deriv_scale) {
   return footprint_texels(dFdx(uv) * pc.tex.xy * deriv_scale, dFdy(uv) * pc.tex.xy * deriv_scale,
                           1.0 / pc.tex.xy, float(v_misc.z));
+}
+
+// A page file level's size in texels (runtime/page_table.h): level 0's (pc.tex.xy) halved with
+// ceil, where Vulkan's mips halve with floor.
+ivec2 vt_level_size(int level) {
+  return max(ivec2(1), (ivec2(pc.tex.xy) + (1 << level) - 1) >> level);
 }
 
 vec2 tap_offset(Footprint f, int i) { return f.step * (float(i) - 0.5 * float(f.taps - 1)); }

@@ -20,10 +20,32 @@ vec3 linear_to_srgb(vec3 c) {
   return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, greaterThan(c, vec3(0.0031308)));
 }
 
+// One bilinear tap of a page file's level (v_misc.w == 1): it lies in the top-left corner of
+// mip `level`, which the padding makes a little larger (render/streaming_check.cpp). The mip's
+// size is level 0's shifted (the padded sizes halve exactly), not textureSize(u_texture, level):
+// lavapipe answers that query for one pixel's level per group of pixels, and at silhouettes,
+// where neighbours want different levels, taps landed up to 60 steps off.
+vec4 file_level_tap(vec2 uv, int level) {
+  vec2 scale = vec2(vt_level_size(level)) / vec2(textureSize(u_texture, 0) >> level);
+  return textureLod(u_texture, uv * scale, float(level));
+}
+
 void main() {
   Footprint f = footprint(v_uv, 1.0);
   vec4 c = vec4(0.0);
-  for (int i = 0; i < f.taps; ++i) c += textureLod(u_texture, tap_uv(v_uv, f, i), f.lod);
+  if (v_misc.w == 1) {
+    // Two levels blended as the virtual texture's taps are (virtual_texture.glsl, vt_filtered).
+    int l0 = int(floor(f.lod));
+    int l1 = min(l0 + 1, v_misc.z);
+    float blend = f.lod - float(l0);
+    for (int i = 0; i < f.taps; ++i) {
+      vec2 t = tap_uv(v_uv, f, i);
+      vec4 a = file_level_tap(t, l0);
+      c += l1 != l0 ? mix(a, file_level_tap(t, l1), blend) : a;
+    }
+  } else {
+    for (int i = 0; i < f.taps; ++i) c += textureLod(u_texture, tap_uv(v_uv, f, i), f.lod);
+  }
   c /= float(f.taps);
   // Skipped for white so that scenes without vertex colours render exactly as before.
   if (v_color.rgb != vec3(1.0)) {

@@ -3,10 +3,6 @@
 // reads. Include after common.glsl. The page table is the RGBA8 mip chain of runtime/: R, G =
 // physical slot, B = resident level, A bit 0 = valid.
 
-ivec2 vt_level_size(int level) {
-  return max(ivec2(1), (ivec2(pc.tex.xy) + (1 << level) - 1) >> level);
-}
-
 // The page of `level` holding `uv`.
 ivec2 vt_page(vec2 uv, int level) {
   ivec2 pages = (vt_level_size(level) + pc.vt.y - 1) / pc.vt.y;

@@ -1,7 +1,8 @@
 // The exact streaming check: the level texture assembly on a hand-made page source (payloads
 // tiled, borders ignored, absent pages from their ancestor, fine levels dropped over the side
-// limit), then on bakes of the procedural sample scene: a correct bake agrees with its baked
-// levels to rounding, and a cache fed wrong borders or a wrong page fails.
+// limit, levels that halve with ceil in padded mips), then on bakes of the procedural sample
+// scene: a correct bake agrees with its baked levels to rounding, and a cache fed wrong borders
+// or a wrong page, at level 0 or at a coarse level that halves with ceil, fails.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -63,6 +64,12 @@ class HandMadeSource : public PageSource {
   RuntimeFormat format_;
 };
 
+// Texel (x, y) of a mip `w` texels wide.
+std::array<int, 4> texel_at(const std::vector<uint8_t>& mip, uint32_t w, uint32_t x, uint32_t y) {
+  const uint8_t* p = &mip[(size_t(y) * w + x) * 4];
+  return {p[0], p[1], p[2], p[3]};
+}
+
 TEST(LevelTexture, TilesPayloadsIgnoringBordersAndFillsAbsentPagesFromTheirAncestor) {
   HandMadeSource source(RuntimeFormat::kRgba8);
   ASSERT_TRUE(source.geometry().validate().ok());
@@ -72,25 +79,35 @@ TEST(LevelTexture, TilesPayloadsIgnoringBordersAndFillsAbsentPagesFromTheirAnces
   EXPECT_EQ(t->level_count, 2u);
   EXPECT_EQ(t->absent_pages, 1u);
   ASSERT_EQ(t->texture.levels.size(), 2u);
-  EXPECT_EQ(t->texture.width, 6u);
-  EXPECT_EQ(t->texture.height, 8u);
+  EXPECT_EQ(t->texture.levels_width, 6u);
+  EXPECT_EQ(t->texture.levels_height, 8u);
+  // Padded for two levels: a multiple of 2, at least 4 longer (2 texels past each level).
+  EXPECT_EQ(t->texture.width, 10u);
+  EXPECT_EQ(t->texture.height, 12u);
   EXPECT_EQ(t->texture.max_level, 1u);
   EXPECT_EQ(t->texture.address_mode, AddressMode::kWrap);
   const auto& l0 = t->texture.levels[0];
   const auto& l1 = t->texture.levels[1];
-  ASSERT_EQ(l0.size(), 6u * 8 * 4);
-  ASSERT_EQ(l1.size(), 3u * 4 * 4);
-  auto at = [](const std::vector<uint8_t>& l, uint32_t w, uint32_t x, uint32_t y) {
-    const uint8_t* p = &l[(size_t(y) * w + x) * 4];
-    return std::array<int, 4>{p[0], p[1], p[2], p[3]};
-  };
+  ASSERT_EQ(l0.size(), 10u * 12 * 4);
+  ASSERT_EQ(l1.size(), 5u * 6 * 4);
   // Page (0, 1) of level 0, texel (3, 2) of its payload at level texel (3, 6).
-  EXPECT_EQ(at(l0, 6, 3, 6), (std::array<int, 4>{4, 3 * 16 + 2, 7, 9}));
-  EXPECT_EQ(at(l0, 6, 0, 0), (std::array<int, 4>{0, 0, 7, 9}));
-  EXPECT_EQ(at(l0, 6, 5, 7), (std::array<int, 4>{5, 1 * 16 + 3, 7, 9}));  // the cut page (1, 1)
+  EXPECT_EQ(texel_at(l0, 10, 3, 6), (std::array<int, 4>{4, 3 * 16 + 2, 7, 9}));
+  EXPECT_EQ(texel_at(l0, 10, 0, 0), (std::array<int, 4>{0, 0, 7, 9}));
+  EXPECT_EQ(texel_at(l0, 10, 5, 7), (std::array<int, 4>{5, 1 * 16 + 3, 7, 9}));  // cut page (1, 1)
   // Level 0's absent page (1, 0) covers texels x 4-5, y 0-3: level 1 texel (x / 2, y / 2).
-  EXPECT_EQ(at(l0, 6, 5, 3), at(l1, 3, 2, 1));
-  EXPECT_EQ(at(l1, 3, 2, 1), (std::array<int, 4>{16, 2 * 16 + 1, 7, 9}));
+  EXPECT_EQ(texel_at(l0, 10, 5, 3), texel_at(l1, 5, 2, 1));
+  EXPECT_EQ(texel_at(l1, 5, 2, 1), (std::array<int, 4>{16, 2 * 16 + 1, 7, 9}));
+  // The padding wraps: past the end the first texels, at the mip's end (before texel 0 for a
+  // REPEAT sampler) the last ones; corners both ways.
+  for (uint32_t y = 0; y < 8; ++y) {
+    EXPECT_EQ(texel_at(l0, 10, 6, y), texel_at(l0, 10, 0, y)) << y;
+    EXPECT_EQ(texel_at(l0, 10, 9, y), texel_at(l0, 10, 5, y)) << y;
+  }
+  EXPECT_EQ(texel_at(l0, 10, 2, 8), texel_at(l0, 10, 2, 0));
+  EXPECT_EQ(texel_at(l0, 10, 2, 11), texel_at(l0, 10, 2, 7));
+  EXPECT_EQ(texel_at(l0, 10, 9, 11), texel_at(l0, 10, 5, 7));
+  EXPECT_EQ(texel_at(l1, 5, 3, 0), texel_at(l1, 5, 0, 0));  // level 1: 3 x 4 in 5 x 6
+  EXPECT_EQ(texel_at(l1, 5, 4, 5), texel_at(l1, 5, 2, 3));
   for (size_t i = 0; i < l0.size(); ++i) ASSERT_NE(l0[i], 0xEE) << "border texel at byte " << i;
 }
 
@@ -100,23 +117,28 @@ TEST(LevelTexture, MissingChannelsReadAsTheGpuReadsThemAndFineLevelsDropOverTheL
   ASSERT_TRUE(t.ok()) << t.status().message();
   EXPECT_EQ(t->first_level, 1u);  // level 0 is 6 x 8
   ASSERT_EQ(t->texture.levels.size(), 1u);
-  EXPECT_EQ(t->texture.width, 3u);
-  const uint8_t* p = &t->texture.levels[0][(1 * 3 + 2) * 4];
-  EXPECT_EQ(int(p[0]), 16);
-  EXPECT_EQ(int(p[1]), 2 * 16 + 1);
-  EXPECT_EQ(int(p[2]), 0);
-  EXPECT_EQ(int(p[3]), 255);
+  EXPECT_EQ(t->texture.levels_width, 3u);
+  EXPECT_EQ(t->texture.width, 5u);
+  EXPECT_EQ(texel_at(t->texture.levels[0], 5, 2, 1), (std::array<int, 4>{16, 2 * 16 + 1, 0, 255}));
 }
 
-TEST(LevelTexture, CoarseLevelsThatDoNotHalveAsVulkanMipsAreDropped) {
-  // 7 wide: level 1 is ceil(7 / 2) = 4 texels, a Vulkan mip of 7 is 3.
+// 7 wide: level 1 is ceil(7 / 2) = 4 texels where a Vulkan mip of 7 is 3. Both levels are held,
+// each in the corner of a mip of a 12-texel chain, the padding clamped to the level's edges.
+TEST(LevelTexture, LevelsThatDoNotHalveAsVulkanMipsSitInPaddedMips) {
   HandMadeSource source(RuntimeFormat::kRgba8, 7);
   auto t = assemble_level_texture(source, 0, AddressMode::kClamp);
   ASSERT_TRUE(t.ok());
   EXPECT_EQ(t->first_level, 0u);
   EXPECT_EQ(t->level_count, 2u);
-  EXPECT_EQ(t->texture.levels.size(), 1u);
-  EXPECT_EQ(t->texture.max_level, 0u);
+  ASSERT_EQ(t->texture.levels.size(), 2u);
+  EXPECT_EQ(t->texture.max_level, 1u);
+  EXPECT_EQ(t->texture.width, 12u);
+  const auto& l1 = t->texture.levels[1];
+  ASSERT_EQ(l1.size(), 6u * 6 * 4);
+  // Level 1's page (0, 0) holds texels 0-3 of both axes: texel (3, 2).
+  EXPECT_EQ(texel_at(l1, 6, 3, 2), (std::array<int, 4>{16, 3 * 16 + 2, 7, 9}));
+  EXPECT_EQ(texel_at(l1, 6, 4, 2), texel_at(l1, 6, 3, 2));  // past the end: the last texel
+  EXPECT_EQ(texel_at(l1, 6, 5, 2), texel_at(l1, 6, 0, 2));  // before texel 0: the first
 }
 
 // A close view of a large atlas wants only levels finer than the check holds: that view says
@@ -251,15 +273,16 @@ class StreamingCheck : public ::testing::Test {
     so.sphere_segments = 12;
     so.texture_size = 128;
     Status s = write_sample_scene(dir_ + "/scene", so);
-    for (const char* codec : {"dct", "bc", "raw"}) {
+    // "raw9": 9 pages across, so that level 4 (67.5 texels) halves with ceil, not as a mip.
+    for (const char* codec : {"dct", "bc", "raw", "raw9"}) {
       if (!s.ok()) break;
       SceneBakeOptions o;
       o.build.output = dir_ + "/" + codec + ".vtpf";
       const std::string c = codec;
-      o.build.codec.codec = c == "raw"  ? CodecKind::kRaw
+      o.build.codec.codec = c == "dct"  ? CodecKind::kDct
                             : c == "bc" ? CodecKind::kBc
-                                        : CodecKind::kDct;
-      o.unwrap.size_pages = 4;
+                                        : CodecKind::kRaw;
+      o.unwrap.size_pages = c == "raw9" ? 9 : 4;
       auto baked = bake_scene(dir_ + "/scene/scene.gltf", o);
       if (!baked.ok()) s = baked.status();
     }
@@ -281,8 +304,9 @@ class StreamingCheck : public ::testing::Test {
 
   // validate_bake's setup around validate_views, with `edit` applied to what the cache
   // receives and, unless `cache_only`, to the level texture as well (an edited file).
+  // `distance`: the orbit's distance over the default one (far views want coarse levels).
   Expected<ValidationReport> validate(const std::string& codec, const EditedSource::Edit& edit,
-                                      bool cache_only = false) {
+                                      bool cache_only = false, float distance = 1.0f) {
     VT_ASSIGN_OR_RETURN(std::shared_ptr<const PageFileReader> reader,
                         PageFileReader::open(dir_ + "/" + codec + ".vtpf"));
     VT_ASSIGN_OR_RETURN(scene::Scene original, scene::load_scene(dir_ + "/scene/scene.gltf"));
@@ -301,7 +325,10 @@ class StreamingCheck : public ::testing::Test {
     VT_RETURN_IF_ERROR(renderer->set_meshes(virt.meshes));
     VT_RETURN_IF_ERROR(renderer->set_reference_meshes(ref.meshes));
     VT_RETURN_IF_ERROR(renderer->set_reference_textures(ref.textures));
-    const auto cameras = orbit_views(ref.bounds_min, ref.bounds_max, 3, 1280.0f / 720.0f);
+    const Vec3f centre = (ref.bounds_min + ref.bounds_max) * 0.5f;
+    const auto cameras =
+        orbit_views(centre + (ref.bounds_min - centre) * distance,
+                    centre + (ref.bounds_max - centre) * distance, 3, 1280.0f / 720.0f);
     ValidateOptions vo;
     vo.layer = albedo(*reader);
     vo.address_mode = reader->layers()[vo.layer].address_mode;
@@ -424,6 +451,52 @@ TEST_F(StreamingCheck, APageReplacedByItsNeighbourInTheCacheFails) {
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_TRUE(exact_failed(*r)) << failures(*r);
   print_views("neighbour page", *r);
+}
+
+// The coarsest level of a 9-page atlas (1,080 texels: level 4 is 68 texels, a Vulkan mip of
+// level 0 would be 67) reaches the cache wrong: its one page replaced by a page of level 3 (a
+// cache fault; the level texture holds the file). Views from far away want levels 3 and 4.
+// The check held only the levels that halve as Vulkan mips (0-3) before, excluded every pixel
+// wanting level 4 and could not see this page.
+TEST_F(StreamingCheck, AWrongPageOfALevelThatHalvesWithCeilFails) {
+  auto opened = PageFileReader::open(dir_ + "/raw9.vtpf");
+  ASSERT_TRUE(opened.ok()) << opened.status().message();
+  std::shared_ptr<const PageFileReader> reader = std::move(*opened);
+  const PageGeometry& g = reader->geometry();
+  ASSERT_EQ(g.level_count(), 5u);
+  ASSERT_EQ(g.level_width(4), 68u);
+  PageFileSourceOptions so;
+  so.bc7_as_rgba8 = ctx_->is_lavapipe();
+  auto plain = make_page_file_source(reader, so);
+  ASSERT_TRUE(plain.ok());
+  const PageSource& truth = **plain;
+  const uint32_t layer = albedo(*reader);
+
+  auto correct = validate("raw9", kNoEdit, /*cache_only=*/false, /*distance=*/12.0f);
+  ASSERT_TRUE(correct.ok()) << correct.status().message();
+  EXPECT_EQ(correct->exact.levels_held, 5u);
+  EXPECT_FALSE(exact_failed(*correct)) << failures(*correct);
+  uint64_t compared = 0;
+  for (const StreamingViewResult& v : correct->exact.views) {
+    compared += v.metrics.pixels;
+    EXPECT_EQ(v.metrics.excluded_coarse, 0u);
+  }
+  EXPECT_GT(compared, 1000u);
+  print_views("far views", *correct);
+
+  auto wrong = validate(
+      "raw9",
+      [&](const PageId& id, uint32_t l, std::span<uint8_t> bytes) {
+        if (id.level == 4 && l == layer) EXPECT_TRUE(truth.load(PageId{3, 0, 0}, l, bytes).ok());
+      },
+      /*cache_only=*/true, /*distance=*/12.0f);
+  ASSERT_TRUE(wrong.ok()) << wrong.status().message();
+  EXPECT_TRUE(exact_failed(*wrong)) << failures(*wrong);
+  bool differs = false;
+  for (const StreamingViewResult& v : wrong->exact.views)
+    for (const std::string& f : v.failures) differs |= f.find("largest difference") != f.npos;
+  EXPECT_TRUE(differs) << failures(*wrong);
+  print_views("level 4 page wrong", *wrong);
 }
 
 }  // namespace
