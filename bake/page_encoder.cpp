@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "format/page_error_bounds.h"
+
 namespace vt {
 namespace {
 
@@ -130,6 +132,8 @@ Expected<PageEncoder> PageEncoder::create(LayerSpec& layer, const PageEncoderOpt
   if (!codec.ok()) return codec.status().with_context("layer '" + layer.name + "'");
   PageEncoder e(std::move(codec).value(), layer, options);
   e.dct_settings_ = dct;
+  if (options.min_psnr == kDefaultPageFloor)
+    e.settings_.dct_min_psnr = kDctPagePsnr.of(layer.semantic) + kDctFloorMarginDb;
   if (auto it = options.layer_min_psnr.find(layer.name); it != options.layer_min_psnr.end())
     e.settings_.dct_min_psnr = it->second;
   return e;

@@ -40,6 +40,8 @@ enum class HalfRuntime : uint8_t { kBc6h = 0, kRgba16f = 1 };
 Expected<HalfRuntime> parse_half_runtime(const std::string& name);
 const char* to_string(HalfRuntime v);
 
+inline constexpr double kDefaultPageFloor = -1;
+
 struct PageEncoderOptions {
   CodecKind codec = CodecKind::kDct;
   FloatTexels float_texels = FloatTexels::kAuto;
@@ -49,9 +51,10 @@ struct PageEncoderOptions {
   BcQuality bc_quality = BcQuality::kNormal;
   int zstd_level = 3;
   // DCT layers: the per-page mode decision (format/dct_page_modes.h) and its error floor, a
-  // PSNR per page in dB (0: none), for every layer or by layer name.
+  // PSNR per page in dB (0: none), for every layer or by layer name. kDefaultPageFloor: the
+  // layer's page bound (format/page_error_bounds.h) plus its margin.
   bool dct_page_modes = true;
-  double min_psnr = 0;
+  double min_psnr = kDefaultPageFloor;
   std::map<std::string, double> layer_min_psnr;
 };
 

@@ -1,11 +1,13 @@
 // The build flags (see build_flags.h).
 #include "cli/build_flags.h"
 
+#include <cmath>
 #include <cstdlib>
 
 #include "bake/color.h"
 #include "cli/cli_util.h"
 #include "cli/layer_error_text.h"
+#include "format/page_error_bounds.h"
 
 namespace vt::cli {
 namespace {
@@ -16,6 +18,17 @@ void throw_if_error(const char* flag, const Status& status) {
   const std::string& message = status.message();
   if (message.rfind(flag, 0) == 0) throw CLI::ValidationError(message);
   throw CLI::ValidationError(flag, message);
+}
+
+// The default DCT floors by layer, for --help (format/page_error_bounds.h).
+std::string default_floors_text() {
+  const auto db = [](LayerSemantic s) {
+    return std::to_string(int(std::lround(kDctPagePsnr.of(s) + kDctFloorMarginDb)));
+  };
+  return "albedo " + db(LayerSemantic::kAlbedo) + ", normal " + db(LayerSemantic::kNormal) +
+         ", orm " + db(LayerSemantic::kOrm) + ", emissive " + db(LayerSemantic::kEmissive) +
+         ", others " + db(LayerSemantic::kCustom) + " (" + std::to_string(int(kDctFloorMarginDb)) +
+         " dB over the page bound validate holds the layer to)";
 }
 
 }  // namespace
@@ -34,7 +47,8 @@ void add_build_flags(CLI::App& app, BuildOptions& o) {
           throw_if_error("--min-psnr", parse_min_psnr(t, &o.codec));
       },
       "DCT error floor: no page below DB (PSNR over its channels, stored codec); DB for every "
-      "layer or LAYER=DB, repeatable");
+      "layer or LAYER=DB, repeatable; 0: none. Default: " +
+          default_floors_text());
   app.add_option_function<std::string>(
       "--float-texels",
       [&o](const std::string& name) {

@@ -18,6 +18,7 @@
 #include "common/half.h"
 #include "common/parallel.h"
 #include "common/vec.h"
+#include "format/page_error_bounds.h"
 #include "format/runtime_format.h"
 #include "render/report.h"
 #include "runtime/page_source.h"
@@ -497,18 +498,10 @@ Status uploaded_texels(const PageSource& source, const LayerSpec& spec, const Pa
 }
 
 AtlasLayerBounds default_atlas_bounds(const LayerSpec& layer) {
-  // Worst page on the sample scene (vtbake sample-scene; bake --codec dct | bc | raw), dB:
-  //              albedo  normal  orm   emissive   normal mean / max deg
-  //   dct (q75)  30.1    35.8    32.7  24.8       2.31 / 36.3
-  //   bc         35.2    40.1    33.1  33.8       1.27 / 28.2
-  //   raw        35.2    38.3    33.1  33.6       1.42 / 31.5
-  // Largest page mean shift (8-bit steps): dct 1.0 / 0.40 / 0.98 / 5.1 (ringing clipped at
-  // black around the emissive lines), bc and raw 1.5 / 0.45 / 0.85 / 0.58. Emissive at half
-  // strength shifts a DCT page by 16. The BC transcode sets the error of bc and raw bakes alike.
-  struct Row {
-    double albedo, normal, orm, emissive;
-  };
-  static constexpr Row kDct{27, 32, 29, 21}, kBc{32, 35, 30, 30};
+  // Page PSNR bounds: format/page_error_bounds.h. Largest page mean shift on the sample scene
+  // (8-bit steps): dct 1.0 / 0.40 / 0.98 / 5.1 (albedo / normal / orm / emissive; ringing
+  // clipped at black around the emissive lines), bc and raw 1.5 / 0.45 / 0.85 / 0.58. Emissive
+  // at half strength shifts a DCT page by 16.
   const bool bc_upload = runtime_bc_format(layer.runtime_format).has_value();
   AtlasLayerBounds b;
   if (layer.codec != PageCodec::kDct && !bc_upload) {
@@ -518,22 +511,9 @@ AtlasLayerBounds default_atlas_bounds(const LayerSpec& layer) {
     b.max_mean_shift = 1;
     return b;
   }
-  auto bound = [&](const Row& row) {
-    switch (layer.semantic) {
-      case LayerSemantic::kAlbedo:
-        return row.albedo;
-      case LayerSemantic::kNormal:
-        return row.normal;
-      case LayerSemantic::kOrm:
-        return row.orm;
-      case LayerSemantic::kEmissive:
-        return row.emissive;
-      default:
-        return std::min({row.albedo, row.orm, row.emissive});
-    }
-  };
-  b.min_psnr = bound(layer.codec == PageCodec::kDct ? kDct : kBc);
-  if (layer.codec == PageCodec::kDct) b.floor_margin_db += bound(kBc) - bound(kDct);
+  const double dct = kDctPagePsnr.of(layer.semantic), bc = kBcPagePsnr.of(layer.semantic);
+  b.min_psnr = layer.codec == PageCodec::kDct ? dct : bc;
+  if (layer.codec == PageCodec::kDct) b.floor_margin_db += bc - dct;
   b.max_mean_deg = layer.codec == PageCodec::kDct ? 4.0 : 3.0;
   b.max_max_deg = layer.codec == PageCodec::kDct ? 50.0 : 45.0;
   b.max_mean_shift = layer.codec == PageCodec::kDct ? 8.0 : 3.0;
