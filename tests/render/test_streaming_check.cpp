@@ -302,21 +302,33 @@ class StreamingCheck : public ::testing::Test {
     return 0;
   }
 
+  // `codec`.vtpf as the cache reads it: the pages an edit departs from.
+  struct File {
+    std::shared_ptr<const PageFileReader> reader;
+    std::unique_ptr<PageSource> pages;
+    uint32_t albedo = 0;
+  };
+  Expected<File> open_file(const std::string& codec) {
+    File f;
+    VT_ASSIGN_OR_RETURN(f.reader, PageFileReader::open(dir_ + "/" + codec + ".vtpf"));
+    PageFileSourceOptions so;
+    so.bc7_as_rgba8 = ctx_->is_lavapipe();
+    VT_ASSIGN_OR_RETURN(f.pages, make_page_file_source(f.reader, so));
+    f.albedo = albedo(*f.reader);
+    return f;
+  }
+
   // validate_bake's setup around validate_views, with `edit` applied to what the cache
   // receives and, unless `cache_only`, to the level texture as well (an edited file).
   // `distance`: the orbit's distance over the default one (far views want coarse levels).
   Expected<ValidationReport> validate(const std::string& codec, const EditedSource::Edit& edit,
                                       bool cache_only = false, float distance = 1.0f) {
-    VT_ASSIGN_OR_RETURN(std::shared_ptr<const PageFileReader> reader,
-                        PageFileReader::open(dir_ + "/" + codec + ".vtpf"));
+    VT_ASSIGN_OR_RETURN(File f, open_file(codec));
     VT_ASSIGN_OR_RETURN(scene::Scene original, scene::load_scene(dir_ + "/scene/scene.gltf"));
     VT_ASSIGN_OR_RETURN(scene::Scene baked, scene::load_scene(dir_ + "/" + codec + ".glb"));
     VT_ASSIGN_OR_RETURN(SceneDraws ref, reference_scene_draws(original));
     VT_ASSIGN_OR_RETURN(SceneDraws virt, virtual_scene_draws(baked));
-    PageFileSourceOptions so;
-    so.bc7_as_rgba8 = ctx_->is_lavapipe();
-    VT_ASSIGN_OR_RETURN(std::unique_ptr<PageSource> inner, make_page_file_source(reader, so));
-    std::shared_ptr<const PageSource> file = std::move(inner);
+    std::shared_ptr<const PageSource> file = std::move(f.pages);
     auto source = std::make_shared<EditedSource>(file, edit);
     RenderOptions ro;
     ro.width = 1280;
@@ -330,8 +342,8 @@ class StreamingCheck : public ::testing::Test {
         orbit_views(centre + (ref.bounds_min - centre) * distance,
                     centre + (ref.bounds_max - centre) * distance, 3, 1280.0f / 720.0f);
     ValidateOptions vo;
-    vo.layer = albedo(*reader);
-    vo.address_mode = reader->layers()[vo.layer].address_mode;
+    vo.layer = f.albedo;
+    vo.address_mode = f.reader->layers()[vo.layer].address_mode;
     vo.thresholds = scene_thresholds();
     vo.exact_meshes = virt.meshes;
     if (cache_only) vo.exact_levels = file;
@@ -429,15 +441,10 @@ TEST_F(StreamingCheck, APageReplacedByItsNeighbourInTheCacheFails) {
   // level texture holds the file's pages), so the page's interior shows the wrong texels. The
   // same page swapped in the file itself differs only at its seams, within the codec's border
   // tolerance here; the atlas check catches that one (test_atlas_check.cpp).
-  auto opened = PageFileReader::open(dir_ + "/raw.vtpf");
-  ASSERT_TRUE(opened.ok());
-  std::shared_ptr<const PageFileReader> reader = std::move(*opened);
-  PageFileSourceOptions so;
-  so.bc7_as_rgba8 = ctx_->is_lavapipe();
-  auto plain = make_page_file_source(reader, so);
-  ASSERT_TRUE(plain.ok());
-  const PageSource& truth = **plain;
-  const uint32_t layer = albedo(*reader);
+  auto file = open_file("raw");
+  ASSERT_TRUE(file.ok()) << file.status().message();
+  const PageSource& truth = *file->pages;
+  const uint32_t layer = file->albedo;
   auto r = validate(
       "raw",
       [&](const PageId& id, uint32_t l, std::span<uint8_t> bytes) {
@@ -459,18 +466,13 @@ TEST_F(StreamingCheck, APageReplacedByItsNeighbourInTheCacheFails) {
 // The check held only the levels that halve as Vulkan mips (0-3) before, excluded every pixel
 // wanting level 4 and could not see this page.
 TEST_F(StreamingCheck, AWrongPageOfALevelThatHalvesWithCeilFails) {
-  auto opened = PageFileReader::open(dir_ + "/raw9.vtpf");
-  ASSERT_TRUE(opened.ok()) << opened.status().message();
-  std::shared_ptr<const PageFileReader> reader = std::move(*opened);
-  const PageGeometry& g = reader->geometry();
+  auto file = open_file("raw9");
+  ASSERT_TRUE(file.ok()) << file.status().message();
+  const PageGeometry& g = file->reader->geometry();
   ASSERT_EQ(g.level_count(), 5u);
   ASSERT_EQ(g.level_width(4), 68u);
-  PageFileSourceOptions so;
-  so.bc7_as_rgba8 = ctx_->is_lavapipe();
-  auto plain = make_page_file_source(reader, so);
-  ASSERT_TRUE(plain.ok());
-  const PageSource& truth = **plain;
-  const uint32_t layer = albedo(*reader);
+  const PageSource& truth = *file->pages;
+  const uint32_t layer = file->albedo;
 
   auto correct = validate("raw9", kNoEdit, /*cache_only=*/false, /*distance=*/12.0f);
   ASSERT_TRUE(correct.ok()) << correct.status().message();
