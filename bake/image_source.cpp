@@ -6,6 +6,7 @@
 #include <xxhash.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -122,9 +123,30 @@ class FileImageSource final : public ImageSource {
   std::vector<float> tile_buf_;
 };
 
+// OpenImageIO reads no PCX (Quake's skins, old texture sets): the scene importers' decoder, into
+// memory (8 bits a channel; the decoder refuses a header asking for more texels than the file
+// can hold).
+Expected<std::unique_ptr<ImageSource>> open_pcx_file(const std::string& path) {
+  VT_ASSIGN_OR_RETURN(const scene::Image png, scene::pcx_as_png(path));
+  VT_ASSIGN_OR_RETURN(const scene::FloatImage image, scene::load_float_image(png));
+  ImageInfo info;
+  info.width = image.width;
+  info.height = image.height;
+  info.channels = image.channels;
+  info.alpha_channel = image.channels == 4 ? 3 : -1;
+  std::vector<float> texels(size_t(image.width) * image.height * image.channels);
+  for (size_t i = 0; i < size_t(image.width) * image.height; ++i)
+    std::memcpy(&texels[i * image.channels], &image.rgba[i * 4], image.channels * sizeof(float));
+  return std::unique_ptr<ImageSource>(new MemoryImageSource(info, std::move(texels)));
+}
+
 }  // namespace
 
 Expected<std::unique_ptr<ImageSource>> open_image_file(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".pcx") return open_pcx_file(path);
   VT_RETURN_IF_ERROR(check_png_chunks(path));  // before libpng can print its own line
   std::string error;
   auto in = scene::open_image_input(path, error);

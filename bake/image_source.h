@@ -49,7 +49,8 @@ class ImageSource {
 // XXH3-64 of a file's bytes (a content key: the same file under any path hashes alike).
 Expected<uint64_t> hash_file(const std::string& path);
 
-// Opens an image file OpenImageIO can read (first subimage, level 0). Errors name the file.
+// Opens an image file OpenImageIO can read (first subimage, level 0), or a PCX (read whole by
+// scene::pcx_as_png). Errors name the file.
 Expected<std::unique_ptr<ImageSource>> open_image_file(const std::string& path);
 
 // Texels owned in memory: info.width * info.height * info.channels floats.

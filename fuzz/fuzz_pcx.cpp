@@ -4,12 +4,11 @@
 
 #include "fuzz/fuzz_input.h"
 #include "scene/image_load.h"
-#include "scene/scene_io_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace vt;
   const std::string path = fuzz::write_input("input.pcx", fuzz::as_text(data, size));
-  auto png = scene::detail::pcx_as_png(path);
+  auto png = scene::pcx_as_png(path);
   if (!png.ok()) {
     fuzz::check_refusal(png.status(), path);
     return 0;

@@ -60,6 +60,11 @@ void associate_alpha(float* texels, size_t count, int channels, int alpha);
 // has a size of 0 or over 65536 per side.
 Expected<FloatImage> load_float_image(const scene::Image& image);
 
+// A PCX image file (8 bits, 1 plane + palette, 3 or 4 planes; RLE or not) as an embedded PNG:
+// OpenImageIO has no PCX reader (scene/pcx_image.cpp). kCorrupt names the file and what is
+// wrong.
+Expected<Image> pcx_as_png(const std::string& path);
+
 // Texels an importer made (a packed MTL map, a model's uncompressed embedded skin) as an embedded
 // PNG named `name`: every reader of the scene's images, and the unwrapped scene's .glb, then
 // take them as they take a file. `spec` gives the size, channels and stored format (8 or 16

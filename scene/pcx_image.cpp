@@ -1,5 +1,5 @@
 // ZSoft PCX images (Quake and Quake 2 skins, 3D Studio-era textures), which OpenImageIO cannot
-// read: decoded here and handed on as embedded PNGs (see scene_io_util.h).
+// read: decoded here and handed on as embedded PNGs (image_load.h).
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -8,7 +8,7 @@
 #include "scene/image_load.h"
 #include "scene/scene_io_util.h"
 
-namespace vt::scene::detail {
+namespace vt::scene {
 namespace {
 
 uint32_t u16_at(const std::vector<uint8_t>& b, size_t at) {
@@ -18,7 +18,7 @@ uint32_t u16_at(const std::vector<uint8_t>& b, size_t at) {
 }  // namespace
 
 Expected<Image> pcx_as_png(const std::string& path) {
-  VT_ASSIGN_OR_RETURN(const std::vector<uint8_t> bytes, read_file(path));
+  VT_ASSIGN_OR_RETURN(const std::vector<uint8_t> bytes, detail::read_file(path));
   const auto bad = [&](const std::string& what) {
     return Error(ErrorCode::kCorrupt, path + ": not a readable PCX image (" + what + ")");
   };
@@ -75,4 +75,4 @@ Expected<Image> pcx_as_png(const std::string& path) {
   return embedded_png(path, spec, OIIO::TypeDesc::UINT8, texels.data());
 }
 
-}  // namespace vt::scene::detail
+}  // namespace vt::scene

@@ -12,6 +12,7 @@
 
 #include "common/utf8.h"
 #include "scene/gltf_document.h"
+#include "scene/image_load.h"
 #include "scene/scene.h"
 #include "scene/scene_io_util.h"
 
@@ -549,7 +550,7 @@ Expected<Scene> load_scene(const std::string& path, const SceneLoadOptions& opti
     if (image.embedded() || detail::lower_extension(image.path) != "pcx" ||
         !detail::exists(image.path))
       continue;
-    Expected<Image> png = detail::pcx_as_png(image.path);
+    Expected<Image> png = pcx_as_png(image.path);
     if (!png.ok()) {
       scene.warnings.push_back(png.status().message());  // the texture's read then fails
       continue;

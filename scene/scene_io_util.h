@@ -71,9 +71,6 @@ Expected<Scene> load_drc(const std::string& path);
 Expected<Scene> load_ac3d(const std::string& path);
 // Any other format assimp reads (FBX, COLLADA, 3DS, ...; glTF 1.0).
 Expected<Scene> load_assimp(const std::string& path);
-// A PCX image file (8 bits, 1 plane + palette, 3 or 4 planes; RLE or not) as an embedded PNG:
-// OpenImageIO has no PCX reader. kCorrupt names the file and what is wrong.
-Expected<Image> pcx_as_png(const std::string& path);
 // An uncompressed assimp texture (aiTexels, BGRA, rows top first: Half-Life's and Quake's
 // palette skins) as an embedded PNG, RGB when every texel is opaque; with `colour_key` (a
 // Half-Life masked texture's transparent colour, 0-1 or 0-255) texels of that colour get alpha 0.

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 
 #include "format/page_file.h"
@@ -14,6 +15,7 @@
 #include "samples/procedural.h"
 #include "tests/bake/bake_test_util.h"
 #include "tests/scene/bmp_tga_files.h"
+#include "tests/scene/pcx_files.h"
 
 namespace vt {
 namespace {
@@ -547,6 +549,33 @@ TEST(Build, ExrColourIsPremultipliedInTheFileAndStraightWhenRead) {
   std::vector<float> back(8);
   ASSERT_TRUE((*src)->read_rows(0, 1, back.data()).ok());
   for (size_t i = 0; i < t.size(); ++i) EXPECT_NEAR(back[i], t[i], t[i] / 1024) << i;
+  fs::remove_all(dir);
+}
+
+// A PCX image alone (OpenImageIO reads none): the scene importers' decoder, whatever the letter
+// case of its extension; a file that is no PCX is refused naming it.
+TEST(Build, PcxImagesAreRead) {
+  fs::path dir = temp_dir();
+  const std::string rgb = (dir / "skin.PCX").string(), paletted = (dir / "pal.pcx").string();
+  std::ofstream(rgb, std::ios::binary) << test::pcx_rgb_3x1();
+  std::ofstream(paletted, std::ios::binary) << test::pcx_paletted_3x2();
+  auto src = open_image_file(rgb);
+  ASSERT_TRUE(src.ok()) << src.status().message();
+  ASSERT_EQ((*src)->info().width, 3u);
+  ASSERT_EQ((*src)->info().channels, 3u);
+  EXPECT_EQ((*src)->info().alpha_channel, -1);
+  std::vector<float> texels(9);
+  ASSERT_TRUE((*src)->read_rows(0, 1, texels.data()).ok());
+  const int want[9] = {200, 40, 70, 20, 50, 80, 30, 60, 90};
+  for (int i = 0; i < 9; ++i) EXPECT_EQ(std::lround(texels[i] * 255), want[i]) << i;
+  auto pal = open_image_file(paletted);
+  ASSERT_TRUE(pal.ok()) << pal.status().message();
+  EXPECT_EQ((*pal)->info().height, 2u);
+  std::ofstream(paletted, std::ios::binary) << "not a PCX image at all";
+  auto bad = open_image_file(paletted);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("pal.pcx: not a readable PCX image"), std::string::npos)
+      << bad.status().message();
   fs::remove_all(dir);
 }
 
