@@ -493,6 +493,34 @@ Status check_off_counts(const std::string& path) {
   return check_ceiling(path + ": OFF faces", counts[1], kMaxIndices / 3, "faces");
 }
 
+// Quake 2 stores a model's texture coordinates as signed 16-bit texels (a vertex may lie left of
+// or above the skin, the texture repeating there); assimp 5.2 reads them unsigned, so -4 became
+// 65532 / width: UFO: Alien Invasion's hull1.md2 had u up to 256 on a 256-wide skin, triangles
+// spanning the texture 256 times (baked so, and the atlas sized for it: 15,360 texels a side for
+// a 1024 skin). Folds every coordinate past 32767 texels back by 65536, from the header's skin
+// size (assimp's divisor; 1 when the header gives 0).
+void repair_md2_texture_coordinates(const std::string& path, aiScene& scene) {
+  uint8_t header[20] = {};
+  std::ifstream in(path, std::ios::binary);
+  if (!in.read(reinterpret_cast<char*>(header), sizeof header) ||
+      std::memcmp(header, "IDP2", 4) != 0)
+    return;
+  uint32_t w, h;
+  std::memcpy(&w, header + 8, 4);
+  std::memcpy(&h, header + 12, 4);
+  const double width = w ? w : 1, height = h ? h : 1;
+  for (unsigned i = 0; i < scene.mNumMeshes; ++i) {
+    aiMesh& m = *scene.mMeshes[i];
+    if (!m.mTextureCoords[0]) continue;
+    for (unsigned v = 0; v < m.mNumVertices; ++v) {
+      aiVector3D& uv = m.mTextureCoords[0][v];
+      const double s = double(uv.x) * width, t = (1.0 - double(uv.y)) * height;  // assimp's map
+      if (s >= 32767.5) uv.x = float((s - 65536) / width);
+      if (t >= 32767.5) uv.y = float(1.0 - (t - 65536) / height);
+    }
+  }
+}
+
 // Deletes the meshes without vertices or faces (an STL's empty solid, an exporter's empty
 // geometry) and the nodes' references to them: assimp's validation refuses a whole scene over
 // one. Returns how many went.
@@ -591,6 +619,7 @@ Expected<Scene> load_assimp(const std::string& path) {
     drop(owned->mLights, owned->mNumLights);
     drop(owned->mCameras, owned->mNumCameras);
     empty_meshes = drop_empty_meshes(*owned);
+    if (ext == "md2") repair_md2_texture_coordinates(path, *owned);
     if (owned->mNumMeshes == 0)
       return Error(ErrorCode::kInvalidArgument, path + ": no meshes: nothing to bake (its " +
                                                     std::to_string(empty_meshes) +

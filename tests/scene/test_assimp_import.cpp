@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -410,16 +411,19 @@ TEST(AssimpImport, ColourKeyedEmbeddedTexelsGetAlpha) {
   EXPECT_EQ(texels->channels, 3u);
 }
 
-// A Quake 2 model (IDP2) of one triangle, naming `skin` (none when empty), its frame followed by
-// the GL commands' end marker or, as UFO: Alien Invasion's models are, ending the file.
-std::string quake2_triangle(const std::string& skin, bool gl_commands) {
+// A Quake 2 model (IDP2) of one triangle on an 8 x 8 skin, naming `skin` (none when empty), its
+// frame followed by the GL commands' end marker or, as UFO: Alien Invasion's models are, ending
+// the file; `st`: the three vertices' texel coordinates (signed 16-bit s, t pairs).
+constexpr int16_t kQuake2St[6] = {1, 1, 6, 1, 1, 6};
+std::string quake2_triangle(const std::string& skin, bool gl_commands,
+                            const int16_t (&st_texels)[6] = kQuake2St) {
   const int32_t frame_size = 40 + 3 * 4, skins = skin.empty() ? 0 : 1;
   std::string md2 = "IDP2" + le32({8, 8, 8, frame_size, skins, 3, 3, 1, gl_commands ? 1 : 0, 1});
   const int32_t st = 68 + 64 * skins, tris = st + 3 * 4, frames = tris + 12,
                 gl = frames + frame_size;
   md2 += le32({68, st, tris, frames, gl_commands ? gl : 0, gl_commands ? gl + 4 : gl});
   if (skins) md2 += skin + std::string(64 - skin.size(), '\0');
-  md2 += std::string("\1\0\1\0\6\0\1\0\1\0\6\0", 12);      // s t of three vertices (short)
+  md2.append(reinterpret_cast<const char*>(st_texels), sizeof st_texels);  // little-endian
   md2 += std::string("\0\0\1\0\2\0\0\0\1\0\2\0", 12);      // vertex and UV indices (short)
   md2 += lef({1, 1, 1, 0, 0, 0}) + std::string(16, '\0');  // scale, translate, name
   md2 += std::string("\0\0\0\0\10\0\0\0\0\10\0\0", 12);    // three vertices (x y z, normal)
@@ -469,6 +473,26 @@ TEST(AssimpImport, Md2EndingAtItsFramesWithADottedSkinIsRead) {
   ASSERT_FALSE(refused.ok());
   EXPECT_NE(refused.status().message().find("Invalid MD2 file"), std::string::npos)
       << refused.status().message();
+}
+
+// Quake 2's texture coordinates are signed (a vertex left of the skin: the texture repeats);
+// assimp reads them unsigned, -2 texels as 65534 / 8 = 8191.75 (UFO:AI's hull1.md2: triangles
+// spanning the skin 256 times, an atlas 13x too large). Read back as -2 / 8.
+TEST(AssimpImport, Md2TextureCoordinatesAreSigned) {
+  fs::path d = fresh_dir("md2_signed");
+  const int16_t st[6] = {-2, 1, 6, -3, 1, 6};
+  write_text(d / "hull.md2", quake2_triangle("", true, st));
+  auto hull = scene::load_scene((d / "hull.md2").string());
+  ASSERT_TRUE(hull.ok()) << hull.status().message();
+  const scene::Primitive& p = hull->meshes.at(0).primitives.at(0);
+  ASSERT_EQ(p.uvs.at(0).size(), 3u);
+  std::vector<std::array<float, 2>> uvs;
+  for (const auto& uv : p.uvs[0]) uvs.push_back({uv[0], uv[1]});
+  std::sort(uvs.begin(), uvs.end());
+  // s / 8 and t / 8 in glTF's convention (v down from the top, as the skin's t).
+  const std::vector<std::array<float, 2>> want = {
+      {-0.25f, 0.125f}, {0.125f, 0.75f}, {0.75f, -0.375f}};
+  EXPECT_EQ(uvs, want);
 }
 
 // An OFF file's counts are checked against its size before assimp allocates for them: assimp's
