@@ -305,6 +305,7 @@ std::string build_metadata(const BuildOptions& options, const std::vector<LayerP
                    {"dct_adaptive", options.codec.dct_adaptive},
                    {"layers", sources},
                    {"dct_page_modes", options.codec.dct_page_modes},
+                   // -1 (kDefaultPageFloor): each layer's default floor, page_error_bounds.h
                    {"min_psnr", options.codec.min_psnr},
                    {"layer_min_psnr", options.codec.layer_min_psnr}};
   // Recorded only when set, so that earlier files' metadata (and plans) stay as they were.
