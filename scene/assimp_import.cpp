@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <string_view>
 
 #include "scene/image_load.h"
 #include "scene/import_budget.h"
@@ -86,7 +87,9 @@ bool md2_ends_at_its_last_section(const std::vector<uint8_t>& bytes) {
 // - files that start with a UTF-16 byte-order mark, as UTF-8: its XML readers (COLLADA;
 //   Irrlicht's .irr scenes, which Irrlicht writes in UTF-16) and its ASE reader take the bytes
 //   as UTF-8, and failed ("malformed XML", "No meshes remaining");
-// - MD2 models whose last section ends the file, with one zero byte after it (above).
+// - MD2 models whose last section ends the file, with one zero byte after it (above);
+// - Doom 3 MD5 meshes without their `MD5Version 10` line, with it: the Cube 2 engine does not
+//   ask for it (Red Eclipse's zapper), assimp refused them ("MD5Version tag has not been found").
 class FilesAsAssimpReadsThem : public Assimp::DefaultIOSystem {
  public:
   Assimp::IOStream* Open(const char* file, const char* mode) override {
@@ -99,20 +102,27 @@ class FilesAsAssimpReadsThem : public Assimp::DefaultIOSystem {
     stream->Seek(0, aiOrigin_SET);
     const bool utf16 = (mark[0] == 0xff && mark[1] == 0xfe) || (mark[0] == 0xfe && mark[1] == 0xff);
     const bool md2 = std::memcmp(mark, "IDP2", 4) == 0;
-    if (!utf16 && !md2) return stream;
+    const bool md5 = lower_extension(file) == "md5mesh";
+    if (!utf16 && !md2 && !md5) return stream;
     std::vector<uint8_t> bytes(stream->FileSize());
     bytes.resize(stream->Read(bytes.data(), 1, bytes.size()));
     stream->Seek(0, aiOrigin_SET);
+    constexpr std::string_view kMd5Version = "MD5Version";
     std::string served;
     if (utf16) {
       std::string note;
       Expected<std::string> text = decode_text(bytes, file, &note);
       if (!text.ok()) return stream;  // odd-length UTF-16: assimp's own error says what it finds
       served = std::move(*text);
-    } else {
+    } else if (md2) {
       if (!md2_ends_at_its_last_section(bytes)) return stream;
       served.assign(bytes.begin(), bytes.end());
       served.push_back('\0');
+    } else {
+      if (std::search(bytes.begin(), bytes.end(), kMd5Version.begin(), kMd5Version.end()) !=
+          bytes.end())
+        return stream;
+      served = "MD5Version 10\n" + std::string(bytes.begin(), bytes.end());
     }
     Close(stream);
     auto* copy = new uint8_t[served.size()];

@@ -495,6 +495,26 @@ TEST(AssimpImport, Md2TextureCoordinatesAreSigned) {
   EXPECT_EQ(uvs, want);
 }
 
+// A Doom 3 mesh (MD5) without its `MD5Version 10` line, as the Cube 2 engine reads them (Red
+// Eclipse's zapper): assimp refused it; it is handed the line. With the line, as before.
+TEST(AssimpImport, Md5MeshWithoutItsVersionLineIsRead) {
+  fs::path d = fresh_dir("md5");
+  const std::string body =
+      "commandline \"\"\n\nnumJoints 1\nnumMeshes 1\n\n"
+      "joints {\n\t\"origin\" -1 ( 0.0 0.0 0.0 ) ( -0.5 -0.5 -0.5 )\n}\n\n"
+      "mesh {\n\tshader \"skin\"\n\n\tnumverts 3\n"
+      "\tvert 0 ( 0.0 0.0 ) 0 1\n\tvert 1 ( 1.0 0.0 ) 1 1\n\tvert 2 ( 0.0 1.0 ) 2 1\n\n"
+      "\tnumtris 1\n\ttri 0 0 1 2\n\n\tnumweights 3\n"
+      "\tweight 0 0 1.0 ( 0.0 0.0 0.0 )\n\tweight 1 0 1.0 ( 1.0 0.0 0.0 )\n"
+      "\tweight 2 0 1.0 ( 0.0 1.0 0.0 )\n}\n";
+  for (const std::string& text : {body, "MD5Version 10\n" + body}) {
+    write_text(d / "item.md5mesh", text);
+    auto item = scene::load_scene((d / "item.md5mesh").string());
+    ASSERT_TRUE(item.ok()) << item.status().message();
+    EXPECT_EQ(item->triangle_count(), 1u);
+  }
+}
+
 // An OFF file's counts are checked against its size before assimp allocates for them: assimp's
 // own invalid/OutOfMemory.off (309 bytes, 353,535,235,358 vertices declared) took 16 GB and 90 s.
 TEST(AssimpImport, OffCountsBeyondTheFileAreRefusedBeforeAssimpReadsThem) {
