@@ -517,6 +517,7 @@ Expected<Scene> load_by_extension(const std::string& path, const SceneLoadOption
 Expected<Scene> load_scene(const std::string& path, const SceneLoadOptions& options) {
   VT_RETURN_IF_ERROR(detail::check_regular_file(path));
   VT_ASSIGN_OR_RETURN(Scene scene, load_by_extension(path, options));
+  detail::apply_cube2_config(path, scene);
   // Names go into messages, JSON reports, the metadata and the unwrapped glTF: UTF-8 from here
   // on. File paths stay as the disk has them.
   for (Material& m : scene.materials) m.name = as_utf8(m.name);

@@ -45,6 +45,14 @@ std::string percent_encode_path(const std::string& path);
 std::string resolve_written_path(const std::string& folder, const std::string& written,
                                  std::string* note);
 
+// Cube 2 engine games (Sauerbraten, Tesseract, Red Eclipse) name a model's textures in a config
+// beside it (`iqm.cfg`, `md5.cfg`, `md3.cfg`, `obj.cfg`, `smd.cfg` by the model's format):
+// `iqmskin * DIFFUSE [masks]` and `iqmbumpmap * NORMAL` (load modifiers such as `<dds>`
+// dropped, paths relative to the config) become every material's base colour and normal
+// textures, with a warning naming them, unless the config's `iqmload` names another model.
+// Lines for named meshes are counted in the warning, not applied.
+void apply_cube2_config(const std::string& model_path, Scene& scene);
+
 // The folder holding the scene's folder (absolute, symlinks resolved): the tree a scene's
 // files must lie in (SceneLoadOptions::allow_outside_paths).
 std::string scene_folder_tree(const std::string& scene_path);
