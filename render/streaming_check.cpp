@@ -334,7 +334,7 @@ Expected<StreamingCheckReport> run_streaming_check(Renderer& renderer, const Pag
   report.levels_held = uint32_t(texture->texture.levels.size());
   report.level_count = texture->level_count;
   report.absent_pages = texture->absent_pages;
-  if (report.first_level > 0 || report.levels_held + report.first_level < report.level_count) {
+  if (report.first_level > 0) {  // every coarser level is held
     report.note = "levels " + std::to_string(report.first_level) + "-" +
                   std::to_string(report.first_level + report.levels_held - 1) + " of " +
                   std::to_string(report.level_count) + " held (finer than " +
