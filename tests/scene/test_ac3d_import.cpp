@@ -8,6 +8,7 @@
 
 #include "scene/scene.h"
 #include "tests/scene/bmp_tga_files.h"
+#include "tests/scene/scene_warnings.h"
 
 namespace vt::test {
 namespace {
@@ -30,12 +31,6 @@ Expected<scene::Scene> load_text(const fs::path& dir, const std::string& name,
                                  const scene::SceneLoadOptions& options = {}) {
   write_text(dir / name, text);
   return scene::load_scene((dir / name).string(), options);
-}
-
-bool warned(const scene::Scene& s, const std::string& what) {
-  for (const std::string& w : s.warnings)
-    if (w.find(what) != std::string::npos) return true;
-  return false;
 }
 
 const std::string kMaterials =

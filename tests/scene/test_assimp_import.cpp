@@ -14,6 +14,7 @@
 #include "scene/image_load.h"
 #include "scene/scene.h"
 #include "scene/scene_io_util.h"
+#include "tests/scene/scene_warnings.h"
 
 namespace vt::test {
 namespace {
@@ -29,12 +30,6 @@ fs::path fresh_dir(const std::string& name) {
 
 void write_text(const fs::path& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
-}
-
-// True when one of the scene's warnings says `what`.
-bool warned(const scene::Scene& s, const std::string& what) {
-  return std::any_of(s.warnings.begin(), s.warnings.end(),
-                     [&](const std::string& w) { return w.find(what) != std::string::npos; });
 }
 
 // A COLLADA quad (two triangles) with UVs (`uvs`: four S T pairs), vertex colours and a diffuse

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "scene/scene.h"
+#include "tests/scene/scene_warnings.h"
 
 namespace vt::test {
 namespace {
@@ -49,12 +50,9 @@ TEST(Cube2Config, SkinsForEveryMeshBecomeTheMaterialsTextures) {
   ASSERT_EQ(s->materials.size(), 1u);
   EXPECT_EQ(texture_file(*s, s->materials[0].base_color_texture), "skin.png");
   EXPECT_EQ(texture_file(*s, s->materials[0].normal_texture), "norm.png");
-  bool warned = false;
-  for (const std::string& w : s->warnings)
-    warned |= w.find(
-                  "skin 'skin.png', normal map 'norm.png' for every mesh (1 line for named "
-                  "meshes not applied)") != std::string::npos;
-  EXPECT_TRUE(warned);
+  EXPECT_TRUE(warned(*s,
+                     "skin 'skin.png', normal map 'norm.png' for every mesh (1 line for named "
+                     "meshes not applied)"));
 }
 
 TEST(Cube2Config, AConfigBelowThatLoadsTheModelApplies) {

@@ -11,6 +11,7 @@
 
 #include "scene/image_load.h"
 #include "tests/scene/pcx_files.h"
+#include "tests/scene/scene_warnings.h"
 #include "tests/unwrap/mesh_gen.h"
 
 namespace vt::test {
@@ -460,21 +461,15 @@ TEST(SceneIo, PcxTexturesAreReadAsEmbeddedImages) {
   auto big = scene::load_scene(temp("pcx.obj"));
   ASSERT_TRUE(big.ok()) << big.status().message();
   EXPECT_FALSE(big->images[1].embedded());
-  bool refused = false;
-  for (const std::string& w : big->warnings)
-    refused |= w.find("65535 x 65536 texels need more data than the file holds") != w.npos;
-  EXPECT_TRUE(refused);
+  EXPECT_TRUE(warned(*big, "65535 x 65536 texels need more data than the file holds"));
   // A PCX kind it does not read: a warning naming the file; the image stays a file.
   std::string ega = pcx_header(3, 1, 4, 4);
   ega[3] = 1;
   write_text(temp("pal.pcx"), ega + std::string(16, '\0'));
-  auto warned = scene::load_scene(temp("pcx.obj"));
-  ASSERT_TRUE(warned.ok()) << warned.status().message();
-  EXPECT_FALSE(warned->images[0].embedded());
-  bool found = false;
-  for (const std::string& w : warned->warnings)
-    found |= w.find("pal.pcx: not a readable PCX image (1 bits x 4 planes") != w.npos;
-  EXPECT_TRUE(found);
+  auto ega_scene = scene::load_scene(temp("pcx.obj"));
+  ASSERT_TRUE(ega_scene.ok()) << ega_scene.status().message();
+  EXPECT_FALSE(ega_scene->images[0].embedded());
+  EXPECT_TRUE(warned(*ega_scene, "pal.pcx: not a readable PCX image (1 bits x 4 planes"));
 }
 
 TEST(EmbeddedImage, ExtensionFromMimeTypeThenMagic) {
