@@ -374,6 +374,12 @@ Status unwrap_and_transfer(const scene::Scene& input, const SceneBakeOptions& op
   for (const MissingTexture& m : summary.missing_textures)
     summary.warnings.push_back(m.message() + " (baked from the factor alone)");
   summary.above_one = layer_ranges(transfer->layers);
+  if (const uint64_t below = summary.transfer.below_horizon_samples; below > 0) {
+    summary.warnings.push_back(
+        "normal: the normal maps point below the surface (blue under half) at " +
+        with_thousands(below) + " of the transfer's " + with_thousands(summary.transfer.samples) +
+        " samples; stored at the horizon, the nearest direction the layer holds");
+  }
   if (const LightingStats& l = summary.transfer.lighting; l.clamped + l.non_finite > 0) {
     summary.warnings.push_back("lighting: " + with_thousands(l.clamped) + " samples above " +
                                std::to_string(int(kMaxIrradiance)) + " lux clamped to it, " +
@@ -551,6 +557,7 @@ nlohmann::json to_json(const SceneBakeSummary& s) {
         {"edge_only_texels", t.edge_only_texels},
         {"contested_texels", t.contested_texels},
         {"samples", t.samples},
+        {"below_horizon_samples", t.below_horizon_samples},
         {"bands", t.bands},
         {"bands_cached", t.bands_cached},
         {"texels_per_second", t.seconds > 0 ? double(t.covered_texels) / t.seconds : 0.0},

@@ -267,6 +267,7 @@ static_assert(slots_in_semantic_order(), "TransferResult::layers must be in Laye
 struct Sample {
   float albedo[4];
   float normal[3];
+  bool below_horizon;  // the normal map pointed below the surface: `normal` is at the horizon
   float orm[3];
   float emissive[3];
   float lighting[4];
@@ -370,7 +371,7 @@ struct LayerFacts {
 
 // Texel and sample counts over the passes.
 struct RowCounts {
-  uint64_t sampled = 0, edge_only = 0, contested = 0, samples = 0;
+  uint64_t sampled = 0, edge_only = 0, contested = 0, samples = 0, below_horizon = 0;
 };
 
 struct BandBytes;
@@ -894,7 +895,10 @@ void Transfer::evaluate(const TriEval& te, const double l[3], uint64_t seed, Sam
       t = normalized(
           t - n * dot(n, t),
           normalized(cross(std::abs(n.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0}, n), {1, 0, 0}));
-      double w = tg[te.v[0]][3] < 0 ? -1.0 : 1.0;
+      // Handedness per sample, as a renderer takes the sign of the interpolated w: a face whose
+      // corners disagree (a mirror seam through shared vertices) flips part-way, not whole.
+      double w =
+          tg[te.v[0]][3] * l[0] + tg[te.v[1]][3] * l[1] + tg[te.v[2]][3] * l[2] < 0 ? -1.0 : 1.0;
       Vec3d b = cross(n, t) * w;
       double x = (tex[0] * 2.0 - 1.0) * m.normal_scale, y = (tex[1] * 2.0 - 1.0) * m.normal_scale;
       double z = tex[2] * 2.0 - 1.0;
@@ -908,9 +912,19 @@ void Transfer::evaluate(const TriEval& te, const double l[3], uint64_t seed, Sam
         normalized(cross(std::abs(n.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0}, n), {1, 0, 0}));
     double wa = dot(cross(n, ta), te.dpdy) > 0 ? -1.0 : 1.0;
     Vec3d ba = cross(n, ta) * wa;
-    s.normal[0] = float(dot(world, ta));
-    s.normal[1] = float(dot(world, ba));
-    s.normal[2] = float(dot(world, n));
+    // The layer keeps x and y (BC5) and its reader rebuilds z >= 0, so a normal map's texel
+    // pointing below the surface (blue under half: hand-painted maps have them at steep edges)
+    // is stored at the horizon, the nearest direction the layer holds, not mirrored above it
+    // (Red Eclipse's zapper: lit check 27 -> 35 dB). Counted, and the bake warns.
+    double x = dot(world, ta), y = dot(world, ba), z = dot(world, n);
+    s.below_horizon = z < 0;
+    if (s.below_horizon) {
+      const double h = std::sqrt(x * x + y * y);
+      x = h > 0 ? x / h : 0, y = h > 0 ? y / h : 0, z = h > 0 ? 0 : 1;
+    }
+    s.normal[0] = float(x);
+    s.normal[1] = float(y);
+    s.normal[2] = float(z);
     if (want_[kLightingSlot]) {
       LightingSample ls;
       ls.position = world_point(te.p->world, lerp3(te.p->prim->positions, te.v, l));
@@ -1013,7 +1027,7 @@ void Transfer::transfer_band(uint32_t b, float* const (&acc)[kSlots], uint8_t* c
                     [&](size_t i, const double* l, uint32_t sub) {
                       evaluate(te, l, (uint64_t(y0) * W + i) * 32 + sub, s);
                       store(i, s, weight, true);
-                      ++counts.samples;
+                      ++counts.samples, counts.below_horizon += s.below_horizon;
                     });
   }
   for (size_t i = 0; i < band.best_tri.size(); ++i) {
@@ -1041,14 +1055,14 @@ void Transfer::transfer_band(uint32_t b, float* const (&acc)[kSlots], uint8_t* c
     tris_[t].closest_barycentrics((i % W) + 0.5, (y0 + i / W) + 0.5, l);
     evaluate(te, l, (uint64_t(y0) * W + i) * 32 + 16, s);
     store(i, s, 1.0f, false);
-    ++counts.samples;
+    ++counts.samples, counts.below_horizon += s.below_horizon;
   }
 }
 
 // A band's finished texels as the band cache stores them: its counts, its layers' facts, its
 // coverage (a byte a texel), then each layer's texels. `n` texels; sizes only with null data.
 struct BandBytes {
-  static constexpr size_t kCounts = 4 * sizeof(uint64_t), kFacts = 16;
+  static constexpr size_t kCounts = 5 * sizeof(uint64_t), kFacts = 16;
   size_t n = 0, size = 0;
   size_t offset[kSlots] = {};  // of each wanted layer's texels
   BandBytes(size_t texels, const bool (&want)[kSlots], const uint32_t (&channels)[kSlots])
@@ -1062,7 +1076,8 @@ struct BandBytes {
 void Transfer::pack_band(const BandBytes& f, float* const (&acc)[kSlots], const uint8_t* coverage,
                          const RowCounts& counts, const LayerFacts (&facts)[kSlots],
                          uint8_t* out) const {
-  const uint64_t c[4] = {counts.sampled, counts.edge_only, counts.contested, counts.samples};
+  const uint64_t c[5] = {counts.sampled, counts.edge_only, counts.contested, counts.samples,
+                         counts.below_horizon};
   std::memcpy(out, c, sizeof c);
   for (int l = 0; l < kSlots; ++l) {
     uint8_t* p = out + BandBytes::kCounts + l * BandBytes::kFacts;
@@ -1079,9 +1094,10 @@ void Transfer::pack_band(const BandBytes& f, float* const (&acc)[kSlots], const 
 void Transfer::unpack_band(const BandBytes& f, const uint8_t* in, float* const (&acc)[kSlots],
                            uint8_t* coverage, RowCounts& counts,
                            LayerFacts (&facts)[kSlots]) const {
-  uint64_t c[4];
+  uint64_t c[5];
   std::memcpy(c, in, sizeof c);
   counts.sampled = c[0], counts.edge_only = c[1], counts.contested = c[2], counts.samples = c[3];
+  counts.below_horizon = c[4];
   for (int l = 0; l < kSlots; ++l) {
     const uint8_t* p = in + BandBytes::kCounts + l * BandBytes::kFacts;
     std::memcpy(&facts[l].texels_above_one, p, 8);
@@ -1162,6 +1178,7 @@ Status Transfer::transfer_rows(uint32_t r0, uint32_t r1, float* const (&acc)[kSl
   for (const Outcome& o : outcome) {
     counts.sampled += o.counts.sampled, counts.edge_only += o.counts.edge_only;
     counts.contested += o.counts.contested, counts.samples += o.counts.samples;
+    counts.below_horizon += o.counts.below_horizon;
     bands_cached_ += o.cached;
     for (int l = 0; l < kSlots; ++l) {
       LayerFacts& f = facts[l];
@@ -1349,6 +1366,7 @@ Expected<TransferResult> Transfer::run() {
   result.stats.covered_texels = counts.sampled + counts.edge_only;
   result.stats.contested_texels = counts.contested;
   result.stats.samples = counts.samples;
+  result.stats.below_horizon_samples = counts.below_horizon;
   if (lighting_) result.stats.lighting = lighting_->stats();
   result.stats.texture_bytes = texture_bytes_;
   result.stats.bands = bins_.size();

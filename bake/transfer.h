@@ -121,9 +121,11 @@ struct TransferStats {
   uint64_t edge_only_texels = 0;  // covered conservatively only (closest-point value)
   uint64_t contested_texels = 0;  // touched by two charts (0 when the atlas has a gutter)
   uint64_t samples = 0;           // material evaluations
-  LightingStats lighting;         // the lighting layer's samples and rays (none: all 0)
-  uint64_t texture_bytes = 0;     // the source textures' MIP levels (memory or mapped scratch)
-  uint64_t bands = 0;             // bands of rows, and those read from the band cache
+  // Normal-map samples that pointed below the surface, stored at the horizon (Transfer::evaluate).
+  uint64_t below_horizon_samples = 0;
+  LightingStats lighting;      // the lighting layer's samples and rays (none: all 0)
+  uint64_t texture_bytes = 0;  // the source textures' MIP levels (memory or mapped scratch)
+  uint64_t bands = 0;          // bands of rows, and those read from the band cache
   uint64_t bands_cached = 0;
   double seconds = 0;
   // Where `seconds` went, in order: "setup" (triangles, bins, band keys), "stores" (the layers'

@@ -155,13 +155,14 @@ Expected<ReferenceFrame> LightingReference::render(const Camera& camera, uint32_
     const size_t mat = mesh.reference_texture;
     if (mat < materials_.size() && materials_[mat].has_normal_map) {
       // As the transfer applies a normal map (bake/transfer.cpp): the tangent made orthogonal to
-      // the interpolated normal, the first vertex's handedness.
+      // the interpolated normal, the sign of the interpolated handedness.
       const LitMaterial& lm = materials_[mat];
       Vec3d t = lerp([](const Vertex& x) { return Vec3d{x.tx, x.ty, x.tz}; });
       t = normalized(
           t - n * dot(n, t),
           normalized(cross(std::abs(n.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0}, n), {1, 0, 0}));
-      const Vec3d bt = cross(n, t) * (v[0]->tw < 0 ? -1.0 : 1.0);
+      const Vec3d bt =
+          cross(n, t) * (lerp([](const Vertex& x) { return double(x.tw); }) < 0 ? -1.0 : 1.0);
       double tex[4];
       sample_bilinear(lm.normal,
                       lerp([](const Vertex& x) { return double(x.tex_uv[kLitNormalUv][0]); }),

@@ -20,6 +20,7 @@
 #include "bake/unwrap/unwrap.h"
 #include "bake/unwrap/unwrap_internal.h"
 #include "common/parallel.h"
+#include "scene/material_rules.h"
 #include "scene/tangent_frame.h"
 
 namespace vt::unwrap {
@@ -991,8 +992,8 @@ struct StretchSums {
 // the float UVs actually written) and the surface's stretch sums.
 void write_surface_uvs(const Surface& s, const std::vector<Chart>& charts,
                        const std::vector<uint32_t>& chart_ids, const PackedAtlas& atlas, double W,
-                       double H, const scene::Primitive& src, scene::Primitive* dst,
-                       std::vector<AtlasTriangle>* tris, StretchSums* sums) {
+                       double H, const scene::Primitive& src, const scene::TextureRef* normal_map,
+                       scene::Primitive* dst, std::vector<AtlasTriangle>* tris, StretchSums* sums) {
   size_t faces = s.tri.size() / 3;
   std::vector<uint32_t> new_index(s.tri.size());
   std::vector<scene::Vec2> atlas_uv;
@@ -1045,7 +1046,16 @@ void write_surface_uvs(const Surface& s, const std::vector<Chart>& charts,
   const std::vector<scene::Vec3> smoothed =
       own_normals ? std::vector<scene::Vec3>{} : scene::compute_normals(src);
   gather(own_normals ? src.normals : smoothed, dst->normals);
-  gather(src.tangents, dst->tangents);
+  // The same for the frame a normal map is decoded in: derived after the split, a vertex on a
+  // chart edge would average only its own chart's faces (a face alone in a chart, or one whose
+  // source UVs are degenerate, would get an arbitrary tangent) where the reference, deriving it
+  // on the source, averages them all.
+  const bool derive_tangents = src.tangents.size() != src.positions.size() && normal_map &&
+                               scene::texture_uv_set(src, *normal_map);
+  gather(derive_tangents ? scene::compute_tangents(src, own_normals ? src.normals : smoothed,
+                                                   normal_map->texcoord)
+                         : src.tangents,
+         dst->tangents);
   gather(src.colors, dst->colors);
   dst->uvs.resize(src.uvs.size());
   for (size_t n = 0; n < src.uvs.size(); ++n) gather(src.uvs[n], dst->uvs[n]);
@@ -1090,9 +1100,15 @@ void write_atlas_uvs(const scene::Scene& in, const std::vector<Surface>& surface
   std::vector<StretchSums> sums(surfaces.size());
   parallel_for(surfaces.size(), threads, [&](size_t si) {
     const Surface& s = surfaces[si];
-    write_surface_uvs(
-        s, charts, charts_of[si], atlas, W, H, in.meshes[s.source_mesh].primitives[s.out_prim],
-        &result->scene.meshes[s.out_mesh].primitives[s.out_prim], &tri_out[si], &sums[si]);
+    const scene::Primitive& src = in.meshes[s.source_mesh].primitives[s.out_prim];
+    const bool has_material = src.material >= 0 && size_t(src.material) < in.materials.size();
+    const scene::TextureRef* normal_map =
+        has_material && in.materials[src.material].normal_texture.valid()
+            ? &in.materials[src.material].normal_texture
+            : nullptr;
+    write_surface_uvs(s, charts, charts_of[si], atlas, W, H, src, normal_map,
+                      &result->scene.meshes[s.out_mesh].primitives[s.out_prim], &tri_out[si],
+                      &sums[si]);
   });
   result->triangles.resize(0);
   double num = 0, a3 = 0, auv = 0, li = 0;

@@ -274,6 +274,123 @@ TEST(SceneBake, NormalMappedSphereKeepsItsNormals) {
   EXPECT_LT(p95, 2.0) << "mean " << mean << " max " << angles.back();
 }
 
+// A normal map's texels that point below the surface (blue under half: hand-painted maps have
+// them at steep edges) are stored at the horizon, the nearest direction a two-channel layer
+// holds; mirrored above the surface (its x and y kept, z rebuilt positive) they lit the wrong
+// way (Red Eclipse's zapper). Counted, and the bake warns.
+TEST(SceneBake, NormalsBelowTheSurfaceAreStoredAtTheHorizon) {
+  test::ScratchDir dir;
+  // Left half: (0.8, 0, -0.6), below; right half: straight up.
+  auto half_below = [](double u, double, float* t) {
+    t[0] = u < 0.5 ? 0.9f : 0.5f, t[1] = 0.5f, t[2] = u < 0.5 ? 0.2f : 1.0f;
+  };
+  ASSERT_TRUE(write_texture(dir.file("n.png"), 64, 64, 3, half_below).ok());
+  scene::Material m;
+  m.name = "steep";
+  scene::Scene s = test::single_mesh_scene(make_grid(1.0f, 1, 1), m);
+  s.materials[0].normal_texture.image = test::add_image(s, dir.file("n.png"));
+  SceneBakeOptions o;
+  o.build.output = dir.file("out.vtpf");
+  o.unwrap.texels_per_unit = 64;
+  o.build.codec.codec = CodecKind::kRaw;
+  auto summary = bake_scene(s, o);
+  ASSERT_TRUE(summary.ok()) << summary.status().message();
+  const uint64_t below = summary->transfer.below_horizon_samples;
+  EXPECT_GT(below, summary->transfer.samples * 2 / 5);
+  EXPECT_LT(below, summary->transfer.samples * 3 / 5);
+  EXPECT_TRUE(std::any_of(summary->warnings.begin(), summary->warnings.end(), [](auto& w) {
+    return w.rfind("normal: ", 0) == 0 && w.find("point below the surface") != std::string::npos &&
+           w.find("stored at the horizon") != std::string::npos;
+  }));
+  auto reader = PageFileReader::open(o.build.output);
+  ASSERT_TRUE(reader.ok());
+  const int nl = test::find_layer(**reader, LayerSemantic::kNormal);
+  ASSERT_GE(nl, 0);
+  const test::Level0 level = test::read_level0(**reader, uint32_t(nl));
+  auto un = scene::load_scene(dir.file("out.glb"));
+  ASSERT_TRUE(un.ok());
+  const scene::Primitive& p = un->meshes[0].primitives[0];
+  const auto& atlas = p.uvs.back();
+  int horizon = 0, up = 0;
+  test::for_each_source_texel(
+      p, 64, 64, [&](const uint32_t v[3], const double l[3], double u, double vv) {
+        // Texels straddling the two halves mix both; at the quad's border, the gutter.
+        if (std::abs(u - 0.5) < 0.05 || std::min({u, vv, 1 - u, 1 - vv}) < 0.05) return;
+        double px = 0, py = 0;
+        for (int k = 0; k < 3; ++k)
+          px += l[k] * atlas[v[k]][0] * level.width, py += l[k] * atlas[v[k]][1] * level.height;
+        const double x = level.at(px, py, 0) * 2.0 - 1, y = level.at(px, py, 1) * 2.0 - 1;
+        const double xy = std::sqrt(x * x + y * y);  // 1 at the horizon; 0.8 mirrored; 0 up
+        if (u < 0.5) {
+          EXPECT_NEAR(xy, 1.0, 0.01) << u;
+          ++horizon;
+        } else {
+          EXPECT_LT(xy, 0.01) << u;
+          ++up;
+        }
+      });
+  EXPECT_GT(horizon, 1400);
+  EXPECT_GT(up, 1400);
+}
+
+// A face whose corners disagree on the tangent frame's handedness (a mirror seam through
+// shared vertices) flips where the interpolated w changes sign, as a renderer's shader and the
+// validator's reference take it; the first corner's w alone flipped (or kept) the whole face.
+TEST(SceneBake, HandednessFollowsTheInterpolatedW) {
+  test::ScratchDir dir;
+  auto tilted = [](double, double, float* t) { t[0] = 0.5f, t[1] = 0.8f, t[2] = 0.9f; };
+  ASSERT_TRUE(write_texture(dir.file("n.png"), 16, 16, 3, tilted).ok());
+  // Corners 0 (uv 0,0), 1 (1,0), 2 (0,1), 3 (1,1); faces {0, 2, 1} and {1, 2, 3}.
+  scene::Primitive quad = make_grid(1.0f, 1, 1);
+  for (size_t v = 0; v < quad.positions.size(); ++v)
+    quad.tangents.push_back({1, 0, 0, v == 0 ? -1.0f : 1.0f});  // +u; bitangent up the image
+  scene::Material m;
+  m.name = "seam";
+  scene::Scene s = test::single_mesh_scene(quad, m);
+  s.materials[0].normal_texture.image = test::add_image(s, dir.file("n.png"));
+  SceneBakeOptions o;
+  o.build.output = dir.file("out.vtpf");
+  o.unwrap.texels_per_unit = 64;
+  o.build.codec.codec = CodecKind::kRaw;
+  auto summary = bake_scene(s, o);
+  ASSERT_TRUE(summary.ok()) << summary.status().message();
+  auto reader = PageFileReader::open(o.build.output);
+  ASSERT_TRUE(reader.ok());
+  const int nl = test::find_layer(**reader, LayerSemantic::kNormal);
+  ASSERT_GE(nl, 0);
+  const test::Level0 level = test::read_level0(**reader, uint32_t(nl));
+  auto un = scene::load_scene(dir.file("out.glb"));
+  ASSERT_TRUE(un.ok());
+  const scene::Primitive& p = un->meshes[0].primitives[0];
+  const auto& atlas = p.uvs.back();
+  // Baked (x, y) by region: 0 near corner 0 (its w weighs over a half), 1 the rest of the first
+  // face, 2 the second face.
+  double sum[3][2] = {}, count[3] = {};
+  test::for_each_source_texel(
+      p, 64, 64, [&](const uint32_t v[3], const double l[3], double u, double vv) {
+        const double d = u + vv;
+        const int region = d < 0.3 ? 0 : d > 0.6 && d < 0.9 ? 1 : d > 1.1 ? 2 : -1;
+        if (region < 0) return;
+        double px = 0, py = 0;
+        for (int k = 0; k < 3; ++k)
+          px += l[k] * atlas[v[k]][0] * level.width, py += l[k] * atlas[v[k]][1] * level.height;
+        sum[region][0] += level.at(px, py, 0) * 2.0 - 1,
+            sum[region][1] += level.at(px, py, 1) * 2.0 - 1;
+        ++count[region];
+      });
+  double mean[3][2];
+  for (int r = 0; r < 3; ++r) {
+    ASSERT_GT(count[r], 100) << r;
+    mean[r][0] = sum[r][0] / count[r], mean[r][1] = sum[r][1] / count[r];
+  }
+  auto distance = [&](int a, int b) {
+    return std::hypot(mean[a][0] - mean[b][0], mean[a][1] - mean[b][1]);
+  };
+  EXPECT_LT(distance(1, 2), 0.02);         // the first face beyond the seam line as the second face
+  EXPECT_NEAR(distance(0, 2), 1.2, 0.03);  // near corner 0: the bitangent's 0.6 mirrored
+  EXPECT_NEAR(std::hypot(mean[2][0], mean[2][1]), 0.6, 0.02);
+}
+
 // A linear EXR of fine stripes, baked at 1/16 of its density: every supersampling rate must be
 // at the footprint average (reference: 32 x 32 exact samples per texel), and more samples per
 // texel never further from it. (OpenImageIO's TextureSystem, before 2026-12-03, gave RMSE

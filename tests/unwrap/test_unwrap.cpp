@@ -162,6 +162,53 @@ TEST(Unwrap, ACornerSharedAcrossChartsKeepsItsSmoothNormal) {
   }
 }
 
+TEST(Unwrap, ANormalMappedCornerSharedAcrossChartsKeepsItsSourceTangent) {
+  // As the smooth normal above: a normal map's frame, derived from the source UVs where the
+  // file gives none, averages every face around a shared corner in the validator's reference
+  // (which derives it on the source). Derived on the corners split along the charts, a corner
+  // averages its own chart's faces alone, so the unwrapped box carries the source's.
+  Primitive box;
+  for (int i = 0; i < 8; ++i) {
+    const float x = float(i & 1), y = float(i >> 1 & 1), z = float(i >> 2);
+    box.positions.push_back({x, y, z});
+    box.uvs.resize(1);
+    box.uvs[0].push_back({0.7f * x + 0.3f * z, 0.6f * y + 0.2f * x + 0.1f * z});
+  }
+  const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads)
+    box.indices.insert(box.indices.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
+  box.material = 0;
+  const std::vector<scene::Vec4> source =
+      scene::compute_tangents(box, scene::compute_normals(box), 0);
+  Scene s = scene_of(box);
+  s.materials.resize(1);
+  s.materials[0].normal_texture.image = 0;  // the unwrap reads no image
+  auto r = unwrap::unwrap_scene(s, small_options());
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  expect_valid(s, *r, 4);
+  const Primitive& out = r->scene.meshes[0].primitives[0];
+  ASSERT_GT(out.positions.size(), 8u);  // corners split along the charts
+  ASSERT_EQ(out.tangents.size(), out.positions.size());
+  const std::vector<scene::Vec4> split = scene::compute_tangents(out, out.normals, 0);
+  int differs = 0;
+  for (size_t v = 0; v < out.positions.size(); ++v) {
+    const auto& q = out.positions[v];
+    const size_t corner = size_t(q[0]) | size_t(q[1]) << 1 | size_t(q[2]) << 2;
+    for (int k = 0; k < 4; ++k) EXPECT_FLOAT_EQ(out.tangents[v][k], source[corner][k]) << v;
+    differs += std::abs(split[v][0] - source[corner][0]) +
+                   std::abs(split[v][1] - source[corner][1]) +
+                   std::abs(split[v][2] - source[corner][2]) >
+               0.01f;
+  }
+  EXPECT_GT(differs, 0);  // what deriving on the split corners would have given instead
+  // Without a normal map no frame is needed, and none is made.
+  s.materials[0].normal_texture.image = -1;
+  auto plain = unwrap::unwrap_scene(s, small_options());
+  ASSERT_TRUE(plain.ok());
+  EXPECT_TRUE(plain->scene.meshes[0].primitives[0].tangents.empty());
+}
+
 TEST(Unwrap, MaterialBoundariesCut) {
   Primitive a = flat_grid(4, 4), b = flat_grid(4, 4);
   for (auto& v : b.positions) v[0] += 1.0f;  // shares the x = 1 edge geometrically
