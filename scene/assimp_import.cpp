@@ -465,6 +465,66 @@ class AssimpScene {
   int depth_ = 0;
 };
 
+// An Inter-Quake Model's sections against its size, before assimp reads them: its reader follows
+// every offset and count the header and the meshes give without a check, so a crafted file had
+// it read (or allocate) far past its buffer. Checked: the text, the meshes, the vertex arrays,
+// each mesh's triangles and, for the arrays assimp reads (position, texture coordinates, normal,
+// colour), each mesh's vertices; a mesh's material name ends inside the text. A file assimp
+// refuses anyway (magic, version, size) is left to it.
+Status check_iqm_layout(const std::string& path) {
+  Expected<std::vector<uint8_t>> bytes = read_file(path);
+  if (!bytes.ok()) return Status::Ok();
+  const std::vector<uint8_t>& b = *bytes;
+  auto u32 = [&b](uint64_t at) {
+    return uint32_t(b[at]) | uint32_t(b[at + 1]) << 8 | uint32_t(b[at + 2]) << 16 |
+           uint32_t(b[at + 3]) << 24;
+  };
+  constexpr uint64_t kHeader = 124, kMesh = 24, kArray = 20, kTriangle = 12;
+  if (b.size() < kHeader || std::memcmp(b.data(), "INTERQUAKEMODEL", 16) != 0 || u32(16) != 2 ||
+      u32(20) != b.size())
+    return Status::Ok();
+  // `count` entries of `unit` bytes from byte `start` (a double: no overflow) inside the file.
+  auto inside = [&](const std::string& what, double start, uint64_t count, uint64_t unit) {
+    if (start > double(b.size()))
+      return Error(ErrorCode::kCorrupt, path + ": IQM " + what + " start past the end of the file");
+    return check_backed(path + ": IQM " + what, count, unit, "the file after its start",
+                        b.size() - uint64_t(start));
+  };
+  const uint64_t num_text = u32(28), ofs_text = u32(32), num_meshes = u32(36);
+  const uint64_t ofs_meshes = u32(40), num_arrays = u32(44), ofs_arrays = u32(52);
+  const uint64_t ofs_triangles = u32(60);
+  VT_RETURN_IF_ERROR(inside("text", double(ofs_text), num_text, 1));
+  VT_RETURN_IF_ERROR(inside("meshes", double(ofs_meshes), num_meshes, kMesh));
+  VT_RETURN_IF_ERROR(inside("vertex arrays", double(ofs_arrays), num_arrays, kArray));
+  for (uint64_t m = 0; m < num_meshes; ++m) {
+    const uint64_t at = ofs_meshes + m * kMesh;
+    const uint64_t material = u32(at + 4), first_vertex = u32(at + 8), vertices = u32(at + 12);
+    const uint64_t first_triangle = u32(at + 16), triangles = u32(at + 20);
+    const std::string mesh = "mesh " + std::to_string(m);
+    if (material >= num_text ||
+        !std::memchr(b.data() + ofs_text + material, 0, num_text - material))
+      return Error(ErrorCode::kCorrupt,
+                   path + ": IQM " + mesh + "'s material name is not in the text");
+    VT_RETURN_IF_ERROR(inside(mesh + "'s triangles",
+                              double(ofs_triangles) + double(first_triangle) * kTriangle, triangles,
+                              kTriangle));
+    for (uint64_t a = 0; a < num_arrays; ++a) {
+      const uint64_t array = ofs_arrays + a * kArray;
+      const uint32_t type = u32(array), format = u32(array + 8), size = u32(array + 12);
+      constexpr uint32_t kUbyte = 1, kFloat = 7, kColor = 6;
+      // What assimp reads: float positions, texture coordinates and normals, and colours.
+      const bool read = (type <= 2 && format == kFloat && size >= (type == 1 ? 2u : 3u)) ||
+                        (type == kColor && (format == kUbyte || format == kFloat) && size >= 3);
+      if (!read) continue;
+      const uint64_t unit = format == kFloat ? 4 : 1;
+      VT_RETURN_IF_ERROR(inside(mesh + "'s vertex array " + std::to_string(a),
+                                double(u32(array + 16)) + double(first_vertex) * size * unit,
+                                vertices, uint64_t(size) * unit));
+    }
+  }
+  return Status::Ok();
+}
+
 // An OFF file's vertex and face counts against its size, before assimp allocates for them: a
 // 309-byte file declaring 353,535,235,358 vertices (assimp's own invalid/OutOfMemory.off) made
 // it take 16 GB and 90 s. ASCII OFF: every vertex takes at least "0 0 0\n", every face "0\n".
@@ -593,6 +653,7 @@ Expected<Scene> load_assimp(const std::string& path) {
             ", whose reader of them finds no meshes (assimp issues 4553 and 5014, fixed "
             "in 5.3); bake the meshes the scene names (.3ds, .x, .b3d, .obj) instead");
   if (ext == "off") VT_RETURN_IF_ERROR(check_off_counts(path));
+  if (ext == "iqm") VT_RETURN_IF_ERROR(check_iqm_layout(path));
   Assimp::Importer importer;
   importer.SetIOHandler(new FilesAsAssimpReadsThem);  // the importer owns it
   // Points and lines are dropped by SortByPType; normals are made only where a mesh has none.

@@ -2,8 +2,11 @@
 // beside it, not in the model, whose own material strings are names ("door", "Material.001")
 // or the artist's paths (see scene_io_util.h, apply_cube2_config).
 #include <algorithm>
+#include <array>
 #include <cctype>
+#include <cstring>
 #include <filesystem>
+#include <map>
 #include <optional>
 
 #include "scene/scene_io_util.h"
@@ -41,11 +44,16 @@ std::string without_modifiers(std::string name) {
   return name;
 }
 
-// What one config gives the model: skins for every mesh (`*`), and how many lines name meshes.
+// One `KINDskin` / `KINDbumpmap` line: the mesh it names (`*`: every mesh) and its texture.
+struct SkinLine {
+  bool normal = false;
+  std::string mesh, texture;
+};
+
+// What one config gives the model, its lines in order (a later line overrides an earlier one).
 struct Skins {
   std::string config, folder;  // the config, and the folder its paths are relative to
-  std::string diffuse, normal;
-  size_t named_meshes = 0;
+  std::vector<SkinLine> lines;
 };
 
 // The config's skins when it configures `model`: its `KINDload` names the model (relative to
@@ -75,15 +83,72 @@ std::optional<Skins> read_config(const std::string& config, const std::string& k
       loads_model = std::filesystem::equivalent(loaded, model, ec);
       if (!loads_model) return std::nullopt;
     }
-    if (w.size() < 3 || (w[0] != kind + "skin" && w[0] != kind + "bumpmap")) continue;
-    if (w[1] != "*") {
-      ++skins.named_meshes;
-      continue;
-    }
-    (w[0] == kind + "skin" ? skins.diffuse : skins.normal) = without_modifiers(w[2]);
+    if (w.size() >= 3 && (w[0] == kind + "skin" || w[0] == kind + "bumpmap"))
+      skins.lines.push_back({w[0] == kind + "bumpmap", w[1], without_modifiers(w[2])});
   }
-  if (!loads_model || (skins.diffuse.empty() && skins.normal.empty())) return std::nullopt;
+  if (!loads_model || skins.lines.empty()) return std::nullopt;
   return skins;
+}
+
+uint32_t le32(const std::vector<uint8_t>& b, size_t at) {
+  return uint32_t(b[at]) | uint32_t(b[at + 1]) << 8 | uint32_t(b[at + 2]) << 16 |
+         uint32_t(b[at + 3]) << 24;
+}
+
+// The names the engine gives a model's meshes, one per mesh assimp makes a material for, in
+// file order: MD5's `// meshes: NAME` comment in each mesh block that has vertices and triangles
+// (assimp skips the others), IQM's mesh names. Empty for other kinds or a file not read so.
+std::vector<std::string> engine_mesh_names(const std::string& model_path, const std::string& kind) {
+  std::vector<std::string> names;
+  if (kind != "md5" && kind != "iqm") return names;
+  Expected<std::vector<uint8_t>> bytes = read_file(model_path);
+  if (!bytes.ok()) return names;
+  const std::vector<uint8_t>& b = *bytes;
+  if (kind == "iqm") {
+    // Header: magic[16], version, filesize, flags, num_text, ofs_text, num_meshes, ofs_meshes;
+    // a mesh: name (offset into the text), material, first/num vertices, first/num triangles.
+    constexpr char kMagic[] = "INTERQUAKEMODEL";
+    if (b.size() < 44 || std::memcmp(b.data(), kMagic, 16) != 0) return names;
+    const uint64_t num_text = le32(b, 28), ofs_text = le32(b, 32);
+    const uint64_t num_meshes = le32(b, 36), ofs_meshes = le32(b, 40);
+    if (ofs_text + num_text > b.size() || ofs_meshes + num_meshes * 24 > b.size()) return names;
+    for (uint64_t m = 0; m < num_meshes; ++m) {
+      const uint64_t name = le32(b, size_t(ofs_meshes + m * 24));
+      if (name >= num_text) return {};
+      const char* first = reinterpret_cast<const char*>(b.data() + ofs_text + name);
+      names.emplace_back(first, strnlen(first, size_t(num_text - name)));
+    }
+    return names;
+  }
+  const std::string text(b.begin(), b.end());
+  bool in_mesh = false;
+  std::string name;
+  long verts = 0, tris = 0;
+  size_t at = 0;
+  while (at < text.size()) {
+    size_t end = text.find('\n', at);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(at, end - at);
+    at = end + 1;
+    const size_t first = line.find_first_not_of(" \t\r");
+    line = first == std::string::npos ? "" : line.substr(first);
+    while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
+    if (!in_mesh) {
+      if (line.rfind("mesh", 0) == 0 && line.find('{') != std::string::npos)
+        in_mesh = true, name.clear(), verts = tris = 0;
+    } else if (line.rfind("// meshes:", 0) == 0) {
+      name = line.substr(10);
+      name.erase(0, name.find_first_not_of(" \t"));
+    } else if (line.rfind("numverts", 0) == 0) {
+      verts = std::strtol(line.c_str() + 8, nullptr, 10);
+    } else if (line.rfind("numtris", 0) == 0) {
+      tris = std::strtol(line.c_str() + 7, nullptr, 10);
+    } else if (line.rfind("}", 0) == 0) {
+      if (verts > 0 && tris > 0) names.push_back(name);
+      in_mesh = false;
+    }
+  }
+  return names;
 }
 
 }  // namespace
@@ -106,32 +171,61 @@ void apply_cube2_config(const std::string& model_path, Scene& scene) {
       skins = read_config(below[i], kind, model_path, false);
   }
   if (!skins) return;
+  // Lines naming a mesh apply where the engine's mesh names line up with the materials.
+  std::vector<std::string> names = engine_mesh_names(model_path, kind);
+  if (names.size() != scene.materials.size()) names.clear();
+  std::map<std::string, TextureRef> images;  // one image per texture written
   const auto image_for = [&](const std::string& written) {
-    std::string found_note;
-    Image image;
-    image.name = written;
-    image.uri = written;
-    image.path = resolve_written_path(skins->folder, written, &found_note);
-    scene.images.push_back(std::move(image));
-    TextureRef ref;
-    ref.image = int(scene.images.size() - 1);
-    return ref;
+    auto [it, added] = images.try_emplace(written);
+    if (added) {
+      std::string found_note;
+      Image image;
+      image.name = written;
+      image.uri = written;
+      image.path = resolve_written_path(skins->folder, written, &found_note);
+      scene.images.push_back(std::move(image));
+      it->second.image = int(scene.images.size() - 1);
+    }
+    return it->second;
   };
-  const TextureRef diffuse = skins->diffuse.empty() ? TextureRef{} : image_for(skins->diffuse);
-  const TextureRef normal = skins->normal.empty() ? TextureRef{} : image_for(skins->normal);
-  for (Material& m : scene.materials) {
-    if (diffuse.valid()) m.base_color_texture = diffuse;
-    if (normal.valid()) m.normal_texture = normal;
+  // What each target (`*` or a mesh name) ends with, in order of first mention, for the warning.
+  std::vector<std::pair<std::string, std::array<std::string, 2>>> told;
+  size_t not_applied = 0;
+  for (const SkinLine& line : skins->lines) {
+    bool applied = false;
+    for (size_t m = 0; m < scene.materials.size(); ++m) {
+      if (line.mesh != "*" && (names.empty() || names[m] != line.mesh)) continue;
+      (line.normal ? scene.materials[m].normal_texture : scene.materials[m].base_color_texture) =
+          image_for(line.texture);
+      applied = true;
+    }
+    if (!applied) {
+      not_applied += line.mesh != "*";
+      continue;
+    }
+    auto it = std::find_if(told.begin(), told.end(), [&](auto& t) { return t.first == line.mesh; });
+    if (it == told.end()) it = told.insert(told.end(), {line.mesh, {}});
+    it->second[line.normal] = line.texture;
+  }
+  if (told.empty()) {
+    scene.warnings.push_back(model_path + ": the game's model config " + skins->config +
+                             " names skins for meshes the model does not name (" +
+                             std::to_string(not_applied) + " lines): not applied");
+    return;
+  }
+  std::string what;
+  for (const auto& [mesh, textures] : told) {
+    if (!what.empty()) what += "; ";
+    if (!textures[0].empty()) what += "skin '" + textures[0] + "'";
+    if (!textures[0].empty() && !textures[1].empty()) what += ", ";
+    if (!textures[1].empty()) what += "normal map '" + textures[1] + "'";
+    what += mesh == "*" ? " for every mesh" : " for mesh '" + mesh + "'";
   }
   scene.warnings.push_back(
-      model_path + ": textures from the game's model config " + skins->config + ": " +
-      (diffuse.valid() ? "skin '" + skins->diffuse + "'" : "") +
-      (diffuse.valid() && normal.valid() ? ", " : "") +
-      (normal.valid() ? "normal map '" + skins->normal + "'" : "") + " for every mesh" +
-      (skins->named_meshes
-           ? " (" + std::to_string(skins->named_meshes) +
-                 (skins->named_meshes == 1 ? " line" : " lines") + " for named meshes not applied)"
-           : ""));
+      model_path + ": textures from the game's model config " + skins->config + ": " + what +
+      (not_applied ? " (" + std::to_string(not_applied) + (not_applied == 1 ? " line" : " lines") +
+                         " for meshes the model does not name not applied)"
+                   : ""));
 }
 
 }  // namespace vt::scene::detail

@@ -14,6 +14,7 @@
 #include "scene/image_load.h"
 #include "scene/scene.h"
 #include "scene/scene_io_util.h"
+#include "tests/scene/iqm_file.h"
 #include "tests/scene/scene_warnings.h"
 
 namespace vt::test {
@@ -507,6 +508,39 @@ TEST(AssimpImport, Md5MeshWithoutItsVersionLineIsRead) {
     auto item = scene::load_scene((d / "item.md5mesh").string());
     ASSERT_TRUE(item.ok()) << item.status().message();
     EXPECT_EQ(item->triangle_count(), 1u);
+  }
+}
+
+// assimp's IQM reader follows the file's offsets and counts unchecked: a crafted file had it read
+// and allocate far past its buffer. Every section it reads is checked against the file first.
+TEST(AssimpImport, IqmSectionsOutsideTheFileAreRefusedBeforeAssimpReadsThem) {
+  fs::path d = fresh_dir("iqm");
+  write_text(d / "ok.iqm", IqmFile().bytes);
+  auto ok = scene::load_scene((d / "ok.iqm").string());
+  ASSERT_TRUE(ok.ok()) << ok.status().message();
+  EXPECT_EQ(ok->triangle_count(), 2u);
+  struct Broken {
+    uint32_t at, value;
+    std::string says;
+  };
+  const Broken broken[] = {
+      {16 + 4 * 6, 0x7fffffff, ": IQM meshes start past the end of the file"},
+      {16 + 4 * 5, 0x10000000, ": IQM meshes: count 268435456 x 24 bytes needs"},
+      {IqmFile::kMeshes + 24 + 16, 0x0fffffff, ": IQM mesh 1's triangles start past the end"},
+      {IqmFile::kMeshes + 24 + 20, 1000, ": IQM mesh 1's triangles: count 1000 x 12 bytes"},
+      {IqmFile::kMeshes + 12, 0xffffffff, ": IQM mesh 0's vertex array 0: count 4294967295"},
+      {IqmFile::kArrays + 20 + 16, 0xfffffff0, ": IQM mesh 0's vertex array 1 start past"},
+      {IqmFile::kMeshes + 4, 18, ": IQM mesh 0's material name is not in the text"},
+  };
+  for (const Broken& b : broken) {
+    IqmFile file;
+    file.set(b.at, b.value);
+    write_text(d / "bad.iqm", file.bytes);
+    auto bad = scene::load_scene((d / "bad.iqm").string());
+    ASSERT_FALSE(bad.ok()) << b.says;
+    EXPECT_EQ(bad.status().code(), ErrorCode::kCorrupt) << bad.status().message();
+    EXPECT_NE(bad.status().message().find((d / "bad.iqm").string() + b.says), std::string::npos)
+        << bad.status().message();
   }
 }
 

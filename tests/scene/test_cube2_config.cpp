@@ -1,12 +1,14 @@
 // Cube 2 engine model configs (Sauerbraten, Red Eclipse): the skins `iqm.cfg` / `obj.cfg` / ...
-// name for every mesh become the materials' textures; a config that loads another model, and
-// lines for named meshes, are not applied.
+// name for every mesh, or for a mesh by the engine's name for it, become the materials'
+// textures; a config that loads another model, and lines naming meshes the model does not name,
+// are not applied.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 
 #include "scene/scene.h"
+#include "tests/scene/iqm_file.h"
 #include "tests/scene/scene_warnings.h"
 
 namespace vt::test {
@@ -51,8 +53,8 @@ TEST(Cube2Config, SkinsForEveryMeshBecomeTheMaterialsTextures) {
   EXPECT_EQ(texture_file(*s, s->materials[0].base_color_texture), "skin.png");
   EXPECT_EQ(texture_file(*s, s->materials[0].normal_texture), "norm.png");
   EXPECT_TRUE(warned(*s,
-                     "skin 'skin.png', normal map 'norm.png' for every mesh (1 line for named "
-                     "meshes not applied)"));
+                     "skin 'skin.png', normal map 'norm.png' for every mesh (1 line for meshes "
+                     "the model does not name not applied)"));
 }
 
 TEST(Cube2Config, AConfigBelowThatLoadsTheModelApplies) {
@@ -71,6 +73,60 @@ TEST(Cube2Config, AConfigOfAnotherModelIsNotApplied) {
   auto s = scene::load_scene((d / "door.obj").string());
   ASSERT_TRUE(s.ok()) << s.status().message();
   EXPECT_EQ(texture_file(*s, s->materials.at(0).base_color_texture), "door");
+}
+
+// A Doom 3 mesh (MD5) of three mesh blocks: the engine names them by their `// meshes:`
+// comment; assimp makes a material for each block with vertices and triangles, in order (its
+// parser wants the blank lines between sections).
+std::string md5_block(const std::string& name, int tris) {
+  std::string block = "mesh {\n";
+  if (!name.empty()) block += "\t// meshes: " + name + "\n";
+  block +=
+      "\tshader \"\"\n\tnumverts 3\n\tvert 0 ( 0.0 0.0 ) 0 1\n\tvert 1 ( 1.0 0.0 ) 1 1\n"
+      "\tvert 2 ( 0.0 1.0 ) 2 1\n\tnumtris " +
+      std::to_string(tris) + "\n";
+  if (tris > 0) block += "\ttri 0 0 1 2\n";
+  return block +
+         "\tnumweights 3\n\tweight 0 0 1.0 ( 0.0 0.0 0.0 )\n"
+         "\tweight 1 0 1.0 ( 1.0 0.0 0.0 )\n\tweight 2 0 1.0 ( 0.0 1.0 0.0 )\n}\n\n";
+}
+
+TEST(Cube2Config, SkinsForNamedMeshesGoToTheirMeshes) {
+  const fs::path d = model_folder("named");
+  write_text(d / "gun.md5mesh",
+             "MD5Version 10\ncommandline \"\"\nnumJoints 1\nnumMeshes 4\n\n"
+             "joints {\n\t\"origin\" -1 ( 0.0 0.0 0.0 ) ( -0.5 -0.5 -0.5 )\n}\n\n" +
+                 md5_block("top", 1) + md5_block("empty", 0) + md5_block("", 1) +
+                 md5_block("bottom", 1));
+  write_text(d / "item" / "md5.cfg",
+             "md5load ../gun.md5mesh\nmd5skin * ../skin.png\nmd5skin bottom ../bottom.png\n"
+             "md5bumpmap bottom ../norm.png\nmd5skin barrel ../barrel.png\n");
+  auto s = scene::load_scene((d / "gun.md5mesh").string());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  ASSERT_EQ(s->materials.size(), 3u);  // the empty block has none
+  EXPECT_EQ(texture_file(*s, s->materials[0].base_color_texture), "skin.png");
+  EXPECT_FALSE(s->materials[0].normal_texture.valid());
+  EXPECT_EQ(texture_file(*s, s->materials[1].base_color_texture), "skin.png");
+  EXPECT_EQ(texture_file(*s, s->materials[2].base_color_texture), "bottom.png");
+  EXPECT_EQ(texture_file(*s, s->materials[2].normal_texture), "norm.png");
+  EXPECT_EQ(s->materials[0].base_color_texture.image, s->materials[1].base_color_texture.image);
+  EXPECT_TRUE(warned(*s,
+                     "skin '../skin.png' for every mesh; skin '../bottom.png', normal map "
+                     "'../norm.png' for mesh 'bottom' (1 line for meshes the model does not name "
+                     "not applied)"));
+}
+
+// An Inter-Quake Model names its meshes in its text table.
+TEST(Cube2Config, SkinsForNamedIqmMeshesGoToTheirMeshes) {
+  const fs::path d = model_folder("iqm");
+  write_text(d / "turret.iqm", IqmFile().bytes);
+  write_text(d / "iqm.cfg", "iqmskin cannon skin.png\niqmbumpmap stand norm.png\n");
+  auto s = scene::load_scene((d / "turret.iqm").string());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  ASSERT_EQ(s->materials.size(), 2u);
+  EXPECT_EQ(texture_file(*s, s->materials[0].normal_texture), "norm.png");
+  EXPECT_EQ(texture_file(*s, s->materials[1].base_color_texture), "skin.png");
+  EXPECT_FALSE(s->materials[1].normal_texture.valid());
 }
 
 }  // namespace
