@@ -15,6 +15,7 @@
 #include "scene/gltf_export.h"
 #include "scene/scene.h"
 #include "scene/scene_io_util.h"
+#include "tests/scene/iqm_file.h"
 #include "tests/scene/pcx_files.h"
 
 namespace vt::fuzz {
@@ -253,6 +254,10 @@ void pcx_seeds(const fs::path& dir) {
   write(dir / "rgb.pcx", test::pcx_rgb_3x1());
 }
 
+void iqm_seeds(const fs::path& dir) {
+  write(dir / "two_meshes.iqm", test::IqmFile().bytes);
+}
+
 }  // namespace
 }  // namespace vt::fuzz
 
@@ -260,7 +265,7 @@ int main(int argc, char** argv) {
   using namespace vt::fuzz;
   if (argc != 2) fail("usage: vt_fuzz_seeds DIR");
   const fs::path root = argv[1];
-  for (const char* t : {"page_file", "dct", "gltf", "obj", "ply", "ac3d", "pcx", "scratch"})
+  for (const char* t : {"page_file", "dct", "gltf", "obj", "ply", "ac3d", "pcx", "iqm", "scratch"})
     fs::create_directories(root / t);
   page_file_seeds(root / "page_file");
   dct_seeds(root / "dct");
@@ -269,6 +274,7 @@ int main(int argc, char** argv) {
   ply_seeds(root / "ply");
   ac3d_seeds(root / "ac3d");
   pcx_seeds(root / "pcx");
+  iqm_seeds(root / "iqm");
   fs::remove_all(root / "scratch");
   return 0;
 }

@@ -34,6 +34,7 @@ targets=(
   "ply ply ply.dict 65536"
   "ac3d ac3d ac3d.dict 65536"
   "pcx pcx - 65536"
+  "iqm iqm - 65536"
 )
 
 run_one() {

@@ -496,6 +496,26 @@ Status check_iqm_layout(const std::string& path) {
   VT_RETURN_IF_ERROR(inside("text", double(ofs_text), num_text, 1));
   VT_RETURN_IF_ERROR(inside("meshes", double(ofs_meshes), num_meshes, kMesh));
   VT_RETURN_IF_ERROR(inside("vertex arrays", double(ofs_arrays), num_arrays, kArray));
+  // The arrays assimp reads (float positions, texture coordinates and normals; colours), each
+  // attribute once: it allocates one for every array it reads, and a second one leaked the first.
+  struct Array {
+    uint64_t offset, size, unit;
+  };
+  std::vector<Array> read;
+  bool seen[7] = {};
+  for (uint64_t a = 0; a < num_arrays; ++a) {
+    const uint64_t at = ofs_arrays + a * kArray;
+    const uint32_t type = u32(at), format = u32(at + 8), size = u32(at + 12);
+    constexpr uint32_t kUbyte = 1, kFloat = 7, kColor = 6;
+    if (!((type <= 2 && format == kFloat && size >= (type == 1 ? 2u : 3u)) ||
+          (type == kColor && (format == kUbyte || format == kFloat) && size >= 3)))
+      continue;
+    if (seen[type])
+      return Error(ErrorCode::kCorrupt, path + ": IQM vertex array " + std::to_string(a) +
+                                            " repeats an earlier array's attribute");
+    seen[type] = true;
+    read.push_back({u32(at + 16), size, format == kFloat ? 4u : 1u});
+  }
   for (uint64_t m = 0; m < num_meshes; ++m) {
     const uint64_t at = ofs_meshes + m * kMesh;
     const uint64_t material = u32(at + 4), first_vertex = u32(at + 8), vertices = u32(at + 12);
@@ -508,19 +528,12 @@ Status check_iqm_layout(const std::string& path) {
     VT_RETURN_IF_ERROR(inside(mesh + "'s triangles",
                               double(ofs_triangles) + double(first_triangle) * kTriangle, triangles,
                               kTriangle));
-    for (uint64_t a = 0; a < num_arrays; ++a) {
-      const uint64_t array = ofs_arrays + a * kArray;
-      const uint32_t type = u32(array), format = u32(array + 8), size = u32(array + 12);
-      constexpr uint32_t kUbyte = 1, kFloat = 7, kColor = 6;
-      // What assimp reads: float positions, texture coordinates and normals, and colours.
-      const bool read = (type <= 2 && format == kFloat && size >= (type == 1 ? 2u : 3u)) ||
-                        (type == kColor && (format == kUbyte || format == kFloat) && size >= 3);
-      if (!read) continue;
-      const uint64_t unit = format == kFloat ? 4 : 1;
-      VT_RETURN_IF_ERROR(inside(mesh + "'s vertex array " + std::to_string(a),
-                                double(u32(array + 16)) + double(first_vertex) * size * unit,
-                                vertices, uint64_t(size) * unit));
-    }
+    for (size_t a = 0; a < read.size(); ++a)
+      VT_RETURN_IF_ERROR(
+          inside(mesh + "'s vertices in array " + std::to_string(a),
+                 double(read[a].offset) +
+                     double(first_vertex) * double(read[a].size) * double(read[a].unit),
+                 vertices, read[a].size * read[a].unit));
   }
   return Status::Ok();
 }

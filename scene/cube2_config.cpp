@@ -97,9 +97,20 @@ uint32_t le32(const std::vector<uint8_t>& b, size_t at) {
 
 // The names the engine gives a model's meshes, one per mesh assimp makes a material for, in
 // file order: MD5's `// meshes: NAME` comment in each mesh block that has vertices and triangles
-// (assimp skips the others), IQM's mesh names. Empty for other kinds or a file not read so.
-std::vector<std::string> engine_mesh_names(const std::string& model_path, const std::string& kind) {
+// (assimp skips the others), IQM's mesh names, MD3's surface names (assimp names the materials
+// `MD3_[SKIN][SURFACE]`). Empty for other kinds or a file not read so.
+std::vector<std::string> engine_mesh_names(const std::string& model_path, const std::string& kind,
+                                           const Scene& scene) {
   std::vector<std::string> names;
+  if (kind == "md3") {
+    for (const Material& m : scene.materials) {
+      const size_t open = m.name.rfind("][");
+      if (m.name.rfind("MD3_[", 0) != 0 || open == std::string::npos || m.name.back() != ']')
+        return {};
+      names.push_back(m.name.substr(open + 2, m.name.size() - open - 3));
+    }
+    return names;
+  }
   if (kind != "md5" && kind != "iqm") return names;
   Expected<std::vector<uint8_t>> bytes = read_file(model_path);
   if (!bytes.ok()) return names;
@@ -172,7 +183,7 @@ void apply_cube2_config(const std::string& model_path, Scene& scene) {
   }
   if (!skins) return;
   // Lines naming a mesh apply where the engine's mesh names line up with the materials.
-  std::vector<std::string> names = engine_mesh_names(model_path, kind);
+  std::vector<std::string> names = engine_mesh_names(model_path, kind, scene);
   if (names.size() != scene.materials.size()) names.clear();
   std::map<std::string, TextureRef> images;  // one image per texture written
   const auto image_for = [&](const std::string& written) {

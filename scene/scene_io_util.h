@@ -51,8 +51,9 @@ std::string resolve_written_path(const std::string& folder, const std::string& w
 // dropped, paths relative to the config) become every material's base colour and normal
 // textures, with a warning naming them, unless the config's `iqmload` names another model.
 // `iqmskin NAME ...` gives the mesh the engine calls NAME its textures (MD5: the mesh block's
-// `// meshes: NAME` comment; IQM: the mesh's name), where the importer made a material per mesh
-// (assimp does for both); other lines naming meshes are counted in the warning, not applied.
+// `// meshes: NAME` comment; IQM: the mesh's name; MD3: the surface's), where the importer made
+// a material per mesh (assimp does for all three); other lines naming meshes are counted in the
+// warning, not applied.
 void apply_cube2_config(const std::string& model_path, Scene& scene);
 
 // The folder holding the scene's folder (absolute, symlinks resolved): the tree a scene's

@@ -528,8 +528,9 @@ TEST(AssimpImport, IqmSectionsOutsideTheFileAreRefusedBeforeAssimpReadsThem) {
       {16 + 4 * 5, 0x10000000, ": IQM meshes: count 268435456 x 24 bytes needs"},
       {IqmFile::kMeshes + 24 + 16, 0x0fffffff, ": IQM mesh 1's triangles start past the end"},
       {IqmFile::kMeshes + 24 + 20, 1000, ": IQM mesh 1's triangles: count 1000 x 12 bytes"},
-      {IqmFile::kMeshes + 12, 0xffffffff, ": IQM mesh 0's vertex array 0: count 4294967295"},
-      {IqmFile::kArrays + 20 + 16, 0xfffffff0, ": IQM mesh 0's vertex array 1 start past"},
+      {IqmFile::kMeshes + 12, 0xffffffff, ": IQM mesh 0's vertices in array 0: count 4294967295"},
+      {IqmFile::kArrays + 20 + 16, 0xfffffff0, ": IQM mesh 0's vertices in array 1 start past"},
+      {IqmFile::kArrays, 1, ": IQM vertex array 1 repeats an earlier array's attribute"},
       {IqmFile::kMeshes + 4, 18, ": IQM mesh 0's material name is not in the text"},
   };
   for (const Broken& b : broken) {

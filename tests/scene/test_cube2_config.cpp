@@ -4,8 +4,10 @@
 // are not applied.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include "scene/scene.h"
 #include "tests/scene/iqm_file.h"
@@ -125,6 +127,50 @@ TEST(Cube2Config, SkinsForNamedIqmMeshesGoToTheirMeshes) {
   ASSERT_TRUE(s.ok()) << s.status().message();
   ASSERT_EQ(s->materials.size(), 2u);
   EXPECT_EQ(texture_file(*s, s->materials[0].normal_texture), "norm.png");
+  EXPECT_EQ(texture_file(*s, s->materials[1].base_color_texture), "skin.png");
+  EXPECT_FALSE(s->materials[1].normal_texture.valid());
+}
+
+// A Quake 3 model (MD3) names its surfaces in their headers; assimp names a surface's material
+// `MD3_[SKIN][SURFACE]`.
+std::string md3_of_surfaces(const std::vector<std::string>& surfaces) {
+  std::string out;
+  auto u32 = [&out](uint32_t v) {
+    for (int k = 0; k < 4; ++k) out += char(v >> (8 * k));
+  };
+  auto name = [&out](const std::string& n) { out += n + std::string(64 - n.size(), '\0'); };
+  constexpr uint32_t kHeader = 108, kFrame = 56, kSurface = 236;
+  const uint32_t n = uint32_t(surfaces.size()), size = kHeader + kFrame + n * kSurface;
+  out = "IDP3";
+  u32(15), name("model"), u32(0), u32(1), u32(0), u32(n), u32(0);
+  u32(kHeader), u32(kHeader + kFrame), u32(kHeader + kFrame), u32(size);
+  out += std::string(kFrame, '\0');  // one frame: bounds, origin, radius, name
+  for (const std::string& s : surfaces) {
+    out += "IDP3", name(s), u32(0), u32(1), u32(1), u32(3), u32(1);
+    u32(176), u32(108), u32(188), u32(212), u32(kSurface);  // triangles, shaders, st, xyz, end
+    name(s + ".tga"), u32(0);                               // the shader
+    u32(0), u32(1), u32(2);                                 // the triangle
+    for (float f : {0.f, 0.f, 1.f, 0.f, 0.f, 1.f}) {
+      uint32_t bits;
+      std::memcpy(&bits, &f, 4);
+      u32(bits);
+    }
+    for (int16_t v : {0, 0, 0, 0, 64, 0, 0, 0, 0, 64, 0, 0})
+      out += char(v & 0xff), out += char(v >> 8);
+  }
+  return out;
+}
+
+TEST(Cube2Config, SkinsForNamedMd3SurfacesGoToTheirSurfaces) {
+  const fs::path d = model_folder("md3");
+  write_text(d / "tris.md3", md3_of_surfaces({"bark", "leaves"}));
+  write_text(d / "md3.cfg",
+             "md3load tris.md3\nmd3skin leaves skin.png\nmd3bumpmap bark norm.png\n");
+  auto s = scene::load_scene((d / "tris.md3").string());
+  ASSERT_TRUE(s.ok()) << s.status().message();
+  ASSERT_EQ(s->materials.size(), 2u);
+  EXPECT_EQ(texture_file(*s, s->materials[0].normal_texture), "norm.png");
+  EXPECT_EQ(texture_file(*s, s->materials[0].base_color_texture), "bark.tga");  // its own
   EXPECT_EQ(texture_file(*s, s->materials[1].base_color_texture), "skin.png");
   EXPECT_FALSE(s->materials[1].normal_texture.valid());
 }
