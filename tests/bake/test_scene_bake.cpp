@@ -183,6 +183,46 @@ TEST(SceneBake, LayersFollowTheMaterials) {
                                         LayerSemantic::kOrm, LayerSemantic::kEmissive}));
 }
 
+// A bake of `prim` under a material whose normal map is the image at `normal_png` (raw pages,
+// `density` texels a unit): the summary, the normal layer's level 0 and the unwrapped primitive.
+// `ok` is false (and a test failure recorded) where any step fails.
+struct NormalBake {
+  bool ok = false;
+  SceneBakeSummary summary;
+  test::Level0 level;
+  scene::Scene unwrapped;
+  const scene::Primitive& primitive() const { return unwrapped.meshes[0].primitives[0]; }
+};
+NormalBake bake_normal_map(const test::ScratchDir& dir, scene::Primitive prim,
+                           const std::string& normal_png, double density) {
+  NormalBake out;
+  scene::Material m;
+  m.name = "normal mapped";
+  scene::Scene s = test::single_mesh_scene(std::move(prim), m);
+  s.materials[0].normal_texture.image = test::add_image(s, normal_png);
+  SceneBakeOptions o;
+  o.build.output = dir.file("out.vtpf");
+  o.unwrap.texels_per_unit = density;
+  o.build.codec.codec = CodecKind::kRaw;
+  auto summary = bake_scene(s, o);
+  if (!summary.ok()) {
+    ADD_FAILURE() << summary.status().message();
+    return out;
+  }
+  auto reader = PageFileReader::open(o.build.output);
+  auto un = scene::load_scene(dir.file("out.glb"));
+  const int nl = reader.ok() ? test::find_layer(**reader, LayerSemantic::kNormal) : -1;
+  if (nl < 0 || !un.ok()) {
+    ADD_FAILURE() << "no normal layer, or the unwrapped scene does not load";
+    return out;
+  }
+  out.summary = std::move(summary).value();
+  out.level = test::read_level0(**reader, uint32_t(nl));
+  out.unwrapped = std::move(un).value();
+  out.ok = true;
+  return out;
+}
+
 // Tangent-space normal map of ridges; the expected object-space normal is computed from the
 // analytic sphere frame, independently of the transfer's tangent generation.
 void ridge_normal(double u, double v, float* t) {
@@ -207,25 +247,11 @@ TEST(SceneBake, NormalMappedSphereKeepsItsNormals) {
     V t = {-std::sin(phi), 0, -std::cos(phi)};
     sphere.tangents.push_back({float(t.x), float(t.y), float(t.z), 1.0f});
   }
-  scene::Material m;
-  m.name = "bumpy";
-  scene::Scene s = test::single_mesh_scene(sphere, m);
-  s.materials[0].normal_texture.image = test::add_image(s, dir.file("n.png"));
-  SceneBakeOptions o;
-  o.build.output = dir.file("out.vtpf");
-  o.unwrap.texels_per_unit = 48;
-  o.build.codec.codec = CodecKind::kRaw;
-  auto summary = bake_scene(s, o);
-  ASSERT_TRUE(summary.ok()) << summary.status().message();
-  auto reader = PageFileReader::open(o.build.output);
-  ASSERT_TRUE(reader.ok());
-  int nl = test::find_layer(**reader, LayerSemantic::kNormal);
-  ASSERT_GE(nl, 0);
-  test::Level0 level = test::read_level0(**reader, uint32_t(nl));
+  const NormalBake bake = bake_normal_map(dir, sphere, dir.file("n.png"), 48);
+  ASSERT_TRUE(bake.ok);
+  const test::Level0& level = bake.level;
   ASSERT_EQ(level.channels, 2u);
-  auto un = scene::load_scene(dir.file("out.glb"));
-  ASSERT_TRUE(un.ok());
-  const scene::Primitive& p = un->meshes[0].primitives[0];
+  const scene::Primitive& p = bake.primitive();
   const auto& atlas = p.uvs.back();
   std::vector<double> angles;
   auto pos = [&](uint32_t i) { return V{p.positions[i][0], p.positions[i][1], p.positions[i][2]}; };
@@ -285,31 +311,18 @@ TEST(SceneBake, NormalsBelowTheSurfaceAreStoredAtTheHorizon) {
     t[0] = u < 0.5 ? 0.9f : 0.5f, t[1] = 0.5f, t[2] = u < 0.5 ? 0.2f : 1.0f;
   };
   ASSERT_TRUE(write_texture(dir.file("n.png"), 64, 64, 3, half_below).ok());
-  scene::Material m;
-  m.name = "steep";
-  scene::Scene s = test::single_mesh_scene(make_grid(1.0f, 1, 1), m);
-  s.materials[0].normal_texture.image = test::add_image(s, dir.file("n.png"));
-  SceneBakeOptions o;
-  o.build.output = dir.file("out.vtpf");
-  o.unwrap.texels_per_unit = 64;
-  o.build.codec.codec = CodecKind::kRaw;
-  auto summary = bake_scene(s, o);
-  ASSERT_TRUE(summary.ok()) << summary.status().message();
-  const uint64_t below = summary->transfer.below_horizon_samples;
-  EXPECT_GT(below, summary->transfer.samples * 2 / 5);
-  EXPECT_LT(below, summary->transfer.samples * 3 / 5);
-  EXPECT_TRUE(std::any_of(summary->warnings.begin(), summary->warnings.end(), [](auto& w) {
+  const NormalBake bake = bake_normal_map(dir, make_grid(1.0f, 1, 1), dir.file("n.png"), 64);
+  ASSERT_TRUE(bake.ok);
+  const uint64_t below = bake.summary.transfer.below_horizon_samples;
+  EXPECT_GT(below, bake.summary.transfer.samples * 2 / 5);
+  EXPECT_LT(below, bake.summary.transfer.samples * 3 / 5);
+  const auto& warnings = bake.summary.warnings;
+  EXPECT_TRUE(std::any_of(warnings.begin(), warnings.end(), [](auto& w) {
     return w.rfind("normal: ", 0) == 0 && w.find("point below the surface") != std::string::npos &&
            w.find("stored at the horizon") != std::string::npos;
   }));
-  auto reader = PageFileReader::open(o.build.output);
-  ASSERT_TRUE(reader.ok());
-  const int nl = test::find_layer(**reader, LayerSemantic::kNormal);
-  ASSERT_GE(nl, 0);
-  const test::Level0 level = test::read_level0(**reader, uint32_t(nl));
-  auto un = scene::load_scene(dir.file("out.glb"));
-  ASSERT_TRUE(un.ok());
-  const scene::Primitive& p = un->meshes[0].primitives[0];
+  const test::Level0& level = bake.level;
+  const scene::Primitive& p = bake.primitive();
   const auto& atlas = p.uvs.back();
   int horizon = 0, up = 0;
   test::for_each_source_texel(
@@ -344,24 +357,10 @@ TEST(SceneBake, HandednessFollowsTheInterpolatedW) {
   scene::Primitive quad = make_grid(1.0f, 1, 1);
   for (size_t v = 0; v < quad.positions.size(); ++v)
     quad.tangents.push_back({1, 0, 0, v == 0 ? -1.0f : 1.0f});  // +u; bitangent up the image
-  scene::Material m;
-  m.name = "seam";
-  scene::Scene s = test::single_mesh_scene(quad, m);
-  s.materials[0].normal_texture.image = test::add_image(s, dir.file("n.png"));
-  SceneBakeOptions o;
-  o.build.output = dir.file("out.vtpf");
-  o.unwrap.texels_per_unit = 64;
-  o.build.codec.codec = CodecKind::kRaw;
-  auto summary = bake_scene(s, o);
-  ASSERT_TRUE(summary.ok()) << summary.status().message();
-  auto reader = PageFileReader::open(o.build.output);
-  ASSERT_TRUE(reader.ok());
-  const int nl = test::find_layer(**reader, LayerSemantic::kNormal);
-  ASSERT_GE(nl, 0);
-  const test::Level0 level = test::read_level0(**reader, uint32_t(nl));
-  auto un = scene::load_scene(dir.file("out.glb"));
-  ASSERT_TRUE(un.ok());
-  const scene::Primitive& p = un->meshes[0].primitives[0];
+  const NormalBake bake = bake_normal_map(dir, quad, dir.file("n.png"), 64);
+  ASSERT_TRUE(bake.ok);
+  const test::Level0& level = bake.level;
+  const scene::Primitive& p = bake.primitive();
   const auto& atlas = p.uvs.back();
   // Baked (x, y) by region: 0 near corner 0 (its w weighs over a half), 1 the rest of the first
   // face, 2 the second face.
