@@ -68,11 +68,7 @@ std::string mime_from_hint(const char* hint) {
 // file and one of those assimp checks ends exactly at its end.
 bool md2_ends_at_its_last_section(const std::vector<uint8_t>& bytes) {
   if (bytes.size() < 68 || std::memcmp(bytes.data(), "IDP2", 4) != 0) return false;
-  const auto field = [&](int i) {
-    uint32_t v;
-    std::memcpy(&v, &bytes[4 + 4 * i], 4);
-    return uint64_t(v);
-  };
+  const auto field = [&](int i) { return uint64_t(le32(&bytes[4 + 4 * i])); };
   // skins, texture coordinates, triangles, frames (assimp's sizes; a frame is 40 bytes + 4 a
   // vertex), GL commands.
   const uint64_t ends[5] = {field(10) + field(4) * 64, field(11) + field(6) * 4,
@@ -475,10 +471,7 @@ Status check_iqm_layout(const std::string& path) {
   Expected<std::vector<uint8_t>> bytes = read_file(path);
   if (!bytes.ok()) return Status::Ok();
   const std::vector<uint8_t>& b = *bytes;
-  auto u32 = [&b](uint64_t at) {
-    return uint32_t(b[at]) | uint32_t(b[at + 1]) << 8 | uint32_t(b[at + 2]) << 16 |
-           uint32_t(b[at + 3]) << 24;
-  };
+  auto u32 = [&b](uint64_t at) { return le32(&b[size_t(at)]); };
   constexpr uint64_t kHeader = 124, kMesh = 24, kArray = 20, kTriangle = 12;
   if (b.size() < kHeader || std::memcmp(b.data(), "INTERQUAKEMODEL", 16) != 0 || u32(16) != 2 ||
       u32(20) != b.size())
@@ -499,7 +492,7 @@ Status check_iqm_layout(const std::string& path) {
   // The arrays assimp reads (float positions, texture coordinates and normals; colours), each
   // attribute once: it allocates one for every array it reads, and a second one leaked the first.
   struct Array {
-    uint64_t offset, size, unit;
+    uint64_t index, offset, size, unit;
   };
   std::vector<Array> read;
   bool seen[7] = {};
@@ -514,7 +507,7 @@ Status check_iqm_layout(const std::string& path) {
       return Error(ErrorCode::kCorrupt, path + ": IQM vertex array " + std::to_string(a) +
                                             " repeats an earlier array's attribute");
     seen[type] = true;
-    read.push_back({u32(at + 16), size, format == kFloat ? 4u : 1u});
+    read.push_back({a, u32(at + 16), size, format == kFloat ? 4u : 1u});
   }
   for (uint64_t m = 0; m < num_meshes; ++m) {
     const uint64_t at = ofs_meshes + m * kMesh;
@@ -528,12 +521,10 @@ Status check_iqm_layout(const std::string& path) {
     VT_RETURN_IF_ERROR(inside(mesh + "'s triangles",
                               double(ofs_triangles) + double(first_triangle) * kTriangle, triangles,
                               kTriangle));
-    for (size_t a = 0; a < read.size(); ++a)
-      VT_RETURN_IF_ERROR(
-          inside(mesh + "'s vertices in array " + std::to_string(a),
-                 double(read[a].offset) +
-                     double(first_vertex) * double(read[a].size) * double(read[a].unit),
-                 vertices, read[a].size * read[a].unit));
+    for (const Array& r : read)
+      VT_RETURN_IF_ERROR(inside(mesh + "'s vertices in array " + std::to_string(r.index),
+                                double(r.offset) + double(first_vertex) * double(r.size * r.unit),
+                                vertices, r.size * r.unit));
   }
   return Status::Ok();
 }
@@ -588,9 +579,7 @@ void repair_md2_texture_coordinates(const std::string& path, aiScene& scene) {
   if (!in.read(reinterpret_cast<char*>(header), sizeof header) ||
       std::memcmp(header, "IDP2", 4) != 0)
     return;
-  uint32_t w, h;
-  std::memcpy(&w, header + 8, 4);
-  std::memcpy(&h, header + 12, 4);
+  const uint32_t w = le32(header + 8), h = le32(header + 12);
   const double width = w ? w : 1, height = h ? h : 1;
   for (unsigned i = 0; i < scene.mNumMeshes; ++i) {
     aiMesh& m = *scene.mMeshes[i];

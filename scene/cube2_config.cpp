@@ -90,11 +90,6 @@ std::optional<Skins> read_config(const std::string& config, const std::string& k
   return skins;
 }
 
-uint32_t le32(const std::vector<uint8_t>& b, size_t at) {
-  return uint32_t(b[at]) | uint32_t(b[at + 1]) << 8 | uint32_t(b[at + 2]) << 16 |
-         uint32_t(b[at + 3]) << 24;
-}
-
 // The names the engine gives a model's meshes, one per mesh assimp makes a material for, in
 // file order: MD5's `// meshes: NAME` comment in each mesh block that has vertices and triangles
 // (assimp skips the others), IQM's mesh names, MD3's surface names (assimp names the materials
@@ -120,11 +115,11 @@ std::vector<std::string> engine_mesh_names(const std::string& model_path, const 
     // a mesh: name (offset into the text), material, first/num vertices, first/num triangles.
     constexpr char kMagic[] = "INTERQUAKEMODEL";
     if (b.size() < 44 || std::memcmp(b.data(), kMagic, 16) != 0) return names;
-    const uint64_t num_text = le32(b, 28), ofs_text = le32(b, 32);
-    const uint64_t num_meshes = le32(b, 36), ofs_meshes = le32(b, 40);
+    const uint64_t num_text = le32(&b[28]), ofs_text = le32(&b[32]);
+    const uint64_t num_meshes = le32(&b[36]), ofs_meshes = le32(&b[40]);
     if (ofs_text + num_text > b.size() || ofs_meshes + num_meshes * 24 > b.size()) return names;
     for (uint64_t m = 0; m < num_meshes; ++m) {
-      const uint64_t name = le32(b, size_t(ofs_meshes + m * 24));
+      const uint64_t name = le32(&b[size_t(ofs_meshes + m * 24)]);
       if (name >= num_text) return {};
       const char* first = reinterpret_cast<const char*>(b.data() + ofs_text + name);
       names.emplace_back(first, strnlen(first, size_t(num_text - name)));

@@ -24,6 +24,10 @@ Expected<std::vector<uint8_t>> read_file(const std::string& path);
 Expected<std::string> decode_text(const std::vector<uint8_t>& bytes, const std::string& path,
                                   std::string* note);
 std::string lower_extension(const std::string& path);
+// The little-endian 32-bit value at `p` (binary model headers), on any host.
+inline uint32_t le32(const uint8_t* p) {
+  return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
 std::string parent_folder(const std::string& path);  // "" or ends with '/'
 // Decodes a data: URI ("data:<mime>;base64,<payload>"); mime receives the media type.
 Expected<std::vector<uint8_t>> decode_data_uri(const std::string& uri, std::string* mime);
