@@ -85,7 +85,9 @@ bool md2_ends_at_its_last_section(const std::vector<uint8_t>& bytes) {
 //   as UTF-8, and failed ("malformed XML", "No meshes remaining");
 // - MD2 models whose last section ends the file, with one zero byte after it (above);
 // - Doom 3 MD5 meshes without their `MD5Version 10` line, with it: the Cube 2 engine does not
-//   ask for it (Red Eclipse's zapper), assimp refused them ("MD5Version tag has not been found").
+//   ask for it (Red Eclipse's zapper), assimp refused them ("MD5Version tag has not been found");
+//   and every MD5 mesh with zero bytes after it: assimp's parser steps past the text's end by a
+//   byte or more where a token ends the file (a 17-byte crafted file read past its buffer).
 class FilesAsAssimpReadsThem : public Assimp::DefaultIOSystem {
  public:
   Assimp::IOStream* Open(const char* file, const char* mode) override {
@@ -115,10 +117,10 @@ class FilesAsAssimpReadsThem : public Assimp::DefaultIOSystem {
       served.assign(bytes.begin(), bytes.end());
       served.push_back('\0');
     } else {
-      if (std::search(bytes.begin(), bytes.end(), kMd5Version.begin(), kMd5Version.end()) !=
-          bytes.end())
-        return stream;
-      served = "MD5Version 10\n" + std::string(bytes.begin(), bytes.end());
+      const bool versioned = std::search(bytes.begin(), bytes.end(), kMd5Version.begin(),
+                                         kMd5Version.end()) != bytes.end();
+      served = (versioned ? "" : "MD5Version 10\n") + std::string(bytes.begin(), bytes.end()) +
+               std::string(16, '\0');
     }
     Close(stream);
     auto* copy = new uint8_t[served.size()];
@@ -461,6 +463,122 @@ class AssimpScene {
   int depth_ = 0;
 };
 
+// A Doom 3 MD5 mesh's indices, before assimp reads them: its reader takes every `tri`, `vert`
+// and `weight` index as given (an index past the count grows the array to it: 2^32 - 1 ran it
+// out of memory), leaves a face the file does not list without indices (it then read through a
+// null pointer), and follows a face's second and third vertex, a vertex's weights and a
+// weight's joint unchecked; it copies a word (a shader) or a joint's quoted name into a
+// 1,024-byte string unchecked, and a lone `"` as a word of -1 bytes. Each mesh block's counts,
+// and every index against its count and the file's joints, are checked; a face must be listed;
+// words are shorter than 1,000 characters and a joint names itself in quotes. Numbers are read
+// as assimp reads them (leading digits).
+Status check_md5_mesh(const std::string& path) {
+  Expected<std::vector<uint8_t>> bytes = read_file(path);
+  if (!bytes.ok()) return Status::Ok();
+  const std::string text(bytes->begin(), bytes->end());
+  // Leading decimal digits of `w` (0 without any), saturated far above any count.
+  auto number = [](const std::string& w) {
+    uint64_t v = 0;
+    for (size_t i = 0;
+         i < w.size() && std::isdigit(static_cast<unsigned char>(w[i])) && v < (1ull << 40); ++i)
+      v = v * 10 + uint64_t(w[i] - '0');
+    return v;
+  };
+  auto refuse = [&](size_t line, const std::string& what) {
+    return Error(ErrorCode::kCorrupt, path + ": MD5 line " + std::to_string(line) + ": " + what);
+  };
+  const uint64_t most = text.size();  // every entry takes a line of its own
+  uint64_t joints = 0;
+  bool in_joints = false, in_mesh = false;
+  uint64_t verts = 0, tris = 0, weights = 0;
+  uint64_t weights_named = 0;  // the current mesh's vertices' weights end here (numweights follows)
+  size_t weights_line = 0;
+  std::vector<bool> listed;  // the current mesh's faces given
+  size_t line_no = 0, at = 0;
+  while (at < text.size()) {
+    // assimp ends a line at a zero byte, a form feed or a carriage return as well.
+    size_t end = text.find_first_of(std::string_view("\n\r\f\0", 4), at);
+    if (end == std::string::npos) end = text.size();
+    const std::string line = text.substr(at, end - at);
+    line_no += at == 0 || text[at - 1] == '\n';
+    at = end + 1;
+    std::vector<std::string> w;
+    for (size_t i = 0; i < line.size();) {
+      while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+      const size_t s = i;
+      while (i < line.size() && !std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+      if (i > s) w.push_back(line.substr(s, i - s));
+    }
+    if (w.empty() || w[0].rfind("//", 0) == 0) continue;
+    for (const std::string& word : w)
+      if (word.size() >= 1000 || word == "\"")
+        return refuse(line_no, word.size() >= 1000
+                                   ? "a word of " + std::to_string(word.size()) + " characters"
+                                   : "a lone quotation mark");
+    if (in_joints) {
+      if (w[0] == "}") {
+        in_joints = false;
+      } else {
+        const size_t open = line.find('"'), close = line.find('"', open + 1);
+        if (open == std::string::npos || close == std::string::npos || close - open > 1000)
+          return refuse(line_no, "a joint without its name in quotation marks");
+        ++joints;
+      }
+      continue;
+    }
+    if (!in_mesh) {
+      if (w[0] == "joints") in_joints = true;
+      if (w[0] == "mesh")
+        in_mesh = true, verts = tris = weights = weights_named = 0, listed.clear();
+      continue;
+    }
+    if (w[0] == "}") {
+      const auto missing = std::find(listed.begin(), listed.end(), false);
+      if (missing != listed.end())
+        return refuse(line_no, "tri " + std::to_string(missing - listed.begin()) + " of " +
+                                   std::to_string(tris) + " is not given");
+      if (weights_named > weights)
+        return refuse(weights_line,
+                      "a vertex names weights past numweights " + std::to_string(weights));
+      in_mesh = false;
+    } else if (w[0] == "numverts" || w[0] == "numtris" || w[0] == "numweights") {
+      const uint64_t n = w.size() > 1 ? number(w[1]) : 0;
+      if (n > most)
+        return refuse(line_no, w[0] + " " + std::to_string(n) + " is more than the file holds");
+      (w[0] == "numverts" ? verts : w[0] == "numtris" ? tris : weights) = n;
+      if (w[0] == "numtris") listed.assign(size_t(n), false);
+    } else if (w[0] == "tri") {
+      const uint64_t i = w.size() > 1 ? number(w[1]) : 0;
+      if (i >= tris)
+        return refuse(line_no,
+                      "tri " + std::to_string(i) + " past numtris " + std::to_string(tris));
+      listed[size_t(i)] = true;
+      for (size_t k = 2; k < 5; ++k)
+        if ((w.size() > k ? number(w[k]) : 0) >= verts)
+          return refuse(line_no, "tri " + std::to_string(i) + " names a vertex past numverts " +
+                                     std::to_string(verts));
+    } else if (w[0] == "vert") {
+      const uint64_t i = w.size() > 1 ? number(w[1]) : 0;
+      const auto close = std::find(w.begin(), w.end(), ")");
+      const uint64_t first = close != w.end() && close + 1 != w.end() ? number(*(close + 1)) : 0;
+      const uint64_t count = close != w.end() && close + 2 < w.end() ? number(*(close + 2)) : 0;
+      if (i >= verts)
+        return refuse(line_no,
+                      "vert " + std::to_string(i) + " past numverts " + std::to_string(verts));
+      if (first + count > weights_named) weights_named = first + count, weights_line = line_no;
+    } else if (w[0] == "weight") {
+      const uint64_t i = w.size() > 1 ? number(w[1]) : 0;
+      if (i >= weights)
+        return refuse(
+            line_no, "weight " + std::to_string(i) + " past numweights " + std::to_string(weights));
+      if ((w.size() > 2 ? number(w[2]) : 0) >= joints)
+        return refuse(line_no, "weight " + std::to_string(i) + " names a joint past the file's " +
+                                   std::to_string(joints));
+    }
+  }
+  return Status::Ok();
+}
+
 // An Inter-Quake Model's sections against its size, before assimp reads them: its reader follows
 // every offset and count the header and the meshes give without a check, so a crafted file had
 // it read (or allocate) far past its buffer. Checked: the text, the meshes, the vertex arrays,
@@ -595,13 +713,14 @@ void repair_md2_texture_coordinates(const std::string& path, aiScene& scene) {
 
 // Deletes the meshes without vertices or faces (an STL's empty solid, an exporter's empty
 // geometry) and the nodes' references to them: assimp's validation refuses a whole scene over
-// one. Returns how many went.
+// one. A null entry goes too (assimp's MD3 reader leaves one for an empty surface that is not
+// its last). Returns how many went.
 unsigned drop_empty_meshes(aiScene& scene) {
   std::vector<int> remap(scene.mNumMeshes, -1);
   unsigned kept = 0;
   for (unsigned i = 0; i < scene.mNumMeshes; ++i) {
     aiMesh* m = scene.mMeshes[i];
-    if (m->mNumVertices == 0 || m->mNumFaces == 0) {
+    if (!m || m->mNumVertices == 0 || m->mNumFaces == 0) {
       delete m;
       continue;
     }
@@ -656,6 +775,7 @@ Expected<Scene> load_assimp(const std::string& path) {
             "in 5.3); bake the meshes the scene names (.3ds, .x, .b3d, .obj) instead");
   if (ext == "off") VT_RETURN_IF_ERROR(check_off_counts(path));
   if (ext == "iqm") VT_RETURN_IF_ERROR(check_iqm_layout(path));
+  if (ext == "md5mesh") VT_RETURN_IF_ERROR(check_md5_mesh(path));
   Assimp::Importer importer;
   importer.SetIOHandler(new FilesAsAssimpReadsThem);  // the importer owns it
   // Points and lines are dropped by SortByPType; normals are made only where a mesh has none.

@@ -511,6 +511,58 @@ TEST(AssimpImport, Md5MeshWithoutItsVersionLineIsRead) {
   }
 }
 
+// `bytes` written to `file` are refused as corrupt before assimp reads them, in words that name
+// the file and then say `says`.
+void expect_corrupt(const fs::path& file, const std::string& bytes, const std::string& says) {
+  write_text(file, bytes);
+  auto bad = scene::load_scene(file.string());
+  ASSERT_FALSE(bad.ok()) << says;
+  EXPECT_EQ(bad.status().code(), ErrorCode::kCorrupt) << bad.status().message();
+  EXPECT_NE(bad.status().message().find(file.string() + says), std::string::npos)
+      << bad.status().message();
+}
+
+// assimp's MD5 reader takes a mesh's indices as given: a face the file does not list was read
+// through a null pointer, an index past its count grew an array to it, a face's later corners,
+// a vertex's weights and a weight's joint were followed unchecked. Each is refused first.
+TEST(AssimpImport, Md5IndicesPastTheirCountsAreRefusedBeforeAssimpReadsThem) {
+  fs::path d = fresh_dir("md5_bad");
+  const std::string head =
+      "MD5Version 10\ncommandline \"\"\n\nnumJoints 1\nnumMeshes 1\n\n"
+      "joints {\n\t\"origin\" -1 ( 0.0 0.0 0.0 ) ( -0.5 -0.5 -0.5 )\n}\n\n"
+      "mesh {\n\tshader \"skin\"\n\n\tnumverts 3\n";
+  const std::string verts =
+      "\tvert 0 ( 0.0 0.0 ) 0 1\n\tvert 1 ( 1.0 0.0 ) 1 1\n\tvert 2 ( 0.0 1.0 ) 2 1\n\n";
+  const std::string weights =
+      "\tnumweights 3\n\tweight 0 0 1.0 ( 0.0 0.0 0.0 )\n\tweight 1 0 1.0 ( 1.0 0.0 0.0 )\n"
+      "\tweight 2 0 1.0 ( 0.0 1.0 0.0 )\n}\n";
+  write_text(d / "ok.md5mesh", head + verts + "\tnumtris 1\n\ttri 0 0 1 2\n\n" + weights);
+  auto ok = scene::load_scene((d / "ok.md5mesh").string());
+  ASSERT_TRUE(ok.ok()) << ok.status().message();
+  EXPECT_EQ(ok->triangle_count(), 1u);
+  struct Broken {
+    std::string text, says;
+  };
+  const Broken broken[] = {
+      {head + verts + "\tnumtris 2\n\ttri 0 0 1 2\n\n" + weights,
+       ": MD5 line 26: tri 1 of 2 is not given"},
+      {head + verts + "\tnumtris 1\n\ttri 4000000000 0 1 2\n\n" + weights,
+       ": MD5 line 20: tri 4000000000 past numtris 1"},
+      {head + verts + "\tnumtris 1\n\ttri 0 0 1 7\n\n" + weights,
+       ": MD5 line 20: tri 0 names a vertex past numverts 3"},
+      {head + "\tvert 0 ( 0.0 0.0 ) 0 1\n\tvert 1 ( 1.0 0.0 ) 1 1\n\tvert 2 ( 0.0 1.0 ) 2 9\n\n" +
+           "\tnumtris 1\n\ttri 0 0 1 2\n\n" + weights,
+       ": MD5 line 17: a vertex names weights past numweights 3"},
+      {head + verts + "\tnumtris 1\n\ttri 0 0 1 2\n\n" +
+           "\tnumweights 3\n\tweight 0 0 1.0 ( 0.0 0.0 0.0 )\n\tweight 1 5 1.0 ( 1.0 0.0 0.0 )\n"
+           "\tweight 2 0 1.0 ( 0.0 1.0 0.0 )\n}\n",
+       ": MD5 line 24: weight 1 names a joint past the file's 1"},
+      {"MD5Version 10\nmesh {\n\tnumverts 99999999999\n}\n",
+       ": MD5 line 3: numverts 99999999999 is more than the file holds"},
+  };
+  for (const Broken& b : broken) expect_corrupt(d / "bad.md5mesh", b.text, b.says);
+}
+
 // assimp's IQM reader follows the file's offsets and counts unchecked: a crafted file had it read
 // and allocate far past its buffer. Every section it reads is checked against the file first.
 TEST(AssimpImport, IqmSectionsOutsideTheFileAreRefusedBeforeAssimpReadsThem) {
@@ -536,12 +588,7 @@ TEST(AssimpImport, IqmSectionsOutsideTheFileAreRefusedBeforeAssimpReadsThem) {
   for (const Broken& b : broken) {
     IqmFile file;
     file.set(b.at, b.value);
-    write_text(d / "bad.iqm", file.bytes);
-    auto bad = scene::load_scene((d / "bad.iqm").string());
-    ASSERT_FALSE(bad.ok()) << b.says;
-    EXPECT_EQ(bad.status().code(), ErrorCode::kCorrupt) << bad.status().message();
-    EXPECT_NE(bad.status().message().find((d / "bad.iqm").string() + b.says), std::string::npos)
-        << bad.status().message();
+    expect_corrupt(d / "bad.iqm", file.bytes, b.says);
   }
 }
 
