@@ -1,5 +1,5 @@
 // libFuzzer target: Inter-Quake Models (IQM), read by assimp behind the layout check that keeps
-// its unchecked reader inside the file (scene/assimp_import.cpp, check_iqm_layout).
+// its unchecked reader inside the file (scene/assimp_import.cpp, iqm_mesh_names).
 #include <cstdint>
 
 #include "fuzz/fuzz_scene.h"

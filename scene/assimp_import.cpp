@@ -68,7 +68,7 @@ std::string mime_from_hint(const char* hint) {
 // file and one of those assimp checks ends exactly at its end.
 bool md2_ends_at_its_last_section(const std::vector<uint8_t>& bytes) {
   if (bytes.size() < 68 || std::memcmp(bytes.data(), "IDP2", 4) != 0) return false;
-  const auto field = [&](int i) { return uint64_t(le32(&bytes[4 + 4 * i])); };
+  const auto field = [&](int i) { return uint64_t(read_u32(&bytes[4 + 4 * i])); };
   // skins, texture coordinates, triangles, frames (assimp's sizes; a frame is 40 bytes + 4 a
   // vertex), GL commands.
   const uint64_t ends[5] = {field(10) + field(4) * 64, field(11) + field(6) * 4,
@@ -463,6 +463,8 @@ class AssimpScene {
   int depth_ = 0;
 };
 
+}  // namespace
+
 // A Doom 3 MD5 mesh's indices, before assimp reads them: its reader takes every `tri`, `vert`
 // and `weight` index as given (an index past the count grows the array to it: 2^32 - 1 ran it
 // out of memory), leaves a face the file does not list without indices (it then read through a
@@ -472,9 +474,10 @@ class AssimpScene {
 // and every index against its count and the file's joints, are checked; a face must be listed;
 // words are shorter than 1,000 characters and a joint names itself in quotes. Numbers are read
 // as assimp reads them (leading digits).
-Status check_md5_mesh(const std::string& path) {
+Expected<std::vector<std::string>> md5_mesh_names(const std::string& path) {
+  std::vector<std::string> names;
   Expected<std::vector<uint8_t>> bytes = read_file(path);
-  if (!bytes.ok()) return Status::Ok();
+  if (!bytes.ok()) return names;
   const std::string text(bytes->begin(), bytes->end());
   // Leading decimal digits of `w` (0 without any), saturated far above any count.
   auto number = [](const std::string& w) {
@@ -494,6 +497,7 @@ Status check_md5_mesh(const std::string& path) {
   uint64_t weights_named = 0;  // the current mesh's vertices' weights end here (numweights follows)
   size_t weights_line = 0;
   std::vector<bool> listed;  // the current mesh's faces given
+  std::string name;          // the current mesh's, from its `// meshes: NAME` comment
   size_t line_no = 0, at = 0;
   while (at < text.size()) {
     // assimp ends a line at a zero byte, a form feed or a carriage return as well.
@@ -509,7 +513,16 @@ Status check_md5_mesh(const std::string& path) {
       while (i < line.size() && !std::isspace(static_cast<unsigned char>(line[i]))) ++i;
       if (i > s) w.push_back(line.substr(s, i - s));
     }
-    if (w.empty() || w[0].rfind("//", 0) == 0) continue;
+    if (w.empty()) continue;
+    if (w[0].rfind("//", 0) == 0) {
+      const size_t tag = line.find("// meshes:");
+      if (in_mesh && tag != std::string::npos && line.find_first_not_of(" \t") == tag) {
+        name = line.substr(tag + 10);
+        name.erase(0, name.find_first_not_of(" \t"));
+        name.erase(name.find_last_not_of(" \t") + 1);
+      }
+      continue;
+    }
     for (const std::string& word : w)
       if (word.size() >= 1000 || word == "\"")
         return refuse(line_no, word.size() >= 1000
@@ -529,7 +542,7 @@ Status check_md5_mesh(const std::string& path) {
     if (!in_mesh) {
       if (w[0] == "joints") in_joints = true;
       if (w[0] == "mesh")
-        in_mesh = true, verts = tris = weights = weights_named = 0, listed.clear();
+        in_mesh = true, verts = tris = weights = weights_named = 0, listed.clear(), name.clear();
       continue;
     }
     if (w[0] == "}") {
@@ -540,6 +553,7 @@ Status check_md5_mesh(const std::string& path) {
       if (weights_named > weights)
         return refuse(weights_line,
                       "a vertex names weights past numweights " + std::to_string(weights));
+      if (verts > 0 && tris > 0) names.push_back(name);  // assimp skips the others
       in_mesh = false;
     } else if (w[0] == "numverts" || w[0] == "numtris" || w[0] == "numweights") {
       const uint64_t n = w.size() > 1 ? number(w[1]) : 0;
@@ -576,7 +590,7 @@ Status check_md5_mesh(const std::string& path) {
                                    std::to_string(joints));
     }
   }
-  return Status::Ok();
+  return names;
 }
 
 // An Inter-Quake Model's sections against its size, before assimp reads them: its reader follows
@@ -584,16 +598,24 @@ Status check_md5_mesh(const std::string& path) {
 // it read (or allocate) far past its buffer. Checked: the text, the meshes, the vertex arrays,
 // each mesh's triangles and, for the arrays assimp reads (position, texture coordinates, normal,
 // colour), each mesh's vertices; a mesh's material name ends inside the text. A file assimp
-// refuses anyway (magic, version, size) is left to it.
-Status check_iqm_layout(const std::string& path) {
+// refuses anyway (magic, version, size) is left to it (no names).
+namespace iqm {
+// Byte offsets of the header's fields (after the 16-byte magic), the header's and a mesh
+// record's size (name, material, first and count of vertices, first and count of triangles).
+constexpr size_t kVersion = 16, kFileSize = 20, kNumText = 28, kOfsText = 32, kNumMeshes = 36,
+                 kOfsMeshes = 40, kNumArrays = 44, kOfsArrays = 52, kOfsTriangles = 60;
+constexpr size_t kHeaderSize = 124, kMeshSize = 24;
+}  // namespace iqm
+Expected<std::vector<std::string>> iqm_mesh_names(const std::string& path) {
+  std::vector<std::string> names;
   Expected<std::vector<uint8_t>> bytes = read_file(path);
-  if (!bytes.ok()) return Status::Ok();
+  if (!bytes.ok()) return names;
   const std::vector<uint8_t>& b = *bytes;
-  auto u32 = [&b](uint64_t at) { return le32(&b[size_t(at)]); };
-  constexpr uint64_t kHeader = 124, kMesh = 24, kArray = 20, kTriangle = 12;
-  if (b.size() < kHeader || std::memcmp(b.data(), "INTERQUAKEMODEL", 16) != 0 || u32(16) != 2 ||
-      u32(20) != b.size())
-    return Status::Ok();
+  auto u32 = [&b](uint64_t at) { return read_u32(&b[size_t(at)]); };
+  constexpr uint64_t kArray = 20, kTriangle = 12, kMesh = iqm::kMeshSize;
+  if (b.size() < iqm::kHeaderSize || std::memcmp(b.data(), "INTERQUAKEMODEL", 16) != 0 ||
+      u32(iqm::kVersion) != 2 || u32(iqm::kFileSize) != b.size())
+    return names;
   // `count` entries of `unit` bytes from byte `start` (a double: no overflow) inside the file.
   auto inside = [&](const std::string& what, double start, uint64_t count, uint64_t unit) {
     if (start > double(b.size()))
@@ -601,9 +623,10 @@ Status check_iqm_layout(const std::string& path) {
     return check_backed(path + ": IQM " + what, count, unit, "the file after its start",
                         b.size() - uint64_t(start));
   };
-  const uint64_t num_text = u32(28), ofs_text = u32(32), num_meshes = u32(36);
-  const uint64_t ofs_meshes = u32(40), num_arrays = u32(44), ofs_arrays = u32(52);
-  const uint64_t ofs_triangles = u32(60);
+  const uint64_t num_text = u32(iqm::kNumText), ofs_text = u32(iqm::kOfsText);
+  const uint64_t num_meshes = u32(iqm::kNumMeshes), ofs_meshes = u32(iqm::kOfsMeshes);
+  const uint64_t num_arrays = u32(iqm::kNumArrays), ofs_arrays = u32(iqm::kOfsArrays);
+  const uint64_t ofs_triangles = u32(iqm::kOfsTriangles);
   VT_RETURN_IF_ERROR(inside("text", double(ofs_text), num_text, 1));
   VT_RETURN_IF_ERROR(inside("meshes", double(ofs_meshes), num_meshes, kMesh));
   VT_RETURN_IF_ERROR(inside("vertex arrays", double(ofs_arrays), num_arrays, kArray));
@@ -643,9 +666,17 @@ Status check_iqm_layout(const std::string& path) {
       VT_RETURN_IF_ERROR(inside(mesh + "'s vertices in array " + std::to_string(r.index),
                                 double(r.offset) + double(first_vertex) * double(r.size * r.unit),
                                 vertices, r.size * r.unit));
+    // Its name: an offset into the text (not read by assimp: an unending one is cut; one
+    // outside the text leaves the model without names).
+    const uint64_t name = u32(at);
+    const char* text = reinterpret_cast<const char*>(b.data() + ofs_text);
+    if (name < num_text) names.emplace_back(text + name, strnlen(text + name, num_text - name));
   }
-  return Status::Ok();
+  if (names.size() != num_meshes) names.clear();
+  return names;
 }
+
+namespace {
 
 // An OFF file's vertex and face counts against its size, before assimp allocates for them: a
 // 309-byte file declaring 353,535,235,358 vertices (assimp's own invalid/OutOfMemory.off) made
@@ -697,7 +728,7 @@ void repair_md2_texture_coordinates(const std::string& path, aiScene& scene) {
   if (!in.read(reinterpret_cast<char*>(header), sizeof header) ||
       std::memcmp(header, "IDP2", 4) != 0)
     return;
-  const uint32_t w = le32(header + 8), h = le32(header + 12);
+  const uint32_t w = read_u32(header + 8), h = read_u32(header + 12);
   const double width = w ? w : 1, height = h ? h : 1;
   for (unsigned i = 0; i < scene.mNumMeshes; ++i) {
     aiMesh& m = *scene.mMeshes[i];
@@ -774,8 +805,8 @@ Expected<Scene> load_assimp(const std::string& path) {
             ", whose reader of them finds no meshes (assimp issues 4553 and 5014, fixed "
             "in 5.3); bake the meshes the scene names (.3ds, .x, .b3d, .obj) instead");
   if (ext == "off") VT_RETURN_IF_ERROR(check_off_counts(path));
-  if (ext == "iqm") VT_RETURN_IF_ERROR(check_iqm_layout(path));
-  if (ext == "md5mesh") VT_RETURN_IF_ERROR(check_md5_mesh(path));
+  if (ext == "iqm") VT_RETURN_IF_ERROR(iqm_mesh_names(path).status());
+  if (ext == "md5mesh") VT_RETURN_IF_ERROR(md5_mesh_names(path).status());
   Assimp::Importer importer;
   importer.SetIOHandler(new FilesAsAssimpReadsThem);  // the importer owns it
   // Points and lines are dropped by SortByPType; normals are made only where a mesh has none.

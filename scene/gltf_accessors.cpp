@@ -11,12 +11,6 @@ namespace vt::scene::detail {
 
 using json = nlohmann::json;
 
-uint32_t read_u32(const uint8_t* p) {
-  uint32_t v;
-  std::memcpy(&v, p, 4);
-  return v;
-}
-
 const json& member(const json& obj, const char* key) {
   static const json kNull;
   if (!obj.is_object()) return kNull;

@@ -37,8 +37,6 @@ struct Gltf {
   }
 };
 
-uint32_t read_u32(const uint8_t* p);
-
 // obj[key], or null when obj is no object or lacks the key (never throws, never inserts).
 const nlohmann::json& member(const nlohmann::json& obj, const char* key);
 

@@ -24,8 +24,9 @@ Expected<std::vector<uint8_t>> read_file(const std::string& path);
 Expected<std::string> decode_text(const std::vector<uint8_t>& bytes, const std::string& path,
                                   std::string* note);
 std::string lower_extension(const std::string& path);
-// The little-endian 32-bit value at `p` (binary model headers), on any host.
-inline uint32_t le32(const uint8_t* p) {
+// The little-endian 32-bit value at `p` (glTF's binary chunks and buffers, model headers), on
+// any host.
+inline uint32_t read_u32(const uint8_t* p) {
   return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
 }
 std::string parent_folder(const std::string& path);  // "" or ends with '/'
@@ -48,6 +49,14 @@ std::string percent_encode_path(const std::string& path);
 // against `folder` is returned (the caller reports it missing).
 std::string resolve_written_path(const std::string& folder, const std::string& written,
                                  std::string* note);
+
+// Game model files assimp reads without checking their indices and offsets, checked before it
+// does (scene/assimp_import.cpp): kCorrupt naming the file and what is wrong; else the names the
+// Cube 2 engine gives the meshes assimp makes, in its order (MD5: the `// meshes: NAME` comment
+// of each mesh block with vertices and triangles; IQM: the mesh table's names), empty where the
+// file is not read so (unreadable, or a file assimp refuses by itself).
+Expected<std::vector<std::string>> md5_mesh_names(const std::string& path);
+Expected<std::vector<std::string>> iqm_mesh_names(const std::string& path);
 
 // Cube 2 engine games (Sauerbraten, Tesseract, Red Eclipse) name a model's textures in a config
 // beside it (`iqm.cfg`, `md5.cfg`, `md3.cfg`, `obj.cfg`, `smd.cfg` by the model's format):

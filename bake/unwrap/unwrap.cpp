@@ -1045,17 +1045,18 @@ void write_surface_uvs(const Surface& s, const std::vector<Chart>& charts,
   const bool own_normals = src.normals.size() == src.positions.size() || src.indices.empty();
   const std::vector<scene::Vec3> smoothed =
       own_normals ? std::vector<scene::Vec3>{} : scene::compute_normals(src);
-  gather(own_normals ? src.normals : smoothed, dst->normals);
+  const std::vector<scene::Vec3>& normals = own_normals ? src.normals : smoothed;
+  gather(normals, dst->normals);
   // The same for the frame a normal map is decoded in: derived after the split, a vertex on a
   // chart edge would average only its own chart's faces (a face alone in a chart, or one whose
   // source UVs are degenerate, would get an arbitrary tangent) where the reference, deriving it
   // on the source, averages them all.
   const bool derive_tangents = src.tangents.size() != src.positions.size() && normal_map &&
-                               scene::texture_uv_set(src, *normal_map);
-  gather(derive_tangents ? scene::compute_tangents(src, own_normals ? src.normals : smoothed,
-                                                   normal_map->texcoord)
-                         : src.tangents,
-         dst->tangents);
+                               scene::texture_uv_set(src, *normal_map) &&
+                               normals.size() == src.positions.size();
+  gather(
+      derive_tangents ? scene::compute_tangents(src, normals, normal_map->texcoord) : src.tangents,
+      dst->tangents);
   gather(src.colors, dst->colors);
   dst->uvs.resize(src.uvs.size());
   for (size_t n = 0; n < src.uvs.size(); ++n) gather(src.uvs[n], dst->uvs[n]);

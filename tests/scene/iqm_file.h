@@ -5,9 +5,9 @@
 #pragma once
 
 #include <cstdint>
-#include <cstring>
 #include <string>
-#include <vector>
+
+#include "tests/scene/le_bytes.h"
 
 namespace vt::test {
 
@@ -18,25 +18,16 @@ struct IqmFile {
   std::string bytes;
 
   IqmFile() {
-    auto put = [this](uint32_t v) {
-      for (int k = 0; k < 4; ++k) bytes += char(v >> (8 * k));
-    };
     bytes.assign("INTERQUAKEMODEL\0", 16);
-    // version, filesize, flags, text, meshes, vertex arrays and vertices, triangles; the
-    // joints, poses, animations, frames, comments and extensions none.
-    std::vector<uint32_t> header = {2,       kSize, 0, 18,      kText, 2,
-                                    kMeshes, 2,     3, kArrays, 2,     kTriangles};
-    header.resize(27, 0);
-    for (uint32_t v : header) put(v);
+    // version, filesize, flags, text, meshes, vertex arrays and vertices, triangles; then 15
+    // zero words: no adjacency, joints, poses, animations, frames, bounds, comments, extensions.
+    bytes += le32({2, kSize, 0, 18, kText, 2, kMeshes, 2, 3, kArrays, 2, kTriangles}) +
+             std::string(15 * 4, '\0');
     bytes.append("\0stand\0cannon\0mat\0", 18);
-    for (uint32_t v : {1u, 14u, 0u, 3u, 0u, 1u, 7u, 14u, 0u, 3u, 1u, 1u}) put(v);  // meshes
-    for (uint32_t v : {0u, 0u, 7u, 3u, kPositions, 1u, 0u, 7u, 2u, kUvs}) put(v);  // arrays
-    for (uint32_t v : {0u, 1u, 2u, 0u, 2u, 1u}) put(v);                            // triangles
-    for (float f : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 1.f}) {
-      uint32_t bits;
-      std::memcpy(&bits, &f, 4);
-      put(bits);
-    }
+    bytes += le32({1, 14, 0, 3, 0, 1, 7, 14, 0, 3, 1, 1});        // meshes
+    bytes += le32({0, 0, 7, 3, kPositions, 1, 0, 7, 2, kUvs});    // arrays
+    bytes += le32({0, 1, 2, 0, 2, 1});                            // triangles
+    bytes += lef({0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 1});  // positions, uvs
   }
 
   // Overwrites the 32-bit little-endian value at byte `at`.

@@ -15,6 +15,7 @@
 #include "scene/scene.h"
 #include "scene/scene_io_util.h"
 #include "tests/scene/iqm_file.h"
+#include "tests/scene/le_bytes.h"
 #include "tests/scene/scene_warnings.h"
 
 namespace vt::test {
@@ -311,23 +312,6 @@ TEST(AssimpImport, ColladaOpacityZeroIsReadAsOpaque) {
   EXPECT_EQ(m.alpha_mode, scene::AlphaMode::kOpaque);
   EXPECT_FLOAT_EQ(m.base_color_factor[3], 1.0f);
   EXPECT_TRUE(warned(*s, "opacity 0"));
-}
-
-// Little-endian binary helpers for the Quake model files below.
-std::string le32(std::initializer_list<int32_t> values) {
-  std::string out;
-  for (int32_t v : values)
-    for (int b = 0; b < 4; ++b) out.push_back(char(uint32_t(v) >> (8 * b)));
-  return out;
-}
-std::string lef(std::initializer_list<float> values) {
-  std::string out;
-  for (float f : values) {
-    uint32_t v;
-    std::memcpy(&v, &f, 4);
-    out += le32({int32_t(v)});
-  }
-  return out;
 }
 
 // A Quake 1 model (IDPO): one triangle and an 8 x 8 palette skin, rows 0-3 colour 15 (the

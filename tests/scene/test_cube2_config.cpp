@@ -4,13 +4,13 @@
 // are not applied.
 #include <gtest/gtest.h>
 
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <vector>
 
 #include "scene/scene.h"
 #include "tests/scene/iqm_file.h"
+#include "tests/scene/le_bytes.h"
 #include "tests/scene/scene_warnings.h"
 
 namespace vt::test {
@@ -134,27 +134,19 @@ TEST(Cube2Config, SkinsForNamedIqmMeshesGoToTheirMeshes) {
 // A Quake 3 model (MD3) names its surfaces in their headers; assimp names a surface's material
 // `MD3_[SKIN][SURFACE]`.
 std::string md3_of_surfaces(const std::vector<std::string>& surfaces) {
-  std::string out;
-  auto u32 = [&out](uint32_t v) {
-    for (int k = 0; k < 4; ++k) out += char(v >> (8 * k));
-  };
-  auto name = [&out](const std::string& n) { out += n + std::string(64 - n.size(), '\0'); };
+  auto name = [](const std::string& n) { return n + std::string(64 - n.size(), '\0'); };
   constexpr uint32_t kHeader = 108, kFrame = 56, kSurface = 236;
   const uint32_t n = uint32_t(surfaces.size()), size = kHeader + kFrame + n * kSurface;
-  out = "IDP3";
-  u32(15), name("model"), u32(0), u32(1), u32(0), u32(n), u32(0);
-  u32(kHeader), u32(kHeader + kFrame), u32(kHeader + kFrame), u32(size);
+  // version, name, flags, frames, tags, surfaces, skins; offsets of frames, tags, surfaces, end
+  std::string out = "IDP3" + le32({15}) + name("model") + le32({0, 1, 0, n, 0}) +
+                    le32({kHeader, kHeader + kFrame, kHeader + kFrame, size});
   out += std::string(kFrame, '\0');  // one frame: bounds, origin, radius, name
   for (const std::string& s : surfaces) {
-    out += "IDP3", name(s), u32(0), u32(1), u32(1), u32(3), u32(1);
-    u32(176), u32(108), u32(188), u32(212), u32(kSurface);  // triangles, shaders, st, xyz, end
-    name(s + ".tga"), u32(0);                               // the shader
-    u32(0), u32(1), u32(2);                                 // the triangle
-    for (float f : {0.f, 0.f, 1.f, 0.f, 0.f, 1.f}) {
-      uint32_t bits;
-      std::memcpy(&bits, &f, 4);
-      u32(bits);
-    }
+    out += "IDP3" + name(s) + le32({0, 1, 1, 3, 1});  // flags, frames, shaders, vertices, tris
+    out += le32({176, 108, 188, 212, kSurface});      // triangles, shaders, st, xyz, end
+    out += name(s + ".tga") + le32({0});              // the shader
+    out += le32({0, 1, 2});                           // the triangle
+    out += lef({0, 0, 1, 0, 0, 1});                   // texture coordinates
     for (int16_t v : {0, 0, 0, 0, 64, 0, 0, 0, 0, 64, 0, 0})
       out += char(v & 0xff), out += char(v >> 8);
   }
